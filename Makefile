@@ -1,0 +1,98 @@
+# flexmbs — `make run` and `make test` set up a fresh Debian machine, build and run.
+#
+#   make run     install what is missing, build (release), run the main example
+#   make test    install what is missing, build (debug, bounds checks), run every suite
+#   make bench   install what is missing, build (release), run the benchmarks
+#   make install PREFIX=...   install library, modules and the classic faces
+
+SHELL := /bin/bash
+.DEFAULT_GOAL := run
+
+APT_PACKAGES := gfortran libsundials-dev libsundials-fortran-dev libsuitesparse-dev \
+                liblapack-dev libopenblas-dev libhdf5-dev
+BUILD        := $(CURDIR)/build
+VENV         := $(BUILD)/venv
+# One set of flags for every fpm call: changing them makes fpm rebuild everything.
+export FPM_FFLAGS := -I/usr/include/hdf5/serial -I/usr/include/sundials/fortran
+export FPM_CFLAGS := -I/usr/include/suitesparse
+FPM          = $(shell command -v fpm 2>/dev/null || echo $(VENV)/bin/fpm)
+PREFIX_DEBUG   := $(BUILD)/prefix-debug
+PREFIX_RELEASE := $(BUILD)/prefix-release
+PREFIX       ?= /usr/local
+# The link line a user needs after the flexmbs library (see README).
+SYSLIBS      := -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig \
+                -lhdf5_serial_fortran -lhdf5_serial -llapack -lblas
+MAIN_INPUT   := inputs/van_der_pol.nml
+
+.PHONY: run test bench deps build build-debug install install-debug legacy-test clean help
+
+help:
+	@echo "make run | make test | make bench | make install PREFIX=dir | make clean"
+
+# Install the system packages and fpm when they are missing.
+deps:
+	@missing=""; \
+	for p in $(APT_PACKAGES); do \
+	    dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" \
+	        || missing="$$missing $$p"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+	    echo "installing:$$missing"; \
+	    SUDO=""; [ "$$(id -u)" -ne 0 ] && SUDO=sudo; \
+	    $$SUDO apt-get update -qq && \
+	    DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $$missing >/dev/null \
+	        || { echo "apt-get install failed for:$$missing" >&2; exit 1; }; \
+	fi
+	@if ! command -v fpm >/dev/null 2>&1 && [ ! -x $(VENV)/bin/fpm ]; then \
+	    echo "installing fpm"; \
+	    pip install --quiet fpm 2>/dev/null || pip3 install --quiet fpm 2>/dev/null || \
+	    { python3 -m venv $(VENV) && $(VENV)/bin/pip install --quiet fpm; } || \
+	    { echo "could not install fpm" >&2; exit 1; }; \
+	fi
+
+build: deps
+	$(FPM) build --profile release
+
+build-debug: deps
+	$(FPM) build --profile debug
+
+run: build
+	$(FPM) run --profile release flexmbs -- run $(MAIN_INPUT)
+
+# Root suites, then the classic fixed-form drivers linked against the
+# installed library exactly as a user links them; one summary line last.
+test: deps
+	@mkdir -p $(BUILD)
+	@set -o pipefail; $(FPM) test --profile debug 2>&1 | tee $(BUILD)/test-root.log; \
+	    echo "exit $$?" >> $(BUILD)/test-root.log
+	@$(MAKE) --no-print-directory legacy-test PREFIX_USED=$(PREFIX_DEBUG) PROFILE=debug \
+	    > $(BUILD)/test-legacy.log 2>&1; echo "exit $$?" >> $(BUILD)/test-legacy.log; \
+	    cat $(BUILD)/test-legacy.log
+	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log
+
+PROFILE     ?= debug
+PREFIX_USED ?= $(PREFIX_DEBUG)
+LEGACY_DRIVERS := $(wildcard legacy/test/*.f)
+
+# Classic drivers: plain `gfortran -std=legacy`, linked against the install.
+legacy-test:
+	@cd legacy && $(FPM) install --profile $(PROFILE) --prefix $(PREFIX_USED) >/dev/null
+	@mkdir -p $(BUILD)/legacy-test
+	@for src in $(LEGACY_DRIVERS); do \
+	    exe=$(BUILD)/legacy-test/$$(basename $$src .f); \
+	    echo "== $$src"; \
+	    gfortran -std=legacy -o $$exe $$src -L$(PREFIX_USED)/lib \
+	        -lflexmbs-legacy -lflexmbs $(SYSLIBS) \
+	        || { echo "FAIL compile $$src"; continue; }; \
+	    ( cd $(BUILD)/legacy-test && $$exe ) || echo "FAIL run $$src (exit $$?)"; \
+	done
+
+install: deps
+	cd legacy && $(FPM) install --profile release --prefix $(PREFIX)
+
+bench: deps
+	$(FPM) build --profile release
+	bash bench/run.sh
+
+clean:
+	rm -rf $(BUILD) legacy/build

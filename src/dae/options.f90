@@ -1,0 +1,92 @@
+!> Options common to every DAE solver.
+module flexmbs_dae_options
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input
+    implicit none
+    private
+
+    type, public :: dae_options_t
+        real(wp) :: rtol = 1.0e-6_wp
+        real(wp) :: atol = 1.0e-6_wp
+        real(wp), allocatable :: rtol_vector(:) !! per component; overrides rtol
+        real(wp), allocatable :: atol_vector(:) !! per component; overrides atol
+        real(wp) :: h0 = 0.0_wp     !! initial step; 0 = automatic
+        real(wp) :: hmax = 0.0_wp   !! maximal step; 0 = |t_end - t0|
+        integer :: max_steps = 100000
+        integer :: pmax = 5         !! maximal BDF order / extrapolation stages
+        character(len=8) :: linear_solver = 'auto' !! 'auto' | 'dense' | 'klu'
+        character(len=8) :: jacobian = 'analytic'  !! 'analytic' | 'fd'
+        real(wp), allocatable :: output_times(:)   !! dense output at these times
+        logical :: output_steps = .false.          !! also every accepted step
+    contains
+        procedure :: validate => options_validate
+        procedure :: tolerances => options_tolerances
+    end type dae_options_t
+
+contains
+
+    !> Check ranges for a problem of size n.
+    subroutine options_validate(self, n, status)
+        class(dae_options_t), intent(in) :: self
+        integer, intent(in) :: n
+        type(status_t), intent(out) :: status
+        character(len=200) :: msg
+        if (allocated(self%rtol_vector)) then
+            if (size(self%rtol_vector) /= n) then
+                call status%set(status_bad_input, 'options: rtol vector length differs from n')
+                return
+            end if
+            if (any(self%rtol_vector <= 0.0_wp)) then
+                call status%set(status_bad_input, 'options: rtol must be positive')
+                return
+            end if
+        else if (.not. self%rtol > 0.0_wp) then
+            write (msg, '(a,es12.4,a)') 'options: rtol = ', self%rtol, ': must be positive'
+            call status%set(status_bad_input, trim(msg))
+            return
+        end if
+        if (allocated(self%atol_vector)) then
+            if (size(self%atol_vector) /= n) then
+                call status%set(status_bad_input, 'options: atol vector length differs from n')
+                return
+            end if
+            if (any(self%atol_vector <= 0.0_wp)) then
+                call status%set(status_bad_input, 'options: atol must be positive')
+                return
+            end if
+        else if (.not. self%atol > 0.0_wp) then
+            write (msg, '(a,es12.4,a)') 'options: atol = ', self%atol, ': must be positive'
+            call status%set(status_bad_input, trim(msg))
+            return
+        end if
+        if (self%hmax < 0.0_wp) then
+            call status%set(status_bad_input, 'options: hmax must not be negative')
+        else if (self%max_steps <= 0) then
+            call status%set(status_bad_input, 'options: max_steps must be positive')
+        else if (self%pmax < 1) then
+            call status%set(status_bad_input, 'options: pmax must be at least 1')
+        else if (all(self%linear_solver /= [character(len=8) :: 'auto', 'dense', 'klu'])) then
+            call status%set(status_bad_input, "options: linear_solver = '" // &
+                trim(self%linear_solver) // "': must be 'auto', 'dense' or 'klu'")
+        else if (all(self%jacobian /= [character(len=8) :: 'analytic', 'fd'])) then
+            call status%set(status_bad_input, "options: jacobian = '" // &
+                trim(self%jacobian) // "': must be 'analytic' or 'fd'")
+        end if
+    end subroutine options_validate
+
+    !> Per-component tolerance vectors of length n.
+    pure subroutine options_tolerances(self, rtol, atol)
+        class(dae_options_t), intent(in) :: self
+        real(wp), intent(out) :: rtol(:), atol(:)
+        if (allocated(self%rtol_vector)) then
+            rtol = self%rtol_vector
+        else
+            rtol = self%rtol
+        end if
+        if (allocated(self%atol_vector)) then
+            atol = self%atol_vector
+        else
+            atol = self%atol
+        end if
+    end subroutine options_tolerances
+end module flexmbs_dae_options

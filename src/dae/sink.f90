@@ -1,0 +1,71 @@
+!> Output of a solver: dense output objects and sinks.
+!>
+!> A solver calls `output` at every requested output time, with values from
+!> its dense output, and (when the sink wants it) `step` after every
+!> accepted step with the step's dense output. HDF5 files, tables, the
+!> progress display and the classic SOLOUT adapters are sinks.
+module flexmbs_dae_sink
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t
+    implicit none
+    private
+
+    !> Continuous extension of the last accepted step [t_old, t].
+    type, abstract, public :: dense_output_t
+    contains
+        procedure(evaluate_i), deferred :: evaluate
+    end type dense_output_t
+
+    abstract interface
+        !> y(s) for s in [t_old, t] of the last accepted step.
+        subroutine evaluate_i(self, s, y)
+            import :: dense_output_t, wp
+            class(dense_output_t), intent(in) :: self
+            real(wp), intent(in) :: s
+            real(wp), intent(out) :: y(:)
+        end subroutine evaluate_i
+    end interface
+
+    type, abstract, public :: sink_t
+    contains
+        procedure(output_i), deferred :: output
+        procedure :: wants_steps => default_wants_steps
+        procedure :: step => default_step
+        procedure :: finish => default_finish
+    end type sink_t
+
+    abstract interface
+        !> The solution at a requested output time.
+        subroutine output_i(self, t, y, status)
+            import :: sink_t, wp, status_t
+            class(sink_t), intent(inout) :: self
+            real(wp), intent(in) :: t, y(:)
+            type(status_t), intent(inout) :: status
+        end subroutine output_i
+    end interface
+
+contains
+
+    !> True when `step` should be called after every accepted step.
+    logical function default_wants_steps(self)
+        class(sink_t), intent(in) :: self
+        default_wants_steps = .false.
+    end function default_wants_steps
+
+    !> Called after each accepted step [t_old, t] (and once at t0 with
+    !> t_old = t). Setting `stop` ends the integration (status interrupted).
+    subroutine default_step(self, nr, t_old, t, y, dense, stop, status)
+        class(sink_t), intent(inout) :: self
+        integer, intent(in) :: nr                  !! 1 at t0, then accepted steps + 1
+        real(wp), intent(in) :: t_old, t, y(:)
+        class(dense_output_t), intent(in) :: dense
+        logical, intent(inout) :: stop
+        type(status_t), intent(inout) :: status
+    end subroutine default_step
+
+    !> Called once at the end, successful or not.
+    subroutine default_finish(self, status)
+        class(sink_t), intent(inout) :: self
+        type(status_t), intent(inout) :: status
+    end subroutine default_finish
+end module flexmbs_dae_sink

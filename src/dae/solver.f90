@@ -1,0 +1,43 @@
+!> The abstract DAE solver: every solver integrates a problem from (t, y)
+!> to t_end with common options, feeds a sink and fills common statistics.
+module flexmbs_dae_solver
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t
+    use flexmbs_dae_problem, only: dae_problem_t
+    use flexmbs_dae_options, only: dae_options_t
+    use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_sink, only: sink_t
+    implicit none
+    private
+
+    type, abstract, public :: dae_solver_t
+    contains
+        procedure(integrate_i), deferred :: integrate
+        procedure(name_i), deferred :: name
+    end type dae_solver_t
+
+    abstract interface
+        !> Integrate from (t, y) to t_end. On return t and y hold the last
+        !> point reached (t_end on success); on failure `status` says why and
+        !> at which time, and `stats` what was spent.
+        subroutine integrate_i(self, problem, t, y, t_end, options, stats, status, sink, yp)
+            import :: dae_solver_t, dae_problem_t, dae_options_t, dae_stats_t, &
+                status_t, sink_t, wp
+            class(dae_solver_t), intent(inout) :: self
+            class(dae_problem_t), intent(inout) :: problem
+            real(wp), intent(inout) :: t
+            real(wp), intent(inout) :: y(:)
+            real(wp), intent(in) :: t_end
+            type(dae_options_t), intent(in) :: options
+            type(dae_stats_t), intent(out) :: stats
+            type(status_t), intent(out) :: status
+            class(sink_t), intent(inout), optional :: sink
+            real(wp), intent(inout), optional :: yp(:)
+        end subroutine integrate_i
+        function name_i(self) result(name)
+            import :: dae_solver_t
+            class(dae_solver_t), intent(in) :: self
+            character(len=:), allocatable :: name
+        end function name_i
+    end interface
+end module flexmbs_dae_solver

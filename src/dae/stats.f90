@@ -1,0 +1,44 @@
+!> Common solver statistics, one meaning for every solver (DESIGN.md).
+module flexmbs_dae_stats
+    use flexmbs_core_kinds, only: wp
+    implicit none
+    private
+
+    type, public :: dae_stats_t
+        integer :: nst = 0     !! attempted steps (accepted + rejected + failed)
+        integer :: nac = 0     !! accepted steps
+        integer :: nrj = 0     !! nst - nac
+        integer :: nfe = 0     !! F/G/f evaluations, difference-Jacobian calls excluded
+        integer :: nfe_jac = 0 !! evaluations made for difference Jacobians
+        integer :: nje = 0     !! Jacobian evaluations
+        integer :: ndec = 0    !! factorisations (RADAU5's real+complex pair counts 1)
+        integer :: nsol = 0    !! solves with a factorisation, error-estimate solves included
+        integer :: nprj = 0    !! projections
+        real(wp) :: cpu = 0.0_wp  !! CPU seconds
+        real(wp) :: wall = 0.0_wp !! wall seconds
+        real(wp) :: t_reached = 0.0_wp !! last time reached (t_end on success)
+        real(wp) :: h_last = 0.0_wp    !! last accepted step size
+    contains
+        procedure :: reset => stats_reset
+        procedure :: summary => stats_summary
+    end type dae_stats_t
+
+contains
+
+    pure subroutine stats_reset(self)
+        class(dae_stats_t), intent(inout) :: self
+        self = dae_stats_t()
+    end subroutine stats_reset
+
+    !> One line: 'NST=... NAC=... ...'.
+    function stats_summary(self) result(line)
+        class(dae_stats_t), intent(in) :: self
+        character(len=:), allocatable :: line
+        character(len=400) :: buf
+        write (buf, '(9(a,i0),2(a,f0.4))') 'NST=', self%nst, ' NAC=', self%nac, &
+            ' NRJ=', self%nrj, ' NFE=', self%nfe, ' NFE_JAC=', self%nfe_jac, &
+            ' NJE=', self%nje, ' NDEC=', self%ndec, ' NSOL=', self%nsol, &
+            ' NPRJ=', self%nprj, ' CPU=', self%cpu, ' WALL=', self%wall
+        line = trim(buf)
+    end function stats_summary
+end module flexmbs_dae_stats

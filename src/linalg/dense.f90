@@ -1,0 +1,155 @@
+!> Dense LU (LAPACK getrf/getrs) of real and complex shifted matrices.
+module flexmbs_linalg_dense
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
+        reason_singular_matrix
+    use flexmbs_linalg_matrix, only: matrix_t, storage_identity, storage_dense, storage_sparse
+    use flexmbs_linalg_linear_solver, only: linear_solver_t
+    use flexmbs_linalg_lapack, only: dgetrf, dgetrs, zgetrf, zgetrs
+    implicit none
+    private
+
+    !> Dense LU of c*M - J, real and complex factors kept side by side.
+    type, extends(linear_solver_t), public :: dense_solver_t
+        real(wp), allocatable :: a(:, :)
+        complex(wp), allocatable :: za(:, :)
+        integer, allocatable :: ipiv(:), zipiv(:)
+        !> Dense copies of sparse M or J, refreshed at each factorisation.
+        real(wp), allocatable :: mass_work(:, :), jac_work(:, :)
+    contains
+        procedure :: init => dense_init
+        procedure :: factor_real => dense_factor_real
+        procedure :: factor_complex => dense_factor_complex
+        procedure :: solve_real => dense_solve_real
+        procedure :: solve_complex => dense_solve_complex
+        procedure :: name => dense_name
+    end type dense_solver_t
+
+    public :: dense_lu_factor, dense_lu_solve
+
+contains
+
+    subroutine dense_init(self, mass, jac, status)
+        class(dense_solver_t), intent(inout) :: self
+        type(matrix_t), intent(in) :: mass, jac
+        type(status_t), intent(out) :: status
+        integer :: n
+        n = jac%n
+        if (n <= 0) then
+            call status%set(status_bad_input, 'dense solver: matrix order must be positive')
+            return
+        end if
+        self%n = n
+        if (allocated(self%a)) deallocate (self%a, self%za, self%ipiv, self%zipiv)
+        allocate (self%a(n, n), self%za(n, n), self%ipiv(n), self%zipiv(n))
+        if (allocated(self%mass_work)) deallocate (self%mass_work)
+        if (allocated(self%jac_work)) deallocate (self%jac_work)
+        if (mass%storage == storage_sparse) allocate (self%mass_work(n, n))
+        if (jac%storage == storage_sparse) allocate (self%jac_work(n, n))
+    end subroutine dense_init
+
+    !> Write c*M - J (real part of the shift only) into a.
+    subroutine shifted(self, c, mass, jac, a)
+        class(dense_solver_t), intent(inout) :: self
+        real(wp), intent(in) :: c
+        type(matrix_t), intent(in) :: mass, jac
+        real(wp), intent(out) :: a(:, :)
+        integer :: i
+        select case (jac%storage)
+        case (storage_dense)
+            a = -jac%dense
+        case (storage_sparse)
+            call jac%csc%to_dense(self%jac_work)
+            a = -self%jac_work
+        case default
+            a = 0.0_wp
+        end select
+        select case (mass%storage)
+        case (storage_dense)
+            a = a + c * mass%dense
+        case (storage_sparse)
+            call mass%csc%to_dense(self%mass_work)
+            a = a + c * self%mass_work
+        case (storage_identity)
+            do i = 1, self%n
+                a(i, i) = a(i, i) + c
+            end do
+        end select
+    end subroutine shifted
+
+    subroutine dense_factor_real(self, c, mass, jac, status)
+        class(dense_solver_t), intent(inout) :: self
+        real(wp), intent(in) :: c
+        type(matrix_t), intent(in) :: mass, jac
+        type(status_t), intent(out) :: status
+        integer :: info
+        call shifted(self, c, mass, jac, self%a)
+        call dgetrf(self%n, self%n, self%a, self%n, self%ipiv, info)
+        if (info /= 0) call status%set(status_solver_failure, &
+            'dense LU: real iteration matrix is singular', reason_singular_matrix)
+    end subroutine dense_factor_real
+
+    subroutine dense_factor_complex(self, c, mass, jac, status)
+        class(dense_solver_t), intent(inout) :: self
+        complex(wp), intent(in) :: c
+        type(matrix_t), intent(in) :: mass, jac
+        type(status_t), intent(out) :: status
+        integer :: info, i
+        ! c*M - J = (Re c * M - J) + i Im c * M
+        call shifted(self, real(c, wp), mass, jac, self%a)
+        self%za = cmplx(self%a, 0.0_wp, kind=wp)
+        select case (mass%storage)
+        case (storage_dense)
+            self%za = self%za + cmplx(0.0_wp, aimag(c), kind=wp) * mass%dense
+        case (storage_sparse)
+            self%za = self%za + cmplx(0.0_wp, aimag(c), kind=wp) * self%mass_work
+        case (storage_identity)
+            do i = 1, self%n
+                self%za(i, i) = self%za(i, i) + cmplx(0.0_wp, aimag(c), kind=wp)
+            end do
+        end select
+        call zgetrf(self%n, self%n, self%za, self%n, self%zipiv, info)
+        if (info /= 0) call status%set(status_solver_failure, &
+            'dense LU: complex iteration matrix is singular', reason_singular_matrix)
+    end subroutine dense_factor_complex
+
+    subroutine dense_solve_real(self, b)
+        class(dense_solver_t), intent(inout) :: self
+        real(wp), intent(inout) :: b(:)
+        integer :: info
+        call dgetrs('N', self%n, 1, self%a, self%n, self%ipiv, b, self%n, info)
+    end subroutine dense_solve_real
+
+    subroutine dense_solve_complex(self, b)
+        class(dense_solver_t), intent(inout) :: self
+        complex(wp), intent(inout) :: b(:)
+        integer :: info
+        call zgetrs('N', self%n, 1, self%za, self%n, self%zipiv, b, self%n, info)
+    end subroutine dense_solve_complex
+
+    function dense_name(self) result(name)
+        class(dense_solver_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'dense'
+    end function dense_name
+
+    !> Plain LU of a general dense matrix in place (pivots in ipiv).
+    subroutine dense_lu_factor(a, ipiv, status)
+        real(wp), intent(inout) :: a(:, :)
+        integer, intent(out) :: ipiv(:)
+        type(status_t), intent(out) :: status
+        integer :: info
+        call dgetrf(size(a, 1), size(a, 2), a, size(a, 1), ipiv, info)
+        if (info /= 0) call status%set(status_solver_failure, 'dense LU: matrix is singular', &
+            reason_singular_matrix)
+    end subroutine dense_lu_factor
+
+    !> Solve with a factor from dense_lu_factor, b overwritten.
+    subroutine dense_lu_solve(a, ipiv, b)
+        real(wp), intent(in) :: a(:, :)
+        integer, intent(in) :: ipiv(:)
+        real(wp), intent(inout) :: b(:)
+        integer :: info
+        call dgetrs('N', size(a, 1), 1, a, size(a, 1), ipiv, b, size(a, 1), info)
+    end subroutine dense_lu_solve
+end module flexmbs_linalg_dense

@@ -1,0 +1,52 @@
+!> Explicit interfaces to the LAPACK routines flexmbs calls.
+module flexmbs_linalg_lapack
+    use flexmbs_core_kinds, only: wp
+    implicit none
+    private
+    public :: dgetrf, dgetrs, zgetrf, zgetrs, dgbtrf, dgbtrs
+
+    interface
+        subroutine dgetrf(m, n, a, lda, ipiv, info)
+            import :: wp
+            integer, intent(in) :: m, n, lda
+            real(wp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine dgetrf
+        subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
+            import :: wp
+            character, intent(in) :: trans
+            integer, intent(in) :: n, nrhs, lda, ldb, ipiv(*)
+            real(wp), intent(in) :: a(lda, *)
+            real(wp), intent(inout) :: b(ldb, *)
+            integer, intent(out) :: info
+        end subroutine dgetrs
+        subroutine zgetrf(m, n, a, lda, ipiv, info)
+            import :: wp
+            integer, intent(in) :: m, n, lda
+            complex(wp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine zgetrf
+        subroutine zgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
+            import :: wp
+            character, intent(in) :: trans
+            integer, intent(in) :: n, nrhs, lda, ldb, ipiv(*)
+            complex(wp), intent(in) :: a(lda, *)
+            complex(wp), intent(inout) :: b(ldb, *)
+            integer, intent(out) :: info
+        end subroutine zgetrs
+        subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
+            import :: wp
+            integer, intent(in) :: m, n, kl, ku, ldab
+            real(wp), intent(inout) :: ab(ldab, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine dgbtrf
+        subroutine dgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
+            import :: wp
+            character, intent(in) :: trans
+            integer, intent(in) :: n, kl, ku, nrhs, ldab, ldb, ipiv(*)
+            real(wp), intent(in) :: ab(ldab, *)
+            real(wp), intent(inout) :: b(ldb, *)
+            integer, intent(out) :: info
+        end subroutine dgbtrs
+    end interface
+end module flexmbs_linalg_lapack

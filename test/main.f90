@@ -1,0 +1,18 @@
+!> The one test driver: runs every suite and prints `N passed, M failed`.
+!> An optional argument filters tests by substring of 'suite/test'.
+program flexmbs_tests
+    use testing, only: run_suite
+    use test_linalg, only: collect_linalg
+    implicit none
+    integer :: npassed, nfailed, nargs
+    character(len=256) :: filter
+
+    filter = ''
+    nargs = command_argument_count()
+    if (nargs >= 1) call get_command_argument(1, filter)
+    npassed = 0
+    nfailed = 0
+    call run_suite('linalg', collect_linalg(), filter, npassed, nfailed)
+    write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
+    if (nfailed > 0) error stop 1
+end program flexmbs_tests
