@@ -75,5 +75,9 @@ contains
         zb = matmul(za, zx)
         call solver%solve_complex(zb)
         call check(error, maxval(abs(zb - zx)) < 1e-13_wp, 'complex solve')
+        ! Both factorisations stay alive: the real one after the complex one.
+        b = matmul(a, x)
+        call solver%solve_real(b)
+        call check(error, maxval(abs(b - x)) < 1e-13_wp, 'real solve after complex factor')
     end subroutine test_dense_shift
 end module test_linalg

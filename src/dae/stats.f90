@@ -27,7 +27,9 @@ contains
 
     pure subroutine stats_reset(self)
         class(dae_stats_t), intent(inout) :: self
-        self = dae_stats_t()
+        self%nst = 0; self%nac = 0; self%nrj = 0; self%nfe = 0; self%nfe_jac = 0
+        self%nje = 0; self%ndec = 0; self%nsol = 0; self%nprj = 0
+        self%cpu = 0.0_wp; self%wall = 0.0_wp; self%t_reached = 0.0_wp; self%h_last = 0.0_wp
     end subroutine stats_reset
 
     !> One line: 'NST=... NAC=... ...'.

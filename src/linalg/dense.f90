@@ -95,17 +95,25 @@ contains
         type(matrix_t), intent(in) :: mass, jac
         type(status_t), intent(out) :: status
         integer :: info, i
-        ! c*M - J = (Re c * M - J) + i Im c * M
-        call shifted(self, real(c, wp), mass, jac, self%a)
-        self%za = cmplx(self%a, 0.0_wp, kind=wp)
+        ! c*M - J, built in za: a holds the live real factorisation.
+        select case (jac%storage)
+        case (storage_dense)
+            self%za = cmplx(-jac%dense, 0.0_wp, kind=wp)
+        case (storage_sparse)
+            call jac%csc%to_dense(self%jac_work)
+            self%za = cmplx(-self%jac_work, 0.0_wp, kind=wp)
+        case default
+            self%za = (0.0_wp, 0.0_wp)
+        end select
         select case (mass%storage)
         case (storage_dense)
-            self%za = self%za + cmplx(0.0_wp, aimag(c), kind=wp) * mass%dense
+            self%za = self%za + c * mass%dense
         case (storage_sparse)
-            self%za = self%za + cmplx(0.0_wp, aimag(c), kind=wp) * self%mass_work
+            call mass%csc%to_dense(self%mass_work)
+            self%za = self%za + c * self%mass_work
         case (storage_identity)
             do i = 1, self%n
-                self%za(i, i) = self%za(i, i) + cmplx(0.0_wp, aimag(c), kind=wp)
+                self%za(i, i) = self%za(i, i) + c
             end do
         end select
         call zgetrf(self%n, self%n, self%za, self%n, self%zipiv, info)
