@@ -60,7 +60,8 @@ run: build
 	$(FPM) run --profile release flexmbs -- run $(MAIN_INPUT)
 
 # Root suites, then the classic fixed-form drivers linked against the
-# installed library exactly as a user links them; one summary line last.
+# installed library exactly as a user links them, then the command-line
+# checks of test/cli.sh; one summary line last.
 test: deps
 	@mkdir -p $(BUILD)
 	@set -o pipefail; $(FPM) test --profile debug 2>&1 | tee $(BUILD)/test-root.log; \
@@ -68,7 +69,9 @@ test: deps
 	@$(MAKE) --no-print-directory legacy-test PREFIX_USED=$(PREFIX_DEBUG) PROFILE=debug \
 	    > $(BUILD)/test-legacy.log 2>&1; echo "exit $$?" >> $(BUILD)/test-legacy.log; \
 	    cat $(BUILD)/test-legacy.log
-	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log
+	@set -o pipefail; FPM="$(FPM)" bash test/cli.sh 2>&1 | tee $(BUILD)/test-cli.log; \
+	    echo "exit $$?" >> $(BUILD)/test-cli.log
+	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log $(BUILD)/test-cli.log
 
 PROFILE     ?= debug
 PREFIX_USED ?= $(PREFIX_DEBUG)

@@ -1,5 +1,173 @@
+!> The flexmbs command line.
+!>
+!>   flexmbs run FILE.nml [--quiet]   run a scene
+!>   flexmbs --help | --version
+!>
+!> Exit codes: 0 success, 2 bad input (nothing written), 3 solver failure
+!> (outputs kept), 4 I/O error. Only this program decides exit codes.
 program flexmbs_main
-    use flexmbs_core_kinds, only: wp
+    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
+    use flexmbs_core_status, only: status_t, status_ok, status_bad_input, &
+        status_solver_failure, status_io_error, status_interrupted, reason_name, reason_none
+    use flexmbs_io_namelist, only: scene_input_t, read_scene
+    use flexmbs_io_scene, only: run_result_t, run_scene
     implicit none
-    print '(a)', 'flexmbs 0.1.0'
+
+    character(len=*), parameter :: version = '0.1.0'
+    integer, parameter :: exit_ok = 0, exit_bad_input = 2, exit_solver = 3, exit_io = 4
+    !> Largest state printed whole; larger ones are summarised.
+    integer, parameter :: max_printed = 12
+
+    character(len=:), allocatable :: command, file, arg
+    logical :: quiet
+    integer :: i, nargs
+
+    nargs = command_argument_count()
+    if (nargs == 0) then
+        call usage(error_unit)
+        call finish(exit_bad_input)
+    end if
+    command = argument(1)
+    select case (command)
+    case ('--help', '-h', 'help')
+        call usage(output_unit)
+        call finish(exit_ok)
+    case ('--version', '-V')
+        write (output_unit, '(a)') 'flexmbs ' // version
+        call finish(exit_ok)
+    case ('run')
+        quiet = .false.
+        file = ''
+        do i = 2, nargs
+            arg = argument(i)
+            if (arg == '--quiet' .or. arg == '-q') then
+                quiet = .true.
+            else if (arg == '--help' .or. arg == '-h') then
+                call usage(output_unit)
+                call finish(exit_ok)
+            else if (arg(1:min(1, len(arg))) == '-') then
+                call fail_usage('unknown option ''' // arg // '''')
+            else if (len(file) > 0) then
+                call fail_usage('run takes one scene file, got ''' // file // ''' and ''' // &
+                                arg // '''')
+            else
+                file = arg
+            end if
+        end do
+        if (len(file) == 0) call fail_usage('run needs a scene file')
+        call run(file, quiet)
+    case default
+        call fail_usage('unknown command ''' // command // '''')
+    end select
+
+contains
+
+    subroutine run(path, quiet)
+        character(len=*), intent(in) :: path
+        logical, intent(in) :: quiet
+        type(scene_input_t) :: scene
+        type(run_result_t) :: result
+        type(status_t) :: status
+
+        call read_scene(path, scene, status)
+        if (.not. status%ok()) call stop_on(status)
+        call run_scene(scene, quiet, result, status)
+        select case (status%code)
+        case (status_ok)
+            if (len_trim(scene%title) > 0) write (output_unit, '(a)') trim(scene%title)
+            call report(result, scene)
+            call finish(exit_ok)
+        case (status_solver_failure, status_interrupted)
+            write (error_unit, '(a)') 'flexmbs: ' // failure_text(status)
+            write (error_unit, '(a,es23.15)') 'flexmbs: time reached t =', result%t
+            write (error_unit, '(a)') 'flexmbs: statistics so far: ' // result%stats%summary()
+            if (result%hdf5_written) write (error_unit, '(a)') &
+                'flexmbs: trajectory up to there kept in ' // scene%output_file
+            call finish(exit_solver)
+        case default
+            call stop_on(status)
+        end select
+    end subroutine run
+
+    !> Statistics line and final state on standard output.
+    subroutine report(result, scene)
+        type(run_result_t), intent(in) :: result
+        type(scene_input_t), intent(in) :: scene
+        integer :: k, n
+        write (output_unit, '(a)') result%solver_name // ': ' // result%stats%summary()
+        n = size(result%y)
+        write (output_unit, '(a,es23.15)') 't =', result%t
+        do k = 1, min(n, max_printed)
+            write (output_unit, '(a,i0,a,es23.15)') 'y(', k, ') =', result%y(k)
+        end do
+        if (n > max_printed) write (output_unit, '(a,i0,a)') '... (', n, &
+            ' components; all of them are in the HDF5 file)'
+        if (len(scene%output_file) > 0) write (output_unit, '(a)') &
+            'trajectory: ' // scene%output_file
+        if (len_trim(scene%table) > 0) write (output_unit, '(a)') 'table: ' // trim(scene%table)
+    end subroutine report
+
+    pure function failure_text(status) result(text)
+        type(status_t), intent(in) :: status
+        character(len=:), allocatable :: text
+        text = 'solver failure'
+        if (status%reason /= reason_none) text = text // ' (' // reason_name(status%reason) // ')'
+        text = text // ': ' // status%text()
+    end function failure_text
+
+    !> Message on standard error and the exit code of the status.
+    subroutine stop_on(status)
+        type(status_t), intent(in) :: status
+        write (error_unit, '(a)') 'flexmbs: ' // status%text()
+        select case (status%code)
+        case (status_bad_input)
+            call finish(exit_bad_input)
+        case (status_io_error)
+            call finish(exit_io)
+        case default
+            call finish(exit_solver)
+        end select
+    end subroutine stop_on
+
+    subroutine fail_usage(message)
+        character(len=*), intent(in) :: message
+        write (error_unit, '(a)') 'flexmbs: ' // message
+        write (error_unit, '(a)') 'try ''flexmbs --help'''
+        call finish(exit_bad_input)
+    end subroutine fail_usage
+
+    subroutine usage(unit)
+        integer, intent(in) :: unit
+        write (unit, '(a)') 'flexmbs ' // version // &
+            ' - flexible multibody dynamics and stiff DAE solvers', &
+            '', &
+            'usage:', &
+            '  flexmbs run FILE.nml [--quiet]   run the scene described by FILE.nml', &
+            '  flexmbs --help                   show this text', &
+            '  flexmbs --version                show the version', &
+            '', &
+            'FILE.nml holds the namelist groups &simulation, &solver and &output', &
+            '(see README.md for every variable, its type, unit and default).', &
+            '--quiet turns the progress display on standard error off.', &
+            '', &
+            'exit codes: 0 success, 2 bad input (no output written),', &
+            '            3 solver failure (outputs kept), 4 I/O error'
+    end subroutine usage
+
+    function argument(i) result(value)
+        integer, intent(in) :: i
+        character(len=:), allocatable :: value
+        integer :: length
+        call get_command_argument(i, length=length)
+        allocate (character(len=length) :: value)
+        if (length > 0) call get_command_argument(i, value)
+    end function argument
+
+    subroutine finish(code)
+        integer, intent(in) :: code
+        flush (output_unit)
+        flush (error_unit)
+        if (code == 0) stop
+        stop code, quiet = .true.
+    end subroutine finish
 end program flexmbs_main

@@ -4,6 +4,7 @@ program flexmbs_tests
     use testing, only: run_suite
     use test_linalg, only: collect_linalg
     use test_radau5, only: collect_radau5
+    use test_io, only: collect_io
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -15,6 +16,7 @@ program flexmbs_tests
     nfailed = 0
     call run_suite('linalg', collect_linalg(), filter, npassed, nfailed)
     call run_suite('radau5', collect_radau5(), filter, npassed, nfailed)
+    call run_suite('io', collect_io(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests

@@ -1,0 +1,452 @@
+!> A sink writing the trajectory to an HDF5 file as it is computed.
+!>
+!> Layout (Fortran dimension order; C and Python readers see it reversed):
+!>   /time           (steps)        extendible, chunked
+!>   /y              (n, steps)     extendible, chunked: y(:, k) at time(k)
+!>   /<block>        (m, steps)     optional named slices of y (/q, /v, /lambda)
+!>   attributes on / input_text, solver, outcome, NST ... NPRJ, CPU, WALL, t_reached
+!> Each record is written and the file flushed at once, so a run that
+!> fails or is interrupted leaves a file that opens without repair; the
+!> number of complete records is the length of /time (written last).
+!> The file uses HDF5's default (not 'latest') library-version bounds.
+!> An input text too large for a compact attribute goes to the scalar
+!> string dataset /input_text instead.
+module flexmbs_io_hdf5_sink
+    use hdf5
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_io_error, status_bad_input
+    use flexmbs_dae_sink, only: sink_t, dense_output_t
+    use flexmbs_dae_stats, only: dae_stats_t
+    implicit none
+    private
+
+    !> Attributes stay in the object header below about 64 KiB; larger text
+    !> goes to a dataset.
+    integer, parameter :: max_attribute_text = 32768
+    !> Target bytes of one chunk of /y (records per chunk = this / (8 n)).
+    integer, parameter :: chunk_bytes = 65536
+    integer, parameter :: time_chunk = 1024
+
+    !> A named slice y(first:last) written as its own dataset.
+    type :: block_t
+        character(len=:), allocatable :: name
+        integer :: first = 0, last = 0
+        integer(hid_t) :: dset = -1
+    end type block_t
+
+    type, extends(sink_t), public :: hdf5_sink_t
+        character(len=:), allocatable :: path
+        integer :: n = 0                 !! length of y
+        integer :: records = 0           !! records written so far
+        logical :: every_step = .false.  !! record accepted steps instead of output times
+        logical :: is_open = .false.
+        integer(hid_t) :: file = -1, time_dset = -1, y_dset = -1
+        type(block_t), allocatable :: blocks(:)
+    contains
+        procedure :: create => sink_create
+        procedure :: add_block => sink_add_block
+        procedure :: output => sink_output
+        procedure :: wants_steps => sink_wants_steps
+        procedure :: step => sink_step
+        procedure :: finish => sink_finish
+        procedure :: write_text => sink_write_text
+        procedure :: write_statistics => sink_write_statistics
+        procedure :: close => sink_close
+    end type hdf5_sink_t
+
+    logical, save :: library_open = .false.
+
+contains
+
+    !> Create (or truncate) the file with empty /time and /y for n unknowns.
+    subroutine sink_create(self, path, n, status, input_text, every_step)
+        class(hdf5_sink_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: n                   !! length of y
+        type(status_t), intent(out) :: status
+        character(len=*), intent(in), optional :: input_text !! stored as attribute
+        logical, intent(in), optional :: every_step !! record steps, not output times
+        integer :: err, per_chunk
+
+        if (self%is_open) then
+            call status%set(status_bad_input, path // ': HDF5 sink already open on ' // self%path)
+            return
+        end if
+        if (n < 1) then
+            call status%set(status_bad_input, path // ': HDF5 sink needs n >= 1')
+            return
+        end if
+        self%path = path
+        self%n = n
+        self%records = 0
+        self%every_step = .false.
+        if (present(every_step)) self%every_step = every_step
+        allocate (self%blocks(0))
+        call open_library(err)
+        if (check(err, 'initialise the HDF5 library')) return
+        call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%file, err)
+        if (check(err, 'create the file')) return
+        self%is_open = .true.
+        call create_series(self%file, 'time', 0, time_chunk, self%time_dset, err)
+        if (check(err, 'create /time')) return
+        per_chunk = max(1, min(time_chunk, chunk_bytes / (8 * n)))
+        call create_series(self%file, 'y', n, per_chunk, self%y_dset, err)
+        if (check(err, 'create /y')) return
+        if (present(input_text)) then
+            call self%write_text('input_text', input_text, status)
+            if (.not. status%ok()) return
+        end if
+        call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, err)
+        if (check(err, 'flush')) return
+
+    contains
+
+        logical function check(code, what)
+            integer, intent(in) :: code
+            character(len=*), intent(in) :: what
+            check = code < 0
+            if (check) call status%set(status_io_error, path // ': HDF5 cannot ' // what)
+        end function check
+    end subroutine sink_create
+
+    !> Also write y(first:last) as dataset /name (call before the first record).
+    subroutine sink_add_block(self, name, first, last, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        character(len=*), intent(in) :: name !! e.g. 'q', 'v', 'lambda'
+        integer, intent(in) :: first, last  !! index range in y
+        type(status_t), intent(out) :: status
+        type(block_t) :: block
+        integer :: err, m
+        if (.not. self%is_open) then
+            call status%set(status_bad_input, 'HDF5 sink: add_block before create')
+            return
+        end if
+        if (self%records > 0) then
+            call status%set(status_bad_input, self%path // ': block /' // name // &
+                ' added after records were written')
+            return
+        end if
+        if (first < 1 .or. last > self%n .or. last < first) then
+            call status%set(status_bad_input, self%path // ': block /' // name // &
+                ': index range outside 1..n')
+            return
+        end if
+        if (name == 'time' .or. name == 'y' .or. name == 'input_text') then
+            call status%set(status_bad_input, self%path // ': block /' // name // &
+                ': name is taken')
+            return
+        end if
+        m = last - first + 1
+        block%name = name
+        block%first = first
+        block%last = last
+        call create_series(self%file, name, m, max(1, min(time_chunk, chunk_bytes / (8 * m))), &
+                           block%dset, err)
+        if (err < 0) then
+            call status%set(status_io_error, self%path // ': HDF5 cannot create /' // name)
+            return
+        end if
+        self%blocks = [self%blocks, block]
+    end subroutine sink_add_block
+
+    subroutine sink_output(self, t, y, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        type(status_t), intent(inout) :: status
+        if (self%every_step) return
+        call append(self, t, y, status)
+    end subroutine sink_output
+
+    logical function sink_wants_steps(self)
+        class(hdf5_sink_t), intent(in) :: self
+        sink_wants_steps = self%every_step
+    end function sink_wants_steps
+
+    subroutine sink_step(self, nr, t_old, t, y, dense, stop, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        integer, intent(in) :: nr
+        real(wp), intent(in) :: t_old, t, y(:)
+        class(dense_output_t), intent(in) :: dense
+        logical, intent(inout) :: stop
+        type(status_t), intent(inout) :: status
+        if (.not. self%every_step) return
+        call append(self, t, y, status)
+    end subroutine sink_step
+
+    !> Flush what is written; the file stays open for the statistics.
+    subroutine sink_finish(self, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        type(status_t), intent(inout) :: status
+        integer :: err
+        if (.not. self%is_open) return
+        call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, err)
+        if (err < 0 .and. status%ok()) &
+            call status%set(status_io_error, self%path // ': HDF5 cannot flush')
+    end subroutine sink_finish
+
+    !> Store a text as a string attribute of '/' (a scalar string dataset
+    !> when it is too large for an attribute), replacing an earlier one.
+    subroutine sink_write_text(self, name, text, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        character(len=*), intent(in) :: name, text
+        type(status_t), intent(out) :: status
+        integer(hid_t) :: str_type, space, dset
+        integer :: err
+        if (.not. self%is_open) then
+            call status%set(status_bad_input, 'HDF5 sink: write_text before create')
+            return
+        end if
+        if (len(text) <= max_attribute_text) then
+            call write_string_attribute(self%file, name, text, err)
+        else
+            call string_type(len(text), str_type, err)
+            if (err >= 0) call h5screate_f(H5S_SCALAR_F, space, err)
+            if (err >= 0) call h5dcreate_f(self%file, name, str_type, space, dset, err)
+            if (err >= 0) call h5dwrite_f(dset, str_type, text, [1_hsize_t], err)
+            if (err >= 0) call h5dclose_f(dset, err)
+            if (err >= 0) call h5sclose_f(space, err)
+            if (err >= 0) call h5tclose_f(str_type, err)
+            if (err >= 0) call write_string_attribute(self%file, name, &
+                'stored in dataset /' // name, err)
+        end if
+        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
+    end subroutine sink_write_text
+
+    !> Store the statistics (and optionally solver name and outcome) as
+    !> attributes of '/'; call after the integration, before `close`.
+    subroutine sink_write_statistics(self, stats, status, solver, outcome)
+        class(hdf5_sink_t), intent(inout) :: self
+        type(dae_stats_t), intent(in) :: stats
+        type(status_t), intent(out) :: status
+        character(len=*), intent(in), optional :: solver  !! solver name
+        character(len=*), intent(in), optional :: outcome !! 'ok' or the failure message
+        integer :: err
+        if (.not. self%is_open) then
+            call status%set(status_bad_input, 'HDF5 sink: write_statistics before create')
+            return
+        end if
+        err = 0
+        call put_int('NST', stats%nst)
+        call put_int('NAC', stats%nac)
+        call put_int('NRJ', stats%nrj)
+        call put_int('NFE', stats%nfe)
+        call put_int('NFE_JAC', stats%nfe_jac)
+        call put_int('NJE', stats%nje)
+        call put_int('NDEC', stats%ndec)
+        call put_int('NSOL', stats%nsol)
+        call put_int('NPRJ', stats%nprj)
+        call put_real('CPU', stats%cpu)
+        call put_real('WALL', stats%wall)
+        call put_real('t_reached', stats%t_reached)
+        if (present(solver) .and. err >= 0) &
+            call write_string_attribute(self%file, 'solver', solver, err)
+        if (present(outcome) .and. err >= 0) &
+            call write_string_attribute(self%file, 'outcome', outcome, err)
+        if (err >= 0) call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, err)
+        if (err < 0) call status%set(status_io_error, self%path // &
+            ': HDF5 cannot write the statistics')
+
+    contains
+
+        subroutine put_int(name, value)
+            character(len=*), intent(in) :: name
+            integer, intent(in) :: value
+            integer(hid_t) :: space, attr
+            if (err < 0) return
+            call delete_attribute(self%file, name, err)
+            if (err >= 0) call h5screate_f(H5S_SCALAR_F, space, err)
+            if (err >= 0) call h5acreate_f(self%file, name, H5T_NATIVE_INTEGER, space, attr, err)
+            if (err >= 0) call h5awrite_f(attr, H5T_NATIVE_INTEGER, value, [1_hsize_t], err)
+            if (err >= 0) call h5aclose_f(attr, err)
+            if (err >= 0) call h5sclose_f(space, err)
+        end subroutine put_int
+
+        subroutine put_real(name, value)
+            character(len=*), intent(in) :: name
+            real(wp), intent(in) :: value
+            integer(hid_t) :: space, attr
+            if (err < 0) return
+            call delete_attribute(self%file, name, err)
+            if (err >= 0) call h5screate_f(H5S_SCALAR_F, space, err)
+            if (err >= 0) call h5acreate_f(self%file, name, H5T_NATIVE_DOUBLE, space, attr, err)
+            if (err >= 0) call h5awrite_f(attr, H5T_NATIVE_DOUBLE, value, [1_hsize_t], err)
+            if (err >= 0) call h5aclose_f(attr, err)
+            if (err >= 0) call h5sclose_f(space, err)
+        end subroutine put_real
+    end subroutine sink_write_statistics
+
+    !> Close every dataset and the file. Safe to call twice.
+    subroutine sink_close(self, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        type(status_t), intent(out) :: status
+        integer :: err, worst, i
+        if (.not. self%is_open) return
+        worst = 0
+        if (allocated(self%blocks)) then
+            do i = 1, size(self%blocks)
+                call h5dclose_f(self%blocks(i)%dset, err)
+                worst = min(worst, err)
+            end do
+        end if
+        err = 0
+        if (self%y_dset >= 0) call h5dclose_f(self%y_dset, err)
+        worst = min(worst, err)
+        err = 0
+        if (self%time_dset >= 0) call h5dclose_f(self%time_dset, err)
+        worst = min(worst, err)
+        call h5fclose_f(self%file, err)
+        worst = min(worst, err)
+        self%is_open = .false.
+        self%file = -1
+        self%y_dset = -1
+        self%time_dset = -1
+        if (worst < 0) call status%set(status_io_error, self%path // ': HDF5 cannot close')
+    end subroutine sink_close
+
+    ! ------------------------------------------------------------------
+
+    !> Append one record: /y and the blocks first, /time last, then flush.
+    subroutine append(self, t, y, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        type(status_t), intent(inout) :: status
+        integer :: err, i
+        if (.not. status%ok()) return
+        if (.not. self%is_open) then
+            call status%set(status_bad_input, 'HDF5 sink: record before create')
+            return
+        end if
+        if (size(y) /= self%n) then
+            call status%set(status_bad_input, self%path // ': record of wrong length')
+            return
+        end if
+        call write_column(self%y_dset, self%n, self%records, y, err)
+        do i = 1, size(self%blocks)
+            if (err < 0) exit
+            associate (b => self%blocks(i))
+                call write_column(b%dset, b%last - b%first + 1, self%records, &
+                                  y(b%first:b%last), err)
+            end associate
+        end do
+        if (err >= 0) call write_column(self%time_dset, 0, self%records, [t], err)
+        if (err >= 0) call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, err)
+        if (err < 0) then
+            call status%set(status_io_error, self%path // ': HDF5 cannot append a record')
+            return
+        end if
+        self%records = self%records + 1
+    end subroutine append
+
+    !> An empty extendible dataset: (0) for m = 0, else (m, 0), chunked.
+    subroutine create_series(file, name, m, per_chunk, dset, err)
+        integer(hid_t), intent(in) :: file
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: m, per_chunk
+        integer(hid_t), intent(out) :: dset
+        integer, intent(out) :: err
+        integer(hid_t) :: space, plist
+        integer(hsize_t) :: dims(2), maxdims(2), chunk(2)
+        integer :: rank
+        if (m == 0) then
+            rank = 1
+            dims(1) = 0
+            maxdims(1) = H5S_UNLIMITED_F
+            chunk(1) = int(per_chunk, hsize_t)
+        else
+            rank = 2
+            dims = [int(m, hsize_t), 0_hsize_t]
+            maxdims = [int(m, hsize_t), H5S_UNLIMITED_F]
+            chunk = [int(m, hsize_t), int(per_chunk, hsize_t)]
+        end if
+        dset = -1
+        call h5screate_simple_f(rank, dims(1:rank), space, err, maxdims(1:rank))
+        if (err < 0) return
+        call h5pcreate_f(H5P_DATASET_CREATE_F, plist, err)
+        if (err >= 0) call h5pset_chunk_f(plist, rank, chunk(1:rank), err)
+        if (err >= 0) call h5dcreate_f(file, name, H5T_NATIVE_DOUBLE, space, dset, err, plist)
+        if (err >= 0) call h5pclose_f(plist, err)
+        if (err >= 0) call h5sclose_f(space, err)
+    end subroutine create_series
+
+    !> Extend a series by one record at position `k` (0-based) and write it.
+    subroutine write_column(dset, m, k, values, err)
+        integer(hid_t), intent(in) :: dset
+        integer, intent(in) :: m, k  !! m = 0 for the 1-D /time
+        real(wp), intent(in) :: values(:)
+        integer, intent(out) :: err
+        integer(hid_t) :: filespace, memspace
+        integer(hsize_t) :: size_new(2), offset(2), count(2)
+        integer :: rank
+        if (m == 0) then
+            rank = 1
+            size_new(1) = int(k + 1, hsize_t)
+            offset(1) = int(k, hsize_t)
+            count(1) = 1
+        else
+            rank = 2
+            size_new = [int(m, hsize_t), int(k + 1, hsize_t)]
+            offset = [0_hsize_t, int(k, hsize_t)]
+            count = [int(m, hsize_t), 1_hsize_t]
+        end if
+        call h5dset_extent_f(dset, size_new(1:rank), err)
+        if (err < 0) return
+        call h5dget_space_f(dset, filespace, err)
+        if (err < 0) return
+        call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, offset(1:rank), &
+                                   count(1:rank), err)
+        if (err >= 0) call h5screate_simple_f(rank, count(1:rank), memspace, err)
+        if (err >= 0) then
+            call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, count(1:rank), err, &
+                            mem_space_id=memspace, file_space_id=filespace)
+            call h5sclose_f(memspace, err)
+        end if
+        call h5sclose_f(filespace, err)
+    end subroutine write_column
+
+    !> A fixed-length string type of `n` characters (at least 1).
+    subroutine string_type(n, str_type, err)
+        integer, intent(in) :: n
+        integer(hid_t), intent(out) :: str_type
+        integer, intent(out) :: err
+        call h5tcopy_f(H5T_FORTRAN_S1, str_type, err)
+        if (err >= 0) call h5tset_size_f(str_type, int(max(n, 1), size_t), err)
+    end subroutine string_type
+
+    subroutine write_string_attribute(obj, name, text, err)
+        integer(hid_t), intent(in) :: obj
+        character(len=*), intent(in) :: name, text
+        integer, intent(out) :: err
+        integer(hid_t) :: str_type, space, attr
+        character(len=max(len(text), 1)) :: buf
+        buf = text
+        call delete_attribute(obj, name, err)
+        if (err >= 0) call string_type(len(buf), str_type, err)
+        if (err >= 0) call h5screate_f(H5S_SCALAR_F, space, err)
+        if (err >= 0) call h5acreate_f(obj, name, str_type, space, attr, err)
+        if (err >= 0) call h5awrite_f(attr, str_type, buf, [1_hsize_t], err)
+        if (err >= 0) call h5aclose_f(attr, err)
+        if (err >= 0) call h5sclose_f(space, err)
+        if (err >= 0) call h5tclose_f(str_type, err)
+    end subroutine write_string_attribute
+
+    subroutine delete_attribute(obj, name, err)
+        integer(hid_t), intent(in) :: obj
+        character(len=*), intent(in) :: name
+        integer, intent(out) :: err
+        logical :: exists
+        call h5aexists_f(obj, name, exists, err)
+        if (err >= 0 .and. exists) call h5adelete_f(obj, name, err)
+    end subroutine delete_attribute
+
+    !> Initialise the Fortran HDF5 library once and silence its own error
+    !> printing: every failure is reported through status_t instead.
+    subroutine open_library(err)
+        integer, intent(out) :: err
+        err = 0
+        if (library_open) return
+        call h5open_f(err)
+        if (err < 0) return
+        call h5eset_auto_f(0, err)
+        library_open = err >= 0
+    end subroutine open_library
+end module flexmbs_io_hdf5_sink

@@ -1,0 +1,1103 @@
+!> Scene input: the namelist groups `&simulation`, `&solver` and `&output`.
+!>
+!> The text is checked before Fortran namelist I/O reads it, because the
+!> compiler's own namelist errors name neither the variable nor the value.
+!> A small tokeniser walks every group, rejects unknown groups and
+!> variables and values of the wrong type; the validated text of each group
+!> is then read with `read(..., nml=...)`, and ranges are checked on the
+!> typed values. Every problem yields one `status_t` whose message names
+!> file, group, variable, value and reason, e.g.
+!> `inputs/x.nml: &solver: rtol = -1e-6: must be positive (line 7)`.
+module flexmbs_io_namelist
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use, intrinsic :: ieee_exceptions, only: ieee_status_type, ieee_get_status, ieee_set_status
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input, status_io_error
+    use flexmbs_dae_options, only: dae_options_t
+    implicit none
+    private
+
+    integer, parameter :: kind_string = 1, kind_real = 2, kind_integer = 3, kind_logical = 4
+    integer, parameter :: len_title = 256, len_name = 32, len_path = 512
+
+    !> One variable of the schema.
+    type :: var_spec_t
+        character(len=12) :: group
+        character(len=24) :: name
+        integer :: kind
+    end type var_spec_t
+
+    type(var_spec_t), parameter :: schema(*) = [ &
+        var_spec_t('simulation', 'title', kind_string), &
+        var_spec_t('simulation', 'problem', kind_string), &
+        var_spec_t('simulation', 't_start', kind_real), &
+        var_spec_t('simulation', 't_end', kind_real), &
+        var_spec_t('simulation', 'vdp_eps', kind_real), &
+        var_spec_t('simulation', 'vdp_y1', kind_real), &
+        var_spec_t('simulation', 'vdp_y2', kind_real), &
+        var_spec_t('simulation', 'pendulum_formulation', kind_string), &
+        var_spec_t('simulation', 'pendulum_length', kind_real), &
+        var_spec_t('simulation', 'pendulum_mass', kind_real), &
+        var_spec_t('simulation', 'pendulum_angle', kind_real), &
+        var_spec_t('simulation', 'pendulum_omega', kind_real), &
+        var_spec_t('simulation', 'gravity', kind_real), &
+        var_spec_t('simulation', 'npoints', kind_integer), &
+        var_spec_t('solver', 'name', kind_string), &
+        var_spec_t('solver', 'rtol', kind_real), &
+        var_spec_t('solver', 'atol', kind_real), &
+        var_spec_t('solver', 'h0', kind_real), &
+        var_spec_t('solver', 'hmax', kind_real), &
+        var_spec_t('solver', 'max_steps', kind_integer), &
+        var_spec_t('solver', 'linear_solver', kind_string), &
+        var_spec_t('solver', 'jacobian', kind_string), &
+        var_spec_t('solver', 'nit', kind_integer), &
+        var_spec_t('solver', 'thet', kind_real), &
+        var_spec_t('solver', 'fnewt', kind_real), &
+        var_spec_t('solver', 'quot1', kind_real), &
+        var_spec_t('solver', 'quot2', kind_real), &
+        var_spec_t('solver', 'safe', kind_real), &
+        var_spec_t('solver', 'fac_min', kind_real), &
+        var_spec_t('solver', 'fac_max', kind_real), &
+        var_spec_t('solver', 'controller', kind_string), &
+        var_spec_t('solver', 'zero_start', kind_logical), &
+        var_spec_t('solver', 'pmax', kind_integer), &
+        var_spec_t('output', 'file', kind_string), &
+        var_spec_t('output', 'n_output', kind_integer), &
+        var_spec_t('output', 'every_step', kind_logical), &
+        var_spec_t('output', 'table', kind_string), &
+        var_spec_t('output', 'progress', kind_logical)]
+
+    character(len=12), parameter :: group_names(*) = [character(len=12) :: &
+        'simulation', 'solver', 'output']
+
+    !> Problem names the schema accepts (the scene builder says which exist).
+    character(len=16), parameter, public :: problem_names(*) = [character(len=16) :: &
+        'van_der_pol', 'pendulum', 'robertson', 'brusselator_1d', 'brusselator_2d']
+    character(len=8), parameter, public :: formulation_names(*) = [character(len=8) :: &
+        'index3', 'index2', 'index1', 'ggl']
+
+    !> π/2: the pendulum starts horizontal by default.
+    real(wp), parameter :: half_pi = 1.5707963267948966_wp
+
+    !> Everything a scene file says, with defaults for what it leaves out.
+    type, public :: scene_input_t
+        character(len=:), allocatable :: path !! the file read
+        character(len=:), allocatable :: text !! its full text (stored in the HDF5 file)
+        ! &simulation
+        character(len=len_title) :: title = ''
+        character(len=len_name) :: problem = ''
+        real(wp) :: t_start = 0.0_wp          !! s
+        real(wp) :: t_end = 0.0_wp            !! s, required, > t_start
+        real(wp) :: vdp_eps = 1.0e-6_wp
+        real(wp) :: vdp_y1 = 2.0_wp
+        real(wp) :: vdp_y2 = -0.66_wp
+        character(len=len_name) :: pendulum_formulation = 'index2'
+        real(wp) :: pendulum_length = 1.0_wp  !! m
+        real(wp) :: pendulum_mass = 1.0_wp    !! kg
+        real(wp) :: pendulum_angle = half_pi  !! rad from the downward vertical
+        real(wp) :: pendulum_omega = 0.0_wp   !! rad/s
+        real(wp) :: gravity = 9.81_wp         !! m/s²
+        integer :: npoints = 100              !! grid points per direction (Brusselator)
+        ! &solver
+        character(len=len_name) :: solver_name = 'radau5'
+        real(wp) :: rtol = 1.0e-6_wp
+        real(wp) :: atol = 1.0e-6_wp
+        real(wp) :: h0 = 0.0_wp               !! s, 0 = automatic
+        real(wp) :: hmax = 0.0_wp             !! s, 0 = |t_end - t_start|
+        integer :: max_steps = 100000
+        character(len=len_name) :: linear_solver = 'auto'
+        character(len=len_name) :: jacobian = 'analytic'
+        integer :: nit = 7
+        real(wp) :: thet = 0.001_wp
+        real(wp) :: fnewt = 0.0_wp            !! 0 = the solver's default
+        real(wp) :: quot1 = 1.0_wp
+        real(wp) :: quot2 = 1.2_wp
+        real(wp) :: safe = 0.9_wp
+        real(wp) :: fac_min = 0.2_wp
+        real(wp) :: fac_max = 8.0_wp
+        character(len=len_name) :: controller = 'predictive'
+        logical :: zero_start = .false.
+        integer :: pmax = 5
+        ! &output
+        !> HDF5 file; '' = none. Derived from the input name when not given.
+        character(len=:), allocatable :: output_file
+        integer :: n_output = 101
+        logical :: every_step = .false.
+        character(len=len_path) :: table = ''
+        logical :: progress = .true.
+    end type scene_input_t
+
+    !> One `name = value` of the text.
+    type :: entry_t
+        character(len=:), allocatable :: group, name, value
+        integer :: line = 0
+        logical :: quoted = .false.
+    end type entry_t
+
+    !> Text span [first, last] of a group, from '&name' to its closing '/'.
+    type :: span_t
+        integer :: first = 0, last = 0
+    end type span_t
+
+    public :: read_scene, parse_scene, scene_dae_options, controller_code
+
+contains
+
+    !> Read and validate a scene file. A missing file is bad input; a file
+    !> that exists but cannot be read is an I/O error.
+    subroutine read_scene(path, scene, status)
+        character(len=*), intent(in) :: path      !! scene file
+        type(scene_input_t), intent(out) :: scene !! defaults plus the file's values
+        type(status_t), intent(out) :: status
+        character(len=:), allocatable :: text
+        logical :: exists
+        integer :: unit, ios, nbytes
+        character(len=256) :: msg
+
+        inquire (file=path, exist=exists)
+        if (.not. exists) then
+            call status%set(status_bad_input, path // ': no such file')
+            return
+        end if
+        open (newunit=unit, file=path, access='stream', form='unformatted', &
+              action='read', status='old', iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+            call status%set(status_io_error, path // ': cannot open: ' // trim(msg))
+            return
+        end if
+        inquire (unit=unit, size=nbytes)
+        if (nbytes < 0) then
+            close (unit)
+            call status%set(status_io_error, path // ': cannot determine its size')
+            return
+        end if
+        allocate (character(len=nbytes) :: text)
+        if (nbytes > 0) read (unit, iostat=ios, iomsg=msg) text
+        close (unit)
+        if (ios /= 0) then
+            call status%set(status_io_error, path // ': cannot read: ' // trim(msg))
+            return
+        end if
+        call parse_scene(text, path, scene, status)
+    end subroutine read_scene
+
+    !> Validate and read scene text; `path` is used in messages and for the
+    !> default output name.
+    subroutine parse_scene(text, path, scene, status)
+        character(len=*), intent(in) :: text      !! the whole file
+        character(len=*), intent(in) :: path      !! where it came from
+        type(scene_input_t), intent(out) :: scene
+        type(status_t), intent(out) :: status
+        type(entry_t), allocatable :: entries(:)
+        type(span_t) :: spans(size(group_names))
+        character(len=:), allocatable :: clean
+        integer :: g
+
+        scene%path = path
+        scene%text = text
+        call tokenise(text, path, entries, spans, clean, status)
+        if (.not. status%ok()) return
+        call check_types(entries, path, status)
+        if (.not. status%ok()) return
+        do g = 1, size(group_names)
+            if (spans(g)%first == 0) cycle
+            call read_group(clean(spans(g)%first:spans(g)%last), trim(group_names(g)), &
+                            path, scene, status)
+            if (.not. status%ok()) return
+        end do
+        call normalise(scene)
+        call check_ranges(scene, entries, path, status)
+        if (.not. status%ok()) return
+        call resolve_output(scene, entries, path, status)
+    end subroutine parse_scene
+
+    ! ------------------------------------------------------------------
+    ! Tokenising: find groups, names and raw values, with line numbers.
+    ! ------------------------------------------------------------------
+
+    !> Walk the text; return the `name = value` entries, each group's span
+    !> in `clean` (the text with comments blanked, same length).
+    subroutine tokenise(text, path, entries, spans, clean, status)
+        character(len=*), intent(in) :: text, path
+        type(entry_t), allocatable, intent(out) :: entries(:)
+        type(span_t), intent(inout) :: spans(:)
+        character(len=:), allocatable, intent(out) :: clean
+        type(status_t), intent(inout) :: status
+        integer :: pos, line, g, n, first, vline
+        character(len=:), allocatable :: word, group, name, value, previous
+        logical :: quoted
+
+        allocate (entries(0))
+        clean = blank_comments(text)
+        n = len(clean)
+        pos = 1
+        line = 1
+        do
+            ! outside any group
+            call skip_blank(clean, pos, line)
+            if (pos > n) exit
+            if (clean(pos:pos) /= '&') then
+                word = bare_word(clean, pos)
+                call status%set(status_bad_input, path // ': unexpected text ''' // word // &
+                    ''' outside a group (groups start with &name and end with /)' // at(line))
+                return
+            end if
+            first = pos
+            pos = pos + 1
+            group = lower(name_word(clean, pos))
+            g = find_group(group)
+            if (g == 0) then
+                call status%set(status_bad_input, path // ': &' // group // &
+                    ': unknown group (expected &simulation, &solver or &output)' // at(line))
+                return
+            end if
+            if (spans(g)%first /= 0) then
+                call status%set(status_bad_input, path // ': &' // group // &
+                    ': group given more than once' // at(line))
+                return
+            end if
+            previous = ''
+            do
+                ! inside group `group`
+                call skip_blank(clean, pos, line)
+                if (pos > n) then
+                    call status%set(status_bad_input, path // ': &' // group // &
+                        ': not closed by ''/''' // at(line))
+                    return
+                end if
+                if (clean(pos:pos) == '/') then
+                    pos = pos + 1
+                    exit
+                end if
+                if (clean(pos:pos) == '&') then
+                    pos = pos + 1
+                    word = lower(name_word(clean, pos))
+                    if (word == 'end') exit
+                    call status%set(status_bad_input, path // ': &' // group // &
+                        ': not closed by ''/'' before &' // word // at(line))
+                    return
+                end if
+                if (clean(pos:pos) == ',' .and. len(previous) > 0) then
+                    pos = pos + 1
+                    cycle
+                end if
+                if (.not. is_letter(clean(pos:pos))) then
+                    word = bare_word(clean, pos)
+                    if (len(previous) > 0) then
+                        call status%set(status_bad_input, path // ': &' // group // ': ' // &
+                            previous // ': unexpected ''' // word // &
+                            ''' after its value (one value per variable)' // at(line))
+                    else
+                        call status%set(status_bad_input, path // ': &' // group // &
+                            ': unexpected ''' // word // ''' (expected name = value)' // at(line))
+                    end if
+                    return
+                end if
+                name = lower(variable_word(clean, pos))
+                if (find_var(group, name) == 0) then
+                    call status%set(status_bad_input, path // ': &' // group // ': ' // name // &
+                        ': unknown variable (known: ' // known_vars(group) // ')' // at(line))
+                    return
+                end if
+                if (has_entry(entries, group, name)) then
+                    call status%set(status_bad_input, path // ': &' // group // ': ' // name // &
+                        ': given more than once' // at(line))
+                    return
+                end if
+                call skip_blank(clean, pos, line)
+                if (pos > n) then
+                    call status%set(status_bad_input, path // ': &' // group // ': ' // name // &
+                        ': expected ''='' after the name' // at(line))
+                    return
+                end if
+                if (clean(pos:pos) /= '=') then
+                    call status%set(status_bad_input, path // ': &' // group // ': ' // name // &
+                        ': expected ''='' after the name' // at(line))
+                    return
+                end if
+                pos = pos + 1
+                call skip_blank(clean, pos, line)
+                vline = line
+                if (pos > n) then
+                    value = ''
+                else if (scan(clean(pos:pos), ',/&') > 0) then
+                    value = ''
+                else
+                    call value_word(clean, pos, value, quoted, status)
+                    if (.not. status%ok()) then
+                        call status%set(status_bad_input, path // ': &' // group // ': ' // &
+                            name // ' = ' // value // ': unterminated string' // at(vline))
+                        return
+                    end if
+                end if
+                if (len(value) == 0) then
+                    call status%set(status_bad_input, path // ': &' // group // ': ' // name // &
+                        ': has no value' // at(vline))
+                    return
+                end if
+                entries = [entries, entry_t(group, name, value, vline, quoted)]
+                previous = name
+            end do
+            spans(g)%first = first
+            spans(g)%last = pos - 1
+        end do
+    end subroutine tokenise
+
+    !> The text with every comment ('!' outside a string, to the end of
+    !> its line) replaced by blanks; positions and newlines are kept.
+    pure function blank_comments(text) result(clean)
+        character(len=*), intent(in) :: text
+        character(len=len(text)) :: clean
+        integer :: i
+        character :: quote
+        logical :: comment
+        clean = text
+        quote = ' '
+        comment = .false.
+        do i = 1, len(text)
+            if (text(i:i) == new_line('a')) then
+                comment = .false.
+                quote = ' '
+            else if (comment) then
+                clean(i:i) = ' '
+            else if (quote /= ' ') then
+                if (text(i:i) == quote) quote = ' '
+            else if (text(i:i) == '''' .or. text(i:i) == '"') then
+                quote = text(i:i)
+            else if (text(i:i) == '!') then
+                comment = .true.
+                clean(i:i) = ' '
+            end if
+        end do
+    end function blank_comments
+
+    !> Skip blanks, tabs, carriage returns and newlines, counting lines.
+    pure subroutine skip_blank(text, pos, line)
+        character(len=*), intent(in) :: text
+        integer, intent(inout) :: pos, line
+        do while (pos <= len(text))
+            if (text(pos:pos) == new_line('a')) then
+                line = line + 1
+            else if (.not. is_space(text(pos:pos))) then
+                exit
+            end if
+            pos = pos + 1
+        end do
+    end subroutine skip_blank
+
+    !> A Fortran name (letters, digits, '_') starting at pos.
+    function name_word(text, pos) result(word)
+        character(len=*), intent(in) :: text
+        integer, intent(inout) :: pos
+        character(len=:), allocatable :: word
+        integer :: start
+        start = pos
+        do while (pos <= len(text))
+            if (.not. (is_letter(text(pos:pos)) .or. is_digit(text(pos:pos)) &
+                       .or. text(pos:pos) == '_')) exit
+            pos = pos + 1
+        end do
+        word = text(start:pos - 1)
+    end function name_word
+
+    !> A variable designator: a name, possibly with a subscript or
+    !> component, so that `y0(1)` is reported whole as unknown.
+    function variable_word(text, pos) result(word)
+        character(len=*), intent(in) :: text
+        integer, intent(inout) :: pos
+        character(len=:), allocatable :: word
+        integer :: start
+        start = pos
+        do while (pos <= len(text))
+            if (is_space(text(pos:pos)) .or. text(pos:pos) == new_line('a')) exit
+            if (scan(text(pos:pos), '=,/&''"') > 0) exit
+            pos = pos + 1
+        end do
+        word = text(start:pos - 1)
+    end function variable_word
+
+    !> Anything up to the next separator (for messages about stray text).
+    function bare_word(text, pos) result(word)
+        character(len=*), intent(in) :: text
+        integer, intent(in) :: pos
+        character(len=:), allocatable :: word
+        integer :: last
+        last = pos
+        do while (last < len(text))
+            if (is_space(text(last + 1:last + 1)) .or. text(last + 1:last + 1) == new_line('a') &
+                .or. scan(text(last + 1:last + 1), ',/=') > 0) exit
+            last = last + 1
+        end do
+        word = text(pos:last)
+    end function bare_word
+
+    !> One value: a quoted string (quotes doubled inside) or a bare token
+    !> ending at a blank, ',', '/' or end of line. Sets status (message
+    !> filled by the caller) when a string is not closed on its line.
+    subroutine value_word(text, pos, value, quoted, status)
+        character(len=*), intent(in) :: text
+        integer, intent(inout) :: pos
+        character(len=:), allocatable, intent(out) :: value
+        logical, intent(out) :: quoted
+        type(status_t), intent(inout) :: status
+        integer :: start
+        character :: quote
+        start = pos
+        quoted = text(pos:pos) == '''' .or. text(pos:pos) == '"'
+        if (quoted) then
+            quote = text(pos:pos)
+            pos = pos + 1
+            do
+                if (pos > len(text)) exit
+                if (text(pos:pos) == new_line('a')) exit
+                if (text(pos:pos) == quote) then
+                    if (pos < len(text)) then
+                        if (text(pos + 1:pos + 1) == quote) then
+                            pos = pos + 2
+                            cycle
+                        end if
+                    end if
+                    pos = pos + 1
+                    value = text(start:pos - 1)
+                    return
+                end if
+                pos = pos + 1
+            end do
+            value = text(start:pos - 1)
+            call status%set(status_bad_input, 'unterminated string')
+            return
+        end if
+        do while (pos <= len(text))
+            if (is_space(text(pos:pos)) .or. text(pos:pos) == new_line('a')) exit
+            if (scan(text(pos:pos), ',/') > 0) exit
+            pos = pos + 1
+        end do
+        value = text(start:pos - 1)
+    end subroutine value_word
+
+    ! ------------------------------------------------------------------
+    ! Types: check each raw value against its variable's kind.
+    ! ------------------------------------------------------------------
+
+    subroutine check_types(entries, path, status)
+        type(entry_t), intent(in) :: entries(:)
+        character(len=*), intent(in) :: path
+        type(status_t), intent(inout) :: status
+        integer :: i, k, ios
+        real(wp) :: x
+        integer :: m
+        character(len=:), allocatable :: reason
+        type(ieee_status_type) :: fp_status
+
+        do i = 1, size(entries)
+            associate (e => entries(i))
+                k = schema(find_var(e%group, e%name))%kind
+                reason = ''
+                select case (k)
+                case (kind_string)
+                    if (.not. e%quoted) then
+                        reason = 'must be a quoted string, e.g. ' // e%name // ' = ''' // &
+                                 e%value // ''''
+                    else if (len(unquote(e%value)) > string_length(e%name)) then
+                        reason = 'longer than ' // itoa(string_length(e%name)) // ' characters'
+                    end if
+                case (kind_real)
+                    if (e%quoted .or. .not. is_real_text(e%value)) then
+                        reason = 'must be a real number'
+                    else
+                        ! an overflowing value must not leave the overflow flag raised
+                        call ieee_get_status(fp_status)
+                        read (e%value, *, iostat=ios) x
+                        call ieee_set_status(fp_status)
+                        if (ios /= 0) then
+                            reason = 'is out of the range of real numbers'
+                        else if (.not. ieee_is_finite(x)) then
+                            reason = 'is out of the range of real numbers'
+                        end if
+                    end if
+                case (kind_integer)
+                    if (e%quoted .or. .not. is_integer_text(e%value)) then
+                        reason = 'must be an integer'
+                    else
+                        read (e%value, *, iostat=ios) m
+                        if (ios /= 0) reason = 'is out of the range of integers'
+                    end if
+                case (kind_logical)
+                    if (e%quoted .or. .not. is_logical_text(e%value)) then
+                        reason = 'must be .true. or .false.'
+                    end if
+                end select
+                if (len(reason) > 0) then
+                    call fail(status, path, e, reason)
+                    return
+                end if
+            end associate
+        end do
+    end subroutine check_types
+
+    pure logical function is_integer_text(s)
+        character(len=*), intent(in) :: s
+        integer :: i, start
+        is_integer_text = .false.
+        start = 1
+        if (len(s) == 0) return
+        if (s(1:1) == '+' .or. s(1:1) == '-') start = 2
+        if (start > len(s)) return
+        do i = start, len(s)
+            if (.not. is_digit(s(i:i))) return
+        end do
+        is_integer_text = .true.
+    end function is_integer_text
+
+    !> [sign] digits [. digits] [e|d [sign] digits], at least one mantissa digit.
+    pure logical function is_real_text(s)
+        character(len=*), intent(in) :: s
+        integer :: i, ndig
+        is_real_text = .false.
+        i = 1
+        ndig = 0
+        if (len(s) == 0) return
+        if (s(1:1) == '+' .or. s(1:1) == '-') i = 2
+        do while (i <= len(s))
+            if (.not. is_digit(s(i:i))) exit
+            ndig = ndig + 1
+            i = i + 1
+        end do
+        if (i <= len(s)) then
+            if (s(i:i) == '.') then
+                i = i + 1
+                do while (i <= len(s))
+                    if (.not. is_digit(s(i:i))) exit
+                    ndig = ndig + 1
+                    i = i + 1
+                end do
+            end if
+        end if
+        if (ndig == 0) return
+        if (i <= len(s)) then
+            if (index('eEdD', s(i:i)) == 0) return
+            i = i + 1
+            if (i <= len(s)) then
+                if (s(i:i) == '+' .or. s(i:i) == '-') i = i + 1
+            end if
+            if (i > len(s)) return
+            do while (i <= len(s))
+                if (.not. is_digit(s(i:i))) return
+                i = i + 1
+            end do
+        end if
+        is_real_text = .true.
+    end function is_real_text
+
+    pure logical function is_logical_text(s)
+        character(len=*), intent(in) :: s
+        character(len=8), parameter :: forms(*) = [character(len=8) :: '.true.', '.false.', &
+            '.t.', '.f.', '.t', '.f', 't', 'f', 'true', 'false']
+        is_logical_text = any(forms == lower(s))
+    end function is_logical_text
+
+    !> Declared length of a string variable.
+    pure integer function string_length(name)
+        character(len=*), intent(in) :: name
+        select case (name)
+        case ('title'); string_length = len_title
+        case ('file', 'table'); string_length = len_path
+        case default; string_length = len_name
+        end select
+    end function string_length
+
+    ! ------------------------------------------------------------------
+    ! Reading: the validated text of one group through namelist I/O.
+    ! ------------------------------------------------------------------
+
+    subroutine read_group(text, group, path, scene, status)
+        character(len=*), intent(in) :: text  !! '&group ... /', comments blanked
+        character(len=*), intent(in) :: group, path
+        type(scene_input_t), intent(inout) :: scene
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: lines(:)
+        integer :: ios
+        character(len=256) :: msg
+        ! Namelist variables carry the schema's names, so they are local.
+        character(len=len_title) :: title
+        character(len=len_name) :: problem, pendulum_formulation, name, linear_solver, &
+            jacobian, controller
+        character(len=len_path) :: file, table
+        real(wp) :: t_start, t_end, vdp_eps, vdp_y1, vdp_y2, pendulum_length, pendulum_mass, &
+            pendulum_angle, pendulum_omega, gravity, rtol, atol, h0, hmax, thet, fnewt, &
+            quot1, quot2, safe, fac_min, fac_max
+        integer :: npoints, max_steps, nit, pmax, n_output
+        logical :: zero_start, every_step, progress
+        namelist /simulation/ title, problem, t_start, t_end, vdp_eps, vdp_y1, vdp_y2, &
+            pendulum_formulation, pendulum_length, pendulum_mass, pendulum_angle, &
+            pendulum_omega, gravity, npoints
+        namelist /solver/ name, rtol, atol, h0, hmax, max_steps, linear_solver, jacobian, &
+            nit, thet, fnewt, quot1, quot2, safe, fac_min, fac_max, controller, zero_start, pmax
+        namelist /output/ file, n_output, every_step, table, progress
+
+        lines = split_lines(text)
+        ios = 0
+        msg = ''
+        select case (group)
+        case ('simulation')
+            title = scene%title
+            problem = scene%problem
+            t_start = scene%t_start
+            t_end = scene%t_end
+            vdp_eps = scene%vdp_eps
+            vdp_y1 = scene%vdp_y1
+            vdp_y2 = scene%vdp_y2
+            pendulum_formulation = scene%pendulum_formulation
+            pendulum_length = scene%pendulum_length
+            pendulum_mass = scene%pendulum_mass
+            pendulum_angle = scene%pendulum_angle
+            pendulum_omega = scene%pendulum_omega
+            gravity = scene%gravity
+            npoints = scene%npoints
+            read (lines, nml=simulation, iostat=ios, iomsg=msg)
+            scene%title = title
+            scene%problem = problem
+            scene%t_start = t_start
+            scene%t_end = t_end
+            scene%vdp_eps = vdp_eps
+            scene%vdp_y1 = vdp_y1
+            scene%vdp_y2 = vdp_y2
+            scene%pendulum_formulation = pendulum_formulation
+            scene%pendulum_length = pendulum_length
+            scene%pendulum_mass = pendulum_mass
+            scene%pendulum_angle = pendulum_angle
+            scene%pendulum_omega = pendulum_omega
+            scene%gravity = gravity
+            scene%npoints = npoints
+        case ('solver')
+            name = scene%solver_name
+            rtol = scene%rtol
+            atol = scene%atol
+            h0 = scene%h0
+            hmax = scene%hmax
+            max_steps = scene%max_steps
+            linear_solver = scene%linear_solver
+            jacobian = scene%jacobian
+            nit = scene%nit
+            thet = scene%thet
+            fnewt = scene%fnewt
+            quot1 = scene%quot1
+            quot2 = scene%quot2
+            safe = scene%safe
+            fac_min = scene%fac_min
+            fac_max = scene%fac_max
+            controller = scene%controller
+            zero_start = scene%zero_start
+            pmax = scene%pmax
+            read (lines, nml=solver, iostat=ios, iomsg=msg)
+            scene%solver_name = name
+            scene%rtol = rtol
+            scene%atol = atol
+            scene%h0 = h0
+            scene%hmax = hmax
+            scene%max_steps = max_steps
+            scene%linear_solver = linear_solver
+            scene%jacobian = jacobian
+            scene%nit = nit
+            scene%thet = thet
+            scene%fnewt = fnewt
+            scene%quot1 = quot1
+            scene%quot2 = quot2
+            scene%safe = safe
+            scene%fac_min = fac_min
+            scene%fac_max = fac_max
+            scene%controller = controller
+            scene%zero_start = zero_start
+            scene%pmax = pmax
+        case ('output')
+            file = ''
+            n_output = scene%n_output
+            every_step = scene%every_step
+            table = scene%table
+            progress = scene%progress
+            read (lines, nml=output, iostat=ios, iomsg=msg)
+            scene%output_file = trim(file)
+            scene%n_output = n_output
+            scene%every_step = every_step
+            scene%table = table
+            scene%progress = progress
+        end select
+        if (ios /= 0) then
+            ! Not expected after validation; report what the compiler says.
+            call status%set(status_bad_input, path // ': &' // group // ': ' // trim(msg))
+        end if
+    end subroutine read_group
+
+    !> Split text at newlines into records of equal length.
+    pure function split_lines(text) result(lines)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: lines(:)
+        integer :: i, k, nl, width, start
+        nl = 1
+        width = 1
+        start = 1
+        do i = 1, len(text)
+            if (text(i:i) == new_line('a')) then
+                nl = nl + 1
+                width = max(width, i - start)
+                start = i + 1
+            end if
+        end do
+        width = max(width, len(text) - start + 1)
+        allocate (character(len=width) :: lines(nl))
+        k = 1
+        start = 1
+        do i = 1, len(text)
+            if (text(i:i) == new_line('a')) then
+                lines(k) = text(start:i - 1)
+                k = k + 1
+                start = i + 1
+            end if
+        end do
+        lines(k) = text(start:)
+    end function split_lines
+
+    ! ------------------------------------------------------------------
+    ! Ranges: check the typed values, quoting the text they came from.
+    ! ------------------------------------------------------------------
+
+    !> Lower-case the choice variables (names compare case-insensitively).
+    subroutine normalise(scene)
+        type(scene_input_t), intent(inout) :: scene
+        scene%problem = lower(scene%problem)
+        scene%pendulum_formulation = lower(scene%pendulum_formulation)
+        scene%solver_name = lower(scene%solver_name)
+        scene%linear_solver = lower(scene%linear_solver)
+        scene%jacobian = lower(scene%jacobian)
+        scene%controller = lower(scene%controller)
+    end subroutine normalise
+
+    subroutine check_ranges(scene, entries, path, status)
+        type(scene_input_t), intent(in) :: scene
+        type(entry_t), intent(in) :: entries(:)
+        character(len=*), intent(in) :: path
+        type(status_t), intent(inout) :: status
+        character(len=*), parameter :: sim = 'simulation', sol = 'solver', out = 'output'
+        character(len=:), allocatable :: ext
+
+        ! &simulation
+        if (.not. has_entry(entries, sim, 'problem')) then
+            call missing(sim, 'problem', 'one of ' // choices(problem_names))
+        else if (all(problem_names /= scene%problem)) then
+            call bad(sim, 'problem', 'must be one of ' // choices(problem_names))
+        else if (.not. has_entry(entries, sim, 't_end')) then
+            call missing(sim, 't_end', 'the end time in s, greater than t_start')
+        else if (.not. scene%t_end > scene%t_start) then
+            call bad(sim, 't_end', 'must be greater than t_start = ' // &
+                     raw_value(entries, sim, 't_start', '0'))
+        else if (.not. scene%vdp_eps > 0.0_wp) then
+            call bad(sim, 'vdp_eps', 'must be positive')
+        else if (all(formulation_names /= scene%pendulum_formulation)) then
+            call bad(sim, 'pendulum_formulation', 'must be one of ' // choices(formulation_names))
+        else if (.not. scene%pendulum_length > 0.0_wp) then
+            call bad(sim, 'pendulum_length', 'must be positive')
+        else if (.not. scene%pendulum_mass > 0.0_wp) then
+            call bad(sim, 'pendulum_mass', 'must be positive')
+        else if (scene%gravity < 0.0_wp) then
+            call bad(sim, 'gravity', 'must not be negative (it acts downwards)')
+        else if (scene%npoints < 3) then
+            call bad(sim, 'npoints', 'must be at least 3')
+        ! &solver
+        else if (scene%solver_name /= 'radau5') then
+            call bad(sol, 'name', &
+                     'must be ''radau5'' (ddassl, ida and mexax are not available yet)')
+        else if (.not. scene%rtol > 0.0_wp) then
+            call bad(sol, 'rtol', 'must be positive')
+        else if (.not. scene%rtol < 1.0_wp) then
+            call bad(sol, 'rtol', 'must be less than 1')
+        else if (.not. scene%atol > 0.0_wp) then
+            call bad(sol, 'atol', 'must be positive')
+        else if (scene%h0 < 0.0_wp) then
+            call bad(sol, 'h0', 'must not be negative (0 = automatic)')
+        else if (scene%hmax < 0.0_wp) then
+            call bad(sol, 'hmax', 'must not be negative (0 = the whole interval)')
+        else if (scene%max_steps < 1) then
+            call bad(sol, 'max_steps', 'must be positive')
+        else if (all([character(len=8) :: 'auto', 'dense', 'klu'] /= scene%linear_solver)) then
+            call bad(sol, 'linear_solver', 'must be ''auto'', ''dense'' or ''klu''')
+        else if (all([character(len=8) :: 'analytic', 'fd'] /= scene%jacobian)) then
+            call bad(sol, 'jacobian', 'must be ''analytic'' or ''fd''')
+        else if (scene%nit < 1) then
+            call bad(sol, 'nit', 'must be positive')
+        else if (.not. scene%thet < 1.0_wp) then
+            call bad(sol, 'thet', 'must be less than 1')
+        else if (scene%fnewt < 0.0_wp) then
+            call bad(sol, 'fnewt', 'must not be negative (0 = the solver''s default)')
+        else if (.not. (scene%quot1 > 0.0_wp .and. scene%quot1 <= 1.0_wp)) then
+            call bad(sol, 'quot1', 'must lie in (0, 1]')
+        else if (scene%quot2 < 1.0_wp) then
+            call bad(sol, 'quot2', 'must be at least 1')
+        else if (.not. (scene%safe > 0.001_wp .and. scene%safe < 1.0_wp)) then
+            call bad(sol, 'safe', 'must lie in (0.001, 1)')
+        else if (.not. (scene%fac_min > 0.0_wp .and. scene%fac_min <= 1.0_wp)) then
+            call bad(sol, 'fac_min', 'must lie in (0, 1]')
+        else if (scene%fac_max < 1.0_wp) then
+            call bad(sol, 'fac_max', 'must be at least 1')
+        else if (controller_code(scene%controller) == 0) then
+            call bad(sol, 'controller', 'must be ''predictive'' or ''classical''')
+        else if (scene%pmax < 1 .or. scene%pmax > 12) then
+            call bad(sol, 'pmax', 'must lie in 1..12')
+        ! &output
+        else if (scene%n_output < 2) then
+            call bad(out, 'n_output', 'must be at least 2 (t_start and t_end)')
+        else if (len_trim(scene%table) > 0) then
+            ext = lower(extension(trim(scene%table)))
+            if (all([character(len=4) :: 'md', 'csv', 'tex'] /= ext)) then
+                call bad(out, 'table', 'must end in .md, .csv or .tex')
+            end if
+        end if
+
+    contains
+
+        subroutine bad(group, name, reason)
+            character(len=*), intent(in) :: group, name, reason
+            integer :: i
+            do i = 1, size(entries)
+                if (entries(i)%group == group .and. entries(i)%name == name) then
+                    call fail(status, path, entries(i), reason)
+                    return
+                end if
+            end do
+            ! a default out of range relative to a value that was given
+            call status%set(status_bad_input, path // ': &' // group // ': ' // name // &
+                ' (default): ' // reason)
+        end subroutine bad
+
+        subroutine missing(group, name, what)
+            character(len=*), intent(in) :: group, name, what
+            call status%set(status_bad_input, path // ': &' // group // ': ' // name // &
+                ': required (' // what // ')')
+        end subroutine missing
+    end subroutine check_ranges
+
+    !> RADAU5's controller switch: 1 predictive (Gustafsson), 2 classical; 0 unknown.
+    pure integer function controller_code(name)
+        character(len=*), intent(in) :: name
+        select case (lower(trim(name)))
+        case ('predictive'); controller_code = 1
+        case ('classical'); controller_code = 2
+        case default; controller_code = 0
+        end select
+    end function controller_code
+
+    !> The HDF5 file: as given ('' or 'none' = no file), or the input's
+    !> base name with `.h5` in the working directory.
+    subroutine resolve_output(scene, entries, path, status)
+        type(scene_input_t), intent(inout) :: scene
+        type(entry_t), intent(in) :: entries(:)
+        character(len=*), intent(in) :: path
+        type(status_t), intent(inout) :: status
+        integer :: i
+        if (.not. has_entry(entries, 'output', 'file')) then
+            scene%output_file = stem(basename(path)) // '.h5'
+        else if (lower(scene%output_file) == 'none') then
+            scene%output_file = ''
+        end if
+        if (len(scene%output_file) == 0 .or. scene%output_file /= path) return
+        do i = 1, size(entries)
+            if (entries(i)%group == 'output' .and. entries(i)%name == 'file') then
+                call fail(status, path, entries(i), 'would overwrite the input file')
+                return
+            end if
+        end do
+        call status%set(status_bad_input, path // ': &output: file (default ''' // &
+            scene%output_file // '''): would overwrite the input file')
+    end subroutine resolve_output
+
+    !> Common options of the scene: tolerances, steps, output times.
+    function scene_dae_options(scene) result(options)
+        type(scene_input_t), intent(in) :: scene
+        type(dae_options_t) :: options
+        integer :: i, m
+        options%rtol = scene%rtol
+        options%atol = scene%atol
+        options%h0 = scene%h0
+        options%hmax = scene%hmax
+        options%max_steps = scene%max_steps
+        options%pmax = min(scene%pmax, 12)
+        options%linear_solver = scene%linear_solver
+        options%jacobian = scene%jacobian
+        options%output_steps = scene%every_step
+        m = max(scene%n_output, 2)
+        allocate (options%output_times(m))
+        do i = 1, m
+            options%output_times(i) = scene%t_start + (scene%t_end - scene%t_start) * &
+                real(i - 1, wp) / real(m - 1, wp)
+        end do
+        options%output_times(m) = scene%t_end
+    end function scene_dae_options
+
+    ! ------------------------------------------------------------------
+    ! Small helpers.
+    ! ------------------------------------------------------------------
+
+    !> Record a bad value: 'path: &group: name = value: reason (line n)'.
+    subroutine fail(status, path, e, reason)
+        type(status_t), intent(inout) :: status
+        character(len=*), intent(in) :: path
+        type(entry_t), intent(in) :: e
+        character(len=*), intent(in) :: reason
+        call status%set(status_bad_input, path // ': &' // e%group // ': ' // e%name // &
+            ' = ' // e%value // ': ' // reason // at(e%line))
+    end subroutine fail
+
+    pure function at(line) result(text)
+        integer, intent(in) :: line
+        character(len=:), allocatable :: text
+        text = ' (line ' // itoa(line) // ')'
+    end function at
+
+    pure integer function find_group(name)
+        character(len=*), intent(in) :: name
+        integer :: g
+        find_group = 0
+        do g = 1, size(group_names)
+            if (group_names(g) == name) find_group = g
+        end do
+    end function find_group
+
+    pure integer function find_var(group, name)
+        character(len=*), intent(in) :: group, name
+        integer :: i
+        find_var = 0
+        do i = 1, size(schema)
+            if (schema(i)%group == group .and. schema(i)%name == name) find_var = i
+        end do
+    end function find_var
+
+    pure function known_vars(group) result(list)
+        character(len=*), intent(in) :: group
+        character(len=:), allocatable :: list
+        integer :: i
+        list = ''
+        do i = 1, size(schema)
+            if (schema(i)%group /= group) cycle
+            if (len(list) > 0) list = list // ', '
+            list = list // trim(schema(i)%name)
+        end do
+    end function known_vars
+
+    pure logical function has_entry(entries, group, name)
+        type(entry_t), intent(in) :: entries(:)
+        character(len=*), intent(in) :: group, name
+        integer :: i
+        has_entry = .false.
+        do i = 1, size(entries)
+            if (entries(i)%group == group .and. entries(i)%name == name) has_entry = .true.
+        end do
+    end function has_entry
+
+    pure function choices(names) result(list)
+        character(len=*), intent(in) :: names(:)
+        character(len=:), allocatable :: list
+        integer :: i
+        list = ''
+        do i = 1, size(names)
+            if (i == size(names) .and. i > 1) then
+                list = list // ' or '
+            else if (i > 1) then
+                list = list // ', '
+            end if
+            list = list // '''' // trim(names(i)) // ''''
+        end do
+    end function choices
+
+    !> Contents of a quoted value, doubled quotes made single.
+    pure function unquote(value) result(text)
+        character(len=*), intent(in) :: value
+        character(len=:), allocatable :: text
+        integer :: i
+        character :: quote
+        text = ''
+        if (len(value) < 2) return
+        quote = value(1:1)
+        i = 2
+        do while (i < len(value))
+            text = text // value(i:i)
+            if (value(i:i) == quote) i = i + 1
+            i = i + 1
+        end do
+    end function unquote
+
+    pure function lower(s) result(t)
+        character(len=*), intent(in) :: s
+        character(len=len(s)) :: t
+        integer :: i, c
+        t = s
+        do i = 1, len(s)
+            c = iachar(s(i:i))
+            if (c >= iachar('A') .and. c <= iachar('Z')) t(i:i) = achar(c + 32)
+        end do
+    end function lower
+
+    pure logical function is_letter(c)
+        character, intent(in) :: c
+        is_letter = (c >= 'a' .and. c <= 'z') .or. (c >= 'A' .and. c <= 'Z')
+    end function is_letter
+
+    pure logical function is_digit(c)
+        character, intent(in) :: c
+        is_digit = c >= '0' .and. c <= '9'
+    end function is_digit
+
+    pure logical function is_space(c)
+        character, intent(in) :: c
+        is_space = c == ' ' .or. c == achar(9) .or. c == achar(13)
+    end function is_space
+
+    pure function itoa(i) result(s)
+        integer, intent(in) :: i
+        character(len=:), allocatable :: s
+        character(len=24) :: buf
+        write (buf, '(i0)') i
+        s = trim(buf)
+    end function itoa
+
+    !> The value as written in the file, or `default` when not given.
+    pure function raw_value(entries, group, name, default) result(text)
+        type(entry_t), intent(in) :: entries(:)
+        character(len=*), intent(in) :: group, name, default
+        character(len=:), allocatable :: text
+        integer :: i
+        text = default
+        do i = 1, size(entries)
+            if (entries(i)%group == group .and. entries(i)%name == name) text = entries(i)%value
+        end do
+    end function raw_value
+
+    pure function basename(path) result(name)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: name
+        name = path(index(path, '/', back=.true.) + 1:)
+    end function basename
+
+    !> File name without its last extension.
+    pure function stem(name) result(s)
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable :: s
+        integer :: dot
+        dot = index(name, '.', back=.true.)
+        if (dot > 1) then
+            s = name(1:dot - 1)
+        else
+            s = name
+        end if
+    end function stem
+
+    pure function extension(name) result(ext)
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable :: ext
+        integer :: dot
+        dot = index(name, '.', back=.true.)
+        if (dot > index(name, '/', back=.true.) .and. dot > 0) then
+            ext = name(dot + 1:)
+        else
+            ext = ''
+        end if
+    end function extension
+end module flexmbs_io_namelist

@@ -1,0 +1,155 @@
+!> A progress line on standard error: simulated time, percentage, steps
+!> and rejections, redrawn in place with a carriage return.
+!>
+!> It is silent when standard error is not a terminal (logs and pipes get
+!> no '\r' clutter) or when the user asked for quiet. Redraws are limited
+!> to a few per second so that cheap steps are not slowed by output.
+module flexmbs_io_progress
+    use, intrinsic :: iso_c_binding, only: c_int
+    use, intrinsic :: iso_fortran_env, only: error_unit
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t
+    use flexmbs_core_timer, only: timer_t
+    use flexmbs_dae_sink, only: sink_t, dense_output_t
+    implicit none
+    private
+
+    !> Seconds between two redraws.
+    real(wp), parameter :: redraw_interval = 0.2_wp
+
+    interface
+        function c_isatty(fd) bind(c, name='isatty') result(yes)
+            import :: c_int
+            integer(c_int), value :: fd
+            integer(c_int) :: yes
+        end function c_isatty
+    end interface
+
+    type, extends(sink_t), public :: progress_t
+        logical :: enabled = .false.
+        integer :: unit = error_unit
+        real(wp) :: t_start = 0.0_wp, t_end = 1.0_wp
+        real(wp) :: t = 0.0_wp
+        integer :: steps = 0
+        !> Live step counters of the running solver (attempted, accepted);
+        !> rejections are shown only when they are known.
+        integer, pointer :: attempted => null(), accepted => null()
+        logical :: drawn = .false.
+        real(wp) :: last_draw = -huge(1.0_wp)
+        type(timer_t) :: clock
+    contains
+        procedure :: output => progress_output
+        procedure :: wants_steps => progress_wants_steps
+        procedure :: step => progress_step
+        procedure :: finish => progress_finish
+        procedure :: watch => progress_watch
+        procedure :: line => progress_line
+    end type progress_t
+
+    public :: new_progress, stderr_is_terminal
+
+contains
+
+    !> A progress display for [t_start, t_end]; disabled when `quiet` or
+    !> when standard error is no terminal, unless `unit` is given (tests).
+    function new_progress(t_start, t_end, quiet, unit) result(progress)
+        real(wp), intent(in) :: t_start, t_end
+        logical, intent(in) :: quiet
+        integer, intent(in), optional :: unit !! draw here instead, terminal or not
+        type(progress_t) :: progress
+        progress%t_start = t_start
+        progress%t_end = t_end
+        progress%t = t_start
+        if (present(unit)) then
+            progress%unit = unit
+            progress%enabled = .not. quiet
+        else
+            progress%enabled = .not. quiet .and. stderr_is_terminal()
+        end if
+        call progress%clock%start()
+    end function new_progress
+
+    !> True when file descriptor 2 is a terminal.
+    logical function stderr_is_terminal()
+        stderr_is_terminal = c_isatty(2_c_int) == 1_c_int
+    end function stderr_is_terminal
+
+    !> Show rejections from counters that the solver updates as it goes
+    !> (e.g. RADAU5's native NSTEP and NACCPT); they must outlive the display.
+    subroutine progress_watch(self, attempted, accepted)
+        class(progress_t), intent(inout) :: self
+        integer, intent(in), target :: attempted, accepted
+        self%attempted => attempted
+        self%accepted => accepted
+    end subroutine progress_watch
+
+    subroutine progress_output(self, t, y, status)
+        class(progress_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        type(status_t), intent(inout) :: status
+        if (.not. self%enabled) return
+        self%t = t
+        call draw(self, .false.)
+    end subroutine progress_output
+
+    logical function progress_wants_steps(self)
+        class(progress_t), intent(in) :: self
+        progress_wants_steps = self%enabled
+    end function progress_wants_steps
+
+    subroutine progress_step(self, nr, t_old, t, y, dense, stop, status)
+        class(progress_t), intent(inout) :: self
+        integer, intent(in) :: nr
+        real(wp), intent(in) :: t_old, t, y(:)
+        class(dense_output_t), intent(in) :: dense
+        logical, intent(inout) :: stop
+        type(status_t), intent(inout) :: status
+        if (.not. self%enabled) return
+        self%t = t
+        self%steps = nr - 1
+        call draw(self, .false.)
+    end subroutine progress_step
+
+    !> Draw the final state and end the line, so later output starts clean.
+    subroutine progress_finish(self, status)
+        class(progress_t), intent(inout) :: self
+        type(status_t), intent(inout) :: status
+        if (.not. self%enabled) return
+        call draw(self, .true.)
+        write (self%unit, '(a)') ''
+        flush (self%unit)
+        self%drawn = .false.
+    end subroutine progress_finish
+
+    !> The text of the line as it stands.
+    function progress_line(self) result(line)
+        class(progress_t), intent(in) :: self
+        character(len=:), allocatable :: line
+        character(len=160) :: buf
+        real(wp) :: percent, span
+        span = self%t_end - self%t_start
+        percent = 100.0_wp
+        if (span /= 0.0_wp) percent = 100.0_wp * (self%t - self%t_start) / span
+        percent = max(0.0_wp, min(100.0_wp, percent))
+        write (buf, '(a,es12.5,a,f6.1,a,i0)') 't = ', self%t, ' s  ', percent, &
+            ' %  steps ', self%steps
+        line = trim(buf)
+        if (associated(self%attempted) .and. associated(self%accepted)) then
+            write (buf, '(a,i0)') '  rejected ', self%attempted - self%accepted
+            line = line // trim(buf)
+        end if
+    end function progress_line
+
+    subroutine draw(self, force)
+        class(progress_t), intent(inout) :: self
+        logical, intent(in) :: force
+        real(wp) :: now
+        now = self%clock%wall()
+        if (.not. force .and. now - self%last_draw < redraw_interval) return
+        self%last_draw = now
+        ! pad so a shorter line fully covers the previous one
+        write (self%unit, '(a)', advance='no') achar(13) // self%line() // '   '
+        flush (self%unit)
+        self%drawn = .true.
+    end subroutine draw
+end module flexmbs_io_progress

@@ -1,0 +1,183 @@
+!> From a validated scene to a finished run: the problem and solver the
+!> scene names, its options, the output sinks, and the run itself.
+!>
+!> Everything that can be checked is checked before any output file is
+!> created, so bad input never leaves a half-written file behind.
+module flexmbs_io_scene
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_dae_problem, only: dae_problem_t
+    use flexmbs_dae_options, only: dae_options_t
+    use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_solver, only: dae_solver_t
+    use flexmbs_dae_radau5, only: radau5_t
+    use flexmbs_problems_van_der_pol, only: new_van_der_pol
+    use flexmbs_io_namelist, only: scene_input_t, scene_dae_options, controller_code
+    use flexmbs_io_hdf5_sink, only: hdf5_sink_t
+    use flexmbs_io_progress, only: progress_t, new_progress
+    use flexmbs_io_multi_sink, only: multi_sink_t
+    use flexmbs_io_table, only: new_stats_row, write_table
+    implicit none
+    private
+
+    !> A named slice of y written as its own HDF5 dataset (/q, /v, /lambda).
+    type, public :: block_spec_t
+        character(len=:), allocatable :: name
+        integer :: first = 0, last = 0
+    end type block_spec_t
+
+    !> What a run produced, successful or not.
+    type, public :: run_result_t
+        real(wp) :: t = 0.0_wp                !! last time reached
+        real(wp), allocatable :: y(:)         !! state there
+        type(dae_stats_t) :: stats
+        character(len=:), allocatable :: solver_name
+        logical :: hdf5_written = .false.     !! an HDF5 file was created (and kept)
+    end type run_result_t
+
+    public :: build_problem, build_solver, scene_stab, run_scene
+
+contains
+
+    !> The problem the scene names, its initial value and its named blocks.
+    subroutine build_problem(scene, problem, y0, blocks, status)
+        type(scene_input_t), intent(in) :: scene
+        class(dae_problem_t), allocatable, intent(out) :: problem
+        real(wp), allocatable, intent(out) :: y0(:)
+        type(block_spec_t), allocatable, intent(out) :: blocks(:)
+        type(status_t), intent(out) :: status
+        allocate (blocks(0))
+        select case (trim(scene%problem))
+        case ('van_der_pol')
+            allocate (problem, source=new_van_der_pol(scene%vdp_eps))
+            y0 = [scene%vdp_y1, scene%vdp_y2]
+        case default
+            call status%set(status_bad_input, scene%path // ': &simulation: problem = ''' // &
+                trim(scene%problem) // ''': not available in this build yet')
+        end select
+    end subroutine build_problem
+
+    !> The solver the scene names, with its own settings.
+    subroutine build_solver(scene, solver, status)
+        type(scene_input_t), intent(in) :: scene
+        class(dae_solver_t), allocatable, intent(out) :: solver
+        type(status_t), intent(out) :: status
+        type(radau5_t) :: radau5
+        select case (trim(scene%solver_name))
+        case ('radau5')
+            radau5%nit = scene%nit
+            radau5%thet = scene%thet
+            radau5%fnewt = scene%fnewt
+            radau5%quot1 = scene%quot1
+            radau5%quot2 = scene%quot2
+            radau5%safe = scene%safe
+            radau5%fac_min = scene%fac_min
+            radau5%fac_max = scene%fac_max
+            radau5%controller = controller_code(scene%controller)
+            radau5%zero_start = scene%zero_start
+            allocate (solver, source=radau5)
+        case default
+            call status%set(status_bad_input, scene%path // ': &solver: name = ''' // &
+                trim(scene%solver_name) // ''': not available in this build yet')
+        end select
+    end subroutine build_solver
+
+    !> The "stab." column of the tables: the formulation where there is one.
+    function scene_stab(scene) result(stab)
+        type(scene_input_t), intent(in) :: scene
+        character(len=:), allocatable :: stab
+        if (scene%problem == 'pendulum') then
+            stab = trim(scene%pendulum_formulation)
+        else
+            stab = '-'
+        end if
+    end function scene_stab
+
+    !> Run a validated scene: build, check, create the outputs, integrate,
+    !> store the statistics. `status` is ok, bad_input (before any file is
+    !> created), solver_failure (outputs kept, `result` says how far it
+    !> got) or io_error.
+    subroutine run_scene(scene, quiet, result, status)
+        type(scene_input_t), intent(in) :: scene
+        logical, intent(in) :: quiet             !! no progress display
+        type(run_result_t), intent(out) :: result
+        type(status_t), intent(out) :: status
+        class(dae_problem_t), allocatable :: problem
+        class(dae_solver_t), allocatable, target :: solver
+        type(block_spec_t), allocatable :: blocks(:)
+        type(dae_options_t) :: options
+        type(hdf5_sink_t), target :: h5
+        type(progress_t), target :: progress
+        type(multi_sink_t) :: sinks
+        type(status_t) :: io_status
+        integer :: i
+        character(len=:), allocatable :: outcome
+
+        call build_problem(scene, problem, result%y, blocks, status)
+        if (.not. status%ok()) return
+        call build_solver(scene, solver, status)
+        if (.not. status%ok()) return
+        result%solver_name = solver%name()
+        result%t = scene%t_start
+        options = scene_dae_options(scene)
+        call options%validate(problem%n, status)
+        if (.not. status%ok()) then
+            status%message = scene%path // ': ' // status%message
+            return
+        end if
+
+        if (len(scene%output_file) > 0) then
+            call h5%create(scene%output_file, problem%n, status, input_text=scene%text, &
+                           every_step=scene%every_step)
+            if (.not. status%ok()) then
+                call h5%close(io_status)
+                return
+            end if
+            result%hdf5_written = .true.
+            do i = 1, size(blocks)
+                call h5%add_block(blocks(i)%name, blocks(i)%first, blocks(i)%last, status)
+                if (.not. status%ok()) return
+            end do
+            call h5%write_text('problem', trim(scene%problem), status)
+            if (status%ok()) call h5%write_text('title', trim(scene%title), status)
+            if (status%ok()) call h5%write_text('input_file', scene%path, status)
+            if (.not. status%ok()) return
+            call sinks%attach(h5)
+        end if
+        progress = new_progress(scene%t_start, scene%t_end, quiet .or. .not. scene%progress)
+        select type (solver)
+        type is (radau5_t)
+            call progress%watch(solver%native%nstep, solver%native%naccpt)
+        end select
+        call sinks%attach(progress)
+
+        call solver%integrate(problem, result%t, result%y, scene%t_end, options, &
+                              result%stats, status, sinks)
+
+        if (h5%is_open) then
+            outcome = 'ok'
+            if (.not. status%ok()) outcome = status%text()
+            call h5%write_statistics(result%stats, io_status, result%solver_name, outcome)
+            if (status%ok() .and. .not. io_status%ok()) status = io_status
+            call h5%close(io_status)
+            if (status%ok() .and. .not. io_status%ok()) status = io_status
+            ! A solver that refused its input computed nothing: leave no file.
+            if (status%code == status_bad_input .and. h5%records == 0) then
+                call delete_file(scene%output_file)
+                result%hdf5_written = .false.
+            end if
+        end if
+        if (len_trim(scene%table) > 0 .and. status%code /= status_bad_input) then
+            call write_table(trim(scene%table), [new_stats_row(result%solver_name, &
+                scene%rtol, scene_stab(scene), result%stats)], io_status)
+            if (status%ok() .and. .not. io_status%ok()) status = io_status
+        end if
+    end subroutine run_scene
+
+    subroutine delete_file(path)
+        character(len=*), intent(in) :: path
+        integer :: unit, ios
+        open (newunit=unit, file=path, status='old', iostat=ios)
+        if (ios == 0) close (unit, status='delete')
+    end subroutine delete_file
+end module flexmbs_io_scene

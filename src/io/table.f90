@@ -1,0 +1,286 @@
+!> Statistics tables in Markdown, CSV and LaTeX.
+!>
+!> The columns are those of the paper's Table 3 (solver, TOL, stab., ERR,
+!> NST, NAC, NFE, NJE, CPU) followed by NRJ, NDEC and NSOL. A row whose
+!> error was not measured shows '-' for ERR.
+module flexmbs_io_table
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input, status_io_error
+    use flexmbs_dae_stats, only: dae_stats_t
+    implicit none
+    private
+
+    integer, parameter, public :: table_markdown = 1
+    integer, parameter, public :: table_csv = 2
+    integer, parameter, public :: table_latex = 3
+
+    integer, parameter :: ncol = 12
+    character(len=6), parameter :: headers(ncol) = [character(len=6) :: 'solver', 'TOL', &
+        'stab.', 'ERR', 'NST', 'NAC', 'NFE', 'NJE', 'CPU', 'NRJ', 'NDEC', 'NSOL']
+    !> Numeric columns are right-aligned.
+    logical, parameter :: numeric(ncol) = [.false., .true., .false., .true., .true., .true., &
+        .true., .true., .true., .true., .true., .true.]
+
+    type :: cell_t
+        character(len=:), allocatable :: s
+    end type cell_t
+
+    !> One run: what was solved how, and what it cost.
+    type, public :: stats_row_t
+        character(len=:), allocatable :: solver !! e.g. 'radau5'
+        character(len=:), allocatable :: stab   !! formulation/stabilisation, '' if none
+        real(wp) :: tol = 0.0_wp                !! the tolerance asked for
+        real(wp) :: err = -1.0_wp               !! ERR of eq. (13); negative = not measured
+        type(dae_stats_t) :: stats
+    end type stats_row_t
+
+    public :: new_stats_row, table_format, table_text, write_table
+
+contains
+
+    !> A row from a run's statistics; `err` omitted when not measured.
+    function new_stats_row(solver, tol, stab, stats, err) result(row)
+        character(len=*), intent(in) :: solver, stab
+        real(wp), intent(in) :: tol
+        type(dae_stats_t), intent(in) :: stats
+        real(wp), intent(in), optional :: err
+        type(stats_row_t) :: row
+        row%solver = solver
+        row%stab = stab
+        row%tol = tol
+        row%stats = stats
+        if (present(err)) row%err = err
+    end function new_stats_row
+
+    !> The format a path's extension asks for (.md, .csv, .tex); 0 otherwise.
+    pure integer function table_format(path)
+        character(len=*), intent(in) :: path
+        integer :: dot
+        character(len=:), allocatable :: ext
+        table_format = 0
+        dot = index(path, '.', back=.true.)
+        if (dot == 0) return
+        ext = path(dot + 1:)
+        select case (ext)
+        case ('md', 'MD'); table_format = table_markdown
+        case ('csv', 'CSV'); table_format = table_csv
+        case ('tex', 'TEX'); table_format = table_latex
+        end select
+    end function table_format
+
+    !> The whole table as text, lines ended by newlines.
+    function table_text(rows, format) result(text)
+        type(stats_row_t), intent(in) :: rows(:)
+        integer, intent(in) :: format !! table_markdown, table_csv or table_latex
+        character(len=:), allocatable :: text
+        type(cell_t), allocatable :: cells(:, :)
+        integer :: i, j, width(ncol)
+        character, parameter :: nl = new_line('a')
+
+        allocate (cells(ncol, 0:size(rows)))
+        do j = 1, ncol
+            cells(j, 0)%s = trim(headers(j))
+        end do
+        do i = 1, size(rows)
+            call fill_cells(rows(i), format, cells(:, i))
+        end do
+        text = ''
+        select case (format)
+        case (table_markdown)
+            do j = 1, ncol
+                width(j) = max(3, maxval([(len(cells(j, i)%s), i=0, size(rows))]))
+            end do
+            text = md_line(cells(:, 0), width)
+            text = text // '|'
+            do j = 1, ncol
+                if (numeric(j)) then
+                    text = text // ' ' // repeat('-', width(j) - 1) // ': |'
+                else
+                    text = text // ' ' // repeat('-', width(j)) // ' |'
+                end if
+            end do
+            text = text // nl
+            do i = 1, size(rows)
+                text = text // md_line(cells(:, i), width)
+            end do
+        case (table_csv)
+            do i = 0, size(rows)
+                do j = 1, ncol
+                    if (j > 1) text = text // ','
+                    text = text // csv_field(cells(j, i)%s)
+                end do
+                text = text // nl
+            end do
+        case (table_latex)
+            text = '\begin{tabular}{'
+            do j = 1, ncol
+                text = text // merge('r', 'l', numeric(j))
+            end do
+            text = text // '}' // nl // '\hline' // nl
+            do i = 0, size(rows)
+                do j = 1, ncol
+                    if (j > 1) text = text // ' & '
+                    text = text // cells(j, i)%s
+                end do
+                text = text // ' \\' // nl
+                if (i == 0) text = text // '\hline' // nl
+            end do
+            text = text // '\hline' // nl // '\end{tabular}' // nl
+        end select
+
+    contains
+
+        function md_line(row, width) result(line)
+            type(cell_t), intent(in) :: row(:)
+            integer, intent(in) :: width(:)
+            character(len=:), allocatable :: line
+            integer :: k, pad
+            line = '|'
+            do k = 1, size(row)
+                pad = width(k) - len(row(k)%s)
+                if (numeric(k)) then
+                    line = line // ' ' // repeat(' ', pad) // row(k)%s // ' |'
+                else
+                    line = line // ' ' // row(k)%s // repeat(' ', pad) // ' |'
+                end if
+            end do
+            line = line // nl
+        end function md_line
+    end function table_text
+
+    !> Write the table to `path` in the format of its extension.
+    subroutine write_table(path, rows, status)
+        character(len=*), intent(in) :: path
+        type(stats_row_t), intent(in) :: rows(:)
+        type(status_t), intent(out) :: status
+        integer :: format, unit, ios
+        character(len=256) :: msg
+        format = table_format(path)
+        if (format == 0) then
+            call status%set(status_bad_input, path // ': table format unknown: ' // &
+                'the name must end in .md, .csv or .tex')
+            return
+        end if
+        open (newunit=unit, file=path, access='stream', form='unformatted', &
+              status='replace', action='write', iostat=ios, iomsg=msg)
+        if (ios == 0) then
+            write (unit, iostat=ios, iomsg=msg) table_text(rows, format)
+            close (unit)
+        end if
+        if (ios /= 0) call status%set(status_io_error, path // ': cannot write: ' // trim(msg))
+    end subroutine write_table
+
+    ! ------------------------------------------------------------------
+
+    subroutine fill_cells(row, format, cells)
+        type(stats_row_t), intent(in) :: row
+        integer, intent(in) :: format
+        type(cell_t), intent(out) :: cells(:)
+        character(len=32) :: buf
+        cells(1)%s = text_cell(row%solver, format)
+        cells(2)%s = sci(row%tol, format)
+        if (allocated(row%stab)) then
+            cells(3)%s = text_cell(row%stab, format)
+        else
+            cells(3)%s = ''
+        end if
+        if (len(cells(3)%s) == 0) cells(3)%s = '-'
+        if (row%err < 0.0_wp .or. .not. ieee_is_finite(row%err)) then
+            cells(4)%s = '-'
+        else
+            cells(4)%s = sci(row%err, format)
+        end if
+        cells(5)%s = itoa(row%stats%nst)
+        cells(6)%s = itoa(row%stats%nac)
+        cells(7)%s = itoa(row%stats%nfe)
+        cells(8)%s = itoa(row%stats%nje)
+        write (buf, '(f0.3)') row%stats%cpu
+        if (buf(1:1) == '.') buf = '0' // buf
+        cells(9)%s = trim(buf)
+        cells(10)%s = itoa(row%stats%nrj)
+        cells(11)%s = itoa(row%stats%ndec)
+        cells(12)%s = itoa(row%stats%nsol)
+    end subroutine fill_cells
+
+    !> 1.0e-04 (Markdown, CSV) or $1.0\cdot 10^{-4}$ (LaTeX).
+    function sci(x, format) result(s)
+        real(wp), intent(in) :: x
+        integer, intent(in) :: format
+        character(len=:), allocatable :: s
+        character(len=32) :: buf
+        integer :: e
+        if (x == 0.0_wp) then
+            s = '0'
+            return
+        end if
+        write (buf, '(es9.1e2)') x
+        s = trim(adjustl(buf))
+        if (format /= table_latex) then
+            s = lower_e(s)
+            return
+        end if
+        ! exponent from the rounded text, so 9.96e-5 gives 10^{-4}
+        read (s(index(s, 'E') + 1:), *) e
+        write (buf, '(i0)') e
+        if (s(1:index(s, 'E') - 1) == '1.0') then
+            s = '$10^{' // trim(buf) // '}$'
+        else
+            s = '$' // s(1:index(s, 'E') - 1) // '\cdot 10^{' // trim(buf) // '}$'
+        end if
+    end function sci
+
+    pure function lower_e(s) result(t)
+        character(len=*), intent(in) :: s
+        character(len=len(s)) :: t
+        integer :: k
+        t = s
+        k = index(t, 'E')
+        if (k > 0) t(k:k) = 'e'
+    end function lower_e
+
+    !> A text cell, with LaTeX's special characters escaped.
+    pure function text_cell(s, format) result(t)
+        character(len=*), intent(in) :: s
+        integer, intent(in) :: format
+        character(len=:), allocatable :: t
+        integer :: i
+        if (format /= table_latex) then
+            t = s
+            return
+        end if
+        t = ''
+        do i = 1, len(s)
+            if (index('_&%#$', s(i:i)) > 0) then
+                t = t // '\' // s(i:i)
+            else
+                t = t // s(i:i)
+            end if
+        end do
+    end function text_cell
+
+    !> Quote a CSV field when it holds a comma, a quote or a newline.
+    pure function csv_field(s) result(t)
+        character(len=*), intent(in) :: s
+        character(len=:), allocatable :: t
+        integer :: i
+        if (scan(s, ',"' // new_line('a')) == 0) then
+            t = s
+            return
+        end if
+        t = '"'
+        do i = 1, len(s)
+            t = t // s(i:i)
+            if (s(i:i) == '"') t = t // '"'
+        end do
+        t = t // '"'
+    end function csv_field
+
+    pure function itoa(i) result(s)
+        integer, intent(in) :: i
+        character(len=:), allocatable :: s
+        character(len=24) :: buf
+        write (buf, '(i0)') i
+        s = trim(buf)
+    end function itoa
+end module flexmbs_io_table

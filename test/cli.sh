@@ -1,0 +1,126 @@
+#!/usr/bin/env bash
+# Command-line tests of the flexmbs executable: bad input gives exit 2, a
+# message naming file, group, variable and reason, and no output file;
+# --help and --version exit 0; a solver failure exits 3 and keeps its HDF5
+# file; an unwritable output exits 4.
+#
+#   bash test/cli.sh [path/to/flexmbs]
+#
+# Without an argument the debug build is used (built if needed). The last
+# line is `N passed, M failed`; the exit status is non-zero on failures.
+set -u
+root=$(cd "$(dirname "$0")/.." && pwd)
+if [ $# -ge 1 ]; then
+    exe=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
+else
+    # the Makefile's flags: other flags would make fpm rebuild everything
+    export FPM_FFLAGS=${FPM_FFLAGS:-"-I/usr/include/hdf5/serial -I/usr/include/sundials/fortran"}
+    export FPM_CFLAGS=${FPM_CFLAGS:-"-I/usr/include/suitesparse"}
+    exe=$(cd "$root" && ${FPM:-fpm} run --profile debug --runner echo flexmbs 2>/dev/null | tail -n 1)
+    [ -n "$exe" ] && exe="$root/$exe"
+fi
+if [ -z "$exe" ] || [ ! -x "$exe" ]; then
+    echo "FAIL cli: no executable (got '$exe')"
+    echo "0 passed, 1 failed"
+    exit 1
+fi
+
+work=$(mktemp -d "${TMPDIR:-/tmp}/flexmbs-cli.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+cd "$work" || exit 1
+passed=0
+failed=0
+
+pass() { passed=$((passed + 1)); echo "pass cli/$1"; }
+fail() { failed=$((failed + 1)); echo "FAIL cli/$1: $2"; }
+
+# check NAME CODE PATTERN [ARGS...]: run, then set $problem to what is
+# wrong with the exit code and the output (PATTERN, a fixed string, must be
+# in standard error + output); empty when both are right.
+check() {
+    local code=$2 pattern=$3
+    shift 3
+    local rc
+    output=$("$exe" "$@" 2>&1)
+    rc=$?
+    problem=""
+    if [ "$rc" -ne "$code" ]; then
+        problem="exit $rc, expected $code; output: $output"
+    elif ! grep -qF -- "$pattern" <<<"$output"; then
+        problem="output lacks '$pattern': $output"
+    fi
+}
+
+# expect NAME CODE PATTERN [ARGS...]: one test of exit code and message.
+expect() {
+    check "$@"
+    if [ -n "$problem" ]; then fail "$1" "$problem"; else pass "$1"; fi
+}
+
+# bad NAME PATTERN FILE: exit 2, the message, and no HDF5 file anywhere.
+bad() {
+    local name=$1 pattern=$2 file=$3
+    rm -f ./*.h5 out/*.h5
+    check "$name" 2 "$pattern" run "$file" --quiet
+    if [ -z "$problem" ] && { compgen -G "*.h5" >/dev/null || compgen -G "out/*.h5" >/dev/null; }
+    then
+        problem="an output file was created: $(ls ./*.h5 out/*.h5 2>/dev/null)"
+    fi
+    if [ -n "$problem" ]; then fail "$name" "$problem"; else pass "$name"; fi
+}
+
+# kept NAME CODE PATTERN FILE ARGS...: exit code, message, and FILE written.
+kept() {
+    local name=$1 code=$2 pattern=$3 file=$4
+    shift 4
+    rm -f "$file"
+    check "$name" "$code" "$pattern" "$@"
+    if [ -z "$problem" ] && [ ! -s "$file" ]; then problem="$file was not written"; fi
+    if [ -n "$problem" ]; then fail "$name" "$problem"; else pass "$name"; fi
+}
+
+mkdir -p out
+sim="&simulation problem = 'van_der_pol', t_end = 2 /"
+out="&output file = 'out/run.h5' /"
+
+printf '%s\n&solver rtol = 1e-4\n  atoll = 1e-4 /\n%s\n' "$sim" "$out" > unknown_var.nml
+bad unknown-variable "unknown_var.nml: &solver: atoll: unknown variable" unknown_var.nml
+
+printf '%s\n&solver max_steps = 1.5 /\n%s\n' "$sim" "$out" > wrong_type.nml
+bad wrong-type "wrong_type.nml: &solver: max_steps = 1.5: must be an integer" wrong_type.nml
+
+printf '%s\n&solver rtol = -1e-6 /\n%s\n' "$sim" "$out" > negative_tol.nml
+bad negative-tolerance "negative_tol.nml: &solver: rtol = -1e-6: must be positive" \
+    negative_tol.nml
+
+bad missing-file "missing.nml: no such file" missing.nml
+
+printf '%s\n&solvers rtol = 1e-4 /\n' "$sim" > unknown_group.nml
+bad unknown-group "unknown_group.nml: &solvers: unknown group" unknown_group.nml
+
+# default output name (derived from the input) must not appear either
+printf '%s\n&solver rtol = -1 /\n' "$sim" > derived.nml
+bad derived-name-not-created "derived.nml: &solver: rtol = -1: must be positive" derived.nml
+
+expect help 0 "usage:" --help
+expect version 0 "flexmbs 0." --version
+expect no-arguments 2 "usage:"
+expect unknown-command 2 "unknown command 'fly'" fly
+expect unknown-option 2 "unknown option '--loud'" run x.nml --loud
+
+# success: exit 0, statistics and final state printed, file written
+printf '%s\n&solver rtol = 1e-4, atol = 1e-4, h0 = 1e-6 /\n%s\n' "$sim" "$out" > ok.nml
+kept success 0 "y(1) =  1.7061611" out/run.h5 run ok.nml --quiet
+kept success-statistics 0 "radau5: NST=275 NAC=238" out/run.h5 run ok.nml --quiet
+
+# solver failure: exit 3, reason, time reached, statistics, file kept
+printf '%s\n&solver max_steps = 5 /\n%s\n' "$sim" "$out" > fails.nml
+kept solver-failure 3 "maximum number of steps" out/run.h5 run fails.nml --quiet
+kept solver-failure-statistics 3 "statistics so far: NST=" out/run.h5 run fails.nml --quiet
+
+# I/O error: the output directory does not exist
+printf "%s\n&output file = 'no/such/dir/x.h5' /\n" "$sim" > io_error.nml
+expect io-error 4 "no/such/dir/x.h5: HDF5 cannot create the file" run io_error.nml --quiet
+
+echo "${passed} passed, ${failed} failed"
+[ "$failed" -eq 0 ]

@@ -1,0 +1,620 @@
+!> Input and output: namelist validation, tables, the HDF5 sink, the
+!> progress display, and one scene run end to end.
+module test_io
+    use hdf5
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input, status_io_error
+    use flexmbs_dae_options, only: dae_options_t
+    use flexmbs_dae_sink, only: dense_output_t
+    use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_io_namelist, only: scene_input_t, read_scene, parse_scene, scene_dae_options
+    use flexmbs_io_table, only: stats_row_t, new_stats_row, table_text, table_format, &
+        write_table, table_markdown, table_csv, table_latex
+    use flexmbs_io_hdf5_sink, only: hdf5_sink_t
+    use flexmbs_io_progress, only: progress_t, new_progress
+    use flexmbs_io_scene, only: run_result_t, run_scene
+    use testing, only: test_case_t, new_test, error_t, check, check_close
+    implicit none
+    private
+    public :: collect_io
+
+    character, parameter :: nl = new_line('a')
+
+    !> A constant dense output, enough to drive `step`.
+    type, extends(dense_output_t) :: still_t
+        real(wp) :: value = 0.0_wp
+    contains
+        procedure :: evaluate => still_evaluate
+    end type still_t
+
+contains
+
+    function collect_io() result(tests)
+        type(test_case_t), allocatable :: tests(:)
+        tests = [new_test('valid_file_parses', test_valid_file), &
+                 new_test('defaults_and_derived_output', test_defaults), &
+                 new_test('options_from_scene', test_options), &
+                 new_test('unknown_variable', test_unknown_variable), &
+                 new_test('wrong_type', test_wrong_type), &
+                 new_test('negative_tolerance', test_negative_tolerance), &
+                 new_test('missing_file', test_missing_file), &
+                 new_test('unknown_group', test_unknown_group), &
+                 new_test('other_bad_text', test_other_bad_text), &
+                 new_test('table_formats', test_table_formats), &
+                 new_test('hdf5_round_trip', test_hdf5_round_trip), &
+                 new_test('hdf5_every_step', test_hdf5_every_step), &
+                 new_test('hdf5_unwritable_path', test_hdf5_unwritable), &
+                 new_test('progress_line', test_progress), &
+                 new_test('run_scene_van_der_pol', test_run_scene)]
+    end function collect_io
+
+    ! ------------------------------------------------------------------
+    ! Namelist input
+    ! ------------------------------------------------------------------
+
+    subroutine test_valid_file(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_input_t) :: scene
+        type(status_t) :: status
+        character(len=:), allocatable :: path
+        path = scratch('valid.nml')
+        ! groups out of order, comments, mixed case, '&end', commas
+        call write_text(path, &
+            '! a scene' // nl // &
+            '&output file = ''out/run.h5'', n_output = 5, every_step = .true. /' // nl // &
+            '&SOLVER' // nl // &
+            '  rtol = 1d-8, atol=1.0e-9 ! tight' // nl // &
+            '  max_steps = 5000' // nl // &
+            '  controller = ''Classical''' // nl // &
+            '  thet = -1, zero_start = T' // nl // &
+            '&end' // nl // &
+            '&simulation title = ''it''''s a test ! not a comment'', problem = ''pendulum''' // &
+            nl // '  t_start = 1, t_end = 3.5, pendulum_formulation = ''ggl''' // nl // &
+            '  pendulum_length = 2.0 gravity = 1.62 npoints = 40' // nl // '/' // nl)
+        call read_scene(path, scene, status)
+        call check(error, status%ok(), 'status: ' // status%text())
+        if (allocated(error)) return
+        call check(error, scene%title == 'it''s a test ! not a comment', 'title: ' // &
+                   trim(scene%title))
+        call check(error, scene%problem == 'pendulum', 'problem')
+        call check_close(error, scene%t_start, 1.0_wp, 0.0_wp, 't_start')
+        call check_close(error, scene%t_end, 3.5_wp, 0.0_wp, 't_end')
+        call check(error, scene%pendulum_formulation == 'ggl', 'formulation')
+        call check_close(error, scene%pendulum_length, 2.0_wp, 0.0_wp, 'length')
+        call check_close(error, scene%gravity, 1.62_wp, 0.0_wp, 'gravity')
+        call check(error, scene%npoints == 40, 'npoints')
+        call check_close(error, scene%rtol, 1.0e-8_wp, 0.0_wp, 'rtol')
+        call check_close(error, scene%atol, 1.0e-9_wp, 0.0_wp, 'atol')
+        call check(error, scene%max_steps == 5000, 'max_steps')
+        call check(error, scene%controller == 'classical', 'controller lower-cased')
+        call check_close(error, scene%thet, -1.0_wp, 0.0_wp, 'thet')
+        call check(error, scene%zero_start, 'zero_start')
+        call check(error, scene%output_file == 'out/run.h5', 'file')
+        call check(error, scene%n_output == 5, 'n_output')
+        call check(error, scene%every_step, 'every_step')
+        call check(error, scene%nit == 7, 'nit default')
+        call check(error, index(scene%text, '&SOLVER') > 0, 'text kept')
+        call delete(path)
+    end subroutine test_valid_file
+
+    subroutine test_defaults(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_input_t) :: scene
+        type(status_t) :: status
+        call parse_scene('&simulation problem = ''van_der_pol'', t_end = 2 /', &
+                         'inputs/vdp.nml', scene, status)
+        call check(error, status%ok(), 'status: ' // status%text())
+        call check(error, scene%solver_name == 'radau5', 'solver default')
+        call check_close(error, scene%rtol, 1.0e-6_wp, 0.0_wp, 'rtol default')
+        call check_close(error, scene%vdp_eps, 1.0e-6_wp, 0.0_wp, 'eps default')
+        call check(error, scene%linear_solver == 'auto', 'linear_solver default')
+        call check(error, scene%output_file == 'vdp.h5', 'derived file: ' // scene%output_file)
+        call check(error, scene%n_output == 101 .and. .not. scene%every_step, 'output defaults')
+        call parse_scene('&simulation problem = ''van_der_pol'', t_end = 2 /' // nl // &
+                         '&output file = ''none'' /', 'x.nml', scene, status)
+        call check(error, status%ok() .and. len(scene%output_file) == 0, 'file = none')
+    end subroutine test_defaults
+
+    subroutine test_options(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_input_t) :: scene
+        type(status_t) :: status
+        type(dae_options_t) :: options
+        call parse_scene('&simulation problem = ''van_der_pol'', t_start = 1, t_end = 2 /' // &
+            nl // '&solver rtol = 1e-5, atol = 1e-7, hmax = 0.1, max_steps = 77, ' // &
+            'linear_solver = ''klu'' /' // nl // '&output n_output = 5 /', 'x.nml', scene, status)
+        call check(error, status%ok(), 'status: ' // status%text())
+        if (allocated(error)) return
+        options = scene_dae_options(scene)
+        call check_close(error, options%rtol, 1.0e-5_wp, 0.0_wp, 'rtol')
+        call check_close(error, options%atol, 1.0e-7_wp, 0.0_wp, 'atol')
+        call check_close(error, options%hmax, 0.1_wp, 0.0_wp, 'hmax')
+        call check(error, options%max_steps == 77, 'max_steps')
+        call check(error, options%linear_solver == 'klu', 'linear_solver')
+        call check(error, size(options%output_times) == 5, 'output count')
+        call check_close(error, options%output_times(1), 1.0_wp, 0.0_wp, 'first output')
+        call check_close(error, options%output_times(3), 1.5_wp, 1e-15_wp, 'middle output')
+        call check_close(error, options%output_times(5), 2.0_wp, 0.0_wp, 'last output')
+        call options%validate(2, status)
+        call check(error, status%ok(), 'options validate')
+    end subroutine test_options
+
+    subroutine test_unknown_variable(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(status_t) :: status
+        status = parse_status('&simulation problem = ''van_der_pol'', t_end = 2 /' // nl // &
+                              '&solver rtol = 1e-4' // nl // '  atoll = 1e-4 /')
+        call check(error, status%code == status_bad_input, 'code')
+        call expect(error, status, 'in.nml: &solver: atoll: unknown variable')
+        call expect(error, status, '(line 3)')
+        call expect(error, status, 'atol')
+    end subroutine test_unknown_variable
+
+    subroutine test_wrong_type(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(status_t) :: status
+        status = parse_status(vdp_sim() // '&solver max_steps = 1.5 /')
+        call check(error, status%code == status_bad_input, 'code (integer)')
+        call expect(error, status, 'in.nml: &solver: max_steps = 1.5: must be an integer')
+        status = parse_status(vdp_sim() // '&solver rtol = ''small'' /')
+        call expect(error, status, 'in.nml: &solver: rtol = ''small'': must be a real number')
+        status = parse_status(vdp_sim() // '&solver rtol = 1e-4x /')
+        call expect(error, status, 'in.nml: &solver: rtol = 1e-4x: must be a real number')
+        status = parse_status(vdp_sim() // '&output every_step = yes /')
+        call expect(error, status, 'every_step = yes: must be .true. or .false.')
+        status = parse_status(vdp_sim() // '&solver name = radau5 /')
+        call expect(error, status, 'name = radau5: must be a quoted string')
+        status = parse_status(vdp_sim() // '&solver rtol = 1e999 /')
+        call expect(error, status, 'rtol = 1e999: is out of the range of real numbers')
+    end subroutine test_wrong_type
+
+    subroutine test_negative_tolerance(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(status_t) :: status
+        status = parse_status(vdp_sim() // '&solver' // nl // '  rtol = -1e-6' // nl // '/')
+        call check(error, status%code == status_bad_input, 'code')
+        call check(error, status%text() == 'in.nml: &solver: rtol = -1e-6: must be positive' // &
+                   ' (line 3)', 'message: ' // status%text())
+        status = parse_status(vdp_sim() // '&solver atol = 0 /')
+        call expect(error, status, 'in.nml: &solver: atol = 0: must be positive')
+        status = parse_status('&simulation problem = ''van_der_pol'', t_start = 3, ' // &
+                              't_end = 2 /')
+        call expect(error, status, '&simulation: t_end = 2: must be greater than t_start = 3')
+        status = parse_status('&simulation problem = ''van_der_pol'' /')
+        call expect(error, status, '&simulation: t_end: required')
+        status = parse_status(vdp_sim() // '&solver linear_solver = ''lu'' /')
+        call expect(error, status, 'linear_solver = ''lu'': must be ''auto'', ''dense'' or')
+        status = parse_status(vdp_sim() // '&output table = ''x.txt'' /')
+        call expect(error, status, 'table = ''x.txt'': must end in .md, .csv or .tex')
+    end subroutine test_negative_tolerance
+
+    subroutine test_missing_file(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_input_t) :: scene
+        type(status_t) :: status
+        character(len=:), allocatable :: path
+        path = scratch('does_not_exist.nml')
+        call read_scene(path, scene, status)
+        call check(error, status%code == status_bad_input, 'code')
+        call expect(error, status, path // ': no such file')
+    end subroutine test_missing_file
+
+    subroutine test_unknown_group(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(status_t) :: status
+        status = parse_status(vdp_sim() // '! the solver' // nl // '&solvers rtol = 1e-4 /')
+        call check(error, status%code == status_bad_input, 'code')
+        call expect(error, status, 'in.nml: &solvers: unknown group (expected &simulation, ' // &
+                    '&solver or &output) (line 3)')
+    end subroutine test_unknown_group
+
+    subroutine test_other_bad_text(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(status_t) :: status
+        status = parse_status(vdp_sim() // '&solver rtol = 1e-4')
+        call expect(error, status, '&solver: not closed by ''/''')
+        status = parse_status(vdp_sim() // '&solver rtol = 1e-4 2e-4 /')
+        call expect(error, status, '&solver: rtol: unexpected ''2e-4'' after its value')
+        status = parse_status(vdp_sim() // '&solver rtol = 1e-4, rtol = 1e-5 /')
+        call expect(error, status, '&solver: rtol: given more than once')
+        status = parse_status(vdp_sim() // vdp_sim())
+        call expect(error, status, '&simulation: group given more than once')
+        status = parse_status(vdp_sim() // 'rtol = 1 /')
+        call expect(error, status, 'unexpected text ''rtol'' outside a group')
+        status = parse_status(vdp_sim() // '&solver rtol = /')
+        call expect(error, status, '&solver: rtol: has no value')
+        status = parse_status(vdp_sim() // '&solver name = ''radau5 /')
+        call expect(error, status, 'unterminated string')
+        status = parse_status(vdp_sim() // '&solver name = ''dassl'' /')
+        call expect(error, status, 'name = ''dassl'': must be ''radau5''')
+        status = parse_status('&simulation problem = ''duffing'', t_end = 1 /')
+        call expect(error, status, 'problem = ''duffing'': must be one of ''van_der_pol''')
+    end subroutine test_other_bad_text
+
+    ! ------------------------------------------------------------------
+    ! Tables
+    ! ------------------------------------------------------------------
+
+    subroutine test_table_formats(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(stats_row_t) :: rows(2)
+        type(dae_stats_t) :: stats
+        character(len=:), allocatable :: text, path
+        type(status_t) :: status
+        stats%nst = 275
+        stats%nac = 238
+        stats%nrj = 37
+        stats%nfe = 2218
+        stats%nje = 161
+        stats%ndec = 248
+        stats%nsol = 906
+        stats%cpu = 0.0123_wp
+        rows(1) = new_stats_row('radau5', 1.0e-4_wp, 'index2', stats, err=2.5e-5_wp)
+        rows(2) = new_stats_row('my_solver', 1.0e-6_wp, '', stats)
+
+        text = table_text(rows, table_markdown)
+        call check(error, count_char(text, nl) == 4, 'markdown: 4 lines')
+        call check(error, index(text, '| solver    |     TOL | stab.  |     ERR | NST |') == 1, &
+                   'markdown header: ' // text)
+        call check(error, index(text, '| NRJ | NDEC | NSOL |') > 0, 'markdown extra columns')
+        call check(error, index(text, '| radau5    | 1.0e-04 | index2 | 2.5e-05 | 275 | 238 |' &
+                   // ' 2218 | 161 | 0.012 |  37 |  248 |  906 |') > 0, 'markdown row: ' // text)
+        call check(error, index(text, '| my_solver | 1.0e-06 | -      |       - |') > 0, &
+                   'markdown missing ERR and stab')
+
+        text = table_text(rows, table_csv)
+        call check(error, index(text, 'solver,TOL,stab.,ERR,NST,NAC,NFE,NJE,CPU,NRJ,NDEC,NSOL' &
+                   // nl) == 1, 'csv header')
+        call check(error, index(text, 'radau5,1.0e-04,index2,2.5e-05,275,238,2218,161,0.012,' &
+                   // '37,248,906' // nl) > 0, 'csv row: ' // text)
+
+        text = table_text(rows, table_latex)
+        call check(error, index(text, '\begin{tabular}{lrlrrrrrrrrr}') == 1, 'latex begin')
+        call check(error, index(text, 'radau5 & $10^{-4}$ & index2 & $2.5\cdot 10^{-5}$ & ' // &
+                   '275 & 238 & 2218 & 161 & 0.012 & 37 & 248 & 906 \\') > 0, 'latex row: ' // text)
+        call check(error, index(text, 'my\_solver') > 0, 'latex escapes _')
+        call check(error, index(text, '\end{tabular}') > 0, 'latex end')
+
+        call check(error, table_format('a/b.md') == table_markdown, 'format md')
+        call check(error, table_format('b.csv') == table_csv, 'format csv')
+        call check(error, table_format('b.tex') == table_latex, 'format tex')
+        call check(error, table_format('b.txt') == 0, 'format unknown')
+
+        path = scratch('table.csv')
+        call write_table(path, rows, status)
+        call check(error, status%ok(), 'write_table: ' // status%text())
+        call check(error, read_text(path) == table_text(rows, table_csv), 'file content')
+        call delete(path)
+        call write_table(scratch('table.txt'), rows, status)
+        call check(error, status%code == status_bad_input, 'write_table unknown format')
+    end subroutine test_table_formats
+
+    ! ------------------------------------------------------------------
+    ! HDF5
+    ! ------------------------------------------------------------------
+
+    subroutine test_hdf5_round_trip(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(hdf5_sink_t) :: sink
+        type(status_t) :: status
+        type(dae_stats_t) :: stats
+        character(len=:), allocatable :: path, big
+        real(wp), allocatable :: time(:), y(:, :), q(:, :)
+        real(wp) :: rec(4)
+        integer :: k, i, nst
+        path = scratch('round_trip.h5')
+        big = repeat('x', 40000)
+        call sink%create(path, 4, status, input_text='&simulation t_end = 1 /')
+        call check(error, status%ok(), 'create: ' // status%text())
+        if (allocated(error)) return
+        call sink%add_block('q', 2, 3, status)
+        call check(error, status%ok(), 'add_block: ' // status%text())
+        do k = 1, 3
+            rec = [(real(10 * k + i, wp), i = 1, 4)]
+            call sink%output(0.5_wp * k, rec, status)
+        end do
+        call check(error, status%ok(), 'output: ' // status%text())
+        call sink%finish(status)
+        stats%nst = 42
+        stats%cpu = 1.5_wp
+        call sink%write_statistics(stats, status, 'radau5', 'ok')
+        call check(error, status%ok(), 'statistics: ' // status%text())
+        call sink%write_text('big_text', big, status)
+        call check(error, status%ok(), 'big text: ' // status%text())
+        call sink%close(status)
+        call check(error, status%ok(), 'close: ' // status%text())
+        if (allocated(error)) return
+
+        call read_series(path, time, y, q, nst, error)
+        if (allocated(error)) return
+        call check(error, size(time) == 3, 'time length')
+        call check(error, all(shape(y) == [4, 3]), 'y shape')
+        call check(error, all(shape(q) == [2, 3]), 'q shape')
+        if (allocated(error)) return
+        call check(error, all(time == [0.5_wp, 1.0_wp, 1.5_wp]), 'time values')
+        call check(error, all(y(:, 2) == [21.0_wp, 22.0_wp, 23.0_wp, 24.0_wp]), 'y values')
+        call check(error, all(y(4, :) == [14.0_wp, 24.0_wp, 34.0_wp]), 'y row')
+        call check(error, all(q(:, 3) == [32.0_wp, 33.0_wp]), 'q block values')
+        call check(error, nst == 42, 'NST attribute')
+        call check(error, read_string_attribute(path, 'input_text') == &
+                   '&simulation t_end = 1 /', 'input_text attribute')
+        call check(error, read_string_attribute(path, 'solver') == 'radau5', 'solver attr')
+        call check(error, read_string_attribute(path, 'big_text') == &
+                   'stored in dataset /big_text', 'large text moved to a dataset')
+        call delete(path)
+    end subroutine test_hdf5_round_trip
+
+    subroutine test_hdf5_every_step(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(hdf5_sink_t) :: sink
+        type(status_t) :: status
+        type(still_t) :: dense
+        character(len=:), allocatable :: path
+        real(wp), allocatable :: time(:), y(:, :), q(:, :)
+        logical :: stop
+        integer :: nst
+        path = scratch('every_step.h5')
+        stop = .false.
+        call sink%create(path, 2, status, every_step=.true.)
+        call check(error, sink%wants_steps(), 'wants steps')
+        call sink%step(1, 0.0_wp, 0.0_wp, [1.0_wp, 2.0_wp], dense, stop, status)
+        call sink%output(0.05_wp, [9.0_wp, 9.0_wp], status)   ! ignored in this mode
+        call sink%step(2, 0.0_wp, 0.1_wp, [3.0_wp, 4.0_wp], dense, stop, status)
+        call check(error, status%ok(), 'steps: ' // status%text())
+        call sink%close(status)
+        call read_series(path, time, y, q, nst, error)
+        if (allocated(error)) return
+        call check(error, size(time) == 2, 'two records')
+        call check(error, all(time == [0.0_wp, 0.1_wp]), 'step times')
+        call check(error, all(y(:, 2) == [3.0_wp, 4.0_wp]), 'step values')
+        call delete(path)
+    end subroutine test_hdf5_every_step
+
+    subroutine test_hdf5_unwritable(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(hdf5_sink_t) :: sink
+        type(status_t) :: status
+        call sink%create(scratch('no_such_dir/x.h5'), 2, status)
+        call check(error, status%code == status_io_error, 'code')
+        call expect(error, status, 'no_such_dir/x.h5: HDF5 cannot create the file')
+        call sink%close(status)
+    end subroutine test_hdf5_unwritable
+
+    !> /time, /y and (if present) /q of a file, and its NST attribute.
+    subroutine read_series(path, time, y, q, nst, error)
+        character(len=*), intent(in) :: path
+        real(wp), allocatable, intent(out) :: time(:), y(:, :), q(:, :)
+        integer, intent(out) :: nst
+        type(error_t), allocatable, intent(inout) :: error
+        integer(hid_t) :: file, dset, space, attr
+        integer(hsize_t) :: dims(2), maxdims(2)
+        integer :: err
+        logical :: exists
+        nst = -1
+        call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
+        call check(error, err >= 0, 'reopen ' // path)
+        if (allocated(error)) return
+        call h5dopen_f(file, 'time', dset, err)
+        call h5dget_space_f(dset, space, err)
+        call h5sget_simple_extent_dims_f(space, dims(1:1), maxdims(1:1), err)
+        allocate (time(dims(1)))
+        call h5dread_f(dset, H5T_NATIVE_DOUBLE, time, dims(1:1), err)
+        call check(error, err >= 0, 'read /time')
+        call h5sclose_f(space, err)
+        call h5dclose_f(dset, err)
+        call h5dopen_f(file, 'y', dset, err)
+        call h5dget_space_f(dset, space, err)
+        call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
+        call check(error, maxdims(2) == H5S_UNLIMITED_F, '/y extendible')
+        allocate (y(dims(1), dims(2)))
+        call h5dread_f(dset, H5T_NATIVE_DOUBLE, y, dims, err)
+        call check(error, err >= 0, 'read /y')
+        call h5sclose_f(space, err)
+        call h5dclose_f(dset, err)
+        call h5lexists_f(file, 'q', exists, err)
+        if (exists) then
+            call h5dopen_f(file, 'q', dset, err)
+            call h5dget_space_f(dset, space, err)
+            call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
+            allocate (q(dims(1), dims(2)))
+            call h5dread_f(dset, H5T_NATIVE_DOUBLE, q, dims, err)
+            call check(error, err >= 0, 'read /q')
+            call h5sclose_f(space, err)
+            call h5dclose_f(dset, err)
+        else
+            allocate (q(0, 0))
+        end if
+        call h5aexists_f(file, 'NST', exists, err)
+        if (exists) then
+            call h5aopen_f(file, 'NST', attr, err)
+            call h5aread_f(attr, H5T_NATIVE_INTEGER, nst, [1_hsize_t], err)
+            call h5aclose_f(attr, err)
+        end if
+        call h5fclose_f(file, err)
+    end subroutine read_series
+
+    function read_string_attribute(path, name) result(text)
+        character(len=*), intent(in) :: path, name
+        character(len=:), allocatable :: text
+        integer(hid_t) :: file, attr, atype
+        integer(size_t) :: length
+        integer :: err
+        text = '<unreadable>'
+        call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
+        if (err < 0) return
+        call h5aopen_f(file, name, attr, err)
+        if (err >= 0) then
+            call h5aget_type_f(attr, atype, err)
+            call h5tget_size_f(atype, length, err)
+            deallocate (text)
+            allocate (character(len=length) :: text)
+            call h5aread_f(attr, atype, text, [1_hsize_t], err)
+            call h5tclose_f(atype, err)
+            call h5aclose_f(attr, err)
+        end if
+        call h5fclose_f(file, err)
+    end function read_string_attribute
+
+    ! ------------------------------------------------------------------
+    ! Progress display and a whole run
+    ! ------------------------------------------------------------------
+
+    subroutine test_progress(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(progress_t) :: progress
+        type(status_t) :: status
+        type(still_t) :: dense
+        character(len=:), allocatable :: path, text
+        integer :: unit, attempted, accepted
+        logical :: stop
+        path = scratch('progress.txt')
+        open (newunit=unit, file=path, status='replace', action='write')
+        progress = new_progress(0.0_wp, 2.0_wp, quiet=.false., unit=unit)
+        attempted = 12
+        accepted = 10
+        call progress%watch(attempted, accepted)
+        stop = .false.
+        call check(error, progress%wants_steps(), 'wants steps')
+        call progress%step(11, 0.9_wp, 1.0_wp, [0.0_wp], dense, stop, status)
+        call check(error, index(progress%line(), '50.0 %') > 0, 'percent: ' // progress%line())
+        call check(error, index(progress%line(), 'steps 10') > 0, 'steps')
+        call check(error, index(progress%line(), 'rejected 2') > 0, 'rejected')
+        call progress%finish(status)
+        close (unit)
+        text = read_text(path)
+        call check(error, text(1:1) == achar(13), 'redrawn with a carriage return')
+        call check(error, index(text, 't =  1.00000E+00 s') > 0, 'time shown: ' // text)
+        call delete(path)
+        progress = new_progress(0.0_wp, 2.0_wp, quiet=.true., unit=unit)
+        call check(error, .not. progress%wants_steps(), 'quiet display wants nothing')
+    end subroutine test_progress
+
+    subroutine test_run_scene(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_input_t) :: scene
+        type(status_t) :: status
+        type(run_result_t) :: result
+        character(len=:), allocatable :: h5, table
+        real(wp), allocatable :: time(:), y(:, :), q(:, :)
+        integer :: nst
+        h5 = scratch('vdp_run.h5')
+        table = scratch('vdp_run.md')
+        call parse_scene('&simulation problem = ''van_der_pol'', t_end = 2 /' // nl // &
+            '&solver rtol = 1e-4, atol = 1e-4, h0 = 1e-6 /' // nl // &
+            '&output file = ''' // h5 // ''', n_output = 11, table = ''' // table // ''' /', &
+            'vdp.nml', scene, status)
+        call check(error, status%ok(), 'parse: ' // status%text())
+        if (allocated(error)) return
+        call run_scene(scene, .true., result, status)
+        call check(error, status%ok(), 'run: ' // status%text())
+        if (allocated(error)) return
+        ! the RADAU5 anchor of ALGORITHMS.md §8
+        call check_close(error, result%y(1), 1.706161101_wp, 1e-6_wp, 'y1(2)')
+        call check_close(error, result%y(2), -0.8928074777_wp, 1e-6_wp, 'y2(2)')
+        call check(error, result%stats%nst == 275, 'NST')
+        call read_series(h5, time, y, q, nst, error)
+        if (allocated(error)) return
+        call check(error, size(time) == 11, 'eleven output records')
+        call check_close(error, time(11), 2.0_wp, 0.0_wp, 'last output time')
+        call check(error, all(y(:, 1) == [2.0_wp, -0.66_wp]), 'first record is y0')
+        call check_close(error, y(1, 11), result%y(1), 1e-12_wp, 'last record is the end state')
+        call check(error, nst == 275, 'NST attribute')
+        call check(error, index(read_string_attribute(h5, 'input_text'), 'van_der_pol') > 0, &
+                   'input text stored')
+        call check(error, index(read_text(table), '| radau5 | 1.0e-04 |') > 0, 'table row')
+        call delete(h5)
+        call delete(table)
+    end subroutine test_run_scene
+
+    ! ------------------------------------------------------------------
+    ! Helpers
+    ! ------------------------------------------------------------------
+
+    subroutine still_evaluate(self, s, y)
+        class(still_t), intent(in) :: self
+        real(wp), intent(in) :: s
+        real(wp), intent(out) :: y(:)
+        y = self%value
+    end subroutine still_evaluate
+
+    function vdp_sim() result(text)
+        character(len=:), allocatable :: text
+        text = '&simulation problem = ''van_der_pol'', t_end = 2 /' // nl
+    end function vdp_sim
+
+    function parse_status(text) result(status)
+        character(len=*), intent(in) :: text
+        type(status_t) :: status
+        type(scene_input_t) :: scene
+        call parse_scene(text, 'in.nml', scene, status)
+    end function parse_status
+
+    !> Fail unless the status message contains `part`.
+    subroutine expect(error, status, part)
+        type(error_t), allocatable, intent(inout) :: error
+        type(status_t), intent(in) :: status
+        character(len=*), intent(in) :: part
+        call check(error, .not. status%ok(), 'expected an error containing: ' // part)
+        call check(error, index(status%text(), part) > 0, 'message "' // status%text() // &
+                   '" lacks "' // part // '"')
+    end subroutine expect
+
+    !> A path in the temporary directory, unique to this test process.
+    function scratch(name) result(path)
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable :: path
+        character(len=:), allocatable, save :: prefix
+        character(len=512) :: dir
+        integer :: length, stat
+        integer(8) :: count
+        if (.not. allocated(prefix)) then
+            call get_environment_variable('TMPDIR', dir, length, stat)
+            if (stat /= 0 .or. length == 0) dir = '/tmp'
+            call system_clock(count)
+            write (dir, '(a,a,i0,a)') trim(dir), '/flexmbs_test_io_', count, '_'
+            prefix = trim(dir)
+        end if
+        path = prefix // name
+    end function scratch
+
+    subroutine write_text(path, text)
+        character(len=*), intent(in) :: path, text
+        integer :: unit
+        open (newunit=unit, file=path, access='stream', form='unformatted', status='replace')
+        write (unit) text
+        close (unit)
+    end subroutine write_text
+
+    function read_text(path) result(text)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: text
+        integer :: unit, n, ios
+        open (newunit=unit, file=path, access='stream', form='unformatted', status='old', &
+              iostat=ios)
+        if (ios /= 0) then
+            text = ''
+            return
+        end if
+        inquire (unit=unit, size=n)
+        allocate (character(len=n) :: text)
+        read (unit) text
+        close (unit)
+    end function read_text
+
+    subroutine delete(path)
+        character(len=*), intent(in) :: path
+        integer :: unit, ios
+        open (newunit=unit, file=path, status='old', iostat=ios)
+        if (ios == 0) close (unit, status='delete')
+    end subroutine delete
+
+    pure integer function count_char(text, c)
+        character(len=*), intent(in) :: text
+        character, intent(in) :: c
+        integer :: i
+        count_char = 0
+        do i = 1, len(text)
+            if (text(i:i) == c) count_char = count_char + 1
+        end do
+    end function count_char
+end module test_io
