@@ -3,6 +3,7 @@
 program flexmbs_tests
     use testing, only: run_suite
     use test_linalg, only: collect_linalg
+    use test_problems, only: collect_problems
     use test_radau5, only: collect_radau5
     implicit none
     integer :: npassed, nfailed, nargs
@@ -14,6 +15,7 @@ program flexmbs_tests
     npassed = 0
     nfailed = 0
     call run_suite('linalg', collect_linalg(), filter, npassed, nfailed)
+    call run_suite('problems', collect_problems(), filter, npassed, nfailed)
     call run_suite('radau5', collect_radau5(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
