@@ -104,6 +104,8 @@ module flexmbs_dae_radau5
         real(wp) :: uround = 1.0e-16_wp    !! rounding unit (WORK(1))
         integer :: controller = radau5_controller_predictive !! IWORK(8)
         logical :: zero_start = .false.    !! zero Newton starting values (IWORK(4))
+        !> Constant step h0, every converged step accepted (order studies).
+        logical :: fixed_step = .false.
         !> Velocity projection only every this many accepted steps (§6).
         integer :: projection_interval = 1
         ! Results of the last integration.
@@ -195,6 +197,10 @@ contains
         end if
         call options%validate(n, status)
         if (.not. status%ok()) return
+        if (self%fixed_step .and. .not. options%h0 > 0.0_wp) then
+            call bad('fixed_step needs a positive h0')
+            return
+        end if
         uround = self%uround
         if (uround <= 1.0e-19_wp .or. uround >= 1.0_wp) then
             call bad('uround must lie in (1e-19, 1)')
@@ -515,7 +521,12 @@ contains
                 end do newton
 
                 ! §1.7: error estimate.
-                call estimate_error(fstatus)
+                if (self%fixed_step) then
+                    err = err_floor
+                    fstatus%code = status_ok
+                else
+                    call estimate_error(fstatus)
+                end if
                 if (.not. fstatus%ok()) then
                     call unexpected_failure()
                     cycle main
@@ -524,12 +535,13 @@ contains
                 fac = min(self%safe, self%safe * real(1 + 2 * nit, wp) / real(newt + 2 * nit, wp))
                 quot = max(facr, min(facl, err**0.25_wp / fac))
                 hnew = h / quot
+                if (self%fixed_step) hnew = h
 
                 if (err < 1.0_wp) then
                     ! ---- R4: accept ----
                     first = .false.
                     self%native%naccpt = self%native%naccpt + 1
-                    if (pred) then
+                    if (pred .and. .not. self%fixed_step) then
                         if (self%native%naccpt > 1) then
                             facgus = (hacc / h) * (err**2 / erracc)**0.25_wp / self%safe
                             facgus = max(facr, min(facl, facgus))
@@ -595,7 +607,8 @@ contains
                     hopt = min(h, hnew)
                     if (reject) hnew = posneg * min(abs(hnew), abs(h))
                     reject = .false.
-                    if ((x + hnew / self%quot1 - xend) * posneg >= 0.0_wp) then
+                    if ((x + hnew / self%quot1 - xend) * posneg >= 0.0_wp .or. (self%fixed_step &
+                        .and. (x + hnew * end_factor - xend) * posneg >= 0.0_wp)) then
                         h = xend - x
                         last = .true.
                     else

@@ -1,0 +1,23 @@
+!> The umbrella module: `use flexmbs` gives the public API.
+module flexmbs
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_status, only: status_t, status_ok, status_bad_input, &
+        status_solver_failure, status_io_error, status_interrupted, reason_name
+    use flexmbs_core_timer, only: timer_t
+    use flexmbs_linalg_csc, only: csc_matrix_t
+    use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_identity, &
+        storage_dense, storage_sparse
+    use flexmbs_linalg_linear_solver, only: linear_solver_t
+    use flexmbs_linalg_dense, only: dense_solver_t
+    use flexmbs_linalg_factory, only: new_linear_solver
+    use flexmbs_dae_problem, only: dae_problem_t
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    use flexmbs_dae_options, only: dae_options_t
+    use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_sink, only: sink_t, dense_output_t
+    use flexmbs_dae_solver, only: dae_solver_t
+    use flexmbs_dae_radau5, only: radau5_t, radau5_dense_t, radau5_native_t
+    use flexmbs_dae_error_measure, only: paper_error
+    implicit none
+    public
+end module flexmbs
