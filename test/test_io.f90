@@ -45,7 +45,9 @@ contains
                  new_test('hdf5_every_step', test_hdf5_every_step), &
                  new_test('hdf5_unwritable_path', test_hdf5_unwritable), &
                  new_test('progress_line', test_progress), &
-                 new_test('run_scene_van_der_pol', test_run_scene)]
+                 new_test('run_scene_van_der_pol', test_run_scene), &
+                 new_test('run_scene_pendulum_blocks', test_run_pendulum), &
+                 new_test('run_scene_bad_linear_solver_no_file', test_run_bad_solver)]
     end function collect_io
 
     ! ------------------------------------------------------------------
@@ -525,6 +527,56 @@ contains
         call delete(h5)
         call delete(table)
     end subroutine test_run_scene
+
+    subroutine test_run_pendulum(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_input_t) :: scene
+        type(status_t) :: status
+        type(run_result_t) :: result
+        character(len=:), allocatable :: h5
+        real(wp), allocatable :: time(:), y(:, :), q(:, :)
+        integer :: nst, k
+        h5 = scratch('pendulum_run.h5')
+        call parse_scene('&simulation problem = ''pendulum'', t_end = 1, ' // &
+            'pendulum_length = 2, pendulum_formulation = ''index2'' /' // nl // &
+            '&solver rtol = 1e-6, atol = 1e-6 /' // nl // &
+            '&output file = ''' // h5 // ''', n_output = 6 /', 'pendulum.nml', scene, status)
+        call check(error, status%ok(), 'parse: ' // status%text())
+        if (allocated(error)) return
+        call run_scene(scene, .true., result, status)
+        call check(error, status%ok(), 'run: ' // status%text())
+        call check(error, size(result%y) == 5, 'n = 5 in index 2')
+        call read_series(h5, time, y, q, nst, error)
+        if (allocated(error)) return
+        call check(error, all(shape(q) == [2, 6]), '/q block shape')
+        if (allocated(error)) return
+        call check(error, all(q == y(1:2, :)), '/q equals y(1:2)')
+        do k = 1, 6
+            ! the rod keeps its length: x² + y² = L² (index 2 drifts slowly)
+            call check_close(error, sqrt(q(1, k)**2 + q(2, k)**2), 2.0_wp, 1e-4_wp, 'length')
+        end do
+        call delete(h5)
+    end subroutine test_run_pendulum
+
+    !> A linear solver that does not exist is bad input: no file is left.
+    subroutine test_run_bad_solver(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_input_t) :: scene
+        type(status_t) :: status
+        type(run_result_t) :: result
+        character(len=:), allocatable :: h5
+        logical :: exists
+        h5 = scratch('bad_solver.h5')
+        call parse_scene('&simulation problem = ''van_der_pol'', t_end = 1 /' // nl // &
+            '&output file = ''' // h5 // ''' /', 'x.nml', scene, status)
+        call check(error, status%ok(), 'parse: ' // status%text())
+        scene%linear_solver = 'nonsense'
+        call run_scene(scene, .true., result, status)
+        call check(error, status%code == status_bad_input, 'bad input expected')
+        call expect(error, status, 'x.nml: &solver: ')
+        inquire (file=h5, exist=exists)
+        call check(error, .not. exists, 'no HDF5 file on bad input')
+    end subroutine test_run_bad_solver
 
     ! ------------------------------------------------------------------
     ! Helpers

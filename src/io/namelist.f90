@@ -39,7 +39,7 @@ module flexmbs_io_namelist
         var_spec_t('simulation', 'pendulum_length', kind_real), &
         var_spec_t('simulation', 'pendulum_mass', kind_real), &
         var_spec_t('simulation', 'pendulum_angle', kind_real), &
-        var_spec_t('simulation', 'pendulum_omega', kind_real), &
+        var_spec_t('simulation', 'pendulum_projection', kind_logical), &
         var_spec_t('simulation', 'gravity', kind_real), &
         var_spec_t('simulation', 'npoints', kind_integer), &
         var_spec_t('solver', 'name', kind_string), &
@@ -94,8 +94,8 @@ module flexmbs_io_namelist
         character(len=len_name) :: pendulum_formulation = 'index2'
         real(wp) :: pendulum_length = 1.0_wp  !! m
         real(wp) :: pendulum_mass = 1.0_wp    !! kg
-        real(wp) :: pendulum_angle = half_pi  !! rad from the downward vertical
-        real(wp) :: pendulum_omega = 0.0_wp   !! rad/s
+        real(wp) :: pendulum_angle = half_pi  !! rad from the downward vertical, at rest
+        logical :: pendulum_projection = .false. !! project onto both constraints
         real(wp) :: gravity = 9.81_wp         !! m/s²
         integer :: npoints = 100              !! grid points per direction (Brusselator)
         ! &solver
@@ -624,13 +624,13 @@ contains
             jacobian, controller
         character(len=len_path) :: file, table
         real(wp) :: t_start, t_end, vdp_eps, vdp_y1, vdp_y2, pendulum_length, pendulum_mass, &
-            pendulum_angle, pendulum_omega, gravity, rtol, atol, h0, hmax, thet, fnewt, &
+            pendulum_angle, gravity, rtol, atol, h0, hmax, thet, fnewt, &
             quot1, quot2, safe, fac_min, fac_max
         integer :: npoints, max_steps, nit, pmax, n_output
-        logical :: zero_start, every_step, progress
+        logical :: pendulum_projection, zero_start, every_step, progress
         namelist /simulation/ title, problem, t_start, t_end, vdp_eps, vdp_y1, vdp_y2, &
             pendulum_formulation, pendulum_length, pendulum_mass, pendulum_angle, &
-            pendulum_omega, gravity, npoints
+            pendulum_projection, gravity, npoints
         namelist /solver/ name, rtol, atol, h0, hmax, max_steps, linear_solver, jacobian, &
             nit, thet, fnewt, quot1, quot2, safe, fac_min, fac_max, controller, zero_start, pmax
         namelist /output/ file, n_output, every_step, table, progress
@@ -651,7 +651,7 @@ contains
             pendulum_length = scene%pendulum_length
             pendulum_mass = scene%pendulum_mass
             pendulum_angle = scene%pendulum_angle
-            pendulum_omega = scene%pendulum_omega
+            pendulum_projection = scene%pendulum_projection
             gravity = scene%gravity
             npoints = scene%npoints
             read (lines, nml=simulation, iostat=ios, iomsg=msg)
@@ -666,7 +666,7 @@ contains
             scene%pendulum_length = pendulum_length
             scene%pendulum_mass = pendulum_mass
             scene%pendulum_angle = pendulum_angle
-            scene%pendulum_omega = pendulum_omega
+            scene%pendulum_projection = pendulum_projection
             scene%gravity = gravity
             scene%npoints = npoints
         case ('solver')
@@ -800,8 +800,8 @@ contains
             call bad(sim, 'pendulum_mass', 'must be positive')
         else if (scene%gravity < 0.0_wp) then
             call bad(sim, 'gravity', 'must not be negative (it acts downwards)')
-        else if (scene%npoints < 3) then
-            call bad(sim, 'npoints', 'must be at least 3')
+        else if (scene%npoints < 1) then
+            call bad(sim, 'npoints', 'must be positive')
         ! &solver
         else if (scene%solver_name /= 'radau5') then
             call bad(sol, 'name', &
@@ -920,8 +920,8 @@ contains
         options%hmax = scene%hmax
         options%max_steps = scene%max_steps
         options%pmax = min(scene%pmax, 12)
-        options%linear_solver = scene%linear_solver
-        options%jacobian = scene%jacobian
+        options%linear_solver = trim(scene%linear_solver)
+        options%jacobian = trim(scene%jacobian)
         options%output_steps = scene%every_step
         m = max(scene%n_output, 2)
         allocate (options%output_times(m))

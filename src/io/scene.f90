@@ -11,7 +11,14 @@ module flexmbs_io_scene
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_solver, only: dae_solver_t
     use flexmbs_dae_radau5, only: radau5_t
+    use flexmbs_linalg_linear_solver, only: linear_solver_t
+    use flexmbs_linalg_factory, only: new_linear_solver
     use flexmbs_problems_van_der_pol, only: new_van_der_pol
+    use flexmbs_problems_robertson, only: robertson_t, new_robertson, robertson_initial
+    use flexmbs_problems_pendulum, only: pendulum_t, new_pendulum, pendulum_initial, &
+        pendulum_index1, pendulum_index2, pendulum_index3, pendulum_ggl
+    use flexmbs_problems_reaction_diffusion, only: reaction_diffusion_t, &
+        new_reaction_diffusion, reaction_diffusion_initial
     use flexmbs_io_namelist, only: scene_input_t, scene_dae_options, controller_code
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_progress, only: progress_t, new_progress
@@ -40,22 +47,70 @@ module flexmbs_io_scene
 contains
 
     !> The problem the scene names, its initial value and its named blocks.
+    !> Small problems report a CSC Jacobian only when KLU is asked for; the
+    !> Brusselator reports CSC unless the dense solver is forced.
     subroutine build_problem(scene, problem, y0, blocks, status)
         type(scene_input_t), intent(in) :: scene
         class(dae_problem_t), allocatable, intent(out) :: problem
         real(wp), allocatable, intent(out) :: y0(:)
         type(block_spec_t), allocatable, intent(out) :: blocks(:)
         type(status_t), intent(out) :: status
+        type(robertson_t) :: robertson
+        type(pendulum_t) :: pendulum
+        type(reaction_diffusion_t) :: bruss
+        logical :: klu
+        klu = scene%linear_solver == 'klu'
         allocate (blocks(0))
         select case (trim(scene%problem))
         case ('van_der_pol')
-            allocate (problem, source=new_van_der_pol(scene%vdp_eps))
+            allocate (problem, source=new_van_der_pol(scene%vdp_eps, sparse=klu))
             y0 = [scene%vdp_y1, scene%vdp_y2]
+        case ('robertson')
+            robertson = new_robertson(sparse=klu, sparse_mass=klu)
+            allocate (y0(robertson%n))
+            call robertson_initial(robertson, y0)
+            allocate (problem, source=robertson)
+        case ('pendulum')
+            pendulum = new_pendulum(formulation_code(scene%pendulum_formulation), &
+                scene%pendulum_angle, mass=scene%pendulum_mass, length=scene%pendulum_length, &
+                gravity=scene%gravity, sparse=klu, sparse_mass=klu, &
+                projection=scene%pendulum_projection, status=status)
+            if (.not. status%ok()) then
+                status%message = scene%path // ': &simulation: ' // status%message
+                return
+            end if
+            allocate (y0(pendulum%n))
+            call pendulum_initial(pendulum, y0)
+            ! y = (x, y, u, v, λ[, μ])
+            blocks = [block_spec_t('q', 1, 2), block_spec_t('v', 3, 4), &
+                      block_spec_t('lambda', 5, 5)]
+            allocate (problem, source=pendulum)
+        case ('brusselator_1d', 'brusselator_2d')
+            bruss = new_reaction_diffusion(merge(1, 2, scene%problem == 'brusselator_1d'), &
+                scene%npoints, sparse=scene%linear_solver /= 'dense', status=status)
+            if (.not. status%ok()) then
+                status%message = scene%path // ': &simulation: ' // status%message
+                return
+            end if
+            allocate (y0(bruss%n))
+            call reaction_diffusion_initial(bruss, y0)
+            allocate (problem, source=bruss)
         case default
             call status%set(status_bad_input, scene%path // ': &simulation: problem = ''' // &
-                trim(scene%problem) // ''': not available in this build yet')
+                trim(scene%problem) // ''': not available in this build')
         end select
     end subroutine build_problem
+
+    pure integer function formulation_code(name)
+        character(len=*), intent(in) :: name
+        select case (trim(name))
+        case ('index1'); formulation_code = pendulum_index1
+        case ('index2'); formulation_code = pendulum_index2
+        case ('index3'); formulation_code = pendulum_index3
+        case ('ggl'); formulation_code = pendulum_ggl
+        case default; formulation_code = 0
+        end select
+    end function formulation_code
 
     !> The solver the scene names, with its own settings.
     subroutine build_solver(scene, solver, status)
@@ -106,6 +161,7 @@ contains
         class(dae_solver_t), allocatable, target :: solver
         type(block_spec_t), allocatable :: blocks(:)
         type(dae_options_t) :: options
+        class(linear_solver_t), allocatable :: linear_solver
         type(hdf5_sink_t), target :: h5
         type(progress_t), target :: progress
         type(multi_sink_t) :: sinks
@@ -121,8 +177,13 @@ contains
         result%t = scene%t_start
         options = scene_dae_options(scene)
         call options%validate(problem%n, status)
+        if (status%ok()) then
+            ! the linear solver must exist before any file is created
+            call new_linear_solver(options%linear_solver, problem%n, &
+                                   problem%jacobian_storage(), linear_solver, status)
+        end if
         if (.not. status%ok()) then
-            status%message = scene%path // ': ' // status%message
+            status%message = scene%path // ': &solver: ' // status%message
             return
         end if
 

@@ -196,7 +196,7 @@ contains
         cells(7)%s = itoa(row%stats%nfe)
         cells(8)%s = itoa(row%stats%nje)
         write (buf, '(f0.3)') row%stats%cpu
-        if (buf(1:1) == '.') buf = '0' // buf
+        if (buf(1:1) == '.') buf = '0' // trim(buf)
         cells(9)%s = trim(buf)
         cells(10)%s = itoa(row%stats%nrj)
         cells(11)%s = itoa(row%stats%ndec)
