@@ -496,11 +496,7 @@ contains
                                 h = hhfac * h
                                 reject = .true.
                                 last = .false.
-                                if (caljac) then
-                                    block = blk_factor
-                                else
-                                    block = blk_jacobian
-                                end if
+                                call retry_after_failure()
                                 cycle main
                             end if
                         else
@@ -639,11 +635,7 @@ contains
                         h = hnew
                     end if
                     if (self%native%naccpt >= 1) self%native%nrejct = self%native%nrejct + 1
-                    if (caljac) then
-                        block = blk_factor
-                    else
-                        block = blk_jacobian
-                    end if
+                    call retry_after_failure()
                 end if
             end select
         end do main
@@ -705,12 +697,17 @@ contains
             hhfac = failure_factor
             reject = .true.
             last = .false.
+            call retry_after_failure()
+        end subroutine unexpected_failure
+
+        !> Retry with the new h: refactor if J is fresh, else a new J first.
+        subroutine retry_after_failure()
             if (caljac) then
                 block = blk_factor
             else
                 block = blk_jacobian
             end if
-        end subroutine unexpected_failure
+        end subroutine retry_after_failure
 
         !> r1 = G1 − (γ/h) M w1; r2 = G2 − (α/h) M w2 + (β/h) M w3;
         !> r3 = G3 − (β/h) M w2 − (α/h) M w3 (§1.3 step 2).
