@@ -18,6 +18,13 @@ module flexmbs
     use flexmbs_dae_solver, only: dae_solver_t
     use flexmbs_dae_radau5, only: radau5_t, radau5_dense_t, radau5_native_t
     use flexmbs_dae_error_measure, only: paper_error
+    use flexmbs_io_namelist, only: scene_input_t, read_scene, parse_scene, scene_dae_options
+    use flexmbs_io_hdf5_sink, only: hdf5_sink_t
+    use flexmbs_io_table, only: stats_row_t, new_stats_row, table_text, write_table, &
+        table_markdown, table_csv, table_latex
+    use flexmbs_io_progress, only: progress_t, new_progress
+    use flexmbs_io_multi_sink, only: multi_sink_t
+    use flexmbs_io_scene, only: run_scene, run_result_t, build_problem, build_solver
     implicit none
     public
 end module flexmbs
