@@ -3,6 +3,7 @@
 program flexmbs_tests
     use testing, only: run_suite
     use test_linalg, only: collect_linalg
+    use test_klu, only: collect_klu
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -13,6 +14,7 @@ program flexmbs_tests
     npassed = 0
     nfailed = 0
     call run_suite('linalg', collect_linalg(), filter, npassed, nfailed)
+    call run_suite('klu', collect_klu(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests
