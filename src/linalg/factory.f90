@@ -1,24 +1,53 @@
-!> Choice of the linear solver by name.
+!> Choice of the linear solver for iteration matrices c*M - J by name.
 module flexmbs_linalg_factory
     use flexmbs_core_status, only: status_t, status_bad_input
-    use flexmbs_linalg_linear_solver, only: linear_solver_t
+    use flexmbs_linalg_matrix, only: storage_sparse, storage_dense
+    use flexmbs_linalg_linear_solver, only: linear_solver_t, auto_sparse_threshold
     use flexmbs_linalg_dense, only: dense_solver_t
+    use flexmbs_linalg_klu_solver, only: klu_solver_t
     implicit none
     private
+
     public :: new_linear_solver
+
 contains
-    !> 'auto' | 'dense' | 'klu'.
+
+    !> A new, not yet initialised solver: 'dense', 'klu', or 'auto', which
+    !> picks dense for n < auto_sparse_threshold or a J that is not sparse,
+    !> and KLU otherwise. Call `solver%init(mass, jac, status)` next.
     subroutine new_linear_solver(name, n, jac_storage, solver, status)
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: n, jac_storage
+        character(len=*), intent(in) :: name        !! 'auto' | 'dense' | 'klu'
+        integer, intent(in) :: n                    !! order of the iteration matrix
+        integer, intent(in) :: jac_storage          !! storage_* of the Jacobian
         class(linear_solver_t), allocatable, intent(out) :: solver
         type(status_t), intent(out) :: status
-        select case (trim(name))
-        case ('auto', 'dense')
+        character(len=160) :: msg
+
+        if (n <= 0) then
+            write (msg, '(a,i0,a)') 'linear solver: order n = ', n, ': must be positive'
+            call status%set(status_bad_input, trim(msg))
+            return
+        end if
+        select case (trim(adjustl(name)))
+        case ('auto')
+            if (jac_storage == storage_sparse .and. n >= auto_sparse_threshold) then
+                allocate (klu_solver_t :: solver)
+            else
+                allocate (dense_solver_t :: solver)
+            end if
+        case ('dense')
             allocate (dense_solver_t :: solver)
+        case ('klu')
+            ! KLU factors J as given; a difference Jacobian has no storage yet.
+            if (jac_storage /= storage_sparse .and. jac_storage /= storage_dense) then
+                call status%set(status_bad_input, "linear_solver = 'klu' needs the " // &
+                    "Jacobian in sparse (or dense) storage; use 'dense' or 'auto'")
+                return
+            end if
+            allocate (klu_solver_t :: solver)
         case default
             call status%set(status_bad_input, "linear_solver = '" // trim(name) // &
-                "': must be 'auto', 'dense' or 'klu'")
+                "': unknown; use 'auto', 'dense' or 'klu'")
         end select
     end subroutine new_linear_solver
 end module flexmbs_linalg_factory

@@ -1,0 +1,316 @@
+/* flexmbs: a small C shim over KLU's 64-bit API (klu_l_* real, klu_zl_* complex).
+ *
+ * The handle keeps klu_l_common, the symbolic analysis and a copy of the CSC
+ * pattern in C, so Fortran sees an opaque pointer and never mirrors KLU's
+ * structs. One symbolic analysis serves a real and a complex numeric
+ * factorisation, which live side by side (RADAU5 needs both at once).
+ *
+ * Indices are int64_t, 0-based CSC; complex values are interleaved (re, im),
+ * the layout of C's double _Complex and Fortran's complex(c_double_complex).
+ * Every function returns one of the FLEXMBS_KLU_* codes below, which the
+ * Fortran module flexmbs_linalg_klu repeats as named constants.
+ */
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <complex.h>
+#include <math.h>
+#include "klu.h"
+
+_Static_assert(sizeof(SuiteSparse_long) == sizeof(int64_t),
+               "KLU's SuiteSparse_long must be 64-bit for the klu_l_* API");
+
+enum {
+    FLEXMBS_KLU_OK = 0,
+    FLEXMBS_KLU_SINGULAR = 1,       /* a zero pivot: the matrix is singular */
+    FLEXMBS_KLU_OUT_OF_MEMORY = -2, /* same values as KLU's own codes */
+    FLEXMBS_KLU_INVALID = -3,
+    FLEXMBS_KLU_TOO_LARGE = -4,
+    FLEXMBS_KLU_NOT_ANALYSED = -10, /* no symbolic analysis in the handle */
+    FLEXMBS_KLU_NOT_FACTORED = -11, /* no numeric factorisation to solve with */
+    FLEXMBS_KLU_NOT_FINITE = -12    /* a value is Inf or NaN */
+};
+
+enum { PART_REAL = 0, PART_COMPLEX = 1 };
+
+/* klu_l_refactor keeps the pivot order of the last fresh factorisation. It is
+ * accepted while KLU's pivot-ratio estimate rcond and its reciprocal pivot
+ * growth rgrowth both stay above this fraction of their values at that fresh
+ * factorisation; otherwise the matrix is factored afresh with new pivoting.
+ * The LU backward error grows with the pivot growth, so 1e-2 lets a reused
+ * pivot order cost at most about two digits beyond fresh pivoting, which the
+ * simplified Newton iterations of the DAE solvers absorb. */
+static const double refactor_degrade_ratio = 1.0e-2;
+
+typedef struct {
+    klu_l_numeric *numeric;
+    double rcond_fresh, rgrowth_fresh; /* at the last fresh factorisation */
+    double rcond, rgrowth;             /* at the last (re)factorisation */
+    int64_t nfactor, nrefactor;        /* fresh and reused-pivot counts */
+} numeric_part;
+
+typedef struct {
+    klu_l_common common;
+    klu_l_symbolic *symbolic;
+    int64_t n, nnz;
+    SuiteSparse_long *colptr, *rowind; /* copy of the analysed pattern */
+    numeric_part part[2];              /* PART_REAL, PART_COMPLEX */
+} flexmbs_klu;
+
+static int code_of(const klu_l_common *common)
+{
+    switch (common->status) {
+    case KLU_OK:
+        return FLEXMBS_KLU_OK;
+    case KLU_SINGULAR:
+        return FLEXMBS_KLU_SINGULAR;
+    case KLU_OUT_OF_MEMORY:
+        return FLEXMBS_KLU_OUT_OF_MEMORY;
+    case KLU_TOO_LARGE:
+        return FLEXMBS_KLU_TOO_LARGE;
+    default:
+        return FLEXMBS_KLU_INVALID;
+    }
+}
+
+static void free_numeric(flexmbs_klu *h, int which)
+{
+    numeric_part *p = &h->part[which];
+    if (p->numeric != NULL) {
+        if (which == PART_REAL)
+            klu_l_free_numeric(&p->numeric, &h->common);
+        else
+            klu_zl_free_numeric(&p->numeric, &h->common);
+    }
+    p->numeric = NULL;
+}
+
+/* Free numerics, symbolic and pattern; keep the handle and its common. */
+static void clear(flexmbs_klu *h)
+{
+    free_numeric(h, PART_REAL);
+    free_numeric(h, PART_COMPLEX);
+    if (h->symbolic != NULL) klu_l_free_symbolic(&h->symbolic, &h->common);
+    h->symbolic = NULL;
+    free(h->colptr);
+    free(h->rowind);
+    h->colptr = NULL;
+    h->rowind = NULL;
+    h->n = 0;
+    h->nnz = 0;
+    memset(h->part, 0, sizeof h->part);
+}
+
+/* A new empty handle, or NULL when out of memory. */
+void *flexmbs_klu_create(void)
+{
+    flexmbs_klu *h = calloc(1, sizeof *h);
+    if (h == NULL) return NULL;
+    klu_l_defaults(&h->common);
+    return h;
+}
+
+/* Free the handle and everything it holds; *handle becomes NULL. */
+void flexmbs_klu_free(void **handle)
+{
+    if (handle == NULL || *handle == NULL) return;
+    flexmbs_klu *h = *handle;
+    clear(h);
+    free(h);
+    *handle = NULL;
+}
+
+/* Symbolic analysis of an n x n pattern (colptr[n+1], rowind[colptr[n]],
+ * 0-based, no duplicates). Replaces any earlier pattern and factorisation. */
+int flexmbs_klu_analyse(void *handle, int64_t n, const int64_t *colptr,
+                        const int64_t *rowind)
+{
+    flexmbs_klu *h = handle;
+    if (h == NULL || n <= 0 || colptr == NULL || rowind == NULL) return FLEXMBS_KLU_INVALID;
+    clear(h);
+    int64_t nnz = colptr[n];
+    if (colptr[0] != 0 || nnz < 0) return FLEXMBS_KLU_INVALID;
+    h->colptr = malloc((size_t)(n + 1) * sizeof *h->colptr);
+    h->rowind = malloc((size_t)(nnz > 0 ? nnz : 1) * sizeof *h->rowind);
+    if (h->colptr == NULL || h->rowind == NULL) {
+        clear(h);
+        return FLEXMBS_KLU_OUT_OF_MEMORY;
+    }
+    memcpy(h->colptr, colptr, (size_t)(n + 1) * sizeof *h->colptr);
+    memcpy(h->rowind, rowind, (size_t)nnz * sizeof *h->rowind);
+    h->symbolic = klu_l_analyze(n, h->colptr, h->rowind, &h->common);
+    if (h->symbolic == NULL) {
+        int code = code_of(&h->common);
+        clear(h);
+        return code == FLEXMBS_KLU_OK ? FLEXMBS_KLU_INVALID : code;
+    }
+    h->n = n;
+    h->nnz = nnz;
+    return FLEXMBS_KLU_OK;
+}
+
+/* Record rcond and rgrowth of the current numeric factorisation. */
+static int measure(flexmbs_klu *h, int which, double *values)
+{
+    numeric_part *p = &h->part[which];
+    SuiteSparse_long ok;
+    if (which == PART_REAL) {
+        ok = klu_l_rcond(h->symbolic, p->numeric, &h->common)
+             && klu_l_rgrowth(h->colptr, h->rowind, values, h->symbolic, p->numeric,
+                              &h->common);
+    } else {
+        ok = klu_zl_rcond(h->symbolic, p->numeric, &h->common)
+             && klu_zl_rgrowth(h->colptr, h->rowind, values, h->symbolic, p->numeric,
+                               &h->common);
+    }
+    if (!ok) return code_of(&h->common);
+    p->rcond = h->common.rcond;
+    p->rgrowth = h->common.rgrowth;
+    return FLEXMBS_KLU_OK;
+}
+
+/* KLU pivots straight through Inf and NaN; catch them before factoring. */
+static int all_finite(const flexmbs_klu *h, int which, const double *values)
+{
+    int64_t nvalues = (which == PART_REAL ? 1 : 2) * h->nnz;
+    for (int64_t k = 0; k < nvalues; k++)
+        if (!isfinite(values[k])) return 0;
+    return 1;
+}
+
+/* Factor afresh, choosing a new pivot order. */
+static int fresh_factor(flexmbs_klu *h, int which, double *values)
+{
+    numeric_part *p = &h->part[which];
+    if (h->symbolic == NULL) return FLEXMBS_KLU_NOT_ANALYSED;
+    free_numeric(h, which);
+    if (!all_finite(h, which, values)) return FLEXMBS_KLU_NOT_FINITE;
+    if (which == PART_REAL)
+        p->numeric = klu_l_factor(h->colptr, h->rowind, values, h->symbolic, &h->common);
+    else
+        p->numeric = klu_zl_factor(h->colptr, h->rowind, values, h->symbolic, &h->common);
+    /* With halt_if_singular (KLU's default) a singular matrix yields NULL. */
+    if (p->numeric == NULL || h->common.status != KLU_OK) {
+        int code = code_of(&h->common);
+        free_numeric(h, which);
+        return code == FLEXMBS_KLU_OK ? FLEXMBS_KLU_INVALID : code;
+    }
+    int code = measure(h, which, values);
+    if (code != FLEXMBS_KLU_OK) {
+        free_numeric(h, which);
+        return code;
+    }
+    p->rcond_fresh = p->rcond;
+    p->rgrowth_fresh = p->rgrowth;
+    p->nfactor++;
+    return FLEXMBS_KLU_OK;
+}
+
+/* Refactor with the old pivot order when there is one and it stays good
+ * (see refactor_degrade_ratio); factor afresh otherwise. */
+static int refactor(flexmbs_klu *h, int which, double *values)
+{
+    numeric_part *p = &h->part[which];
+    if (h->symbolic == NULL) return FLEXMBS_KLU_NOT_ANALYSED;
+    if (p->numeric == NULL) return fresh_factor(h, which, values);
+    if (!all_finite(h, which, values)) {
+        free_numeric(h, which);
+        return FLEXMBS_KLU_NOT_FINITE;
+    }
+    SuiteSparse_long ok;
+    if (which == PART_REAL)
+        ok = klu_l_refactor(h->colptr, h->rowind, values, h->symbolic, p->numeric,
+                            &h->common);
+    else
+        ok = klu_zl_refactor(h->colptr, h->rowind, values, h->symbolic, p->numeric,
+                             &h->common);
+    if (!ok || h->common.status != KLU_OK) {
+        /* A zero pivot in the old order need not mean a singular matrix. */
+        if (h->common.status == KLU_SINGULAR) return fresh_factor(h, which, values);
+        int code = code_of(&h->common);
+        free_numeric(h, which);
+        return code == FLEXMBS_KLU_OK ? FLEXMBS_KLU_INVALID : code;
+    }
+    if (measure(h, which, values) != FLEXMBS_KLU_OK
+        || !(p->rcond >= refactor_degrade_ratio * p->rcond_fresh)
+        || !(p->rgrowth >= refactor_degrade_ratio * p->rgrowth_fresh))
+        return fresh_factor(h, which, values);
+    p->nrefactor++;
+    return FLEXMBS_KLU_OK;
+}
+
+int flexmbs_klu_factor(void *handle, const double *values)
+{
+    if (handle == NULL) return FLEXMBS_KLU_NOT_ANALYSED;
+    return fresh_factor(handle, PART_REAL, (double *)values);
+}
+
+int flexmbs_klu_refactor(void *handle, const double *values)
+{
+    if (handle == NULL) return FLEXMBS_KLU_NOT_ANALYSED;
+    return refactor(handle, PART_REAL, (double *)values);
+}
+
+int flexmbs_klu_zfactor(void *handle, const double _Complex *values)
+{
+    if (handle == NULL) return FLEXMBS_KLU_NOT_ANALYSED;
+    return fresh_factor(handle, PART_COMPLEX, (double *)values);
+}
+
+int flexmbs_klu_zrefactor(void *handle, const double _Complex *values)
+{
+    if (handle == NULL) return FLEXMBS_KLU_NOT_ANALYSED;
+    return refactor(handle, PART_COMPLEX, (double *)values);
+}
+
+/* Overwrite b (n x nrhs, column-major) with A^-1 b. */
+int flexmbs_klu_solve(void *handle, int64_t nrhs, double *b)
+{
+    flexmbs_klu *h = handle;
+    if (h == NULL || h->symbolic == NULL) return FLEXMBS_KLU_NOT_ANALYSED;
+    if (h->part[PART_REAL].numeric == NULL) return FLEXMBS_KLU_NOT_FACTORED;
+    if (nrhs < 1 || b == NULL) return FLEXMBS_KLU_INVALID;
+    if (!klu_l_solve(h->symbolic, h->part[PART_REAL].numeric, h->n, nrhs, b, &h->common))
+        return code_of(&h->common);
+    return FLEXMBS_KLU_OK;
+}
+
+int flexmbs_klu_zsolve(void *handle, int64_t nrhs, double _Complex *b)
+{
+    flexmbs_klu *h = handle;
+    if (h == NULL || h->symbolic == NULL) return FLEXMBS_KLU_NOT_ANALYSED;
+    if (h->part[PART_COMPLEX].numeric == NULL) return FLEXMBS_KLU_NOT_FACTORED;
+    if (nrhs < 1 || b == NULL) return FLEXMBS_KLU_INVALID;
+    if (!klu_zl_solve(h->symbolic, h->part[PART_COMPLEX].numeric, h->n, nrhs, (double *)b,
+                      &h->common))
+        return code_of(&h->common);
+    return FLEXMBS_KLU_OK;
+}
+
+/* Statistics of one part (0 real, 1 complex): counts of fresh and reused
+ * factorisations, rcond and rgrowth of the latest, whether one is alive. */
+int flexmbs_klu_stats(const void *handle, int part, int64_t *nfactor, int64_t *nrefactor,
+                      double *rcond, double *rgrowth, int *factored)
+{
+    const flexmbs_klu *h = handle;
+    *nfactor = 0;
+    *nrefactor = 0;
+    *rcond = 0.0;
+    *rgrowth = 0.0;
+    *factored = 0;
+    if (h == NULL) return FLEXMBS_KLU_NOT_ANALYSED;
+    if (part != PART_REAL && part != PART_COMPLEX) return FLEXMBS_KLU_INVALID;
+    const numeric_part *p = &h->part[part];
+    *nfactor = p->nfactor;
+    *nrefactor = p->nrefactor;
+    *rcond = p->rcond;
+    *rgrowth = p->rgrowth;
+    *factored = p->numeric != NULL;
+    return FLEXMBS_KLU_OK;
+}
+
+/* The threshold of the refactor check, for documentation and tests. */
+double flexmbs_klu_refactor_degrade_ratio(void)
+{
+    return refactor_degrade_ratio;
+}
