@@ -7,6 +7,7 @@ program flexmbs_tests
     use test_problems, only: collect_problems
     use test_radau5, only: collect_radau5
     use test_radau5_dae, only: collect_radau5_dae
+    use test_radau5_sparse, only: collect_radau5_sparse
     use test_io, only: collect_io
     implicit none
     integer :: npassed, nfailed, nargs
@@ -22,6 +23,7 @@ program flexmbs_tests
     call run_suite('problems', collect_problems(), filter, npassed, nfailed)
     call run_suite('radau5', collect_radau5(), filter, npassed, nfailed)
     call run_suite('radau5_dae', collect_radau5_dae(), filter, npassed, nfailed)
+    call run_suite('radau5_sparse', collect_radau5_sparse(), filter, npassed, nfailed)
     call run_suite('io', collect_io(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
