@@ -15,7 +15,7 @@
 #include <string.h>
 #include <complex.h>
 #include <math.h>
-#include "klu.h"
+#include <suitesparse/klu.h> /* Debian: klu.h lives in suitesparse/ */
 
 _Static_assert(sizeof(SuiteSparse_long) == sizeof(int64_t),
                "KLU's SuiteSparse_long must be 64-bit for the klu_l_* API");
