@@ -76,21 +76,31 @@ test: deps
 PROFILE     ?= debug
 PREFIX_USED ?= $(PREFIX_DEBUG)
 LEGACY_DRIVERS := $(wildcard legacy/test/*.f)
+LEGACY_MODERN  := $(wildcard legacy/test/*.f90)
 
-# Classic drivers: plain `gfortran -std=legacy`, linked against the install.
+# Classic drivers: plain `gfortran -std=legacy`, linked against the install;
+# modern callers (*.f90) use the installed interface modules. The root is
+# installed too (--no-prune: the whole library), for `-lflexmbs`.
 legacy-test:
+	@$(FPM) install --no-prune --profile $(PROFILE) --prefix $(PREFIX_USED) >/dev/null
 	@cd legacy && $(FPM) install --profile $(PROFILE) --prefix $(PREFIX_USED) >/dev/null
 	@mkdir -p $(BUILD)/legacy-test
-	@for src in $(LEGACY_DRIVERS); do \
-	    exe=$(BUILD)/legacy-test/$$(basename $$src .f); \
+	@for src in $(LEGACY_DRIVERS) $(LEGACY_MODERN); do \
+	    name=$$(basename $$src); exe=$(BUILD)/legacy-test/$${name%.*}; \
+	    case $$src in \
+	        *.f) flags="-std=legacy" ;; \
+	        *) flags="-std=f2018 -I$(PREFIX_USED)/include -J$(BUILD)/legacy-test" ;; \
+	    esac; \
 	    echo "== $$src"; \
-	    gfortran -std=legacy -o $$exe $$src -L$(PREFIX_USED)/lib \
+	    gfortran $$flags -o $$exe $$src -L$(PREFIX_USED)/lib \
 	        -lflexmbs-legacy -lflexmbs $(SYSLIBS) \
 	        || { echo "FAIL compile $$src"; continue; }; \
 	    ( cd $(BUILD)/legacy-test && $$exe ) || echo "FAIL run $$src (exit $$?)"; \
 	done
 
+# libflexmbs.a needs --no-prune: fpm would otherwise keep only what app/ uses.
 install: deps
+	$(FPM) install --no-prune --profile release --prefix $(PREFIX)
 	cd legacy && $(FPM) install --profile release --prefix $(PREFIX)
 
 bench: deps
