@@ -185,6 +185,7 @@ contains
         stats%t_reached = t
         fd_jacobian = .false.
         self%native = radau5_native_t()
+        self%h_opt = 0.0_wp
         self%nsol_error = 0
         n = problem%n
         x = t
