@@ -24,7 +24,7 @@ SYSLIBS      := -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig \
                 -lhdf5_serial_fortran -lhdf5_serial -llapack -lblas
 MAIN_INPUT   := inputs/van_der_pol.nml
 
-.PHONY: run test bench deps build build-debug install install-debug legacy-test clean help
+.PHONY: run test bench deps build build-debug install legacy-test clean help
 
 help:
 	@echo "make run | make test | make bench | make install PREFIX=dir | make clean"
