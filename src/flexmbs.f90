@@ -18,6 +18,7 @@ module flexmbs
     use flexmbs_dae_solver, only: dae_solver_t
     use flexmbs_dae_radau5, only: radau5_t, radau5_dense_t, radau5_native_t
     use flexmbs_dae_error_measure, only: paper_error
+    use flexmbs_dae_bdf_stability, only: bdf_stability_angle, bdf_boundary_locus
     use flexmbs_io_namelist, only: scene_input_t, read_scene, parse_scene, scene_dae_options
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_table, only: stats_row_t, new_stats_row, table_text, write_table, &
