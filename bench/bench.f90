@@ -3,7 +3,7 @@
 !>
 !>   flexmbs-bench PROBLEM N SOLVER [MAX_STEPS] [RTOL]
 !>   PROBLEM: vdp | rd1d | rd2d (N: unknowns for rd1d, grid points per side
-!>   for rd2d, ignored for vdp); SOLVER: dense | klu | auto.
+!>   for rd2d, ignored for vdp); SOLVER: dense | klu | band | auto.
 !> bench/run.sh runs the grid of configurations; these are figures, not tests.
 program flexmbs_bench
     use flexmbs_core_kinds, only: wp
@@ -28,7 +28,8 @@ program flexmbs_bench
     character(len=16) :: outcome
 
     if (command_argument_count() < 3) then
-        write (*, '(a)') 'usage: flexmbs-bench vdp|rd1d|rd2d N dense|klu|auto [MAX_STEPS] [RTOL]'
+        write (*, '(a)') 'usage: flexmbs-bench vdp|rd1d|rd2d N dense|klu|band|auto ' // &
+            '[MAX_STEPS] [RTOL]'
         error stop 2
     end if
     call get_command_argument(1, problem_name)

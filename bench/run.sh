@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # `make bench`: RADAU5 on van der Pol and on the sparse reaction-diffusion
-# problems at 1e2..1e5 unknowns, dense and KLU. Prints figures (CPU, wall,
-# time per step, peak memory, counters), never asserts. Dense LU is capped
-# in steps where it would take minutes, and skipped where it cannot fit.
+# problems at 1e2..1e5 unknowns, dense and KLU (band LU too in 1-D). Prints
+# figures (CPU, wall, time per step, peak memory, counters), never asserts.
+# Dense LU is capped in steps where it would take minutes, and skipped where
+# it cannot fit.
 set -u
 cd "$(dirname "$0")/.."
 FPM=${FPM:-fpm}
@@ -29,6 +30,7 @@ for n in 100 1000 10000 100000; do
         10000)    run rd1d $n dense 3 ;;   # ~1 GB of dense matrices: capped at 3 steps
     esac
     run rd1d $n klu
+    run rd1d $n band   # bandwidths 2, 2: the case for band LU
 done
 # 2-D: 2·N² unknowns for N = 7, 22, 71, 224 (about 1e2, 1e3, 1e4, 1e5).
 for m in 7 22 71 224; do

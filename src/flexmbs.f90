@@ -9,6 +9,7 @@ module flexmbs
         storage_dense, storage_sparse
     use flexmbs_linalg_linear_solver, only: linear_solver_t
     use flexmbs_linalg_dense, only: dense_solver_t
+    use flexmbs_linalg_band, only: band_solver_t
     use flexmbs_linalg_factory, only: new_linear_solver
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t

@@ -14,7 +14,11 @@ module flexmbs_dae_options
         real(wp) :: hmax = 0.0_wp   !! maximal step; 0 = |t_end - t0|
         integer :: max_steps = 100000
         integer :: pmax = 5         !! maximal BDF order / extrapolation stages
-        character(len=8) :: linear_solver = 'auto' !! 'auto' | 'dense' | 'klu'
+        character(len=8) :: linear_solver = 'auto' !! 'auto' | 'dense' | 'klu' | 'band'
+        !> Bandwidths of M and J for 'band' when the caller knows them; -1:
+        !> found from the patterns (a dense Jacobian needs them given).
+        integer :: band_lower = -1
+        integer :: band_upper = -1
         character(len=8) :: jacobian = 'analytic'  !! 'analytic' | 'fd'
         real(wp), allocatable :: output_times(:)   !! dense output at these times
         logical :: output_steps = .false.          !! also every accepted step
@@ -65,9 +69,16 @@ contains
             call status%set(status_bad_input, 'options: max_steps must be positive')
         else if (self%pmax < 1) then
             call status%set(status_bad_input, 'options: pmax must be at least 1')
-        else if (all(self%linear_solver /= [character(len=8) :: 'auto', 'dense', 'klu'])) then
+        else if (all(self%linear_solver /= &
+                     [character(len=8) :: 'auto', 'dense', 'klu', 'band'])) then
             call status%set(status_bad_input, "options: linear_solver = '" // &
-                trim(self%linear_solver) // "': must be 'auto', 'dense' or 'klu'")
+                trim(self%linear_solver) // "': must be 'auto', 'dense', 'klu' or 'band'")
+        else if (self%band_lower < -1 .or. self%band_upper < -1 .or. &
+                 ((self%band_lower == -1) .neqv. (self%band_upper == -1))) then
+            write (msg, '(a,i0,a,i0,a)') 'options: band_lower = ', self%band_lower, &
+                ', band_upper = ', self%band_upper, &
+                ': give both (>= 0) or neither (-1, found from the patterns)'
+            call status%set(status_bad_input, trim(msg))
         else if (all(self%jacobian /= [character(len=8) :: 'analytic', 'fd'])) then
             call status%set(status_bad_input, "options: jacobian = '" // &
                 trim(self%jacobian) // "': must be 'analytic' or 'fd'")

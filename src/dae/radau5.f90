@@ -270,7 +270,15 @@ contains
         ! Matrices and the linear solver: patterns fixed here, once.
         call setup_matrices(status)
         if (.not. status%ok()) return
-        call new_linear_solver(options%linear_solver, n, jac%storage, ls, status)
+        ! A dense J holds no values yet, so its band cannot be seen at init.
+        if (options%linear_solver == 'band' .and. jac%storage == storage_dense .and. &
+            options%band_lower < 0) then
+            call bad("linear_solver = 'band' with a dense or difference Jacobian needs " // &
+                "options%band_lower and band_upper; or give J as a sparse pattern")
+            return
+        end if
+        call new_linear_solver(options%linear_solver, n, jac%storage, ls, status, &
+            options%band_lower, options%band_upper)
         if (.not. status%ok()) return
         call ls%init(mass, jac, status)
         if (.not. status%ok()) return
@@ -381,6 +389,11 @@ contains
                 if (.not. singular) then
                     call ls%factor_complex(cmplx(alphn, betan, kind=wp), mass, jac, fstatus)
                     singular = .not. fstatus%ok()
+                end if
+                ! Misuse (e.g. J outside the band fixed at init) is no singularity.
+                if (fstatus%code == status_bad_input) then
+                    status = fstatus
+                    exit main
                 end if
                 if (singular) then
                     nsing = nsing + 1

@@ -818,8 +818,9 @@ contains
             call bad(sol, 'hmax', 'must not be negative (0 = the whole interval)')
         else if (scene%max_steps < 1) then
             call bad(sol, 'max_steps', 'must be positive')
-        else if (all([character(len=8) :: 'auto', 'dense', 'klu'] /= scene%linear_solver)) then
-            call bad(sol, 'linear_solver', 'must be ''auto'', ''dense'' or ''klu''')
+        else if (all([character(len=8) :: 'auto', 'dense', 'klu', 'band'] &
+                     /= scene%linear_solver)) then
+            call bad(sol, 'linear_solver', 'must be ''auto'', ''dense'', ''klu'' or ''band''')
         else if (all([character(len=8) :: 'analytic', 'fd'] /= scene%jacobian)) then
             call bad(sol, 'jacobian', 'must be ''analytic'' or ''fd''')
         else if (scene%nit < 1) then

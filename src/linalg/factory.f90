@@ -5,6 +5,7 @@ module flexmbs_linalg_factory
     use flexmbs_linalg_linear_solver, only: linear_solver_t, auto_sparse_threshold
     use flexmbs_linalg_dense, only: dense_solver_t
     use flexmbs_linalg_klu_solver, only: klu_solver_t
+    use flexmbs_linalg_band, only: band_solver_t
     implicit none
     private
 
@@ -12,15 +13,20 @@ module flexmbs_linalg_factory
 
 contains
 
-    !> A new, not yet initialised solver: 'dense', 'klu', or 'auto', which
-    !> picks dense for n < auto_sparse_threshold or a J that is not sparse,
-    !> and KLU otherwise. Call `solver%init(mass, jac, status)` next.
-    subroutine new_linear_solver(name, n, jac_storage, solver, status)
-        character(len=*), intent(in) :: name        !! 'auto' | 'dense' | 'klu'
+    !> A new, not yet initialised solver: 'dense', 'klu', 'band', or 'auto',
+    !> which picks dense for n < auto_sparse_threshold or a J that is not
+    !> sparse, and KLU otherwise. For 'band', `lower` and `upper` (both or
+    !> neither; negative = found by init) fix the bandwidths. Call
+    !> `solver%init(mass, jac, status)` next.
+    subroutine new_linear_solver(name, n, jac_storage, solver, status, lower, upper)
+        character(len=*), intent(in) :: name        !! 'auto' | 'dense' | 'klu' | 'band'
         integer, intent(in) :: n                    !! order of the iteration matrix
         integer, intent(in) :: jac_storage          !! storage_* of the Jacobian
         class(linear_solver_t), allocatable, intent(out) :: solver
         type(status_t), intent(out) :: status
+        integer, intent(in), optional :: lower      !! lower bandwidth for 'band'
+        integer, intent(in), optional :: upper      !! upper bandwidth for 'band'
+        type(band_solver_t), allocatable :: band
         character(len=160) :: msg
 
         if (n <= 0) then
@@ -45,9 +51,14 @@ contains
                 return
             end if
             allocate (klu_solver_t :: solver)
+        case ('band')
+            allocate (band)
+            if (present(lower)) band%lower = lower
+            if (present(upper)) band%upper = upper
+            call move_alloc(band, solver)
         case default
             call status%set(status_bad_input, "linear_solver = '" // trim(name) // &
-                "': unknown; use 'auto', 'dense' or 'klu'")
+                "': unknown; use 'auto', 'dense', 'klu' or 'band'")
         end select
     end subroutine new_linear_solver
 end module flexmbs_linalg_factory

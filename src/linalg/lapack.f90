@@ -3,7 +3,7 @@ module flexmbs_linalg_lapack
     use flexmbs_core_kinds, only: wp
     implicit none
     private
-    public :: dgetrf, dgetrs, zgetrf, zgetrs, dgbtrf, dgbtrs
+    public :: dgetrf, dgetrs, zgetrf, zgetrs, dgbtrf, dgbtrs, zgbtrf, zgbtrs
 
     interface
         subroutine dgetrf(m, n, a, lda, ipiv, info)
@@ -48,5 +48,19 @@ module flexmbs_linalg_lapack
             real(wp), intent(inout) :: b(ldb, *)
             integer, intent(out) :: info
         end subroutine dgbtrs
+        subroutine zgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
+            import :: wp
+            integer, intent(in) :: m, n, kl, ku, ldab
+            complex(wp), intent(inout) :: ab(ldab, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine zgbtrf
+        subroutine zgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
+            import :: wp
+            character, intent(in) :: trans
+            integer, intent(in) :: n, kl, ku, nrhs, ldab, ldb, ipiv(*)
+            complex(wp), intent(in) :: ab(ldab, *)
+            complex(wp), intent(inout) :: b(ldb, *)
+            integer, intent(out) :: info
+        end subroutine zgbtrs
     end interface
 end module flexmbs_linalg_lapack

@@ -15,7 +15,9 @@ module flexmbs_linalg_linear_solver
     !> `linear_solver = 'auto'`. `make bench` (RADAU5, OpenBLAS, 2 cores):
     !> CPU per step dense/KLU on the 1-D Brusselator is 1.3 at n = 10, 3.5 at
     !> 20, 5.3 at 60, 18 at 100, 256 at 1000; below ~20 the two are equal
-    !> within noise and dense is the more robust choice.
+    !> within noise and dense is the more robust choice. Band LU is never
+    !> chosen: on the same banded problem it is 10-20 % slower than KLU at
+    !> n = 1e2..1e5 (README, Benchmarks).
     integer, parameter, public :: auto_sparse_threshold = 20
 
     type, abstract, public :: linear_solver_t
@@ -65,7 +67,7 @@ module flexmbs_linalg_linear_solver
             class(linear_solver_t), intent(inout) :: self
             complex(wp), intent(inout) :: b(:)
         end subroutine solve_complex_i
-        !> 'dense' or 'klu'.
+        !> 'dense', 'klu' or 'band'.
         function name_i(self) result(name)
             import :: linear_solver_t
             class(linear_solver_t), intent(in) :: self
