@@ -530,7 +530,6 @@ contains
                 'IDASetLinearSolver')) return
             if (data%jac_mode /= jac_quotients) ok = check(FIDASetJacFn(mem, &
                 c_funloc(ida_jacobian)), 'IDASetJacFn')
-            if (.not. st%ok()) return
         end subroutine attach_linear_solver
 
         !> IDA_NORMAL to each output time, then to t_end (IDA interpolates).
@@ -723,6 +722,8 @@ contains
     end subroutine append_pattern
 
     ! ---- bind(C) callbacks ----
+    ! The N_Vector arguments are intent(inout) only because FN_VGetArrayPointer
+    ! declares its argument so; y and y' are read, never written.
 
     !> IDAResFn: r = M y' − F(t, y). Failures and non-finite values are
     !> recoverable (1): IDA retries with a smaller step.
