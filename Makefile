@@ -20,7 +20,13 @@ PREFIX_DEBUG   := $(BUILD)/prefix-debug
 PREFIX_RELEASE := $(BUILD)/prefix-release
 PREFIX       ?= /usr/local
 # The link line a user needs after the flexmbs library (see README).
-SYSLIBS      := -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig \
+SYSLIBS      := -lsundials_fida_mod -lsundials_fnvecserial_mod \
+                -lsundials_fsunmatrixdense_mod -lsundials_fsunmatrixsparse_mod \
+                -lsundials_fsunlinsoldense_mod -lsundials_fsunlinsolklu_mod \
+                -lsundials_ida -lsundials_nvecserial -lsundials_sunmatrixdense \
+                -lsundials_sunmatrixsparse -lsundials_sunlinsoldense -lsundials_sunlinsolklu \
+                -lsundials_generic \
+                -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig \
                 -lhdf5_serial_fortran -lhdf5_serial -llapack -lblas
 MAIN_INPUT   := inputs/van_der_pol.nml
 

@@ -12,6 +12,7 @@ program flexmbs_tests
     use test_io, only: collect_io
     use test_bdf_stability, only: collect_bdf_stability
     use test_reference, only: collect_reference
+    use test_ida, only: collect_ida
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -31,6 +32,7 @@ program flexmbs_tests
     call run_suite('io', collect_io(), filter, npassed, nfailed)
     call run_suite('bdf_stability', collect_bdf_stability(), filter, npassed, nfailed)
     call run_suite('reference', collect_reference(), filter, npassed, nfailed)
+    call run_suite('ida', collect_ida(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests
