@@ -112,6 +112,8 @@ expect unknown-option 2 "unknown option '--loud'" run x.nml --loud
 printf '%s\n&solver rtol = 1e-4, atol = 1e-4, h0 = 1e-6 /\n%s\n' "$sim" "$out" > ok.nml
 kept success 0 "y(1) =  1.7061611" out/run.h5 run ok.nml --quiet
 kept success-statistics 0 "radau5: NST=275 NAC=238" out/run.h5 run ok.nml --quiet
+printf '%s\n&solver name = '"'ida'"', rtol = 1e-8, atol = 1e-8 /\n%s\n' "$sim" "$out" > ida.nml
+kept success-ida 0 "y(1) =  1.70616" out/run.h5 run ida.nml --quiet
 
 # solver failure: exit 3, reason, time reached, statistics, file kept
 printf '%s\n&solver max_steps = 5 /\n%s\n' "$sim" "$out" > fails.nml

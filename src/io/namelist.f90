@@ -803,9 +803,9 @@ contains
         else if (scene%npoints < 1) then
             call bad(sim, 'npoints', 'must be positive')
         ! &solver
-        else if (scene%solver_name /= 'radau5') then
+        else if (scene%solver_name /= 'radau5' .and. scene%solver_name /= 'ida') then
             call bad(sol, 'name', &
-                     'must be ''radau5'' (ddassl, ida and mexax are not available yet)')
+                     'must be ''radau5'' or ''ida'' (ddassl and mexax are not available yet)')
         else if (.not. scene%rtol > 0.0_wp) then
             call bad(sol, 'rtol', 'must be positive')
         else if (.not. scene%rtol < 1.0_wp) then

@@ -11,6 +11,7 @@ module flexmbs_io_scene
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_solver, only: dae_solver_t
     use flexmbs_dae_radau5, only: radau5_t
+    use flexmbs_dae_ida, only: ida_t
     use flexmbs_linalg_linear_solver, only: linear_solver_t
     use flexmbs_linalg_factory, only: new_linear_solver
     use flexmbs_problems_van_der_pol, only: new_van_der_pol
@@ -118,6 +119,7 @@ contains
         class(dae_solver_t), allocatable, intent(out) :: solver
         type(status_t), intent(out) :: status
         type(radau5_t) :: radau5
+        type(ida_t) :: ida
         select case (trim(scene%solver_name))
         case ('radau5')
             radau5%nit = scene%nit
@@ -131,6 +133,8 @@ contains
             radau5%controller = controller_code(scene%controller)
             radau5%zero_start = scene%zero_start
             allocate (solver, source=radau5)
+        case ('ida')
+            allocate (solver, source=ida)
         case default
             call status%set(status_bad_input, scene%path // ': &solver: name = ''' // &
                 trim(scene%solver_name) // ''': not available in this build yet')
