@@ -10,6 +10,7 @@ program flexmbs_tests
     use test_radau5_sparse, only: collect_radau5_sparse
     use test_io, only: collect_io
     use test_bdf_stability, only: collect_bdf_stability
+    use test_ddassl, only: collect_ddassl
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -27,6 +28,7 @@ program flexmbs_tests
     call run_suite('radau5_sparse', collect_radau5_sparse(), filter, npassed, nfailed)
     call run_suite('io', collect_io(), filter, npassed, nfailed)
     call run_suite('bdf_stability', collect_bdf_stability(), filter, npassed, nfailed)
+    call run_suite('ddassl', collect_ddassl(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests
