@@ -16,6 +16,8 @@ module test_ddassl
     use flexmbs_problems_robertson, only: robertson_t, new_robertson, robertson_initial
     use flexmbs_problems_pendulum, only: pendulum_t, new_pendulum, pendulum_initial, &
         pendulum_reference, pendulum_index2, pendulum_ggl
+    use flexmbs_io_namelist, only: scene_input_t, parse_scene
+    use flexmbs_io_scene, only: run_result_t, run_scene
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
     private
@@ -70,7 +72,8 @@ contains
                  new_test('pmax_honoured', test_pmax), &
                  new_test('non_finite_is_failure', test_non_finite), &
                  new_test('max_steps_reports_time', test_max_steps), &
-                 new_test('bad_input', test_bad_input)]
+                 new_test('bad_input', test_bad_input), &
+                 new_test('scene_solver_ddassl', test_scene)]
     end function collect_ddassl
 
     subroutine riccati_rhs(self, t, y, f, status)
@@ -537,4 +540,29 @@ contains
         call solver%integrate(problem, t, y, 0.0_wp, options, stats, status)
         call check(error, status%code == status_bad_input, 't_end = t accepted')
     end subroutine test_bad_input
+
+    !> `&solver name = 'ddassl', pmax = …` runs through run_scene; pmax > 5 is refused.
+    subroutine test_scene(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_input_t) :: scene
+        type(status_t) :: status
+        type(run_result_t) :: result
+        character(len=*), parameter :: sim = &
+            '&simulation problem = ''robertson'', t_end = 40 /' // new_line('a')
+        call parse_scene(sim // '&solver name = ''DDASSL'', pmax = 2, rtol = 1e-6, ' // &
+            'atol = 1e-10 /', 'rober.nml', scene, status)
+        call check(error, status%ok(), 'parse: ' // status%text())
+        if (allocated(error)) return
+        call run_scene(scene, .true., result, status)
+        call check(error, status%ok(), 'run: ' // status%text())
+        call check(error, result%solver_name == 'ddassl', 'solver name')
+        call check_close(error, result%t, 40.0_wp, 0.0_wp, 't_end reached')
+        ! y1(40) = 0.7158270687 [MIM06, rober at t = 40].
+        call check_close(error, result%y(1), 0.7158270687_wp, 1.0e-4_wp, 'y1(40)', rel=.true.)
+        call check(error, result%stats%nst == result%stats%nac + result%stats%nrj, 'NST')
+        call parse_scene(sim // '&solver name = ''ddassl'', pmax = 6 /', 'rober.nml', scene, &
+            status)
+        call check(error, .not. status%ok() .and. index(status%text(), 'pmax') > 0, &
+            'pmax = 6 accepted for ddassl: ' // status%text())
+    end subroutine test_scene
 end module test_ddassl

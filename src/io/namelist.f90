@@ -803,9 +803,9 @@ contains
         else if (scene%npoints < 1) then
             call bad(sim, 'npoints', 'must be positive')
         ! &solver
-        else if (scene%solver_name /= 'radau5') then
+        else if (all([character(len=8) :: 'radau5', 'ddassl'] /= scene%solver_name)) then
             call bad(sol, 'name', &
-                     'must be ''radau5'' (ddassl, ida and mexax are not available yet)')
+                     'must be ''radau5'' or ''ddassl'' (ida and mexax are not available yet)')
         else if (.not. scene%rtol > 0.0_wp) then
             call bad(sol, 'rtol', 'must be positive')
         else if (.not. scene%rtol < 1.0_wp) then
@@ -842,6 +842,9 @@ contains
             call bad(sol, 'controller', 'must be ''predictive'' or ''classical''')
         else if (scene%pmax < 1 .or. scene%pmax > 12) then
             call bad(sol, 'pmax', 'must lie in 1..12')
+        else if (scene%solver_name == 'ddassl' .and. scene%pmax > 5) then
+            ! ALGORITHMS.md §2.2: MAXORD ≤ 5.
+            call bad(sol, 'pmax', 'must lie in 1..5 for ddassl (its maximal BDF order)')
         ! &output
         else if (scene%n_output < 2) then
             call bad(out, 'n_output', 'must be at least 2 (t_start and t_end)')

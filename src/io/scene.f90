@@ -11,6 +11,7 @@ module flexmbs_io_scene
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_solver, only: dae_solver_t
     use flexmbs_dae_radau5, only: radau5_t
+    use flexmbs_dae_ddassl, only: ddassl_t
     use flexmbs_linalg_linear_solver, only: linear_solver_t
     use flexmbs_linalg_factory, only: new_linear_solver
     use flexmbs_problems_van_der_pol, only: new_van_der_pol
@@ -131,6 +132,9 @@ contains
             radau5%controller = controller_code(scene%controller)
             radau5%zero_start = scene%zero_start
             allocate (solver, source=radau5)
+        case ('ddassl')
+            ! pmax reaches it through dae_options_t (MAXORD).
+            allocate (ddassl_t :: solver)
         case default
             call status%set(status_bad_input, scene%path // ': &solver: name = ''' // &
                 trim(scene%solver_name) // ''': not available in this build yet')
@@ -209,6 +213,9 @@ contains
         select type (solver)
         type is (radau5_t)
             call progress%watch(solver%native%nstep, solver%native%naccpt)
+        type is (ddassl_t)
+            ! Native NST counts accepted steps only.
+            call progress%watch(solver%native%nst, solver%native%nst)
         end select
         call sinks%attach(progress)
 
