@@ -3,14 +3,16 @@
 module test_ddassl
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use flexmbs_core_kinds, only: wp
-    use flexmbs_core_status, only: status_t, status_solver_failure, status_bad_input
-    use flexmbs_linalg_matrix, only: storage_dense
+    use flexmbs_core_status, only: status_t, status_solver_failure, status_bad_input, &
+        status_interrupted
+    use flexmbs_linalg_matrix, only: matrix_t, storage_dense, storage_none, storage_identity
+    use flexmbs_dae_residual_problem, only: residual_problem_t
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
-    use flexmbs_dae_sink, only: sink_t
+    use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_radau5, only: radau5_t
-    use flexmbs_dae_ddassl, only: ddassl_t
+    use flexmbs_dae_ddassl, only: ddassl_t, ddassl_dense_t
     use flexmbs_dae_error_measure, only: paper_error
     use flexmbs_problems_van_der_pol, only: van_der_pol_t, new_van_der_pol
     use flexmbs_problems_robertson, only: robertson_t, new_robertson, robertson_initial
@@ -37,6 +39,27 @@ module test_ddassl
     contains
         procedure :: rhs => poisoned_rhs
     end type poisoned_t
+
+    !> G = (2 + sin y)(y' + 2t y²): fully implicit, ∂G/∂y' depends on y; the
+    !> solution is that of the Riccati problem. Stops (IRES = −2) past t_stop.
+    type, extends(residual_problem_t) :: implicit_riccati_t
+        real(wp) :: t_stop = huge(1.0_wp)
+    contains
+        procedure :: residual => implicit_residual
+        procedure :: setup_partials => implicit_setup
+        procedure :: partials => implicit_partials
+    end type implicit_riccati_t
+
+    !> Checks the dense output at both ends of every accepted step.
+    type, extends(sink_t) :: step_checker_t
+        integer :: nsteps = 0
+        real(wp) :: max_end = 0.0_wp, max_start = 0.0_wp
+        real(wp) :: y_old(1) = 0.0_wp
+    contains
+        procedure :: output => checker_output
+        procedure :: wants_steps => checker_wants_steps
+        procedure :: step => checker_step
+    end type step_checker_t
 
     !> Keeps the requested outputs.
     type, extends(sink_t) :: output_sink_t
@@ -73,7 +96,11 @@ contains
                  new_test('non_finite_is_failure', test_non_finite), &
                  new_test('max_steps_reports_time', test_max_steps), &
                  new_test('bad_input', test_bad_input), &
-                 new_test('scene_solver_ddassl', test_scene)]
+                 new_test('scene_solver_ddassl', test_scene), &
+                 new_test('residual_problem_analytic_and_fd', test_residual_problem), &
+                 new_test('residual_stop_is_interrupt', test_residual_stop), &
+                 new_test('dense_output_at_step_ends', test_dense_steps), &
+                 new_test('netlib_nonnegative_ddaini_robertson', test_switches)]
     end function collect_ddassl
 
     subroutine riccati_rhs(self, t, y, f, status)
@@ -540,6 +567,176 @@ contains
         call solver%integrate(problem, t, y, 0.0_wp, options, stats, status)
         call check(error, status%code == status_bad_input, 't_end = t accepted')
     end subroutine test_bad_input
+
+    subroutine implicit_residual(self, t, y, yp, g, status)
+        class(implicit_riccati_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:), yp(:)
+        real(wp), intent(out) :: g(:)
+        type(status_t), intent(inout) :: status
+        g(1) = (2.0_wp + sin(y(1))) * (yp(1) + 2.0_wp * t * y(1)**2)
+        if (t > self%t_stop) call status%set(status_interrupted, 'stop requested')
+    end subroutine implicit_residual
+
+    subroutine implicit_setup(self, differenced, a, b, status)
+        class(implicit_riccati_t), intent(inout) :: self
+        logical, intent(in) :: differenced
+        type(matrix_t), intent(inout) :: a, b
+        type(status_t), intent(inout) :: status
+        a%n = 1
+        a%storage = storage_dense
+        allocate (a%dense(1, 1))
+        a%dense = 1.0_wp
+        b%n = 1
+        b%storage = storage_none
+        if (.not. differenced) then
+            b%storage = storage_dense
+            allocate (b%dense(1, 1))
+        end if
+    end subroutine implicit_setup
+
+    !> A = ∂G/∂y' = 2 + sin y, B = −∂G/∂y.
+    subroutine implicit_partials(self, t, y, yp, a, b, status)
+        class(implicit_riccati_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:), yp(:)
+        type(matrix_t), intent(inout) :: a, b
+        type(status_t), intent(inout) :: status
+        a%dense(1, 1) = 2.0_wp + sin(y(1))
+        b%dense(1, 1) = -(cos(y(1)) * (yp(1) + 2.0_wp * t * y(1)**2) &
+            + (2.0_wp + sin(y(1))) * 4.0_wp * t * y(1))
+    end subroutine implicit_partials
+
+    subroutine checker_output(self, t, y, status)
+        class(step_checker_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        type(status_t), intent(inout) :: status
+    end subroutine checker_output
+
+    logical function checker_wants_steps(self)
+        class(step_checker_t), intent(in) :: self
+        checker_wants_steps = .true.
+    end function checker_wants_steps
+
+    subroutine checker_step(self, nr, t_old, t, y, dense, stop, status)
+        class(step_checker_t), intent(inout) :: self
+        integer, intent(in) :: nr
+        real(wp), intent(in) :: t_old, t, y(:)
+        class(dense_output_t), intent(in) :: dense
+        logical, intent(inout) :: stop
+        type(status_t), intent(inout) :: status
+        real(wp) :: u(1)
+        self%nsteps = self%nsteps + 1
+        call dense%evaluate(t, u)
+        self%max_end = max(self%max_end, abs(u(1) - y(1)))
+        if (nr > 1) then
+            call dense%evaluate(t_old, u)
+            self%max_start = max(self%max_start, abs(u(1) - self%y_old(1)))
+        end if
+        self%y_old = y(1:1)
+    end subroutine checker_step
+
+    !> A user residual problem, with analytic partials and differenced.
+    subroutine test_residual_problem(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(implicit_riccati_t) :: problem
+        type(ddassl_t) :: solver
+        type(dae_options_t) :: options
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        real(wp) :: t, y(1), yp(1)
+        integer :: i
+        character(len=8), parameter :: jac(2) = [character(len=8) :: 'analytic', 'fd']
+        problem%n = 1
+        options%rtol = 1.0e-8_wp
+        options%atol = 1.0e-8_wp
+        do i = 1, 2
+            options%jacobian = jac(i)
+            t = 0.0_wp
+            y = 1.0_wp
+            yp = 0.0_wp
+            call solver%integrate_residual(problem, t, y, yp, 2.0_wp, options, stats, status)
+            call check(error, status%ok(), trim(jac(i)) // ': ' // status%text())
+            call check_close(error, y(1), 0.2_wp, 1.0e-6_wp, trim(jac(i)) // ': y(2)')
+            call check_close(error, yp(1), -0.16_wp, 1.0e-5_wp, trim(jac(i)) // ': yp(2)')
+            if (i == 2) call check(error, stats%nfe_jac == stats%nje, 'one call per column')
+            if (i == 1) call check(error, stats%nfe_jac == 0, 'no difference calls')
+        end do
+    end subroutine test_residual_problem
+
+    !> A residual reporting status_interrupted (IRES = −2) ends the run there.
+    subroutine test_residual_stop(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(implicit_riccati_t) :: problem
+        type(ddassl_t) :: solver
+        type(dae_options_t) :: options
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        real(wp) :: t, y(1), yp(1)
+        problem%n = 1
+        problem%t_stop = 0.5_wp
+        t = 0.0_wp
+        y = 1.0_wp
+        yp = 0.0_wp
+        call solver%integrate_residual(problem, t, y, yp, 2.0_wp, options, stats, status)
+        call check(error, status%code == status_interrupted, 'expected interrupt: ' // &
+            status%text())
+        call check(error, t <= 0.5_wp .and. t > 0.3_wp, 'stopped near t_stop')
+        call check_close(error, y(1), 1.0_wp / (1.0_wp + t**2), 1.0e-4_wp, 'y at the stop')
+    end subroutine test_residual_stop
+
+    !> The interpolant of §2.5 reproduces y at both ends of every step.
+    subroutine test_dense_steps(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(riccati_t) :: problem
+        type(ddassl_t) :: solver
+        type(dae_options_t) :: options
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        type(step_checker_t) :: sink
+        real(wp) :: t, y(1), u(1), yp(1)
+        problem%n = 1
+        options%rtol = 1.0e-6_wp
+        options%atol = 1.0e-6_wp
+        t = 0.0_wp
+        y = 1.0_wp
+        call solver%integrate(problem, t, y, 2.0_wp, options, stats, status, sink)
+        call check(error, status%ok(), status%text())
+        call check(error, sink%nsteps == stats%nac + 1, 'one call per accepted step + t0')
+        call check(error, sink%max_end <= 1.0e-14_wp, 'interpolant misses y at t_n')
+        call check(error, sink%max_start <= 1.0e-14_wp, 'interpolant misses y at t_{n-1}')
+        call solver%dense%interpolate(solver%dense%tn, u, yp)
+        call check_close(error, yp(1), -2.0_wp * solver%dense%tn * u(1)**2, 1.0e-4_wp, &
+            'interpolated derivative', rel=.true.)
+    end subroutine test_dense_steps
+
+    !> The netlib revision, y ≥ 0 and DDAINI all integrate Robertson to 40.
+    subroutine test_switches(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(robertson_t) :: problem
+        type(ddassl_t) :: solver
+        type(dae_options_t) :: options
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        real(wp) :: t, y(3), yp(3)
+        integer :: i
+        problem = new_robertson()
+        options%rtol = 1.0e-6_wp
+        options%atol = 1.0e-10_wp
+        do i = 1, 3
+            solver = ddassl_t()
+            solver%netlib = i == 1
+            solver%nonnegative = i == 2
+            solver%initial_derivative = i == 3
+            call robertson_initial(problem, y)
+            yp = 0.0_wp
+            t = 0.0_wp
+            call solver%integrate(problem, t, y, 40.0_wp, options, stats, status, yp=yp)
+            call check(error, status%ok(), 'switch run failed: ' // status%text())
+            ! y1(40) = 0.7158270687 [MIM06, rober at t = 40].
+            call check_close(error, y(1), 0.7158270687_wp, 1.0e-4_wp, 'y1(40)', rel=.true.)
+            call check(error, all(y >= -1.0e-12_wp), 'negative concentration')
+            call check_close(error, yp(1) + yp(2) + yp(3), 0.0_wp, 1.0e-8_wp, 'sum of y''')
+        end do
+    end subroutine test_switches
 
     !> `&solver name = 'ddassl', pmax = …` runs through run_scene; pmax > 5 is refused.
     subroutine test_scene(error)

@@ -262,7 +262,7 @@ contains
         integer :: n, pmax, k, kold, ns, iphase, jcalc, nef, ncf, nsf, iout, nout, knew
         real(wp) :: tn, h, hold, cj, cjlast, cjold, s, hmin, hmax, dir, uround, tout_h0
         real(wp) :: t0, h_fixed, span, est, erkm1, terkm1, terk
-        logical :: fd, ddaini, want_steps, stop_requested, done
+        logical :: fd, ddaini, want_steps, stop_requested, done, ires_stop
 
         call timer%start()
         self%native = ddassl_native_t()
@@ -278,6 +278,7 @@ contains
         uround = self%uround
         pmax = options%pmax
         h = 0.0_wp
+        ires_stop = .false.
         ddaini = self%initial_derivative
         if (present(initial_derivative)) ddaini = initial_derivative
 
@@ -664,6 +665,8 @@ contains
             type(status_t) :: fst
             self%native%nre = self%native%nre + 1
             call res%residual(tn, y, yp, delta, fst)
+            ! IRES = −2 of the classic code: the residual asks to stop.
+            if (fst%code == status_interrupted) ires_stop = .true.
             residual_ok = fst%ok()
             if (residual_ok) residual_ok = all(ieee_is_finite(delta))
         end function residual_ok
@@ -865,7 +868,11 @@ contains
                     end if
                 else
                     self%native%ncfn = self%native%ncfn + 1
-                    if (singular) then
+                    if (ires_stop) then
+                        call st%set(status_interrupted, 'ddassl: the residual asked to stop ' &
+                            // 'at t = ' // real_text(tn + h))
+                        return
+                    else if (singular) then
                         nsf = nsf + 1
                         h = h * fail_quarter
                         if (nsf >= max_nsf .or. abs(h) < hmin) then
@@ -1035,7 +1042,11 @@ contains
                     mb = mb + 1
                     if (m >= ini_max_iter) exit newton
                 end do newton
-                if (converged) then
+                if (ires_stop) then
+                    call st%set(status_interrupted, 'ddassl: the residual asked to stop ' // &
+                        'in DDAINI at t = ' // real_text(tn))
+                    exit
+                else if (converged) then
                     delta = y - ysave
                     err = vnorm(delta)
                     if (err <= 1.0_wp) return
