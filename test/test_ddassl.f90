@@ -5,14 +5,14 @@ module test_ddassl
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_solver_failure, status_bad_input, &
         status_interrupted
-    use flexmbs_linalg_matrix, only: matrix_t, storage_dense, storage_none, storage_identity
+    use flexmbs_linalg_matrix, only: matrix_t, storage_dense, storage_none
     use flexmbs_dae_residual_problem, only: residual_problem_t
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_radau5, only: radau5_t
-    use flexmbs_dae_ddassl, only: ddassl_t, ddassl_dense_t
+    use flexmbs_dae_ddassl, only: ddassl_t
     use flexmbs_dae_error_measure, only: paper_error
     use flexmbs_problems_van_der_pol, only: van_der_pol_t, new_van_der_pol
     use flexmbs_problems_robertson, only: robertson_t, new_robertson, robertson_initial
@@ -49,6 +49,16 @@ module test_ddassl
         procedure :: setup_partials => implicit_setup
         procedure :: partials => implicit_partials
     end type implicit_riccati_t
+
+    !> A stiff, lightly damped oscillator driven slowly: x'' + 2ζω x' + ω² x
+    !> = ω² cos t, eigenvalues ω(−ζ ± i) close to the imaginary axis.
+    type, extends(dae_problem_t) :: oscillator_t
+        real(wp) :: omega = 50.0_wp, zeta = 1.0e-2_wp
+    contains
+        procedure :: rhs => oscillator_rhs
+        procedure :: jacobian_storage => oscillator_storage
+        procedure :: jacobian_dense => oscillator_jacobian
+    end type oscillator_t
 
     !> Checks the dense output at both ends of every accepted step.
     type, extends(sink_t) :: step_checker_t
@@ -100,7 +110,8 @@ contains
                  new_test('residual_problem_analytic_and_fd', test_residual_problem), &
                  new_test('residual_stop_is_interrupt', test_residual_stop), &
                  new_test('dense_output_at_step_ends', test_dense_steps), &
-                 new_test('netlib_nonnegative_ddaini_robertson', test_switches)]
+                 new_test('netlib_nonnegative_ddaini_robertson', test_switches), &
+                 new_test('lightly_damped_pmax_2_vs_5', test_table2_pattern)]
     end function collect_ddassl
 
     subroutine riccati_rhs(self, t, y, f, status)
@@ -123,6 +134,29 @@ contains
         type(status_t), intent(inout) :: status
         jac(1, 1) = -4.0_wp * t * y(1)
     end subroutine riccati_jacobian
+
+    subroutine oscillator_rhs(self, t, y, f, status)
+        class(oscillator_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: f(:)
+        type(status_t), intent(inout) :: status
+        f(1) = y(2)
+        f(2) = self%omega**2 * (cos(t) - y(1)) - 2.0_wp * self%zeta * self%omega * y(2)
+    end subroutine oscillator_rhs
+
+    integer function oscillator_storage(self)
+        class(oscillator_t), intent(in) :: self
+        oscillator_storage = storage_dense
+    end function oscillator_storage
+
+    subroutine oscillator_jacobian(self, t, y, jac, status)
+        class(oscillator_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: jac(:, :)
+        type(status_t), intent(inout) :: status
+        jac = reshape([0.0_wp, -self%omega**2, 1.0_wp, -2.0_wp * self%zeta * self%omega], &
+            [2, 2])
+    end subroutine oscillator_jacobian
 
     subroutine poisoned_rhs(self, t, y, f, status)
         class(poisoned_t), intent(inout) :: self
@@ -737,6 +771,42 @@ contains
             call check_close(error, yp(1) + yp(2) + yp(3), 0.0_wp, 1.0e-8_wp, 'sum of y''')
         end do
     end subroutine test_switches
+
+    !> Paper Table 2 pattern: BDF-3…5 are not A-stable, so on a stiff, lightly
+    !> damped oscillator pmax = 5 pays in rejected steps and Jacobians.
+    subroutine test_table2_pattern(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(oscillator_t) :: problem
+        type(ddassl_t) :: solver
+        type(dae_options_t) :: options
+        type(dae_stats_t) :: stats(2)
+        type(status_t) :: status
+        real(wp) :: t, y(2)
+        integer :: i
+        integer, parameter :: pmax(2) = [2, 5]
+        character(len=300) :: msg
+        complex(wp) :: hgain
+        problem%n = 2
+        hgain = problem%omega**2 / cmplx(problem%omega**2 - 1.0_wp, &
+            2.0_wp * problem%zeta * problem%omega, wp)
+        options%rtol = 1.0e-6_wp
+        options%atol = 1.0e-6_wp
+        do i = 1, 2
+            options%pmax = pmax(i)
+            t = 0.0_wp
+            ! On the slow solution Re(H e^(it)), H = ω²/(ω² − 1 + 2iζω).
+            y = [real(hgain, wp), -aimag(hgain)]
+            call solver%integrate(problem, t, y, 10.0_wp, options, stats(i), status)
+            call check(error, status%ok(), 'run failed: ' // status%text())
+            call check_close(error, y(1), real(hgain * exp(cmplx(0.0_wp, t, wp)), wp), &
+                1.0e-4_wp, 'x(10)')
+        end do
+        ! Measured: pmax 2 NRJ 0, NJE 14; pmax 5 NRJ 42, NJE 83.
+        write (msg, '(a,a,a,a)') 'pmax 2: ', stats(1)%summary(), ' / pmax 5: ', &
+            stats(2)%summary()
+        call check(error, stats(2)%nrj > stats(1)%nrj .and. stats(2)%nje > stats(1)%nje, &
+            'pattern missing: ' // trim(msg))
+    end subroutine test_table2_pattern
 
     !> `&solver name = 'ddassl', pmax = …` runs through run_scene; pmax > 5 is refused.
     subroutine test_scene(error)
