@@ -817,8 +817,11 @@ contains
         character(len=*), parameter :: sim = &
             '&simulation problem = ''robertson'', t_end = 40 /' // new_line('a')
         call parse_scene(sim // '&solver name = ''DDASSL'', pmax = 2, rtol = 1e-6, ' // &
-            'atol = 1e-10 /', 'rober.nml', scene, status)
+            'atol = 1e-10, initial_derivative = .true., netlib = .true. /', 'rober.nml', &
+            scene, status)
         call check(error, status%ok(), 'parse: ' // status%text())
+        call check(error, scene%initial_derivative .and. scene%netlib .and. &
+            scene%exclude_index23, 'DDASSL switches')
         if (allocated(error)) return
         call run_scene(scene, .true., result, status)
         call check(error, status%ok(), 'run: ' // status%text())

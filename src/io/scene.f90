@@ -119,6 +119,7 @@ contains
         class(dae_solver_t), allocatable, intent(out) :: solver
         type(status_t), intent(out) :: status
         type(radau5_t) :: radau5
+        type(ddassl_t) :: ddassl
         select case (trim(scene%solver_name))
         case ('radau5')
             radau5%nit = scene%nit
@@ -134,7 +135,10 @@ contains
             allocate (solver, source=radau5)
         case ('ddassl')
             ! pmax reaches it through dae_options_t (MAXORD).
-            allocate (ddassl_t :: solver)
+            ddassl%initial_derivative = scene%initial_derivative
+            ddassl%exclude_index23 = scene%exclude_index23
+            ddassl%netlib = scene%netlib
+            allocate (solver, source=ddassl)
         case default
             call status%set(status_bad_input, scene%path // ': &solver: name = ''' // &
                 trim(scene%solver_name) // ''': not available in this build yet')
