@@ -215,7 +215,22 @@ contains
             slope = log(errs(2) / errs(3)) / log(2.0_wp)
             write (msg, '(a,i0,a,f6.3,a,3es10.2)') 'BDF-', k, ': slope ', slope, ', errors', errs
             call check(error, abs(slope - real(k, wp)) <= 0.5_wp, trim(msg))
+            call check(error, stats%nac == steps(3) .and. stats%nrj == 0, 'steps not fixed')
         end do
+        ! Without a history the order rises from 1: BDF-2 after a BDF-1 step.
+        deallocate (solver%start_history)
+        options%pmax = 2
+        do j = 1, 3
+            options%h0 = 1.0_wp / real(steps(j), wp)
+            t = 0.0_wp
+            y = 1.0_wp
+            yp = 0.0_wp
+            call solver%integrate(problem, t, y, 1.0_wp, options, stats, status, yp=yp)
+            call check(error, status%ok(), 'fixed-step run failed: ' // status%text())
+            errs(j) = abs(y(1) - 0.5_wp)
+        end do
+        slope = log(errs(2) / errs(3)) / log(2.0_wp)
+        call check(error, abs(slope - 2.0_wp) <= 0.5_wp, 'start-up from order 1')
     end subroutine test_orders
 
     subroutine run_vdp(rtol, y, stats, status)

@@ -88,8 +88,8 @@ module flexmbs_dae_ddassl
         !> driver called with that TOUT) instead of t_end.
         logical :: h0_from_first_output = .false.
         !> Order studies: steps of size h0, every converged step accepted, the
-        !> order raised each step to pmax after a start-up from a small first
-        !> step doubled up to h0 (or from `start_history`).
+        !> order raised each step to pmax (the start-up then limits the global
+        !> error to O(h0²)) or, with `start_history`, BDF-pmax throughout.
         logical :: fixed_step = .false.
         !> With fixed_step: y(t0 − j·h0) in column j = 0..pmax. The integration
         !> then starts at order pmax from this exact history, so every step is
@@ -261,7 +261,7 @@ contains
 
         integer :: n, pmax, k, kold, ns, iphase, jcalc, nef, ncf, nsf, iout, nout, knew
         real(wp) :: tn, h, hold, cj, cjlast, cjold, s, hmin, hmax, dir, uround, tout_h0
-        real(wp) :: t0, h_fixed, span, est, erkm1, terkm1, terk
+        real(wp) :: t0, h_fixed, est, erkm1, terkm1, terk
         logical :: fd, ddaini, want_steps, stop_requested, done, ires_stop
 
         call timer%start()
@@ -348,7 +348,6 @@ contains
         phi = 0.0_wp
 
         ! ---- initial step (§2.7 steps 4 and 5) ----
-        span = abs(t_end - t)
         if (options%h0 > 0.0_wp) then
             h = sign(options%h0, dir)
         else
@@ -357,7 +356,6 @@ contains
             h = sign(h, dir)
         end if
         h_fixed = h
-        if (self%fixed_step .and. pmax > 1) h = startup_step()
         if (abs(h) > hmax) h = h / (abs(h) / hmax)
         if (self%tstop .and. (t + h - t_end) * dir > 0.0_wp) h = t_end - t
 
@@ -580,14 +578,6 @@ contains
             end do
             enorm = vnorm(ytmp)
         end function enorm
-
-        !> First step in fixed-step mode: its local error h^2 is O(h0^(pmax+1))
-        !> on an interval of unit length; the start-up then doubles h up to h0.
-        real(wp) function startup_step()
-            real(wp) :: ratio
-            ratio = min(abs(h_fixed) / span, 1.0_wp)
-            startup_step = h_fixed * ratio**(real(pmax - 1, wp) / 2.0_wp)
-        end function startup_step
 
         !> Constant-step history at order pmax: φ_{j+1} = ∇^j y_0 (§2.2 with
         !> ψ_i = i·h0), from the values y(t0 − j·h0).
@@ -918,11 +908,6 @@ contains
             hnew = h
             if (self%fixed_step) then
                 k = min(k + 1, pmax)
-                if (abs(2.0_wp * h) < abs(h_fixed)) then
-                    hnew = 2.0_wp * h
-                else
-                    hnew = h_fixed
-                end if
             else
                 if (knew == k - 1 .or. k == pmax) iphase = 1
                 if (iphase == 0) then
