@@ -38,7 +38,8 @@ module flexmbs_dae_ddassl
     real(wp), parameter :: roundoff_conv = 100.0_wp   !! §2.3: d ≤ 100·uround·pnorm
     ! Error test, order and step selection (§2.4, §2.6).
     real(wp), parameter :: est_offset = 1.0e-4_wp     !! §2.4: r = (2 est + 1e-4)^(−1/(k+1))
-    real(wp), parameter :: lower_km1_only = 0.5_wp    !! §2.4: k = 2 lowers if TERKM1 ≤ 0.5 TERK
+    !> §2.4: k = 2 lowers if TERKM1 ≤ 0.5 TERK; k = 1 raises if TERKP1 < 0.5 TERK.
+    real(wp), parameter :: half = 0.5_wp
     real(wp), parameter :: r_raise = 2.0_wp           !! §2.4: r ≥ 2 doubles h
     real(wp), parameter :: r_min = 0.5_wp, r_max = 0.9_wp  !! §2.4: clamp(r, 0.5, 0.9)
     real(wp), parameter :: fail_safety = 0.9_wp       !! §2.6: 0.9 (2 est + 1e-4)^(...)
@@ -410,7 +411,7 @@ contains
         end if
         if (want_steps) then
             call copy_dense()
-            call sink%step(1, t0, t0, y, self%dense, stop_requested, status)
+            call sink%step(1, tn, tn, y, self%dense, stop_requested, status)
             if (.not. status%ok()) then
                 call finish()
                 return
@@ -809,7 +810,7 @@ contains
                                 knew = k - 1
                                 est = erkm1
                             end if
-                        else if (terkm1 <= lower_km1_only * terk) then
+                        else if (terkm1 <= half * terk) then
                             knew = k - 1
                             est = erkm1
                         end if
@@ -922,7 +923,7 @@ contains
                         erkp1 = enorm(delta) / real(k + 2, wp)
                         terkp1 = real(k + 2, wp) * erkp1
                         if (k == 1) then
-                            if (terkp1 < lower_km1_only * terk) then
+                            if (terkp1 < half * terk) then
                                 k = k + 1
                                 est = erkp1
                             end if
