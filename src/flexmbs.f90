@@ -19,6 +19,8 @@ module flexmbs
     use flexmbs_dae_solver, only: dae_solver_t
     use flexmbs_dae_radau5, only: radau5_t, radau5_dense_t, radau5_native_t
     use flexmbs_dae_ida, only: ida_t, ida_native_t
+    use flexmbs_dae_residual_problem, only: residual_problem_t, dae_residual_t
+    use flexmbs_dae_ddassl, only: ddassl_t, ddassl_dense_t, ddassl_native_t
     use flexmbs_dae_error_measure, only: paper_error
     use flexmbs_dae_bdf_stability, only: bdf_stability_angle, bdf_boundary_locus
     use flexmbs_io_namelist, only: scene_input_t, read_scene, parse_scene, scene_dae_options

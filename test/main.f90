@@ -13,6 +13,7 @@ program flexmbs_tests
     use test_bdf_stability, only: collect_bdf_stability
     use test_reference, only: collect_reference
     use test_ida, only: collect_ida
+    use test_ddassl, only: collect_ddassl
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -33,6 +34,7 @@ program flexmbs_tests
     call run_suite('bdf_stability', collect_bdf_stability(), filter, npassed, nfailed)
     call run_suite('reference', collect_reference(), filter, npassed, nfailed)
     call run_suite('ida', collect_ida(), filter, npassed, nfailed)
+    call run_suite('ddassl', collect_ddassl(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests

@@ -61,6 +61,9 @@ module flexmbs_io_namelist
         var_spec_t('solver', 'controller', kind_string), &
         var_spec_t('solver', 'zero_start', kind_logical), &
         var_spec_t('solver', 'pmax', kind_integer), &
+        var_spec_t('solver', 'initial_derivative', kind_logical), &
+        var_spec_t('solver', 'exclude_index23', kind_logical), &
+        var_spec_t('solver', 'netlib', kind_logical), &
         var_spec_t('output', 'file', kind_string), &
         var_spec_t('output', 'n_output', kind_integer), &
         var_spec_t('output', 'every_step', kind_logical), &
@@ -118,6 +121,9 @@ module flexmbs_io_namelist
         character(len=len_name) :: controller = 'predictive'
         logical :: zero_start = .false.
         integer :: pmax = 5
+        logical :: initial_derivative = .false. !! DDASSL: y' by DDAINI
+        logical :: exclude_index23 = .true.     !! DDASSL: index-2/3 out of the error test
+        logical :: netlib = .false.             !! DDASSL: later netlib revision
         ! &output
         !> HDF5 file; '' = none. Derived from the input name when not given.
         character(len=:), allocatable :: output_file
@@ -628,11 +634,13 @@ contains
             quot1, quot2, safe, fac_min, fac_max
         integer :: npoints, max_steps, nit, pmax, n_output
         logical :: pendulum_projection, zero_start, every_step, progress
+        logical :: initial_derivative, exclude_index23, netlib
         namelist /simulation/ title, problem, t_start, t_end, vdp_eps, vdp_y1, vdp_y2, &
             pendulum_formulation, pendulum_length, pendulum_mass, pendulum_angle, &
             pendulum_projection, gravity, npoints
         namelist /solver/ name, rtol, atol, h0, hmax, max_steps, linear_solver, jacobian, &
-            nit, thet, fnewt, quot1, quot2, safe, fac_min, fac_max, controller, zero_start, pmax
+            nit, thet, fnewt, quot1, quot2, safe, fac_min, fac_max, controller, zero_start, pmax, &
+            initial_derivative, exclude_index23, netlib
         namelist /output/ file, n_output, every_step, table, progress
 
         lines = split_lines(text)
@@ -689,6 +697,9 @@ contains
             controller = scene%controller
             zero_start = scene%zero_start
             pmax = scene%pmax
+            initial_derivative = scene%initial_derivative
+            exclude_index23 = scene%exclude_index23
+            netlib = scene%netlib
             read (lines, nml=solver, iostat=ios, iomsg=msg)
             scene%solver_name = name
             scene%rtol = rtol
@@ -709,6 +720,9 @@ contains
             scene%controller = controller
             scene%zero_start = zero_start
             scene%pmax = pmax
+            scene%initial_derivative = initial_derivative
+            scene%exclude_index23 = exclude_index23
+            scene%netlib = netlib
         case ('output')
             file = ''
             n_output = scene%n_output
@@ -803,9 +817,9 @@ contains
         else if (scene%npoints < 1) then
             call bad(sim, 'npoints', 'must be positive')
         ! &solver
-        else if (scene%solver_name /= 'radau5' .and. scene%solver_name /= 'ida') then
+        else if (all([character(len=8) :: 'radau5', 'ddassl', 'ida'] /= scene%solver_name)) then
             call bad(sol, 'name', &
-                     'must be ''radau5'' or ''ida'' (ddassl and mexax are not available yet)')
+                     'must be ''radau5'', ''ddassl'' or ''ida'' (mexax is not available yet)')
         else if (.not. scene%rtol > 0.0_wp) then
             call bad(sol, 'rtol', 'must be positive')
         else if (.not. scene%rtol < 1.0_wp) then
@@ -843,6 +857,9 @@ contains
             call bad(sol, 'controller', 'must be ''predictive'' or ''classical''')
         else if (scene%pmax < 1 .or. scene%pmax > 12) then
             call bad(sol, 'pmax', 'must lie in 1..12')
+        else if (scene%solver_name == 'ddassl' .and. scene%pmax > 5) then
+            ! ALGORITHMS.md §2.2: MAXORD ≤ 5.
+            call bad(sol, 'pmax', 'must lie in 1..5 for ddassl (its maximal BDF order)')
         ! &output
         else if (scene%n_output < 2) then
             call bad(out, 'n_output', 'must be at least 2 (t_start and t_end)')

@@ -12,6 +12,7 @@ module flexmbs_io_scene
     use flexmbs_dae_solver, only: dae_solver_t
     use flexmbs_dae_radau5, only: radau5_t
     use flexmbs_dae_ida, only: ida_t
+    use flexmbs_dae_ddassl, only: ddassl_t
     use flexmbs_linalg_linear_solver, only: linear_solver_t
     use flexmbs_linalg_factory, only: new_linear_solver
     use flexmbs_problems_van_der_pol, only: new_van_der_pol
@@ -120,6 +121,7 @@ contains
         type(status_t), intent(out) :: status
         type(radau5_t) :: radau5
         type(ida_t) :: ida
+        type(ddassl_t) :: ddassl
         select case (trim(scene%solver_name))
         case ('radau5')
             radau5%nit = scene%nit
@@ -135,6 +137,12 @@ contains
             allocate (solver, source=radau5)
         case ('ida')
             allocate (solver, source=ida)
+        case ('ddassl')
+            ! pmax reaches it through dae_options_t (MAXORD).
+            ddassl%initial_derivative = scene%initial_derivative
+            ddassl%exclude_index23 = scene%exclude_index23
+            ddassl%netlib = scene%netlib
+            allocate (solver, source=ddassl)
         case default
             call status%set(status_bad_input, scene%path // ': &solver: name = ''' // &
                 trim(scene%solver_name) // ''': not available in this build yet')
@@ -213,6 +221,9 @@ contains
         select type (solver)
         type is (radau5_t)
             call progress%watch(solver%native%nstep, solver%native%naccpt)
+        type is (ddassl_t)
+            ! Native NST counts accepted steps only.
+            call progress%watch(solver%native%nst, solver%native%nst)
         end select
         call sinks%attach(progress)
 

@@ -1,0 +1,1089 @@
+!> DDASSL: variable-order, variable-step BDF for G(t, y, y') = 0.
+!>
+!> Implemented from [BCP89, ch. 5] as specified in ALGORITHMS.md §2:
+!> fixed-leading-coefficient BDF of orders 1..pmax in modified divided
+!> differences, a modified Newton corrector with iteration matrix
+!> PD = ∂G/∂y + cj ∂G/∂y' reused across steps, error estimates at orders
+!> k−2..k+1 deciding order and step, and the BDF interpolant for output.
+!> The SLATEC revision 910624 is the default; `netlib` switches to the
+!> later revision (§2.9). A `dae_problem_t` is integrated as G = M y' − F.
+module flexmbs_dae_ddassl
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
+        status_interrupted, reason_step_too_small, reason_max_steps, reason_singular_matrix, &
+        reason_newton_failure, reason_user_function, reason_non_finite
+    use flexmbs_core_timer, only: timer_t
+    use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_dense, storage_identity
+    use flexmbs_linalg_linear_solver, only: linear_solver_t
+    use flexmbs_linalg_factory, only: new_linear_solver
+    use flexmbs_dae_problem, only: dae_problem_t
+    use flexmbs_dae_residual_problem, only: residual_problem_t, dae_residual_t
+    use flexmbs_dae_options, only: dae_options_t
+    use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_sink, only: sink_t, dense_output_t
+    use flexmbs_dae_solver, only: dae_solver_t
+    implicit none
+    private
+
+    integer, parameter, public :: ddassl_max_order = 5 !! §2.2: MAXORD ≤ 5
+    integer, parameter :: mx = ddassl_max_order + 1    !! coefficient arrays hold k+1 entries
+
+    ! Corrector (§2.3).
+    real(wp), parameter :: s_fresh = 100.0_wp         !! §2.3: s = 100 with a new PD or cj
+    real(wp), parameter :: rate_max = 0.9_wp          !! §2.3: ρ > 0.9 fails
+    real(wp), parameter :: conv_tol = 0.33_wp         !! §2.3: s·d ≤ 0.33 converges
+    integer, parameter :: max_iter = 4                !! §2.3: m ≥ 4 fails
+    real(wp), parameter :: cj_ratio_low = 0.6_wp      !! §2.3: (1 − 0.25)/(1 + 0.25)
+    real(wp), parameter :: roundoff_conv = 100.0_wp   !! §2.3: d ≤ 100·uround·pnorm
+    ! Error test, order and step selection (§2.4, §2.6).
+    real(wp), parameter :: est_offset = 1.0e-4_wp     !! §2.4: r = (2 est + 1e-4)^(−1/(k+1))
+    !> §2.4: k = 2 lowers if TERKM1 ≤ 0.5 TERK; k = 1 raises if TERKP1 < 0.5 TERK.
+    real(wp), parameter :: half = 0.5_wp
+    real(wp), parameter :: r_raise = 2.0_wp           !! §2.4: r ≥ 2 doubles h
+    real(wp), parameter :: r_min = 0.5_wp, r_max = 0.9_wp  !! §2.4: clamp(r, 0.5, 0.9)
+    real(wp), parameter :: fail_safety = 0.9_wp       !! §2.6: 0.9 (2 est + 1e-4)^(...)
+    real(wp), parameter :: fail_min = 0.25_wp         !! §2.6: clamp(·, 0.25, 0.9)
+    real(wp), parameter :: fail_quarter = 0.25_wp     !! §2.6: h/4
+    integer, parameter :: max_ncf = 10                !! §2.6: ncf ≥ 10 gives up
+    integer, parameter :: max_nsf = 3                 !! §2.6: nsf ≥ 3 gives up
+    integer, parameter :: nef_after_conv = 3          !! §2.6: −9 when nef ≥ 3
+    ! Driver (§2.7).
+    real(wp), parameter :: h0_fraction = 0.001_wp     !! §2.7: H0 = 0.001 |TOUT − T|
+    real(wp), parameter :: h0_slope = 0.5_wp          !! §2.7: H0 ≤ 0.5/‖y0'‖
+    real(wp), parameter :: hmin_factor = 4.0_wp       !! §2.7: hmin = 4 uround max(|T|, |TOUT|)
+    real(wp), parameter :: tstop_tol = 100.0_wp       !! §2.7: |T_N − TSTOP| ≤ 100 uround (…)
+    ! DDAINI (§2.8).
+    integer, parameter :: ini_max_iter = 10           !! §2.8: at most 10 iterations
+    integer, parameter :: ini_jac_every = 5           !! §2.8: new PD every 5 iterations
+    real(wp), parameter :: ini_s = 1.0e6_wp           !! §2.8: s = 1e6 after each PD
+    real(wp), parameter :: ini_damp = 0.75_wp         !! §2.8: residual × 0.75
+    integer, parameter :: ini_max_nef = 10            !! §2.8 [R]: nef ≥ 10 gives up
+    real(wp), parameter :: ini_r_min = 0.1_wp, ini_r_max = 0.5_wp !! §2.8 [R]
+
+    !> The BDF interpolant of the last accepted step (§2.5).
+    type, extends(dense_output_t), public :: ddassl_dense_t
+        real(wp) :: tn = 0.0_wp      !! time of the last accepted step
+        integer :: kold = 0          !! order of that step
+        real(wp) :: psi(mx) = 0.0_wp !! ψ_i = t_n − t_{n−i}
+        real(wp), allocatable :: phi(:, :) !! modified divided differences φ_1..φ_{kold+1}
+    contains
+        procedure :: evaluate => dense_evaluate
+        procedure :: interpolate => dense_interpolate
+    end type ddassl_dense_t
+
+    !> The classic code's counters, IWORK(11..15).
+    type, public :: ddassl_native_t
+        integer :: nst = 0, nre = 0, nje = 0, netf = 0, ncfn = 0
+    end type ddassl_native_t
+
+    !> DDASSL settings (the INFO switches of the classic code that make
+    !> sense in the modern core) and the results of the last integration.
+    type, extends(dae_solver_t), public :: ddassl_t
+        logical :: netlib = .false.              !! later netlib revision (§2.9) instead of SLATEC
+        logical :: exclude_index23 = .true.      !! index-2/3 out of the error test (§2.10)
+        logical :: initial_derivative = .false.  !! y' by DDAINI (§2.8, INFO(11) = 1)
+        logical :: nonnegative = .false.         !! enforce y ≥ 0 (INFO(10) = 1)
+        logical :: tstop = .false.               !! never step past t_end (INFO(4) = 1)
+        !> H0 rule of §2.7 with TOUT = the first output time (as the classic
+        !> driver called with that TOUT) instead of t_end.
+        logical :: h0_from_first_output = .false.
+        !> Order studies: steps of size h0, every converged step accepted, the
+        !> order raised each step to pmax (the start-up then limits the global
+        !> error to O(h0²)) or, with `start_history`, BDF-pmax throughout.
+        logical :: fixed_step = .false.
+        !> With fixed_step: y(t0 − j·h0) in column j = 0..pmax. The integration
+        !> then starts at order pmax from this exact history, so every step is
+        !> BDF-pmax with constant step (order studies).
+        real(wp), allocatable :: start_history(:, :)
+        real(wp) :: uround = epsilon(1.0_wp)     !! D1MACH(4)
+        ! Results of the last integration.
+        type(ddassl_native_t) :: native
+        integer :: ndec = 0          !! successful PD factorisations
+        integer :: nsol = 0          !! solves (corrector and DDAINI)
+        integer :: k_last = 0        !! order of the last step (IWORK(8))
+        integer :: k_next = 0        !! order for the next step (IWORK(7))
+        real(wp) :: h_next = 0.0_wp  !! next step size (RWORK(3))
+        type(ddassl_dense_t) :: dense
+    contains
+        procedure :: integrate => ddassl_integrate
+        procedure :: integrate_residual => ddassl_integrate_residual
+        procedure :: name => ddassl_name
+    end type ddassl_t
+
+contains
+
+    function ddassl_name(self) result(name)
+        class(ddassl_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'ddassl'
+    end function ddassl_name
+
+    subroutine dense_evaluate(self, s, y)
+        class(ddassl_dense_t), intent(in) :: self
+        real(wp), intent(in) :: s
+        real(wp), intent(out) :: y(:)
+        call interpolate_history(self%phi, self%psi, self%kold, self%tn, s, y)
+    end subroutine dense_evaluate
+
+    !> y(s) and y'(s).
+    subroutine dense_interpolate(self, s, y, yp)
+        class(ddassl_dense_t), intent(in) :: self
+        real(wp), intent(in) :: s
+        real(wp), intent(out) :: y(:), yp(:)
+        call interpolate_history(self%phi, self%psi, self%kold, self%tn, s, y, yp)
+    end subroutine dense_interpolate
+
+    !> §2.5: y(t̄) = Σ c_j φ_j, y'(t̄) = Σ d_j φ_j.
+    pure subroutine interpolate_history(phi, psi, kold, tn, tbar, y, yp)
+        real(wp), intent(in) :: phi(:, :), psi(:)
+        integer, intent(in) :: kold
+        real(wp), intent(in) :: tn, tbar
+        real(wp), intent(out) :: y(:)
+        real(wp), intent(out), optional :: yp(:)
+        real(wp) :: tau, c, d, g, psim2
+        integer :: j
+        tau = tbar - tn
+        c = 1.0_wp
+        d = 0.0_wp
+        y = phi(:, 1)
+        if (present(yp)) yp = 0.0_wp
+        psim2 = 0.0_wp
+        do j = 2, kold + 1
+            if (j > 2) psim2 = psi(j - 2)
+            g = (tau + psim2) / psi(j - 1)
+            d = d * g + c / psi(j - 1)
+            c = c * g
+            y = y + c * phi(:, j)
+            if (present(yp)) yp = yp + d * phi(:, j)
+        end do
+    end subroutine interpolate_history
+
+    !> Integrate M y' = F(t, y) as G = M y' − F = 0 (ALGORITHMS.md §2.1).
+    !> Without yp, y' comes from `problem%consistent_initial` or, when the
+    !> problem offers none or `initial_derivative` is set, from DDAINI.
+    subroutine ddassl_integrate(self, problem, t, y, t_end, options, stats, status, sink, yp)
+        class(ddassl_t), intent(inout) :: self
+        class(dae_problem_t), intent(inout) :: problem
+        real(wp), intent(inout) :: t
+        real(wp), intent(inout) :: y(:)
+        real(wp), intent(in) :: t_end
+        type(dae_options_t), intent(in) :: options
+        type(dae_stats_t), intent(out) :: stats
+        type(status_t), intent(out) :: status
+        class(sink_t), intent(inout), optional :: sink
+        real(wp), intent(inout), optional :: yp(:)
+        call run_dae(self, problem, t, y, t_end, options, stats, status, sink, yp)
+    end subroutine ddassl_integrate
+
+    !> `target` lets the wrapper point at the problem for this call.
+    subroutine run_dae(self, problem, t, y, t_end, options, stats, status, sink, yp)
+        class(ddassl_t), intent(inout) :: self
+        class(dae_problem_t), intent(inout), target :: problem
+        real(wp), intent(inout) :: t
+        real(wp), intent(inout) :: y(:)
+        real(wp), intent(in) :: t_end
+        type(dae_options_t), intent(in) :: options
+        type(dae_stats_t), intent(out) :: stats
+        type(status_t), intent(out) :: status
+        class(sink_t), intent(inout), optional :: sink
+        real(wp), intent(inout), optional :: yp(:)
+        type(dae_residual_t) :: res
+        real(wp), allocatable :: ypw(:)
+        type(status_t) :: local
+        logical :: ddaini
+
+        if (problem%has_projection()) then
+            call status%set(status_bad_input, 'ddassl: projection is refused, it disturbs ' // &
+                'the BDF history (ALGORITHMS.md §6); use radau5 or switch projection off')
+            return
+        end if
+        if (problem%n <= 0 .or. size(y) /= problem%n) then
+            call status%set(status_bad_input, 'ddassl: size of y differs from problem%n')
+            return
+        end if
+        res%problem => problem
+        res%n = problem%n
+        allocate (ypw(problem%n))
+        ddaini = self%initial_derivative
+        if (present(yp)) then
+            if (size(yp) /= problem%n) then
+                call status%set(status_bad_input, 'ddassl: size of yp differs from problem%n')
+                return
+            end if
+            ypw = yp
+        else
+            ypw = 0.0_wp
+            if (.not. ddaini) then
+                call problem%consistent_initial(t, y, ypw, local)
+                if (.not. local%ok() .and. problem%mass_storage() == storage_identity) then
+                    ! An ODE: y' = F(t0, y0) is consistent (the caller's job in
+                    ! the classic code, hence not counted in NRE).
+                    call local%clear()
+                    call problem%rhs(t, y, ypw, local)
+                end if
+                if (.not. local%ok()) then
+                    ypw = 0.0_wp
+                    ddaini = .true.
+                end if
+            end if
+        end if
+        call self%integrate_residual(res, t, y, ypw, t_end, options, stats, status, sink, &
+            initial_derivative=ddaini)
+        if (present(yp)) yp = ypw
+        nullify (res%problem)
+    end subroutine run_dae
+
+    !> Integrate G(t, y, y') = 0 from (t, y, yp) to t_end (ALGORITHMS.md §2).
+    !> On return t, y, yp hold the last point reached (t_end on success).
+    subroutine ddassl_integrate_residual(self, res, t, y, yp, t_end, options, stats, status, &
+                                         sink, initial_derivative)
+        class(ddassl_t), intent(inout) :: self
+        class(residual_problem_t), intent(inout) :: res
+        real(wp), intent(inout) :: t
+        real(wp), intent(inout) :: y(:), yp(:)
+        real(wp), intent(in) :: t_end
+        type(dae_options_t), intent(in) :: options
+        type(dae_stats_t), intent(out) :: stats
+        type(status_t), intent(out) :: status
+        class(sink_t), intent(inout), optional :: sink
+        logical, intent(in), optional :: initial_derivative !! overrides the component
+
+        ! Workspace, allocated once per integration.
+        real(wp), allocatable :: phi(:, :), delta(:), e(:), wt(:), rtol(:), atol(:)
+        real(wp), allocatable :: ytmp(:), yptmp(:), ysave(:), ypsave(:)
+        logical, allocatable :: in_test(:)
+        integer, allocatable :: classes(:)
+        real(wp) :: psi(mx), alpha(mx), beta(mx), gamma(mx), sigma(mx)
+        type(matrix_t) :: amat, bmat
+        class(linear_solver_t), allocatable :: ls
+        type(timer_t) :: timer
+        type(status_t) :: st
+
+        integer :: n, pmax, k, kold, ns, iphase, jcalc, nef, ncf, nsf, iout, nout, knew
+        real(wp) :: tn, h, hold, cj, cjlast, cjold, s, hmin, hmax, dir, uround, tout_h0
+        real(wp) :: t0, h_fixed, est, erkm1, terkm1, terk
+        logical :: fd, ddaini, want_steps, stop_requested, done, ires_stop
+
+        call timer%start()
+        self%native = ddassl_native_t()
+        self%ndec = 0
+        self%nsol = 0
+        self%k_last = 0
+        self%k_next = 0
+        self%h_next = 0.0_wp
+        n = res%n
+        tn = t
+        t0 = t
+        stats%t_reached = t
+        uround = self%uround
+        pmax = options%pmax
+        h = 0.0_wp
+        ires_stop = .false.
+        ddaini = self%initial_derivative
+        if (present(initial_derivative)) ddaini = initial_derivative
+
+        ! ---- validation (§2.7 first call) ----
+        if (n <= 0 .or. size(y) /= n .or. size(yp) /= n) then
+            call bad('sizes of y and yp must equal the problem size n > 0')
+            return
+        end if
+        call options%validate(n, status)
+        if (.not. status%ok()) return
+        if (pmax > ddassl_max_order) then
+            call bad('pmax = ' // int_text(pmax) // ': must lie in 1..5')
+            return
+        end if
+        if (.not. (uround > 0.0_wp .and. uround < 1.0_wp)) then
+            call bad('uround must lie in (0, 1)')
+            return
+        end if
+        if (self%fixed_step .and. .not. options%h0 > 0.0_wp) then
+            call bad('fixed_step needs a positive h0')
+            return
+        end if
+        allocate (rtol(n), atol(n), wt(n), in_test(n), classes(n))
+        call options%tolerances(rtol, atol)
+        call res%index_classes(classes)
+        in_test = .true.
+        if (self%exclude_index23) in_test = classes < 2
+        dir = sign(1.0_wp, t_end - t)
+        tout_h0 = t_end
+        nout = 0
+        if (allocated(options%output_times)) nout = size(options%output_times)
+        if (self%h0_from_first_output) then
+            do iout = 1, nout
+                if ((options%output_times(iout) - t) * dir > 0.0_wp) then
+                    tout_h0 = options%output_times(iout)
+                    exit
+                end if
+            end do
+        end if
+        call set_weights(y)
+        if (any(.not. wt > 0.0_wp)) then
+            call bad('some weight rtol*|y0| + atol is not positive')
+            return
+        end if
+        hmin = hmin_factor * uround * max(abs(t), abs(tout_h0))
+        if (abs(t_end - t) < hmin .or. t_end == t) then
+            call bad('t_end = ' // real_text(t_end) // ' is too close to t = ' // real_text(t))
+            return
+        end if
+        hmax = huge(1.0_wp)
+        if (options%hmax > 0.0_wp) hmax = options%hmax
+
+        ! Matrices and the linear solver: storages fixed here, once.
+        call res%setup_partials(options%jacobian == 'fd', amat, bmat, status)
+        if (.not. status%ok()) return
+        fd = bmat%storage == storage_none
+        call new_linear_solver(options%linear_solver, n, bmat%storage, ls, status)
+        if (.not. status%ok()) return
+        if (fd) then
+            ! The difference PD is held as −PD and factored with shift 0.
+            bmat%storage = storage_dense
+            allocate (bmat%dense(n, n))
+        end if
+        call ls%init(amat, bmat, status)
+        if (.not. status%ok()) return
+        allocate (phi(n, pmax + 1), delta(n), e(n), ytmp(n), yptmp(n), ysave(n), ypsave(n))
+        phi = 0.0_wp
+
+        ! ---- initial step (§2.7 steps 4 and 5) ----
+        if (options%h0 > 0.0_wp) then
+            h = sign(options%h0, dir)
+        else
+            h = h0_fraction * abs(tout_h0 - t)
+            if (vnorm(yp) > h0_slope / h) h = h0_slope / vnorm(yp)
+            h = sign(h, dir)
+        end if
+        h_fixed = h
+        if (abs(h) > hmax) h = h / (abs(h) / hmax)
+        if (self%tstop .and. (t + h - t_end) * dir > 0.0_wp) h = t_end - t
+
+        ! Outputs at t0.
+        want_steps = .false.
+        stop_requested = .false.
+        if (present(sink)) want_steps = sink%wants_steps()
+        iout = 1
+        do while (iout <= nout)
+            if ((options%output_times(iout) - t) * dir > 0.0_wp) exit
+            if (present(sink) .and. options%output_times(iout) == t) &
+                call sink%output(t, y, status)
+            iout = iout + 1
+            if (.not. status%ok()) then
+                call finish()
+                return
+            end if
+        end do
+
+        if (ddaini) then
+            call initial_step(st)
+            if (.not. st%ok()) then
+                status = st
+                call finish()
+                return
+            end if
+        end if
+
+        ! §2.7 step 7: the history after the first call.
+        phi(:, 1) = y
+        phi(:, 2) = h * yp
+        k = 1
+        kold = 0
+        hold = 0.0_wp
+        psi = 0.0_wp
+        psi(1) = h
+        cj = 1.0_wp / h
+        cjold = cj
+        cjlast = cj
+        s = s_fresh
+        jcalc = -1
+        iphase = 0
+        ns = 0
+        alpha = 0.0_wp; beta = 0.0_wp; gamma = 0.0_wp; sigma = 0.0_wp
+        if (self%fixed_step .and. allocated(self%start_history)) then
+            if (size(self%start_history, 1) /= n .or. size(self%start_history, 2) /= pmax + 1) then
+                call bad('start_history must have shape (n, pmax + 1)')
+                call finish()
+                return
+            end if
+            call history_from_values()
+        end if
+        if (want_steps) then
+            call copy_dense()
+            call sink%step(1, tn, tn, y, self%dense, stop_requested, status)
+            if (.not. status%ok()) then
+                call finish()
+                return
+            end if
+        end if
+        done = (tn - t_end) * dir >= 0.0_wp
+
+        main: do while (.not. done)
+            ! ---- before every step (§2.7) ----
+            if (self%native%nst >= options%max_steps) then
+                call fail('more than ' // int_text(options%max_steps) // ' steps needed', &
+                    reason_max_steps)
+                exit main
+            end if
+            call set_weights(phi(:, 1))
+            if (any(.not. wt > 0.0_wp)) then
+                call fail('a weight rtol*|y| + atol became non-positive', reason_non_finite)
+                exit main
+            end if
+            if (roundoff_conv * uround * vnorm(phi(:, 1)) > 1.0_wp) then
+                call fail('tolerances too small for the machine precision (scale rtol, atol by ' &
+                    // real_text(roundoff_conv * uround * vnorm(phi(:, 1))) // ')', &
+                    reason_step_too_small)
+                exit main
+            end if
+            hmin = hmin_factor * uround * max(abs(tn), abs(t_end))
+            if (abs(h) > hmax) h = h / (abs(h) / hmax)
+            if (self%tstop .and. (tn + h - t_end) * dir > 0.0_wp) h = t_end - tn
+
+            call take_step(st)
+            if (.not. st%ok()) then
+                status = st
+                call interpolate_history(phi, psi, kold, tn, tn, y, yp)
+                exit main
+            end if
+
+            ! ---- output ----
+            stats%t_reached = tn
+            stats%h_last = hold
+            do while (iout <= nout)
+                if ((options%output_times(iout) - tn) * dir > 0.0_wp) exit
+                if (present(sink)) then
+                    call interpolate_history(phi, psi, kold, tn, options%output_times(iout), ytmp)
+                    call sink%output(options%output_times(iout), ytmp, status)
+                end if
+                iout = iout + 1
+                if (.not. status%ok()) exit main
+            end do
+            if (want_steps) then
+                call copy_dense()
+                call sink%step(self%native%nst + 1, tn - hold, tn, phi(:, 1), self%dense, &
+                    stop_requested, status)
+                if (.not. status%ok()) exit main
+                if (stop_requested) then
+                    call status%set(status_interrupted, &
+                        'ddassl: interrupted by the output routine at t = ' // real_text(tn))
+                    call interpolate_history(phi, psi, kold, tn, tn, y, yp)
+                    exit main
+                end if
+            end if
+            if (self%tstop) then
+                done = abs(tn - t_end) <= tstop_tol * uround * (abs(tn) + abs(h)) &
+                    .or. (tn - t_end) * dir >= 0.0_wp
+            else
+                done = (tn - t_end) * dir >= 0.0_wp
+            end if
+        end do main
+
+        if (done .and. status%ok()) then
+            call interpolate_history(phi, psi, kold, tn, t_end, y, yp)
+            t = t_end
+        else
+            t = tn
+        end if
+        call copy_dense()
+        call finish()
+
+    contains
+
+        subroutine bad(reason)
+            character(len=*), intent(in) :: reason
+            call status%set(status_bad_input, 'ddassl: ' // reason)
+        end subroutine bad
+
+        subroutine fail(reason, code)
+            character(len=*), intent(in) :: reason
+            integer, intent(in) :: code
+            call status%set(status_solver_failure, 'ddassl: ' // reason // ' at t = ' // &
+                real_text(tn) // ' (h = ' // real_text(h) // ')', code)
+        end subroutine fail
+
+        !> Common statistics from the native counters (ALGORITHMS.md §4.1).
+        subroutine finish()
+            type(status_t) :: sink_status
+            stats%nst = self%native%nst + self%native%netf + self%native%ncfn
+            stats%nac = self%native%nst
+            stats%nrj = self%native%netf + self%native%ncfn
+            stats%nfe = self%native%nre
+            stats%nje = self%native%nje
+            stats%ndec = self%ndec
+            stats%nsol = self%nsol
+            stats%t_reached = t
+            self%k_last = kold
+            self%k_next = k
+            self%h_next = h
+            stats%cpu = timer%cpu()
+            stats%wall = timer%wall()
+            if (present(sink)) then
+                call sink%finish(sink_status)
+                if (status%ok() .and. .not. sink_status%ok()) status = sink_status
+            end if
+        end subroutine finish
+
+        subroutine copy_dense()
+            if (.not. allocated(self%dense%phi)) then
+                allocate (self%dense%phi(n, pmax + 1))
+            else if (size(self%dense%phi, 1) /= n .or. size(self%dense%phi, 2) /= pmax + 1) then
+                deallocate (self%dense%phi)
+                allocate (self%dense%phi(n, pmax + 1))
+            end if
+            self%dense%phi = phi
+            self%dense%psi = psi
+            self%dense%kold = kold
+            self%dense%tn = tn
+        end subroutine copy_dense
+
+        !> §2.7: wt_i = rtol_i |v_i| + atol_i.
+        subroutine set_weights(v)
+            real(wp), intent(in) :: v(:)
+            wt = rtol * abs(v) + atol
+        end subroutine set_weights
+
+        !> §2.7: ‖v‖ = vmax ((1/n) Σ ((v_i/wt_i)/vmax)²)^(1/2).
+        real(wp) function vnorm(v)
+            real(wp), intent(in) :: v(:)
+            real(wp) :: vmax, acc
+            integer :: i
+            vmax = 0.0_wp
+            do i = 1, n
+                vmax = max(vmax, abs(v(i) / wt(i)))
+            end do
+            if (.not. ieee_is_finite(vmax)) then
+                vnorm = vmax
+                return
+            end if
+            vnorm = 0.0_wp
+            if (vmax <= 0.0_wp) return
+            acc = 0.0_wp
+            do i = 1, n
+                acc = acc + ((v(i) / wt(i)) / vmax)**2
+            end do
+            vnorm = vmax * sqrt(acc / real(n, wp))
+        end function vnorm
+
+        !> The error-test norm: excluded components zeroed, RMS still over n (§2.10).
+        real(wp) function enorm(v)
+            real(wp), intent(in) :: v(:)
+            integer :: i
+            do i = 1, n
+                if (in_test(i)) then
+                    ytmp(i) = v(i)
+                else
+                    ytmp(i) = 0.0_wp
+                end if
+            end do
+            enorm = vnorm(ytmp)
+        end function enorm
+
+        !> Constant-step history at order pmax: φ_{j+1} = ∇^j y_0 (§2.2 with
+        !> ψ_i = i·h0), from the values y(t0 − j·h0).
+        subroutine history_from_values()
+            integer :: i, j
+            real(wp), allocatable :: table(:, :)
+            table = self%start_history
+            phi(:, 1) = table(:, 1)
+            do j = 1, pmax
+                do i = 1, pmax + 1 - j
+                    table(:, i) = table(:, i) - table(:, i + 1)
+                end do
+                phi(:, j + 1) = table(:, 1)
+            end do
+            h = h_fixed
+            hold = h
+            k = pmax
+            kold = pmax
+            do i = 1, mx
+                psi(i) = real(i, wp) * h
+            end do
+            cj = real(pmax, wp) / h
+            cjold = cj
+            cjlast = cj
+            iphase = 1
+        end subroutine history_from_values
+
+        !> Form and factor PD at (tn, y, yp) with cj; delta holds G there.
+        subroutine form_pd(singular)
+            logical, intent(out) :: singular
+            integer :: j
+            real(wp) :: del, ysafe, ypsafe, squr
+            type(status_t) :: fst
+            singular = .false.
+            if (fd) then
+                ! §2.3: column j = (G(y + δ_j e_j, y' + cj δ_j e_j) − δ)/δ_j; held as −PD.
+                squr = sqrt(uround)
+                do j = 1, n
+                    del = squr * max(abs(y(j)), abs(h * yp(j)), wt(j))
+                    del = sign(del, h * yp(j))
+                    del = (y(j) + del) - y(j)
+                    ysafe = y(j)
+                    ypsafe = yp(j)
+                    y(j) = y(j) + del
+                    yp(j) = yp(j) + cj * del
+                    call res%residual(tn, y, yp, yptmp, fst)
+                    stats%nfe_jac = stats%nfe_jac + 1
+                    y(j) = ysafe
+                    yp(j) = ypsafe
+                    if (.not. fst%ok()) then
+                        singular = .true.
+                        return
+                    end if
+                    bmat%dense(:, j) = -(yptmp - delta) / del
+                end do
+                if (.not. all(ieee_is_finite(bmat%dense))) then
+                    singular = .true.
+                    return
+                end if
+                call ls%factor_real(0.0_wp, amat, bmat, fst)
+            else
+                call res%partials(tn, y, yp, amat, bmat, fst)
+                if (.not. fst%ok()) then
+                    singular = .true.
+                    return
+                end if
+                call ls%factor_real(cj, amat, bmat, fst)
+            end if
+            singular = .not. fst%ok()
+            if (.not. singular) self%ndec = self%ndec + 1
+        end subroutine form_pd
+
+        !> g = G(tn, y, yp) into delta; false on failure or non-finite values.
+        logical function residual_ok()
+            type(status_t) :: fst
+            self%native%nre = self%native%nre + 1
+            call res%residual(tn, y, yp, delta, fst)
+            ! IRES = −2 of the classic code: the residual asks to stop.
+            if (fst%code == status_interrupted) ires_stop = .true.
+            residual_ok = fst%ok()
+            if (residual_ok) residual_ok = all(ieee_is_finite(delta))
+        end function residual_ok
+
+        !> §2.3: the corrector iteration from the predictor in (y, yp).
+        subroutine corrector(pnorm, converged, singular, early)
+            real(wp), intent(in) :: pnorm
+            logical, intent(out) :: converged, singular, early
+            integer :: m
+            real(wp) :: d, d0, rate
+            converged = .false.
+            singular = .false.
+            early = .false.
+            if (.not. residual_ok()) then
+                early = .true.
+                return
+            end if
+            if (jcalc == -1) then
+                self%native%nje = self%native%nje + 1
+                jcalc = 0
+                call form_pd(singular)
+                cjold = cj
+                s = s_fresh
+                if (singular) return
+                nsf = 0
+            end if
+            e = 0.0_wp
+            m = 0
+            d0 = 0.0_wp
+            do
+                delta = delta * (2.0_wp / (1.0_wp + cj / cjold))
+                call ls%solve_real(delta)
+                self%nsol = self%nsol + 1
+                y = y - delta
+                e = e - delta
+                yp = yp - cj * delta
+                d = vnorm(delta)
+                if (.not. ieee_is_finite(d)) return
+                if (d <= roundoff_conv * uround * pnorm .and. (.not. self%netlib .or. m == 0)) then
+                    converged = .true.
+                    return
+                end if
+                if (m == 0) then
+                    d0 = d
+                else
+                    rate = (d / d0)**(1.0_wp / real(m, wp))
+                    if (rate > rate_max) return
+                    s = rate / (1.0_wp - rate)
+                end if
+                if (s * d <= conv_tol) then
+                    converged = .true.
+                    return
+                end if
+                m = m + 1
+                if (m >= max_iter) return
+                if (.not. residual_ok()) return
+            end do
+        end subroutine corrector
+
+        !> One step of §2.2–§2.6; on return either accepted or st says why not.
+        subroutine take_step(st)
+            type(status_t), intent(out) :: st
+            integer :: i, j, kdiff
+            real(wp) :: temp1, temp2, alphas, alpha0, ck, pnorm, enrm, erk, err, r, hnew
+            real(wp) :: erkm2, terkm2, erkp1, terkp1
+            logical :: converged, singular, early, passed
+
+            nef = 0
+            ncf = 0
+            nsf = 0
+            attempt: do
+                ! ---- §2.2: coefficients ----
+                if (h /= hold .or. k /= kold) ns = 0
+                ns = min(ns + 1, kold + 2)
+                if (k + 1 >= ns) then
+                    beta(1) = 1.0_wp
+                    alpha(1) = 1.0_wp
+                    sigma(1) = 1.0_wp
+                    gamma(1) = 0.0_wp
+                    temp1 = h
+                    do i = 2, k + 1
+                        temp2 = psi(i - 1)
+                        psi(i - 1) = temp1
+                        beta(i) = beta(i - 1) * psi(i - 1) / temp2
+                        temp1 = temp2 + h
+                        alpha(i) = h / temp1
+                        sigma(i) = real(i - 1, wp) * sigma(i - 1) * alpha(i)
+                        gamma(i) = gamma(i - 1) + alpha(i - 1) / h
+                    end do
+                    psi(k + 1) = temp1
+                end if
+                alphas = 0.0_wp
+                alpha0 = 0.0_wp
+                do i = 1, k
+                    alphas = alphas - 1.0_wp / real(i, wp)
+                    alpha0 = alpha0 - alpha(i)
+                end do
+                cjlast = cj
+                cj = -alphas / h
+                ck = max(abs(alpha(k + 1) + alphas - alpha0), alpha(k + 1))
+                ! §2.3: a new PD when cj moved too far from that of the current PD.
+                temp1 = cj / cjold
+                if (temp1 < cj_ratio_low .or. temp1 > 1.0_wp / cj_ratio_low) jcalc = -1
+                if (cj /= cjlast) s = s_fresh
+                do j = ns + 1, k + 1
+                    phi(:, j) = beta(j) * phi(:, j)
+                end do
+                tn = tn + h
+
+                ! ---- §2.2 predictor, §2.3 corrector (redone once with a fresh PD) ----
+                do
+                    y = phi(:, 1)
+                    yp = 0.0_wp
+                    do j = 2, k + 1
+                        y = y + phi(:, j)
+                        yp = yp + gamma(j) * phi(:, j)
+                    end do
+                    pnorm = vnorm(y)
+                    call corrector(pnorm, converged, singular, early)
+                    if (converged .or. jcalc /= 1 .or. early) exit
+                    jcalc = -1
+                end do
+                jcalc = 1
+                if (converged .and. self%nonnegative) then
+                    delta = min(y, 0.0_wp)
+                    if (vnorm(delta) > conv_tol) then
+                        converged = .false.
+                    else
+                        e = e - delta
+                    end if
+                end if
+
+                passed = .false.
+                if (converged) then
+                    ! ---- §2.4: error estimates ----
+                    enrm = enorm(e)
+                    erk = sigma(k + 1) * enrm
+                    terk = real(k + 1, wp) * erk
+                    est = erk
+                    knew = k
+                    if (k >= 2) then
+                        delta = phi(:, k + 1) + e
+                        erkm1 = sigma(k) * enorm(delta)
+                        terkm1 = real(k, wp) * erkm1
+                        if (k > 2) then
+                            delta = phi(:, k) + delta
+                            erkm2 = sigma(k - 1) * enorm(delta)
+                            terkm2 = real(k - 1, wp) * erkm2
+                            if (max(terkm1, terkm2) <= terk) then
+                                knew = k - 1
+                                est = erkm1
+                            end if
+                        else if (terkm1 <= half * terk) then
+                            knew = k - 1
+                            est = erkm1
+                        end if
+                    end if
+                    err = ck * enrm
+                    if (.not. ieee_is_finite(err) .or. .not. ieee_is_finite(est)) then
+                        est = huge(1.0_wp)
+                        passed = .false.
+                    else
+                        passed = err <= 1.0_wp
+                    end if
+                    if (self%fixed_step) passed = .true.
+                    if (passed) exit attempt
+                end if
+
+                ! ---- §2.6: failed step; restore the history ----
+                if (self%fixed_step) then
+                    call st%set(status_solver_failure, 'ddassl: fixed-step corrector ' // &
+                        'failed at t = ' // real_text(tn - h), reason_newton_failure)
+                    call restore()
+                    return
+                end if
+                call restore()
+                temp2 = h
+                if (converged) then
+                    ! Error-test failure.
+                    nef = nef + 1
+                    self%native%netf = self%native%netf + 1
+                    if (nef == 1) then
+                        k = knew
+                        r = fail_safety * (2.0_wp * est + est_offset)**(-1.0_wp / real(k + 1, wp))
+                        r = min(max(r, fail_min), r_max)
+                        h = h * r
+                    else if (nef == 2) then
+                        k = knew
+                        h = h * fail_quarter
+                    else
+                        k = 1
+                        h = h * fail_quarter
+                    end if
+                    if (abs(h) < hmin) then
+                        call st%set(status_solver_failure, 'ddassl: error test failed ' // &
+                            'repeatedly, step size too small at t = ' // real_text(tn) // &
+                            ' (h = ' // real_text(h) // ')', reason_step_too_small)
+                        return
+                    end if
+                else
+                    self%native%ncfn = self%native%ncfn + 1
+                    if (ires_stop) then
+                        call st%set(status_interrupted, 'ddassl: the residual asked to stop ' &
+                            // 'at t = ' // real_text(tn + h))
+                        return
+                    else if (singular) then
+                        nsf = nsf + 1
+                        h = h * fail_quarter
+                        if (nsf >= max_nsf .or. abs(h) < hmin) then
+                            call st%set(status_solver_failure, 'ddassl: iteration matrix ' // &
+                                'repeatedly singular at t = ' // real_text(tn) // ' (h = ' // &
+                                real_text(h) // ')', reason_singular_matrix)
+                            return
+                        end if
+                    else
+                        ncf = ncf + 1
+                        h = h * fail_quarter
+                        if (ncf >= max_ncf .or. abs(h) < hmin) then
+                            if (nef >= nef_after_conv) then
+                                call st%set(status_solver_failure, 'ddassl: corrector failed ' // &
+                                    'after repeated error-test failures at t = ' // &
+                                    real_text(tn) // ' (h = ' // real_text(h) // ')', &
+                                    reason_newton_failure)
+                            else if (early) then
+                                call st%set(status_solver_failure, 'ddassl: residual failed ' // &
+                                    'repeatedly at t = ' // real_text(tn) // ' (h = ' // &
+                                    real_text(h) // ')', reason_user_function)
+                            else
+                                call st%set(status_solver_failure, 'ddassl: corrector ' // &
+                                    'failed repeatedly at t = ' // real_text(tn) // ' (h = ' // &
+                                    real_text(h) // ')', reason_newton_failure)
+                            end if
+                            return
+                        end if
+                    end if
+                end if
+                if (self%netlib .and. kold == 0) then
+                    ! §2.9: rescale the first-step history to the new h.
+                    psi(1) = h
+                    phi(:, 2) = (h / temp2) * phi(:, 2)
+                end if
+            end do attempt
+
+            ! ---- §2.4: success ----
+            self%native%nst = self%native%nst + 1
+            kdiff = k - kold
+            kold = k
+            hold = h
+            hnew = h
+            if (self%fixed_step) then
+                k = min(k + 1, pmax)
+            else
+                if (knew == k - 1 .or. k == pmax) iphase = 1
+                if (iphase == 0) then
+                    k = k + 1
+                    hnew = 2.0_wp * h
+                else
+                    if (knew == k - 1) then
+                        k = k - 1
+                        est = erkm1
+                    else if (.not. (k == pmax .or. k + 1 >= ns .or. kdiff == 1)) then
+                        delta = e - phi(:, k + 2)
+                        erkp1 = enorm(delta) / real(k + 2, wp)
+                        terkp1 = real(k + 2, wp) * erkp1
+                        if (k == 1) then
+                            if (terkp1 < half * terk) then
+                                k = k + 1
+                                est = erkp1
+                            end if
+                        else if (terkm1 <= min(terk, terkp1)) then
+                            k = k - 1
+                            est = erkm1
+                        else if (terkp1 < terk) then
+                            k = k + 1
+                            est = erkp1
+                        end if
+                    end if
+                    r = (2.0_wp * est + est_offset)**(-1.0_wp / real(k + 1, wp))
+                    if (r >= r_raise) then
+                        hnew = 2.0_wp * h
+                    else if (r <= 1.0_wp) then
+                        hnew = h * min(max(r, r_min), r_max)
+                    end if
+                end if
+            end if
+            ! History, with kold the order used in this step.
+            if (kold /= pmax) phi(:, kold + 2) = e
+            phi(:, kold + 1) = phi(:, kold + 1) + e
+            do j = kold, 1, -1
+                phi(:, j) = phi(:, j) + phi(:, j + 1)
+            end do
+            h = hnew
+        end subroutine take_step
+
+        !> §2.6: undo the β scaling, t_n and ψ of the failed attempt.
+        subroutine restore()
+            integer :: i, j
+            iphase = 1
+            tn = tn - h
+            do j = ns + 1, k + 1
+                phi(:, j) = phi(:, j) / beta(j)
+            end do
+            do i = 2, k + 1
+                psi(i - 1) = psi(i) - h
+            end do
+        end subroutine restore
+
+        !> §2.8 DDAINI: one damped backward-Euler step from (t0, y0) with y0'
+        !> as the guess; advances tn to t0 + h and leaves (y, yp) there.
+        subroutine initial_step(st)
+            type(status_t), intent(out) :: st
+            integer :: m, mb, nefi, ncfi, nsfi
+            real(wp) :: ynorm, d, d0, rate, err, r
+            logical :: converged, singular
+            ysave = y
+            ypsave = yp
+            ynorm = vnorm(y)
+            nefi = 0
+            ncfi = 0
+            nsfi = 0
+            do
+                cj = 1.0_wp / h
+                tn = t0 + h
+                y = ysave + h * ypsave
+                yp = ypsave
+                converged = .false.
+                singular = .false.
+                m = 0
+                mb = 0
+                d0 = 0.0_wp
+                newton: do
+                    if (.not. residual_ok()) exit newton
+                    if (mod(m, ini_jac_every) == 0) then
+                        self%native%nje = self%native%nje + 1
+                        call form_pd(singular)
+                        if (singular) exit newton
+                        s = ini_s
+                        mb = 0
+                    end if
+                    delta = ini_damp * delta
+                    call ls%solve_real(delta)
+                    self%nsol = self%nsol + 1
+                    y = y - delta
+                    yp = yp - cj * delta
+                    if (self%nonnegative) then
+                        ! Clip y and keep y' = (y − y0)/h consistent with it.
+                        where (y < 0.0_wp) yp = yp - cj * y
+                        y = max(y, 0.0_wp)
+                    end if
+                    d = vnorm(delta)
+                    if (.not. ieee_is_finite(d)) exit newton
+                    if (d <= roundoff_conv * uround * ynorm) then
+                        converged = .true.
+                        exit newton
+                    end if
+                    if (mb == 0) then
+                        d0 = d
+                    else
+                        rate = (d / d0)**(1.0_wp / real(mb, wp))
+                        if (rate > rate_max) exit newton
+                        s = rate / (1.0_wp - rate)
+                    end if
+                    if (s * d <= conv_tol) then
+                        converged = .true.
+                        exit newton
+                    end if
+                    m = m + 1
+                    mb = mb + 1
+                    if (m >= ini_max_iter) exit newton
+                end do newton
+                if (ires_stop) then
+                    call st%set(status_interrupted, 'ddassl: the residual asked to stop ' // &
+                        'in DDAINI at t = ' // real_text(tn))
+                    exit
+                else if (converged) then
+                    delta = y - ysave
+                    err = vnorm(delta)
+                    if (err <= 1.0_wp) return
+                    nefi = nefi + 1
+                    r = min(max(fail_safety / (2.0_wp * err + est_offset), ini_r_min), ini_r_max)
+                    h = h * r
+                    if (nefi >= ini_max_nef .or. abs(h) < hmin) then
+                        call st%set(status_solver_failure, 'ddassl: initial derivative ' // &
+                            '(DDAINI) failed the error test at t = ' // real_text(t0), &
+                            reason_step_too_small)
+                        exit
+                    end if
+                else if (singular) then
+                    nsfi = nsfi + 1
+                    h = h * fail_quarter
+                    if (nsfi >= max_nsf .or. abs(h) < hmin) then
+                        call st%set(status_solver_failure, 'ddassl: initial derivative ' // &
+                            '(DDAINI): iteration matrix singular at t = ' // real_text(t0), &
+                            reason_singular_matrix)
+                        exit
+                    end if
+                else
+                    ncfi = ncfi + 1
+                    h = h * fail_quarter
+                    if (ncfi >= max_ncf .or. abs(h) < hmin) then
+                        call st%set(status_solver_failure, 'ddassl: initial derivative ' // &
+                            '(DDAINI): Newton iteration failed at t = ' // real_text(t0), &
+                            reason_newton_failure)
+                        exit
+                    end if
+                end if
+            end do
+            y = ysave
+            yp = ypsave
+            tn = t0
+        end subroutine initial_step
+    end subroutine ddassl_integrate_residual
+
+    pure function real_text(x) result(text)
+        real(wp), intent(in) :: x
+        character(len=:), allocatable :: text
+        character(len=32) :: buf
+        write (buf, '(es14.6)') x
+        text = trim(adjustl(buf))
+    end function real_text
+
+    pure function int_text(i) result(text)
+        integer, intent(in) :: i
+        character(len=:), allocatable :: text
+        character(len=16) :: buf
+        write (buf, '(i0)') i
+        text = trim(buf)
+    end function int_text
+end module flexmbs_dae_ddassl
