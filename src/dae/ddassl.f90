@@ -77,6 +77,48 @@ module flexmbs_dae_ddassl
         integer :: nst = 0, nre = 0, nje = 0, netf = 0, ncfn = 0
     end type ddassl_native_t
 
+    ! Classic IDID of a failure (§2.11), recorded in `ddassl_work_t%failure`.
+    integer, parameter, public :: ddassl_fail_none = 0
+    integer, parameter, public :: ddassl_fail_tolerances = -2 !! rtol, atol scaled up
+    integer, parameter, public :: ddassl_fail_weights = -3    !! some wt_i ≤ 0
+    integer, parameter, public :: ddassl_fail_error_test = -6 !! error test, |h| < hmin
+    integer, parameter, public :: ddassl_fail_corrector = -7
+    integer, parameter, public :: ddassl_fail_singular = -8
+    integer, parameter, public :: ddassl_fail_after_error_test = -9
+    integer, parameter, public :: ddassl_fail_residual = -10  !! IRES = −1 repeatedly
+    integer, parameter, public :: ddassl_fail_stop = -11      !! IRES = −2
+    integer, parameter, public :: ddassl_fail_initial = -12   !! DDAINI
+
+    !> Everything a DDASSL integration carries from step to step: the BDF
+    !> history and coefficients, the Newton state, tolerances and weights,
+    !> the iteration matrix and its factors. It lives in `ddassl_t%work`
+    !> between calls, so that a driver can stop after any step and resume
+    !> (the classic face's INFO(3) and continuation calls); the names are
+    !> those of ALGORITHMS.md §2.
+    type, public :: ddassl_work_t
+        logical :: ready = .false.       !! begin succeeded; step may be called
+        integer :: n = 0, pmax = 0
+        integer :: k = 0, kold = 0, ns = 0, iphase = 0, jcalc = 0, knew = 0
+        integer :: nef = 0, ncf = 0, nsf = 0
+        real(wp) :: tn = 0.0_wp, h = 0.0_wp, hold = 0.0_wp
+        real(wp) :: cj = 0.0_wp, cjlast = 0.0_wp, cjold = 0.0_wp, s = 0.0_wp
+        real(wp) :: hmin = 0.0_wp, hmax = huge(1.0_wp), uround = epsilon(1.0_wp)
+        real(wp) :: t0 = 0.0_wp, h_fixed = 0.0_wp
+        real(wp) :: est = 0.0_wp, erkm1 = 0.0_wp, terkm1 = 0.0_wp, terk = 0.0_wp
+        real(wp) :: tol_scale = 1.0_wp   !! factor applied to rtol, atol (failure −2)
+        integer :: failure = ddassl_fail_none !! ddassl_fail_* of the last failure
+        logical :: fd = .false., ires_stop = .false.
+        real(wp) :: psi(mx) = 0.0_wp, alpha(mx) = 0.0_wp, beta(mx) = 0.0_wp
+        real(wp) :: gamma(mx) = 0.0_wp, sigma(mx) = 0.0_wp
+        real(wp), allocatable :: phi(:, :), delta(:), e(:), wt(:), rtol(:), atol(:)
+        real(wp), allocatable :: ytmp(:), yptmp(:), ysave(:), ypsave(:)
+        logical, allocatable :: in_test(:)
+        type(matrix_t), allocatable :: amat, bmat
+        class(linear_solver_t), allocatable :: ls
+    end type ddassl_work_t
+
+    integer, parameter :: action_begin = 1, action_step = 2
+
     !> DDASSL settings (the INFO switches of the classic code that make
     !> sense in the modern core) and the results of the last integration.
     type, extends(dae_solver_t), public :: ddassl_t
@@ -101,13 +143,18 @@ module flexmbs_dae_ddassl
         type(ddassl_native_t) :: native
         integer :: ndec = 0          !! successful PD factorisations
         integer :: nsol = 0          !! solves (corrector and DDAINI)
+        integer :: nfe_jac = 0       !! residual calls of difference PDs
         integer :: k_last = 0        !! order of the last step (IWORK(8))
         integer :: k_next = 0        !! order for the next step (IWORK(7))
         real(wp) :: h_next = 0.0_wp  !! next step size (RWORK(3))
         type(ddassl_dense_t) :: dense
+        type(ddassl_work_t) :: work  !! the state between steps (begin/step)
     contains
         procedure :: integrate => ddassl_integrate
         procedure :: integrate_residual => ddassl_integrate_residual
+        procedure :: begin => ddassl_begin
+        procedure :: step => ddassl_step
+        procedure :: interpolate => ddassl_interpolate
         procedure :: name => ddassl_name
     end type ddassl_t
 
@@ -249,64 +296,14 @@ contains
         class(sink_t), intent(inout), optional :: sink
         logical, intent(in), optional :: initial_derivative !! overrides the component
 
-        ! Workspace, allocated once per integration.
-        real(wp), allocatable :: phi(:, :), delta(:), e(:), wt(:), rtol(:), atol(:)
-        real(wp), allocatable :: ytmp(:), yptmp(:), ysave(:), ypsave(:)
-        logical, allocatable :: in_test(:)
-        integer, allocatable :: classes(:)
-        real(wp) :: psi(mx), alpha(mx), beta(mx), gamma(mx), sigma(mx)
-        type(matrix_t) :: amat, bmat
-        class(linear_solver_t), allocatable :: ls
+        real(wp), allocatable :: y0(:), ytmp(:)
         type(timer_t) :: timer
-        type(status_t) :: st
-
-        integer :: n, pmax, k, kold, ns, iphase, jcalc, nef, ncf, nsf, iout, nout, knew
-        real(wp) :: tn, h, hold, cj, cjlast, cjold, s, hmin, hmax, dir, uround, tout_h0
-        real(wp) :: t0, h_fixed, est, erkm1, terkm1, terk
-        logical :: fd, ddaini, want_steps, stop_requested, done, ires_stop
+        integer :: iout, nout
+        real(wp) :: dir, tout_h0, hmin
+        logical :: want_steps, stop_requested, done
 
         call timer%start()
-        self%native = ddassl_native_t()
-        self%ndec = 0
-        self%nsol = 0
-        self%k_last = 0
-        self%k_next = 0
-        self%h_next = 0.0_wp
-        n = res%n
-        tn = t
-        t0 = t
         stats%t_reached = t
-        uround = self%uround
-        pmax = options%pmax
-        h = 0.0_wp
-        ires_stop = .false.
-        ddaini = self%initial_derivative
-        if (present(initial_derivative)) ddaini = initial_derivative
-
-        ! ---- validation (§2.7 first call) ----
-        if (n <= 0 .or. size(y) /= n .or. size(yp) /= n) then
-            call bad('sizes of y and yp must equal the problem size n > 0')
-            return
-        end if
-        call options%validate(n, status)
-        if (.not. status%ok()) return
-        if (pmax > ddassl_max_order) then
-            call bad('pmax = ' // int_text(pmax) // ': must lie in 1..5')
-            return
-        end if
-        if (.not. (uround > 0.0_wp .and. uround < 1.0_wp)) then
-            call bad('uround must lie in (0, 1)')
-            return
-        end if
-        if (self%fixed_step .and. .not. options%h0 > 0.0_wp) then
-            call bad('fixed_step needs a positive h0')
-            return
-        end if
-        allocate (rtol(n), atol(n), wt(n), in_test(n), classes(n))
-        call options%tolerances(rtol, atol)
-        call res%index_classes(classes)
-        in_test = .true.
-        if (self%exclude_index23) in_test = classes < 2
         dir = sign(1.0_wp, t_end - t)
         tout_h0 = t_end
         nout = 0
@@ -319,189 +316,103 @@ contains
                 end if
             end do
         end if
-        call set_weights(y)
-        if (any(.not. wt > 0.0_wp)) then
-            call bad('some weight rtol*|y0| + atol is not positive')
-            return
-        end if
-        hmin = hmin_factor * uround * max(abs(t), abs(tout_h0))
+        hmin = hmin_factor * self%uround * max(abs(t), abs(tout_h0))
         if (abs(t_end - t) < hmin .or. t_end == t) then
-            call bad('t_end = ' // real_text(t_end) // ' is too close to t = ' // real_text(t))
+            call status%set(status_bad_input, 'ddassl: t_end = ' // real_text(t_end) // &
+                ' is too close to t = ' // real_text(t))
             return
         end if
-        hmax = huge(1.0_wp)
-        if (options%hmax > 0.0_wp) hmax = options%hmax
-
-        ! Matrices and the linear solver: storages fixed here, once.
-        call res%setup_partials(options%jacobian == 'fd', amat, bmat, status)
-        if (.not. status%ok()) return
-        fd = bmat%storage == storage_none
-        call new_linear_solver(options%linear_solver, n, bmat%storage, ls, status)
-        if (.not. status%ok()) return
-        if (fd) then
-            ! The difference PD is held as −PD and factored with shift 0.
-            bmat%storage = storage_dense
-            allocate (bmat%dense(n, n))
-        end if
-        call ls%init(amat, bmat, status)
-        if (.not. status%ok()) return
-        allocate (phi(n, pmax + 1), delta(n), e(n), ytmp(n), yptmp(n), ysave(n), ypsave(n))
-        phi = 0.0_wp
-
-        ! ---- initial step (§2.7 steps 4 and 5) ----
-        if (options%h0 > 0.0_wp) then
-            h = sign(options%h0, dir)
+        y0 = y
+        if (self%tstop) then
+            call self%begin(res, t, y, yp, tout_h0, options, status, initial_derivative, t_end)
         else
-            h = h0_fraction * abs(tout_h0 - t)
-            if (vnorm(yp) > h0_slope / h) h = h0_slope / vnorm(yp)
-            h = sign(h, dir)
+            call self%begin(res, t, y, yp, tout_h0, options, status, initial_derivative)
         end if
-        h_fixed = h
-        if (abs(h) > hmax) h = h / (abs(h) / hmax)
-        if (self%tstop .and. (t + h - t_end) * dir > 0.0_wp) h = t_end - t
+        if (.not. allocated(self%work%phi)) return  ! bad input: nothing was set up
+        allocate (ytmp(size(y)))
 
         ! Outputs at t0.
         want_steps = .false.
         stop_requested = .false.
         if (present(sink)) want_steps = sink%wants_steps()
         iout = 1
-        do while (iout <= nout)
+        do while (iout <= nout .and. status%ok())
             if ((options%output_times(iout) - t) * dir > 0.0_wp) exit
             if (present(sink) .and. options%output_times(iout) == t) &
-                call sink%output(t, y, status)
+                call sink%output(t, y0, status)
             iout = iout + 1
-            if (.not. status%ok()) then
-                call finish()
-                return
-            end if
         end do
-
-        if (ddaini) then
-            call initial_step(st)
-            if (.not. st%ok()) then
-                status = st
-                call finish()
-                return
-            end if
+        if (.not. status%ok()) then
+            call finish()
+            return
         end if
-
-        ! §2.7 step 7: the history after the first call.
-        phi(:, 1) = y
-        phi(:, 2) = h * yp
-        k = 1
-        kold = 0
-        hold = 0.0_wp
-        psi = 0.0_wp
-        psi(1) = h
-        cj = 1.0_wp / h
-        cjold = cj
-        cjlast = cj
-        s = s_fresh
-        jcalc = -1
-        iphase = 0
-        ns = 0
-        alpha = 0.0_wp; beta = 0.0_wp; gamma = 0.0_wp; sigma = 0.0_wp
-        if (self%fixed_step .and. allocated(self%start_history)) then
-            if (size(self%start_history, 1) /= n .or. size(self%start_history, 2) /= pmax + 1) then
-                call bad('start_history must have shape (n, pmax + 1)')
-                call finish()
-                return
-            end if
-            call history_from_values()
-        end if
-        if (want_steps) then
-            call copy_dense()
-            call sink%step(1, tn, tn, y, self%dense, stop_requested, status)
-            if (.not. status%ok()) then
-                call finish()
-                return
-            end if
-        end if
-        done = (tn - t_end) * dir >= 0.0_wp
-
-        main: do while (.not. done)
-            ! ---- before every step (§2.7) ----
-            if (self%native%nst >= options%max_steps) then
-                call fail('more than ' // int_text(options%max_steps) // ' steps needed', &
-                    reason_max_steps)
-                exit main
-            end if
-            call set_weights(phi(:, 1))
-            if (any(.not. wt > 0.0_wp)) then
-                call fail('a weight rtol*|y| + atol became non-positive', reason_non_finite)
-                exit main
-            end if
-            if (roundoff_conv * uround * vnorm(phi(:, 1)) > 1.0_wp) then
-                call fail('tolerances too small for the machine precision (scale rtol, atol by ' &
-                    // real_text(roundoff_conv * uround * vnorm(phi(:, 1))) // ')', &
-                    reason_step_too_small)
-                exit main
-            end if
-            hmin = hmin_factor * uround * max(abs(tn), abs(t_end))
-            if (abs(h) > hmax) h = h / (abs(h) / hmax)
-            if (self%tstop .and. (tn + h - t_end) * dir > 0.0_wp) h = t_end - tn
-
-            call take_step(st)
-            if (.not. st%ok()) then
-                status = st
-                call interpolate_history(phi, psi, kold, tn, tn, y, yp)
-                exit main
-            end if
-
-            ! ---- output ----
-            stats%t_reached = tn
-            stats%h_last = hold
-            do while (iout <= nout)
-                if ((options%output_times(iout) - tn) * dir > 0.0_wp) exit
-                if (present(sink)) then
-                    call interpolate_history(phi, psi, kold, tn, options%output_times(iout), ytmp)
-                    call sink%output(options%output_times(iout), ytmp, status)
-                end if
-                iout = iout + 1
-                if (.not. status%ok()) exit main
-            end do
+        associate (w => self%work)
             if (want_steps) then
                 call copy_dense()
-                call sink%step(self%native%nst + 1, tn - hold, tn, phi(:, 1), self%dense, &
-                    stop_requested, status)
-                if (.not. status%ok()) exit main
-                if (stop_requested) then
-                    call status%set(status_interrupted, &
-                        'ddassl: interrupted by the output routine at t = ' // real_text(tn))
-                    call interpolate_history(phi, psi, kold, tn, tn, y, yp)
-                    exit main
+                call sink%step(1, w%tn, w%tn, y, self%dense, stop_requested, status)
+                if (.not. status%ok()) then
+                    call finish()
+                    return
                 end if
             end if
-            if (self%tstop) then
-                done = abs(tn - t_end) <= tstop_tol * uround * (abs(tn) + abs(h)) &
-                    .or. (tn - t_end) * dir >= 0.0_wp
-            else
-                done = (tn - t_end) * dir >= 0.0_wp
-            end if
-        end do main
+            done = (w%tn - t_end) * dir >= 0.0_wp
 
-        if (done .and. status%ok()) then
-            call interpolate_history(phi, psi, kold, tn, t_end, y, yp)
-            t = t_end
-        else
-            t = tn
-        end if
+            main: do while (.not. done)
+                if (self%native%nst >= options%max_steps) then
+                    call status%set(status_solver_failure, 'ddassl: more than ' // &
+                        int_text(options%max_steps) // ' steps needed at t = ' // &
+                        real_text(w%tn) // ' (h = ' // real_text(w%h) // ')', reason_max_steps)
+                    exit main
+                end if
+                call self%step(res, y, yp, t_end, status, self%tstop)
+                if (.not. status%ok()) then
+                    call self%interpolate(w%tn, y, yp)
+                    exit main
+                end if
+
+                ! ---- output ----
+                stats%t_reached = w%tn
+                stats%h_last = w%hold
+                do while (iout <= nout)
+                    if ((options%output_times(iout) - w%tn) * dir > 0.0_wp) exit
+                    if (present(sink)) then
+                        call self%interpolate(options%output_times(iout), ytmp)
+                        call sink%output(options%output_times(iout), ytmp, status)
+                    end if
+                    iout = iout + 1
+                    if (.not. status%ok()) exit main
+                end do
+                if (want_steps) then
+                    call copy_dense()
+                    call sink%step(self%native%nst + 1, w%tn - w%hold, w%tn, w%phi(:, 1), &
+                        self%dense, stop_requested, status)
+                    if (.not. status%ok()) exit main
+                    if (stop_requested) then
+                        call status%set(status_interrupted, &
+                            'ddassl: interrupted by the output routine at t = ' // real_text(w%tn))
+                        call self%interpolate(w%tn, y, yp)
+                        exit main
+                    end if
+                end if
+                if (self%tstop) then
+                    done = abs(w%tn - t_end) <= tstop_tol * w%uround * (abs(w%tn) + abs(w%h)) &
+                        .or. (w%tn - t_end) * dir >= 0.0_wp
+                else
+                    done = (w%tn - t_end) * dir >= 0.0_wp
+                end if
+            end do main
+
+            if (done .and. status%ok()) then
+                call self%interpolate(t_end, y, yp)
+                t = t_end
+            else
+                t = w%tn
+            end if
+        end associate
         call copy_dense()
         call finish()
 
     contains
-
-        subroutine bad(reason)
-            character(len=*), intent(in) :: reason
-            call status%set(status_bad_input, 'ddassl: ' // reason)
-        end subroutine bad
-
-        subroutine fail(reason, code)
-            character(len=*), intent(in) :: reason
-            integer, intent(in) :: code
-            call status%set(status_solver_failure, 'ddassl: ' // reason // ' at t = ' // &
-                real_text(tn) // ' (h = ' // real_text(h) // ')', code)
-        end subroutine fail
 
         !> Common statistics from the native counters (ALGORITHMS.md §4.1).
         subroutine finish()
@@ -510,13 +421,14 @@ contains
             stats%nac = self%native%nst
             stats%nrj = self%native%netf + self%native%ncfn
             stats%nfe = self%native%nre
+            stats%nfe_jac = self%nfe_jac
             stats%nje = self%native%nje
             stats%ndec = self%ndec
             stats%nsol = self%nsol
             stats%t_reached = t
-            self%k_last = kold
-            self%k_next = k
-            self%h_next = h
+            self%k_last = self%work%kold
+            self%k_next = self%work%k
+            self%h_next = self%work%h
             stats%cpu = timer%cpu()
             stats%wall = timer%wall()
             if (present(sink)) then
@@ -526,17 +438,361 @@ contains
         end subroutine finish
 
         subroutine copy_dense()
-            if (.not. allocated(self%dense%phi)) then
-                allocate (self%dense%phi(n, pmax + 1))
-            else if (size(self%dense%phi, 1) /= n .or. size(self%dense%phi, 2) /= pmax + 1) then
-                deallocate (self%dense%phi)
-                allocate (self%dense%phi(n, pmax + 1))
-            end if
-            self%dense%phi = phi
-            self%dense%psi = psi
-            self%dense%kold = kold
-            self%dense%tn = tn
+            associate (w => self%work)
+                if (.not. allocated(self%dense%phi)) then
+                    allocate (self%dense%phi, mold=w%phi)
+                else if (any(shape(self%dense%phi) /= shape(w%phi))) then
+                    deallocate (self%dense%phi)
+                    allocate (self%dense%phi, mold=w%phi)
+                end if
+                self%dense%phi = w%phi
+                self%dense%psi = w%psi
+                self%dense%kold = w%kold
+                self%dense%tn = w%tn
+            end associate
         end subroutine copy_dense
+    end subroutine ddassl_integrate_residual
+
+    !> Start an integration of G(t, y, y') = 0 at (t, y, yp) (§2.7, first
+    !> call): validate, fix the storages and the linear solver, choose H0
+    !> from `tout` (and options%h0, options%hmax), run DDAINI when asked, and
+    !> set up the history. The state is kept in `self%work` for `step`.
+    !> Counters restart at zero. With DDAINI, (t, y, yp) are left unchanged
+    !> and the history starts at t + h.
+    subroutine ddassl_begin(self, res, t, y, yp, tout, options, status, initial_derivative, tstop)
+        class(ddassl_t), intent(inout) :: self
+        class(residual_problem_t), intent(inout) :: res
+        real(wp), intent(inout) :: t
+        real(wp), intent(inout) :: y(:), yp(:)
+        real(wp), intent(in) :: tout                !! H0 rule and hmin (§2.7)
+        type(dae_options_t), intent(in) :: options
+        type(status_t), intent(out) :: status
+        logical, intent(in), optional :: initial_derivative !! overrides the component
+        real(wp), intent(in), optional :: tstop    !! H0 never passes it (INFO(4))
+        logical :: ddaini
+        ddaini = self%initial_derivative
+        if (present(initial_derivative)) ddaini = initial_derivative
+        call ddassl_engine(self, res, action_begin, t, y, yp, tout, status, options, ddaini, &
+            tlimit=tstop)
+    end subroutine ddassl_begin
+
+    !> One accepted step after `begin` (§2.7 "before every step" items 2–6,
+    !> then §2.2–§2.6): on success `self%work%tn` is the new t_n; on failure
+    !> status says why and `self%work%failure` gives the classic IDID. `y`,
+    !> `yp` are work space here (the last iterate); `interpolate` gives values.
+    !> `tout` enters hmin; with `tstop` the step never passes it (INFO(4)).
+    subroutine ddassl_step(self, res, y, yp, tout, status, stop_at_tout, tstop)
+        class(ddassl_t), intent(inout) :: self
+        class(residual_problem_t), intent(inout) :: res
+        real(wp), intent(inout) :: y(:), yp(:)
+        real(wp), intent(in) :: tout
+        type(status_t), intent(out) :: status
+        logical, intent(in) :: stop_at_tout         !! never pass tout (modern tstop)
+        real(wp), intent(in), optional :: tstop     !! never pass tstop (classic INFO(4))
+        real(wp) :: t, tlimit
+        logical :: limited
+        if (.not. self%work%ready) then
+            call status%set(status_bad_input, 'ddassl: step called before a successful begin')
+            return
+        end if
+        t = self%work%tn
+        limited = stop_at_tout .or. present(tstop)
+        tlimit = tout
+        if (present(tstop)) tlimit = tstop
+        call ddassl_engine(self, res, action_step, t, y, yp, tout, status, &
+            limited=limited, tlimit=tlimit)
+    end subroutine ddassl_step
+
+    !> y(tbar) and y'(tbar) from the BDF interpolant of the last step (§2.5).
+    subroutine ddassl_interpolate(self, tbar, y, yp)
+        class(ddassl_t), intent(in) :: self
+        real(wp), intent(in) :: tbar
+        real(wp), intent(out) :: y(:)
+        real(wp), intent(out), optional :: yp(:)
+        call interpolate_history(self%work%phi, self%work%psi, self%work%kold, self%work%tn, &
+            tbar, y, yp)
+    end subroutine ddassl_interpolate
+
+    !> The machinery of begin and step. The state lives in self%work between
+    !> calls and in locals (moved, not copied) during one, so that the
+    !> procedures below read as the algorithm does in ALGORITHMS.md §2.
+    subroutine ddassl_engine(self, res, action, t, y, yp, tout, status, options, ddaini, &
+                             limited, tlimit)
+        class(ddassl_t), intent(inout) :: self
+        class(residual_problem_t), intent(inout) :: res
+        integer, intent(in) :: action
+        real(wp), intent(inout) :: t
+        real(wp), intent(inout) :: y(:), yp(:)
+        real(wp), intent(in) :: tout
+        type(status_t), intent(out) :: status
+        type(dae_options_t), intent(in), optional :: options
+        logical, intent(in), optional :: ddaini
+        logical, intent(in), optional :: limited
+        real(wp), intent(in), optional :: tlimit
+
+        real(wp), allocatable :: phi(:, :), delta(:), e(:), wt(:), rtol(:), atol(:)
+        real(wp), allocatable :: ytmp(:), yptmp(:), ysave(:), ypsave(:)
+        logical, allocatable :: in_test(:)
+        real(wp) :: psi(mx), alpha(mx), beta(mx), gamma(mx), sigma(mx)
+        type(matrix_t), allocatable :: amat, bmat
+        class(linear_solver_t), allocatable :: ls
+        type(status_t) :: st
+        integer :: n, pmax, k, kold, ns, iphase, jcalc, nef, ncf, nsf, knew
+        real(wp) :: tn, h, hold, cj, cjlast, cjold, s, hmin, hmax, dir, uround
+        real(wp) :: t0, h_fixed, est, erkm1, terkm1, terk, r
+        logical :: fd, ires_stop
+
+        if (action == action_begin) then
+            call begin_integration()
+        else
+            call load_state()
+            call before_step()
+            if (status%ok()) then
+                call take_step(st)
+                if (.not. st%ok()) status = st
+            end if
+            call save_state()
+        end if
+
+    contains
+
+        subroutine begin_integration()
+            integer, allocatable :: classes(:)
+            self%work = ddassl_work_t()
+            self%native = ddassl_native_t()
+            self%ndec = 0
+            self%nsol = 0
+            self%nfe_jac = 0
+            self%k_last = 0
+            self%k_next = 0
+            self%h_next = 0.0_wp
+            n = res%n
+            tn = t
+            t0 = t
+            uround = self%uround
+            pmax = options%pmax
+            h = 0.0_wp
+            hold = 0.0_wp
+            ires_stop = .false.
+            k = 0
+            kold = 0
+
+            ! ---- validation (§2.7 first call) ----
+            if (n <= 0 .or. size(y) /= n .or. size(yp) /= n) then
+                call bad('sizes of y and yp must equal the problem size n > 0')
+                return
+            end if
+            call options%validate(n, status)
+            if (.not. status%ok()) return
+            if (pmax > ddassl_max_order) then
+                call bad('pmax = ' // int_text(pmax) // ': must lie in 1..5')
+                return
+            end if
+            if (.not. (uround > 0.0_wp .and. uround < 1.0_wp)) then
+                call bad('uround must lie in (0, 1)')
+                return
+            end if
+            if (self%fixed_step .and. .not. options%h0 > 0.0_wp) then
+                call bad('fixed_step needs a positive h0')
+                return
+            end if
+                        allocate (rtol(n), atol(n), wt(n), in_test(n), classes(n))
+            call options%tolerances(rtol, atol)
+            call res%index_classes(classes)
+            in_test = .true.
+            if (self%exclude_index23) in_test = classes < 2
+            dir = sign(1.0_wp, tout - t)
+            call set_weights(y)
+            if (any(.not. wt > 0.0_wp)) then
+                call bad('some weight rtol*|y0| + atol is not positive')
+                return
+            end if
+            hmin = hmin_factor * uround * max(abs(t), abs(tout))
+            if (abs(tout - t) < hmin .or. tout == t) then
+                call bad('tout = ' // real_text(tout) // ' is too close to t = ' // real_text(t))
+                return
+            end if
+            hmax = huge(1.0_wp)
+            if (options%hmax > 0.0_wp) hmax = options%hmax
+
+            ! Matrices and the linear solver: storages fixed here, once.
+            allocate (amat, bmat)
+            call res%setup_partials(options%jacobian == 'fd', amat, bmat, status)
+            if (.not. status%ok()) return
+            fd = bmat%storage == storage_none
+            call new_linear_solver(options%linear_solver, n, bmat%storage, ls, status, &
+                lower=options%band_lower, upper=options%band_upper)
+            if (.not. status%ok()) return
+            if (fd) then
+                ! The difference PD is held as −PD and factored with shift 0.
+                bmat%storage = storage_dense
+                allocate (bmat%dense(n, n))
+            end if
+            call ls%init(amat, bmat, status)
+            if (.not. status%ok()) return
+            allocate (phi(n, pmax + 1), delta(n), e(n), ytmp(n), yptmp(n), ysave(n), ypsave(n))
+            phi = 0.0_wp
+            delta = 0.0_wp
+            e = 0.0_wp
+
+            ! ---- initial step (§2.7 steps 4 and 5) ----
+            if (options%h0 > 0.0_wp) then
+                h = sign(options%h0, dir)
+            else
+                h = h0_fraction * abs(tout - t)
+                if (vnorm(yp) > h0_slope / h) h = h0_slope / vnorm(yp)
+                h = sign(h, dir)
+            end if
+            h_fixed = h
+            if (abs(h) > hmax) h = h / (abs(h) / hmax)
+            if (present(tlimit)) then
+                if ((t + h - tlimit) * dir > 0.0_wp) h = tlimit - t
+            end if
+
+            if (ddaini) then
+                call initial_step(st)
+                if (.not. st%ok()) then
+                    status = st
+                    self%work%failure = ddassl_fail_initial
+                    if (st%code == status_interrupted) self%work%failure = ddassl_fail_stop
+                    call save_state()
+                    self%work%ready = .false.
+                    return
+                end if
+            end if
+
+            ! §2.7 step 7: the history after the first call.
+            phi(:, 1) = y
+            phi(:, 2) = h * yp
+            k = 1
+            kold = 0
+            hold = 0.0_wp
+            psi = 0.0_wp
+            psi(1) = h
+            cj = 1.0_wp / h
+            cjold = cj
+            cjlast = cj
+            s = s_fresh
+            jcalc = -1
+            iphase = 0
+            ns = 0
+            nef = 0
+            ncf = 0
+            nsf = 0
+            knew = 1
+            est = 0.0_wp
+            erkm1 = 0.0_wp
+            terkm1 = 0.0_wp
+            terk = 0.0_wp
+            alpha = 0.0_wp; beta = 0.0_wp; gamma = 0.0_wp; sigma = 0.0_wp
+            if (self%fixed_step .and. allocated(self%start_history)) then
+                if (size(self%start_history, 1) /= n .or. &
+                    size(self%start_history, 2) /= pmax + 1) then
+                    call bad('start_history must have shape (n, pmax + 1)')
+                    return
+                end if
+                call history_from_values()
+            end if
+            call save_state()
+            self%work%ready = .true.
+        end subroutine begin_integration
+
+        !> §2.7, before every step, items 2–6.
+        subroutine before_step()
+            call set_weights(phi(:, 1))
+            if (any(.not. wt > 0.0_wp)) then
+                call fail('a weight rtol*|y| + atol became non-positive', reason_non_finite, &
+                    ddassl_fail_weights)
+                return
+            end if
+            r = roundoff_conv * uround * vnorm(phi(:, 1))
+            if (r > 1.0_wp) then
+                ! The classic code scales the tolerances and reports −2.
+                rtol = r * rtol
+                atol = r * atol
+                self%work%tol_scale = r
+                call fail('tolerances too small for the machine precision (rtol, atol ' // &
+                    'scaled by ' // real_text(r) // ')', reason_step_too_small, &
+                    ddassl_fail_tolerances)
+                return
+            end if
+            hmin = hmin_factor * uround * max(abs(tn), abs(tout))
+            if (abs(h) > hmax) h = h / (abs(h) / hmax)
+            if (present(limited) .and. present(tlimit)) then
+                if (limited .and. (tn + h - tlimit) * dir > 0.0_wp) h = tlimit - tn
+            end if
+        end subroutine before_step
+
+        !> Locals from self%work (arrays moved, not copied).
+        subroutine load_state()
+            associate (w => self%work)
+                n = w%n; pmax = w%pmax; k = w%k; kold = w%kold; ns = w%ns
+                iphase = w%iphase; jcalc = w%jcalc; knew = w%knew
+                nef = w%nef; ncf = w%ncf; nsf = w%nsf
+                tn = w%tn; h = w%h; hold = w%hold; cj = w%cj; cjlast = w%cjlast
+                cjold = w%cjold; s = w%s; hmin = w%hmin; hmax = w%hmax; uround = w%uround
+                t0 = w%t0; h_fixed = w%h_fixed; est = w%est; erkm1 = w%erkm1
+                terkm1 = w%terkm1; terk = w%terk; fd = w%fd; ires_stop = .false.
+                psi = w%psi; alpha = w%alpha; beta = w%beta; gamma = w%gamma; sigma = w%sigma
+                w%failure = ddassl_fail_none
+                dir = sign(1.0_wp, h)
+                call move_alloc(w%phi, phi)
+                call move_alloc(w%delta, delta)
+                call move_alloc(w%e, e)
+                call move_alloc(w%wt, wt)
+                call move_alloc(w%rtol, rtol)
+                call move_alloc(w%atol, atol)
+                call move_alloc(w%ytmp, ytmp)
+                call move_alloc(w%yptmp, yptmp)
+                call move_alloc(w%ysave, ysave)
+                call move_alloc(w%ypsave, ypsave)
+                call move_alloc(w%in_test, in_test)
+                call move_alloc(w%amat, amat)
+                call move_alloc(w%bmat, bmat)
+                call move_alloc(w%ls, ls)
+            end associate
+        end subroutine load_state
+
+        !> Locals back into self%work.
+        subroutine save_state()
+            associate (w => self%work)
+                w%n = n; w%pmax = pmax; w%k = k; w%kold = kold; w%ns = ns
+                w%iphase = iphase; w%jcalc = jcalc; w%knew = knew
+                w%nef = nef; w%ncf = ncf; w%nsf = nsf
+                w%tn = tn; w%h = h; w%hold = hold; w%cj = cj; w%cjlast = cjlast
+                w%cjold = cjold; w%s = s; w%hmin = hmin; w%hmax = hmax; w%uround = uround
+                w%t0 = t0; w%h_fixed = h_fixed; w%est = est; w%erkm1 = erkm1
+                w%terkm1 = terkm1; w%terk = terk; w%fd = fd; w%ires_stop = ires_stop
+                w%psi = psi; w%alpha = alpha; w%beta = beta; w%gamma = gamma; w%sigma = sigma
+                call move_alloc(phi, w%phi)
+                call move_alloc(delta, w%delta)
+                call move_alloc(e, w%e)
+                call move_alloc(wt, w%wt)
+                call move_alloc(rtol, w%rtol)
+                call move_alloc(atol, w%atol)
+                call move_alloc(ytmp, w%ytmp)
+                call move_alloc(yptmp, w%yptmp)
+                call move_alloc(ysave, w%ysave)
+                call move_alloc(ypsave, w%ypsave)
+                call move_alloc(in_test, w%in_test)
+                call move_alloc(amat, w%amat)
+                call move_alloc(bmat, w%bmat)
+                call move_alloc(ls, w%ls)
+            end associate
+        end subroutine save_state
+
+        subroutine bad(reason)
+            character(len=*), intent(in) :: reason
+            call status%set(status_bad_input, 'ddassl: ' // reason)
+        end subroutine bad
+
+        subroutine fail(reason, code, idid)
+            character(len=*), intent(in) :: reason
+            integer, intent(in) :: code, idid
+            call status%set(status_solver_failure, 'ddassl: ' // reason // ' at t = ' // &
+                real_text(tn) // ' (h = ' // real_text(h) // ')', code)
+            self%work%failure = idid
+        end subroutine fail
 
         !> §2.7: wt_i = rtol_i |v_i| + atol_i.
         subroutine set_weights(v)
@@ -625,7 +881,7 @@ contains
                     y(j) = y(j) + del
                     yp(j) = yp(j) + cj * del
                     call res%residual(tn, y, yp, yptmp, fst)
-                    stats%nfe_jac = stats%nfe_jac + 1
+                    self%nfe_jac = self%nfe_jac + 1
                     y(j) = ysafe
                     yp(j) = ypsafe
                     if (.not. fst%ok()) then
@@ -830,6 +1086,7 @@ contains
                 if (self%fixed_step) then
                     call st%set(status_solver_failure, 'ddassl: fixed-step corrector ' // &
                         'failed at t = ' // real_text(tn - h), reason_newton_failure)
+                    self%work%failure = ddassl_fail_corrector
                     call restore()
                     return
                 end if
@@ -855,6 +1112,7 @@ contains
                         call st%set(status_solver_failure, 'ddassl: error test failed ' // &
                             'repeatedly, step size too small at t = ' // real_text(tn) // &
                             ' (h = ' // real_text(h) // ')', reason_step_too_small)
+                        self%work%failure = ddassl_fail_error_test
                         return
                     end if
                 else
@@ -862,6 +1120,7 @@ contains
                     if (ires_stop) then
                         call st%set(status_interrupted, 'ddassl: the residual asked to stop ' &
                             // 'at t = ' // real_text(tn + h))
+                        self%work%failure = ddassl_fail_stop
                         return
                     else if (singular) then
                         nsf = nsf + 1
@@ -870,6 +1129,7 @@ contains
                             call st%set(status_solver_failure, 'ddassl: iteration matrix ' // &
                                 'repeatedly singular at t = ' // real_text(tn) // ' (h = ' // &
                                 real_text(h) // ')', reason_singular_matrix)
+                            self%work%failure = ddassl_fail_singular
                             return
                         end if
                     else
@@ -881,14 +1141,17 @@ contains
                                     'after repeated error-test failures at t = ' // &
                                     real_text(tn) // ' (h = ' // real_text(h) // ')', &
                                     reason_newton_failure)
+                                self%work%failure = ddassl_fail_after_error_test
                             else if (early) then
                                 call st%set(status_solver_failure, 'ddassl: residual failed ' // &
                                     'repeatedly at t = ' // real_text(tn) // ' (h = ' // &
                                     real_text(h) // ')', reason_user_function)
+                                self%work%failure = ddassl_fail_residual
                             else
                                 call st%set(status_solver_failure, 'ddassl: corrector ' // &
                                     'failed repeatedly at t = ' // real_text(tn) // ' (h = ' // &
                                     real_text(h) // ')', reason_newton_failure)
+                                self%work%failure = ddassl_fail_corrector
                             end if
                             return
                         end if
@@ -1069,7 +1332,7 @@ contains
             yp = ypsave
             tn = t0
         end subroutine initial_step
-    end subroutine ddassl_integrate_residual
+    end subroutine ddassl_engine
 
     pure function real_text(x) result(text)
         real(wp), intent(in) :: x
