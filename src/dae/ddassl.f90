@@ -108,6 +108,7 @@ module flexmbs_dae_ddassl
         real(wp) :: tol_scale = 1.0_wp   !! factor applied to rtol, atol (failure −2)
         integer :: failure = ddassl_fail_none !! ddassl_fail_* of the last failure
         logical :: fd = .false., ires_stop = .false.
+        logical :: direct = .false.      !! PD from the problem as it stands (classic JAC)
         real(wp) :: psi(mx) = 0.0_wp, alpha(mx) = 0.0_wp, beta(mx) = 0.0_wp
         real(wp) :: gamma(mx) = 0.0_wp, sigma(mx) = 0.0_wp
         real(wp), allocatable :: phi(:, :), delta(:), e(:), wt(:), rtol(:), atol(:)
@@ -457,8 +458,8 @@ contains
     !> call): validate, fix the storages and the linear solver, choose H0
     !> from `tout` (and options%h0, options%hmax), run DDAINI when asked, and
     !> set up the history. The state is kept in `self%work` for `step`.
-    !> Counters restart at zero. With DDAINI, (t, y, yp) are left unchanged
-    !> and the history starts at t + h.
+    !> Counters restart at zero. With DDAINI the history starts at t + h, and
+    !> (y, yp) hold DDAINI's values there; t is left unchanged.
     subroutine ddassl_begin(self, res, t, y, yp, tout, options, status, initial_derivative, tstop)
         class(ddassl_t), intent(inout) :: self
         class(residual_problem_t), intent(inout) :: res
@@ -540,7 +541,7 @@ contains
         integer :: n, pmax, k, kold, ns, iphase, jcalc, nef, ncf, nsf, knew
         real(wp) :: tn, h, hold, cj, cjlast, cjold, s, hmin, hmax, dir, uround
         real(wp) :: t0, h_fixed, est, erkm1, terkm1, terk, r
-        logical :: fd, ires_stop
+        logical :: fd, ires_stop, direct
 
         if (action == action_begin) then
             call begin_integration()
@@ -620,6 +621,7 @@ contains
             call res%setup_partials(options%jacobian == 'fd', amat, bmat, status)
             if (.not. status%ok()) return
             fd = bmat%storage == storage_none
+            direct = .not. fd .and. res%has_iteration_matrix()
             call new_linear_solver(options%linear_solver, n, bmat%storage, ls, status, &
                 lower=options%band_lower, upper=options%band_upper)
             if (.not. status%ok()) return
@@ -733,6 +735,7 @@ contains
                 cjold = w%cjold; s = w%s; hmin = w%hmin; hmax = w%hmax; uround = w%uround
                 t0 = w%t0; h_fixed = w%h_fixed; est = w%est; erkm1 = w%erkm1
                 terkm1 = w%terkm1; terk = w%terk; fd = w%fd; ires_stop = .false.
+                direct = w%direct
                 psi = w%psi; alpha = w%alpha; beta = w%beta; gamma = w%gamma; sigma = w%sigma
                 w%failure = ddassl_fail_none
                 dir = sign(1.0_wp, h)
@@ -763,6 +766,7 @@ contains
                 w%cjold = cjold; w%s = s; w%hmin = hmin; w%hmax = hmax; w%uround = uround
                 w%t0 = t0; w%h_fixed = h_fixed; w%est = est; w%erkm1 = erkm1
                 w%terkm1 = terkm1; w%terk = terk; w%fd = fd; w%ires_stop = ires_stop
+                w%direct = direct
                 w%psi = psi; w%alpha = alpha; w%beta = beta; w%gamma = gamma; w%sigma = sigma
                 call move_alloc(phi, w%phi)
                 call move_alloc(delta, w%delta)
@@ -894,6 +898,14 @@ contains
                     singular = .true.
                     return
                 end if
+                call ls%factor_real(0.0_wp, amat, bmat, fst)
+            else if (direct) then
+                call res%iteration_matrix(tn, y, yp, cj, bmat%dense, fst)
+                if (.not. fst%ok()) then
+                    singular = .true.
+                    return
+                end if
+                bmat%dense = -bmat%dense
                 call ls%factor_real(0.0_wp, amat, bmat, fst)
             else
                 call res%partials(tn, y, yp, amat, bmat, fst)

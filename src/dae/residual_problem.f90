@@ -21,6 +21,8 @@ module flexmbs_dae_residual_problem
         procedure(partials_i), deferred :: partials
         procedure :: index_classes => residual_index_classes
         procedure :: differential_flags => residual_differential_flags
+        procedure :: has_iteration_matrix => residual_has_iteration_matrix
+        procedure :: iteration_matrix => residual_iteration_matrix
     end type residual_problem_t
 
     abstract interface
@@ -73,6 +75,24 @@ contains
         integer, intent(out) :: classes(:)
         classes = 1
     end subroutine residual_index_classes
+
+    !> Default: no. A problem that computes PD = ∂G/∂y + cj ∂G/∂y' itself
+    !> (the classic DDASSL JAC) says yes and gives `setup_partials` B in
+    !> dense storage; the solver then factors PD as it stands.
+    logical function residual_has_iteration_matrix(self)
+        class(residual_problem_t), intent(in) :: self
+        residual_has_iteration_matrix = .false.
+    end function residual_has_iteration_matrix
+
+    !> PD = ∂G/∂y + cj ∂G/∂y' at (t, y, y'), dense n x n.
+    subroutine residual_iteration_matrix(self, t, y, yp, cj, pd, status)
+        class(residual_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:), yp(:), cj
+        real(wp), intent(out) :: pd(:, :)
+        type(status_t), intent(inout) :: status
+        pd = 0.0_wp
+        call status%set(status_bad_input, 'residual problem: no iteration matrix')
+    end subroutine residual_iteration_matrix
 
     !> Default: every component differential.
     subroutine residual_differential_flags(self, flags)
