@@ -18,6 +18,8 @@ module test_mexax
         pendulum_mechanical_initial, pendulum_angle_exact
     use flexmbs_problems_pendulum_chain, only: pendulum_chain_t, new_pendulum_chain, &
         pendulum_chain_initial, chain_anchor_t1
+    use flexmbs_io_namelist, only: scene_input_t, parse_scene
+    use flexmbs_io_scene, only: run_result_t, run_scene
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
     private
@@ -90,7 +92,8 @@ contains
             new_test('fewer_columns_smaller_steps', test_column_limit), &
             new_test('chain_anchor_counters_euler', test_anchor_counters), &
             new_test('stiff_spring_pendulum_vs_radau5', test_stiff), &
-            new_test('failures', test_failures)]
+            new_test('failures', test_failures), &
+            new_test('scene_namelist', test_scene)]
     end function collect_mexax
 
     ! ---------------------------------------------------------------- helpers
@@ -498,6 +501,47 @@ contains
         call solver%integrate(dae, t, y, 1.0_wp, options, stats, status)
         call check(error, status%code == status_bad_input, 'dae problem: ' // status%text())
     end subroutine test_failures
+
+    !> `&solver name = 'mexax', max_extrapolation, mexax_base` through
+    !> run_scene on the pendulum; bad values are refused by name.
+    subroutine test_scene(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_input_t) :: scene
+        type(status_t) :: status
+        type(run_result_t) :: result
+        real(wp) :: phi, dphi
+        character(len=*), parameter :: sim = '&simulation problem = ''pendulum'', ' // &
+            't_end = 1, pendulum_angle = 1.0, pendulum_formulation = ''ggl'' /' // &
+            new_line('a') // '&output file = ''none'', progress = .false. /' // new_line('a')
+        call parse_scene(sim // '&solver name = ''MEXAX'', max_extrapolation = 6, ' // &
+            'mexax_base = ''Euler'', rtol = 1e-8, atol = 1e-8 /', 'pend.nml', scene, status)
+        call check(error, status%ok(), 'parse: ' // status%text())
+        call check(error, scene%max_extrapolation == 6 .and. scene%mexax_base == 'euler', &
+            'MEXAX settings')
+        if (allocated(error)) return
+        call run_scene(scene, .true., result, status)
+        call check(error, status%ok(), 'run: ' // status%text())
+        call check(error, result%solver_name == 'mexax', 'solver name')
+        call check(error, size(result%y) == 5, 'y = (q, v, lambda)')
+        if (allocated(error)) return
+        call pendulum_angle_exact(1.0_wp, omega, 1.0_wp, phi, dphi, status)
+        call check(error, paper_error(result%y(1:2), [sin(phi), -cos(phi)], 1.0e-8_wp, &
+            1.0e-8_wp) <= 1.0e-7_wp, 'pendulum position at t = 1')
+        call check_close(error, result%y(5), dphi**2 + 9.81_wp * cos(phi), 1.0e-5_wp, &
+            'lambda at t = 1', rel=.true.)
+        call parse_scene(sim // '&solver name = ''mexax'', max_extrapolation = 13 /', &
+            'pend.nml', scene, status)
+        call check(error, index(status%text(), 'max_extrapolation') > 0, &
+            'max_extrapolation = 13 accepted: ' // status%text())
+        call parse_scene(sim // '&solver name = ''mexax'', mexax_base = ''rk4'' /', &
+            'pend.nml', scene, status)
+        call check(error, index(status%text(), 'mexax_base') > 0, &
+            'mexax_base = rk4 accepted: ' // status%text())
+        call parse_scene('&simulation problem = ''robertson'', t_end = 1 /' // new_line('a') &
+            // '&solver name = ''mexax'' /', 'rober.nml', scene, status)
+        call check(error, status%code == status_bad_input .and. &
+            index(status%text(), 'mechanical') > 0, 'mexax on robertson: ' // status%text())
+    end subroutine test_scene
 
     ! ----------------------------------------------------------- type bodies
 
