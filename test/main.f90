@@ -14,6 +14,7 @@ program flexmbs_tests
     use test_reference, only: collect_reference
     use test_ida, only: collect_ida
     use test_ddassl, only: collect_ddassl
+    use test_mexax, only: collect_mexax
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -35,6 +36,7 @@ program flexmbs_tests
     call run_suite('reference', collect_reference(), filter, npassed, nfailed)
     call run_suite('ida', collect_ida(), filter, npassed, nfailed)
     call run_suite('ddassl', collect_ddassl(), filter, npassed, nfailed)
+    call run_suite('mexax', collect_mexax(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests

@@ -10,6 +10,7 @@
 module flexmbs_dae_ddassl
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use flexmbs_core_kinds, only: wp
+    use flexmbs_core_text, only: real_text, int_text
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         status_interrupted, reason_step_too_small, reason_max_steps, reason_singular_matrix, &
         reason_newton_failure, reason_user_function, reason_non_finite
@@ -1345,20 +1346,4 @@ contains
             tn = t0
         end subroutine initial_step
     end subroutine ddassl_engine
-
-    pure function real_text(x) result(text)
-        real(wp), intent(in) :: x
-        character(len=:), allocatable :: text
-        character(len=32) :: buf
-        write (buf, '(es14.6)') x
-        text = trim(adjustl(buf))
-    end function real_text
-
-    pure function int_text(i) result(text)
-        integer, intent(in) :: i
-        character(len=:), allocatable :: text
-        character(len=16) :: buf
-        write (buf, '(i0)') i
-        text = trim(buf)
-    end function int_text
 end module flexmbs_dae_ddassl

@@ -35,6 +35,7 @@ module flexmbs_dae_ida
         IDA_LINIT_FAIL, IDA_LSETUP_FAIL, IDA_LSOLVE_FAIL, IDA_RES_FAIL, IDA_REP_RES_ERR, &
         IDA_FIRST_RES_FAIL, IDA_LINESEARCH_FAIL, IDA_NO_RECOVERY, IDA_BAD_EWT
     use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_text, only: real_text, int_text
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         status_interrupted, reason_step_too_small, reason_max_steps, reason_singular_matrix, &
         reason_newton_failure, reason_user_function, reason_non_finite
@@ -913,20 +914,4 @@ contains
         use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
         ieee_nan = ieee_value(1.0_wp, ieee_quiet_nan)
     end function ieee_nan
-
-    pure function real_text(x) result(text)
-        real(wp), intent(in) :: x
-        character(len=:), allocatable :: text
-        character(len=32) :: buf
-        write (buf, '(es14.6)') x
-        text = trim(adjustl(buf))
-    end function real_text
-
-    pure function int_text(i) result(text)
-        integer, intent(in) :: i
-        character(len=:), allocatable :: text
-        character(len=16) :: buf
-        write (buf, '(i0)') i
-        text = trim(buf)
-    end function int_text
 end module flexmbs_dae_ida

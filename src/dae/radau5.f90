@@ -11,6 +11,7 @@
 module flexmbs_dae_radau5
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use flexmbs_core_kinds, only: wp
+    use flexmbs_core_text, only: real_text, int_text
     use flexmbs_core_status, only: status_t, status_ok, status_bad_input, &
         status_solver_failure, status_interrupted, reason_step_too_small, reason_max_steps, &
         reason_singular_matrix, reason_non_finite, reason_newton_failure, reason_projection, &
@@ -883,20 +884,4 @@ contains
             ieee_nan = ieee_value(1.0_wp, ieee_quiet_nan)
         end function ieee_nan
     end subroutine radau5_integrate
-
-    pure function real_text(x) result(text)
-        real(wp), intent(in) :: x
-        character(len=:), allocatable :: text
-        character(len=32) :: buf
-        write (buf, '(es14.6)') x
-        text = trim(adjustl(buf))
-    end function real_text
-
-    pure function int_text(i) result(text)
-        integer, intent(in) :: i
-        character(len=:), allocatable :: text
-        character(len=16) :: buf
-        write (buf, '(i0)') i
-        text = trim(buf)
-    end function int_text
 end module flexmbs_dae_radau5

@@ -64,6 +64,8 @@ module flexmbs_io_namelist
         var_spec_t('solver', 'initial_derivative', kind_logical), &
         var_spec_t('solver', 'exclude_index23', kind_logical), &
         var_spec_t('solver', 'netlib', kind_logical), &
+        var_spec_t('solver', 'max_extrapolation', kind_integer), &
+        var_spec_t('solver', 'mexax_base', kind_string), &
         var_spec_t('output', 'file', kind_string), &
         var_spec_t('output', 'n_output', kind_integer), &
         var_spec_t('output', 'every_step', kind_logical), &
@@ -124,6 +126,8 @@ module flexmbs_io_namelist
         logical :: initial_derivative = .false. !! DDASSL: y' by DDAINI
         logical :: exclude_index23 = .true.     !! DDASSL: index-2/3 out of the error test
         logical :: netlib = .false.             !! DDASSL: later netlib revision
+        integer :: max_extrapolation = 12       !! MEXAX: extrapolation columns (KDMAX), 2..12
+        character(len=len_name) :: mexax_base = 'midpoint' !! MEXAX: 'midpoint' | 'euler'
         ! &output
         !> HDF5 file; '' = none. Derived from the input name when not given.
         character(len=:), allocatable :: output_file
@@ -627,12 +631,12 @@ contains
         ! Namelist variables carry the schema's names, so they are local.
         character(len=len_title) :: title
         character(len=len_name) :: problem, pendulum_formulation, name, linear_solver, &
-            jacobian, controller
+            jacobian, controller, mexax_base
         character(len=len_path) :: file, table
         real(wp) :: t_start, t_end, vdp_eps, vdp_y1, vdp_y2, pendulum_length, pendulum_mass, &
             pendulum_angle, gravity, rtol, atol, h0, hmax, thet, fnewt, &
             quot1, quot2, safe, fac_min, fac_max
-        integer :: npoints, max_steps, nit, pmax, n_output
+        integer :: npoints, max_steps, nit, pmax, n_output, max_extrapolation
         logical :: pendulum_projection, zero_start, every_step, progress
         logical :: initial_derivative, exclude_index23, netlib
         namelist /simulation/ title, problem, t_start, t_end, vdp_eps, vdp_y1, vdp_y2, &
@@ -640,7 +644,7 @@ contains
             pendulum_projection, gravity, npoints
         namelist /solver/ name, rtol, atol, h0, hmax, max_steps, linear_solver, jacobian, &
             nit, thet, fnewt, quot1, quot2, safe, fac_min, fac_max, controller, zero_start, pmax, &
-            initial_derivative, exclude_index23, netlib
+            initial_derivative, exclude_index23, netlib, max_extrapolation, mexax_base
         namelist /output/ file, n_output, every_step, table, progress
 
         lines = split_lines(text)
@@ -700,6 +704,8 @@ contains
             initial_derivative = scene%initial_derivative
             exclude_index23 = scene%exclude_index23
             netlib = scene%netlib
+            max_extrapolation = scene%max_extrapolation
+            mexax_base = scene%mexax_base
             read (lines, nml=solver, iostat=ios, iomsg=msg)
             scene%solver_name = name
             scene%rtol = rtol
@@ -723,6 +729,8 @@ contains
             scene%initial_derivative = initial_derivative
             scene%exclude_index23 = exclude_index23
             scene%netlib = netlib
+            scene%max_extrapolation = max_extrapolation
+            scene%mexax_base = mexax_base
         case ('output')
             file = ''
             n_output = scene%n_output
@@ -784,6 +792,7 @@ contains
         scene%linear_solver = lower(scene%linear_solver)
         scene%jacobian = lower(scene%jacobian)
         scene%controller = lower(scene%controller)
+        scene%mexax_base = lower(scene%mexax_base)
     end subroutine normalise
 
     subroutine check_ranges(scene, entries, path, status)
@@ -817,9 +826,13 @@ contains
         else if (scene%npoints < 1) then
             call bad(sim, 'npoints', 'must be positive')
         ! &solver
-        else if (all([character(len=8) :: 'radau5', 'ddassl', 'ida'] /= scene%solver_name)) then
-            call bad(sol, 'name', &
-                     'must be ''radau5'', ''ddassl'' or ''ida'' (mexax is not available yet)')
+        else if (all([character(len=8) :: 'radau5', 'ddassl', 'ida', 'mexax'] &
+                     /= scene%solver_name)) then
+            call bad(sol, 'name', 'must be ''radau5'', ''ddassl'', ''ida'' or ''mexax''')
+        else if (scene%solver_name == 'mexax' .and. scene%problem /= 'pendulum') then
+            ! ALGORITHMS.md §6: MEXAX integrates the mechanical form only.
+            call bad(sol, 'name', '''mexax'' integrates mechanical problems only: &
+                &problem must be ''pendulum''')
         else if (.not. scene%rtol > 0.0_wp) then
             call bad(sol, 'rtol', 'must be positive')
         else if (.not. scene%rtol < 1.0_wp) then
@@ -860,6 +873,10 @@ contains
         else if (scene%solver_name == 'ddassl' .and. scene%pmax > 5) then
             ! ALGORITHMS.md §2.2: MAXORD ≤ 5.
             call bad(sol, 'pmax', 'must lie in 1..5 for ddassl (its maximal BDF order)')
+        else if (scene%max_extrapolation < 2 .or. scene%max_extrapolation > 12) then
+            call bad(sol, 'max_extrapolation', 'must lie in 2..12')
+        else if (all([character(len=8) :: 'midpoint', 'euler'] /= scene%mexax_base)) then
+            call bad(sol, 'mexax_base', 'must be ''midpoint'' or ''euler''')
         ! &output
         else if (scene%n_output < 2) then
             call bad(out, 'n_output', 'must be at least 2 (t_start and t_end)')

@@ -13,12 +13,14 @@ module flexmbs_io_scene
     use flexmbs_dae_radau5, only: radau5_t
     use flexmbs_dae_ida, only: ida_t
     use flexmbs_dae_ddassl, only: ddassl_t
+    use flexmbs_dae_mexax, only: mexax_t, mexax_base_midpoint, mexax_base_euler
     use flexmbs_linalg_linear_solver, only: linear_solver_t
     use flexmbs_linalg_factory, only: new_linear_solver
     use flexmbs_problems_van_der_pol, only: new_van_der_pol
     use flexmbs_problems_robertson, only: robertson_t, new_robertson, robertson_initial
     use flexmbs_problems_pendulum, only: pendulum_t, new_pendulum, pendulum_initial, &
-        pendulum_index1, pendulum_index2, pendulum_index3, pendulum_ggl
+        pendulum_index1, pendulum_index2, pendulum_index3, pendulum_ggl, &
+        pendulum_mechanical_t, new_pendulum_mechanical
     use flexmbs_problems_reaction_diffusion, only: reaction_diffusion_t, &
         new_reaction_diffusion, reaction_diffusion_initial
     use flexmbs_io_namelist, only: scene_input_t, scene_dae_options, controller_code
@@ -73,7 +75,10 @@ contains
             call robertson_initial(robertson, y0)
             allocate (problem, source=robertson)
         case ('pendulum')
-            pendulum = new_pendulum(formulation_code(scene%pendulum_formulation), &
+            ! MEXAX takes the mechanical form; its state y = (q, v, λ) has the
+            ! layout and initial values of the index-2 formulation.
+            pendulum = new_pendulum(merge(pendulum_index2, &
+                formulation_code(scene%pendulum_formulation), scene%solver_name == 'mexax'), &
                 scene%pendulum_angle, mass=scene%pendulum_mass, length=scene%pendulum_length, &
                 gravity=scene%gravity, sparse=klu, sparse_mass=klu, &
                 projection=scene%pendulum_projection, status=status)
@@ -122,6 +127,7 @@ contains
         type(radau5_t) :: radau5
         type(ida_t) :: ida
         type(ddassl_t) :: ddassl
+        type(mexax_t) :: mexax
         select case (trim(scene%solver_name))
         case ('radau5')
             radau5%nit = scene%nit
@@ -143,6 +149,11 @@ contains
             ddassl%exclude_index23 = scene%exclude_index23
             ddassl%netlib = scene%netlib
             allocate (solver, source=ddassl)
+        case ('mexax')
+            mexax%max_extrapolation = scene%max_extrapolation
+            mexax%base = merge(mexax_base_euler, mexax_base_midpoint, &
+                scene%mexax_base == 'euler')
+            allocate (solver, source=mexax)
         case default
             call status%set(status_bad_input, scene%path // ': &solver: name = ''' // &
                 trim(scene%solver_name) // ''': not available in this build yet')
@@ -153,7 +164,9 @@ contains
     function scene_stab(scene) result(stab)
         type(scene_input_t), intent(in) :: scene
         character(len=:), allocatable :: stab
-        if (scene%problem == 'pendulum') then
+        if (scene%solver_name == 'mexax') then
+            stab = 'mech'
+        else if (scene%problem == 'pendulum') then
             stab = trim(scene%pendulum_formulation)
         else
             stab = '-'
@@ -224,11 +237,18 @@ contains
         type is (ddassl_t)
             ! Native NST counts accepted steps only.
             call progress%watch(solver%native%nst, solver%native%nst)
+        type is (mexax_t)
+            call progress%watch(solver%native%nstep, solver%native%naccpt)
         end select
         call sinks%attach(progress)
 
-        call solver%integrate(problem, result%t, result%y, scene%t_end, options, &
-                              result%stats, status, sinks)
+        select type (solver)
+        type is (mexax_t)
+            call integrate_pendulum_mechanical(solver)
+        class default
+            call solver%integrate(problem, result%t, result%y, scene%t_end, options, &
+                                  result%stats, status, sinks)
+        end select
 
         if (h5%is_open) then
             outcome = 'ok'
@@ -248,6 +268,20 @@ contains
                 scene%rtol, scene_stab(scene), result%stats)], io_status)
             if (status%ok() .and. .not. io_status%ok()) status = io_status
         end if
+
+    contains
+
+        !> MEXAX on the mechanical pendulum; y = (x, y, u, v, λ) as for the
+        !> index formulations (the namelist admits only the pendulum).
+        subroutine integrate_pendulum_mechanical(mexax)
+            type(mexax_t), intent(inout) :: mexax
+            type(pendulum_mechanical_t) :: mech
+            mech = new_pendulum_mechanical(mass=scene%pendulum_mass, &
+                length=scene%pendulum_length, gravity=scene%gravity, status=status)
+            if (.not. status%ok()) return
+            call mexax%integrate_mechanical(mech, result%t, result%y(1:2), result%y(3:4), &
+                scene%t_end, options, result%stats, status, sinks, lambda=result%y(5:5))
+        end subroutine integrate_pendulum_mechanical
     end subroutine run_scene
 
     subroutine delete_file(path)

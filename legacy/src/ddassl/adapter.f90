@@ -15,6 +15,7 @@
 module flexmbs_legacy_ddassl_adapter
     use, intrinsic :: iso_fortran_env, only: error_unit
     use flexmbs_core_kinds, only: wp
+    use flexmbs_core_text, only: real_text, int_text
     use flexmbs_core_status, only: status_t, status_bad_input, status_interrupted
     use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_identity, storage_dense
     use flexmbs_dae_residual_problem, only: residual_problem_t
@@ -583,20 +584,4 @@ contains
             call self%jac(t, y, yp, pd, cj, self%rpar, self%ipar)
         end if
     end subroutine classic_pd
-
-    pure function real_text(x) result(text)
-        real(wp), intent(in) :: x
-        character(len=:), allocatable :: text
-        character(len=32) :: buf
-        write (buf, '(es14.6)') x
-        text = trim(adjustl(buf))
-    end function real_text
-
-    pure function int_text(i) result(text)
-        integer, intent(in) :: i
-        character(len=:), allocatable :: text
-        character(len=16) :: buf
-        write (buf, '(i0)') i
-        text = trim(buf)
-    end function int_text
 end module flexmbs_legacy_ddassl_adapter

@@ -1,0 +1,27 @@
+!> Numbers as text for status messages.
+module flexmbs_core_text
+    use flexmbs_core_kinds, only: wp
+    implicit none
+    private
+    public :: real_text, int_text
+
+contains
+
+    !> x in the es14.6 format, without blanks.
+    pure function real_text(x) result(text)
+        real(wp), intent(in) :: x
+        character(len=:), allocatable :: text
+        character(len=32) :: buf
+        write (buf, '(es14.6)') x
+        text = trim(adjustl(buf))
+    end function real_text
+
+    !> i without blanks.
+    pure function int_text(i) result(text)
+        integer, intent(in) :: i
+        character(len=:), allocatable :: text
+        character(len=16) :: buf
+        write (buf, '(i0)') i
+        text = trim(buf)
+    end function int_text
+end module flexmbs_core_text

@@ -1,0 +1,182 @@
+!> The planar chain of NB rigid bars of ALGORITHMS.md §8 (the MEXAX anchor
+!> problem) as a mechanical problem in absolute coordinates.
+!>
+!> Body i has q = (x_i, y_i, φ_i) (centre and angle from the downward
+!> vertical), mass m = 1/NB, half-length l = 0.5/NB, moment of inertia
+!> m l²/3 about its centre, T = I and gravity 10 in -y. Bar 1's upper end is
+!> pinned at the origin; the upper end of bar i meets the lower end of bar
+!> i-1. With the upper end (x - l sin φ, y + l cos φ) and the lower end
+!> (x + l sin φ, y - l cos φ) the 2 NB position constraints are
+!>
+!>   0 = -x_1 + l sin φ_1,                       0 = -y_1 - l cos φ_1,
+!>   0 = x_{i-1} + l sin φ_{i-1} - x_i + l sin φ_i,
+!>   0 = y_{i-1} - l cos φ_{i-1} - y_i - l cos φ_i        (i ≥ 2).
+!>
+!> M and f are constant, the constraints scleronomic (g_I = 0). The chain
+!> starts horizontal at rest, φ_i = π/2, x_i = (2i - 1) l, y_i = 0.
+module flexmbs_problems_pendulum_chain
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    implicit none
+    private
+
+    !> §8: gravity of the anchor problem (in -y).
+    real(wp), parameter, public :: chain_gravity = 10.0_wp
+    !> §8: (x_1, y_1, φ_1) at t = 1 for NB = 8, computed by the original
+    !> MEXX with TOL 1e-11.
+    real(wp), parameter, public :: chain_anchor_t1(3) = [-4.86227554026e-2_wp, &
+        -3.92692966204e-2_wp, -8.91418977542e-1_wp]
+
+    real(wp), parameter :: half_pi = 0.5_wp * acos(-1.0_wp)
+
+    type, extends(mechanical_problem_t), public :: pendulum_chain_t
+        integer :: bodies = 0            !! NB
+        real(wp) :: body_mass = 0.0_wp   !! m = 1/NB
+        real(wp) :: half_length = 0.0_wp !! l = 0.5/NB
+        real(wp) :: inertia = 0.0_wp     !! m l²/3
+    contains
+        procedure :: kinematics => chain_kinematics
+        procedure :: mass => chain_mass
+        procedure :: forces => chain_forces
+        procedure :: constraint => chain_constraint
+        procedure :: constraint_jacobian => chain_constraint_jacobian
+        procedure :: constraint_curvature => chain_constraint_curvature
+    end type pendulum_chain_t
+
+    public :: new_pendulum_chain, pendulum_chain_initial
+
+contains
+
+    !> The chain of `bodies` bars (nq = nv = 3 NB, nc = 2 NB).
+    function new_pendulum_chain(bodies, status) result(problem)
+        integer, intent(in) :: bodies !! NB ≥ 1
+        type(status_t), intent(out), optional :: status
+        type(pendulum_chain_t) :: problem
+        type(status_t) :: local
+        character(len=80) :: msg
+        if (bodies < 1) then
+            write (msg, '(a,i0,a)') 'pendulum chain: bodies = ', bodies, ': must be at least 1'
+            call local%set(status_bad_input, trim(msg))
+        else
+            problem%bodies = bodies
+            problem%body_mass = 1.0_wp / bodies
+            problem%half_length = 0.5_wp / bodies
+            problem%inertia = problem%body_mass * problem%half_length**2 / 3.0_wp
+            problem%nq = 3 * bodies
+            problem%nv = 3 * bodies
+            problem%nc = 2 * bodies
+        end if
+        if (present(status)) status = local
+    end function new_pendulum_chain
+
+    !> §8 start: horizontal at rest; λ = 0 (the start is not an equilibrium,
+    !> λ is an output of the solver).
+    pure subroutine pendulum_chain_initial(problem, q, v, lambda)
+        class(pendulum_chain_t), intent(in) :: problem
+        real(wp), intent(out) :: q(:), v(:), lambda(:) !! sizes 3 NB, 3 NB, 2 NB
+        integer :: i
+        do i = 1, problem%bodies
+            q(3 * i - 2) = real(2 * i - 1, wp) * problem%half_length
+            q(3 * i - 1) = 0.0_wp
+            q(3 * i) = half_pi
+        end do
+        v = 0.0_wp
+        lambda = 0.0_wp
+    end subroutine pendulum_chain_initial
+
+    subroutine chain_kinematics(self, t, q, w, qdot, status)
+        class(pendulum_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: qdot(:)
+        type(status_t), intent(inout) :: status
+        qdot = w
+    end subroutine chain_kinematics
+
+    !> M = diag(m, m, m l²/3) per body.
+    subroutine chain_mass(self, t, q, m, status)
+        class(pendulum_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: m(:, :)
+        type(status_t), intent(inout) :: status
+        integer :: i
+        m = 0.0_wp
+        do i = 1, self%bodies
+            m(3 * i - 2, 3 * i - 2) = self%body_mass
+            m(3 * i - 1, 3 * i - 1) = self%body_mass
+            m(3 * i, 3 * i) = self%inertia
+        end do
+    end subroutine chain_mass
+
+    subroutine chain_forces(self, t, q, v, f, status)
+        class(pendulum_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: f(:)
+        type(status_t), intent(inout) :: status
+        integer :: i
+        f = 0.0_wp
+        do i = 1, self%bodies
+            f(3 * i - 1) = -self%body_mass * chain_gravity
+        end do
+    end subroutine chain_forces
+
+    subroutine chain_constraint(self, t, q, g, status)
+        class(pendulum_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: g(:)
+        type(status_t), intent(inout) :: status
+        integer :: i
+        real(wp) :: l
+        l = self%half_length
+        g(1) = -q(1) + l * sin(q(3))
+        g(2) = -q(2) - l * cos(q(3))
+        do i = 2, self%bodies
+            g(2 * i - 1) = q(3 * i - 5) + l * sin(q(3 * i - 3)) - q(3 * i - 2) + l * sin(q(3 * i))
+            g(2 * i) = q(3 * i - 4) - l * cos(q(3 * i - 3)) - q(3 * i - 1) - l * cos(q(3 * i))
+        end do
+    end subroutine chain_constraint
+
+    !> G = g_q (T = I), 2 NB x 3 NB.
+    subroutine chain_constraint_jacobian(self, t, q, gmat, status)
+        class(pendulum_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: gmat(:, :)
+        type(status_t), intent(inout) :: status
+        integer :: i
+        real(wp) :: l
+        l = self%half_length
+        gmat = 0.0_wp
+        gmat(1, 1) = -1.0_wp
+        gmat(1, 3) = l * cos(q(3))
+        gmat(2, 2) = -1.0_wp
+        gmat(2, 3) = l * sin(q(3))
+        do i = 2, self%bodies
+            gmat(2 * i - 1, 3 * i - 5) = 1.0_wp
+            gmat(2 * i - 1, 3 * i - 3) = l * cos(q(3 * i - 3))
+            gmat(2 * i - 1, 3 * i - 2) = -1.0_wp
+            gmat(2 * i - 1, 3 * i) = l * cos(q(3 * i))
+            gmat(2 * i, 3 * i - 4) = 1.0_wp
+            gmat(2 * i, 3 * i - 3) = l * sin(q(3 * i - 3))
+            gmat(2 * i, 3 * i - 1) = -1.0_wp
+            gmat(2 * i, 3 * i) = l * sin(q(3 * i))
+        end do
+    end subroutine chain_constraint_jacobian
+
+    !> γ = (G v)_q v: only the angle entries of G depend on q.
+    subroutine chain_constraint_curvature(self, t, q, v, gamma, status)
+        class(pendulum_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: gamma(:)
+        type(status_t), intent(inout) :: status
+        integer :: i
+        real(wp) :: l
+        l = self%half_length
+        gamma(1) = -l * sin(q(3)) * v(3)**2
+        gamma(2) = l * cos(q(3)) * v(3)**2
+        do i = 2, self%bodies
+            gamma(2 * i - 1) = -l * (sin(q(3 * i - 3)) * v(3 * i - 3)**2 &
+                + sin(q(3 * i)) * v(3 * i)**2)
+            gamma(2 * i) = l * (cos(q(3 * i - 3)) * v(3 * i - 3)**2 + cos(q(3 * i)) * v(3 * i)**2)
+        end do
+    end subroutine chain_constraint_curvature
+end module flexmbs_problems_pendulum_chain
