@@ -74,6 +74,8 @@ contains
         call run_scene(scene, quiet, result, status)
         select case (status%code)
         case (status_ok)
+            if (allocated(result%stats%warning)) &
+                write (error_unit, '(a)') 'flexmbs: warning: ' // result%stats%warning
             if (len_trim(scene%title) > 0) write (output_unit, '(a)') trim(scene%title)
             call report(result, scene)
             call finish(exit_ok)

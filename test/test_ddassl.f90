@@ -17,7 +17,7 @@ module test_ddassl
     use flexmbs_problems_van_der_pol, only: van_der_pol_t, new_van_der_pol
     use flexmbs_problems_robertson, only: robertson_t, new_robertson, robertson_initial
     use flexmbs_problems_pendulum, only: pendulum_t, new_pendulum, pendulum_initial, &
-        pendulum_reference, pendulum_index2, pendulum_ggl
+        pendulum_reference, pendulum_index2, pendulum_ggl, pendulum_index3
     use flexmbs_io_namelist, only: scene_input_t, parse_scene
     use flexmbs_io_scene, only: run_result_t, run_scene
     use testing, only: test_case_t, new_test, error_t, check, check_close
@@ -111,7 +111,8 @@ contains
                  new_test('residual_stop_is_interrupt', test_residual_stop), &
                  new_test('dense_output_at_step_ends', test_dense_steps), &
                  new_test('netlib_nonnegative_ddaini_robertson', test_switches), &
-                 new_test('lightly_damped_pmax_2_vs_5', test_table2_pattern)]
+                 new_test('lightly_damped_pmax_2_vs_5', test_table2_pattern), &
+                 new_test('index3_warning', test_index3_warning)]
     end function collect_ddassl
 
     subroutine riccati_rhs(self, t, y, f, status)
@@ -361,6 +362,21 @@ contains
         call pendulum_reference(problem, t_pendulum, yref, rstatus)
         err = paper_error(y(1:2), yref(1:2), rtol, rtol)
     end subroutine run_pendulum
+
+    !> §6: index 3 is accepted with a warning; index 2 gets none.
+    subroutine test_index3_warning(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        real(wp) :: err
+        call run_pendulum(pendulum_index3, 1.0e-5_wp, err, stats, status)
+        call check(error, allocated(stats%warning), 'index 3: no warning')
+        if (allocated(stats%warning)) call check(error, index(stats%warning, 'index-3') > 0, &
+            'index 3: warning does not say why: ' // stats%warning)
+        call run_pendulum(pendulum_index2, 1.0e-5_wp, err, stats, status)
+        call check(error, status%ok() .and. .not. allocated(stats%warning), &
+            'index 2: unexpected warning or failure: ' // status%text())
+    end subroutine test_index3_warning
 
     subroutine check_formulation(error, formulation, label)
         type(error_t), allocatable, intent(inout) :: error

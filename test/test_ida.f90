@@ -17,7 +17,7 @@ module test_ida
     use flexmbs_problems_robertson, only: robertson_t, new_robertson, robertson_initial
     use flexmbs_problems_pendulum, only: pendulum_t, new_pendulum, pendulum_initial, &
         pendulum_reference, pendulum_position_residual, pendulum_velocity_residual, &
-        pendulum_index2, pendulum_ggl
+        pendulum_index2, pendulum_ggl, pendulum_index3
     use flexmbs_problems_reaction_diffusion, only: reaction_diffusion_t, &
         new_reaction_diffusion, reaction_diffusion_initial
     use testing, only: test_case_t, new_test, error_t, check, check_close
@@ -64,6 +64,7 @@ contains
                  new_test('robertson_sum_and_accuracy', test_robertson), &
                  new_test('robertson_calc_ic', test_calc_ic), &
                  new_test('pendulum_index2_suppressed', test_pendulum_index2), &
+                 new_test('index3_warning', test_index3_warning), &
                  new_test('pendulum_ggl_suppressed', test_pendulum_ggl), &
                  new_test('klu_equals_dense_brusselator_2000', test_brusselator), &
                  new_test('klu_equals_dense_sparse_mass', test_sparse_mass), &
@@ -351,6 +352,21 @@ contains
     !> holds to Newton accuracy, positions drift by up to 10 rtol. The drift
     !> costs accuracy at the tightest tolerance: ERR = 10.5 rtol at 1e-8
     !> (measured; 9.95 at 1e-7), hence 11× there.
+    !> §6: IDA takes the problems DDASSL takes; index 3 with a warning.
+    subroutine test_index3_warning(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        real(wp) :: err, max_position, max_velocity
+        call run_pendulum(pendulum_index3, 1.0e-5_wp, err, max_position, max_velocity, &
+            stats, status)
+        call check(error, allocated(stats%warning), 'index 3: no warning')
+        call run_pendulum(pendulum_index2, 1.0e-5_wp, err, max_position, max_velocity, &
+            stats, status)
+        call check(error, status%ok() .and. .not. allocated(stats%warning), &
+            'index 2: unexpected warning or failure: ' // status%text())
+    end subroutine test_index3_warning
+
     subroutine test_pendulum_index2(error)
         type(error_t), allocatable, intent(out) :: error
         call check_pendulum(error, pendulum_index2, 'index 2', 10.0_wp, 1.0_wp, &

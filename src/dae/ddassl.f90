@@ -21,7 +21,7 @@ module flexmbs_dae_ddassl
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_residual_problem, only: residual_problem_t, dae_residual_t
     use flexmbs_dae_options, only: dae_options_t
-    use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_stats, only: dae_stats_t, index3_warning
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_solver, only: dae_solver_t
     implicit none
@@ -146,6 +146,7 @@ module flexmbs_dae_ddassl
         integer :: ndec = 0          !! successful PD factorisations
         integer :: nsol = 0          !! solves (corrector and DDAINI)
         integer :: nfe_jac = 0       !! residual calls of difference PDs
+        character(len=:), allocatable :: warning !! for stats%warning (§6: index 3)
         integer :: k_last = 0        !! order of the last step (IWORK(8))
         integer :: k_next = 0        !! order for the next step (IWORK(7))
         real(wp) :: h_next = 0.0_wp  !! next step size (RWORK(3))
@@ -428,6 +429,7 @@ contains
             stats%ndec = self%ndec
             stats%nsol = self%nsol
             stats%t_reached = t
+            if (allocated(self%warning)) stats%warning = self%warning
             self%k_last = self%work%kold
             self%k_next = self%work%k
             self%h_next = self%work%h
@@ -561,6 +563,7 @@ contains
         subroutine begin_integration()
             integer, allocatable :: classes(:)
             self%work = ddassl_work_t()
+            if (allocated(self%warning)) deallocate (self%warning)
             self%native = ddassl_native_t()
             self%ndec = 0
             self%nsol = 0
@@ -603,6 +606,7 @@ contains
             call res%index_classes(classes)
             in_test = .true.
             if (self%exclude_index23) in_test = classes < 2
+            if (any(classes >= 3)) self%warning = index3_warning('ddassl')
             dir = sign(1.0_wp, tout - t)
             call set_weights(y)
             if (any(.not. wt > 0.0_wp)) then

@@ -46,7 +46,7 @@ module flexmbs_dae_ida
     use flexmbs_linalg_linear_solver, only: auto_sparse_threshold
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_options, only: dae_options_t
-    use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_stats, only: dae_stats_t, index3_warning
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_solver, only: dae_solver_t
     implicit none
@@ -231,6 +231,7 @@ contains
         call problem%index_classes(classes)
         call problem%differential_flags(flags)
         suppress = self%suppress_alg .and. any(classes > 1)
+        if (any(classes >= 3)) stats%warning = index3_warning('ida')
 
         run: block
             call setup_matrices(status)

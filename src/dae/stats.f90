@@ -4,6 +4,8 @@ module flexmbs_dae_stats
     implicit none
     private
 
+    public :: index3_warning
+
     type, public :: dae_stats_t
         integer :: nst = 0     !! attempted steps (accepted + rejected + failed)
         integer :: nac = 0     !! accepted steps
@@ -18,6 +20,9 @@ module flexmbs_dae_stats
         real(wp) :: wall = 0.0_wp !! wall seconds
         real(wp) :: t_reached = 0.0_wp !! last time reached (t_end on success)
         real(wp) :: h_last = 0.0_wp    !! last accepted step size
+        !> What the caller should know although the run succeeded (e.g. a
+        !> formulation the solver is not made for); empty when none.
+        character(len=:), allocatable :: warning
     contains
         procedure :: reset => stats_reset
         procedure :: summary => stats_summary
@@ -30,6 +35,7 @@ contains
         self%nst = 0; self%nac = 0; self%nrj = 0; self%nfe = 0; self%nfe_jac = 0
         self%nje = 0; self%ndec = 0; self%nsol = 0; self%nprj = 0
         self%cpu = 0.0_wp; self%wall = 0.0_wp; self%t_reached = 0.0_wp; self%h_last = 0.0_wp
+        if (allocated(self%warning)) deallocate (self%warning)
     end subroutine stats_reset
 
     !> One line: 'NST=... NAC=... ...'.
@@ -43,4 +49,13 @@ contains
             ' NPRJ=', self%nprj, ' CPU=', self%cpu, ' WALL=', self%wall
         line = trim(buf)
     end function stats_summary
+
+    !> The warning for index-3 components given to a BDF code (ALGORITHMS.md §6).
+    pure function index3_warning(solver) result(text)
+        character(len=*), intent(in) :: solver
+        character(len=:), allocatable :: text
+        text = solver // ': the problem has index-3 components; BDF is not made for ' // &
+            'index 3 (they are left out of the error test, else it fails at t = 0): ' // &
+            'prefer the index-2 or GGL formulation'
+    end function index3_warning
 end module flexmbs_dae_stats
