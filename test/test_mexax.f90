@@ -375,8 +375,9 @@ contains
     end subroutine test_column_limit
 
     !> §8 chain anchor, base (E), H = 1e-3: native counters beside the
-    !> original's (printed for the calibration of the classic face). The core
-    !> is not calibrated: asserted only within a factor of 2 on NSTEP.
+    !> original's. After the calibration of the (E) rules NSTEP and NACCPT
+    !> (all four TOL) and the TOL 1e-3 cost counters hold within 15 %; NREJCT
+    !> is low by up to 4 (8 vs 11, 9 vs 13) and is asserted only to that.
     subroutine test_anchor_counters(error)
         type(error_t), allocatable, intent(out) :: error
         integer, parameter :: expected(3, 4) = reshape([49, 38, 11, 58, 45, 13, 54, 45, 9, &
@@ -410,9 +411,28 @@ contains
             end associate
             write (*, '(a)') '  mexax anchor ' // trim(msg)
             call check(error, status%ok(), trim(msg) // ': ' // status%text())
-            call check(error, 2 * solver%native%nstep >= expected(1, e) .and. &
-                solver%native%nstep <= 2 * expected(1, e), trim(msg))
+            call check(error, within(solver%native%nstep, expected(1, e)), trim(msg) // &
+                ': NSTEP not within 15 %')
+            call check(error, within(solver%native%naccpt, expected(2, e)), trim(msg) // &
+                ': NACCPT not within 15 %')
+            ! NREJCT is 8..9 against 8..13: within 4 only (see ALGORITHMS.md §8 and
+            ! the calibration notes in src/dae/mexax.f90).
+            call check(error, abs(solver%native%nrejct - expected(3, e)) <= 4, trim(msg) // &
+                ': NREJCT off by more than 4')
+            if (e == 1) then
+                associate (n => solver%native)
+                    call check(error, within(n%nfprob, 2080) .and. within(n%nfcn, 871) .and. &
+                        within(n%ngcn, 44) .and. within(n%nmult, 1126) .and. &
+                        within(n%ndec, 1160) .and. within(n%nsol, 1165), trim(msg) // &
+                        ': a TOL 1e-3 cost counter not within 15 %')
+                end associate
+            end if
         end do
+    contains
+        logical function within(ours, original)
+            integer, intent(in) :: ours, original
+            within = abs(real(ours - original, wp)) <= 0.15_wp * original
+        end function within
     end subroutine test_anchor_counters
 
     !> MEXAX finishes the stiff spring pendulum, with many more steps than

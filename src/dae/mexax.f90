@@ -36,6 +36,10 @@ module flexmbs_dae_mexax
     !> Base methods (§3.2).
     integer, parameter, public :: mexax_base_midpoint = 1 !! (M), h²-extrapolation (default)
     integer, parameter, public :: mexax_base_euler = 2    !! (E), h-extrapolation (MEXX21)
+    !> Where a stopping failure happened (mexax_t%failed_in): the classic face
+    !> tells IERR −15/−17 (in a step) from −16/−18 (in the projection).
+    integer, parameter, public :: mexax_failed_none = 0, mexax_failed_step = 1, &
+        mexax_failed_projection = 2
     !> At most this many extrapolation columns (KDMAX).
     integer, parameter, public :: mexax_max_columns = 12
 
@@ -45,8 +49,18 @@ module flexmbs_dae_mexax
     ! §3.4 (ODEX): safety factors and limits of the column step sizes.
     real(wp), parameter :: safe1 = 0.8_wp, safe2 = 0.93_wp
     real(wp), parameter :: fac1 = 0.1_wp, fac2 = 4.0_wp
-    ! §3.4 [R] (ODEX): order decrease / increase thresholds on the work per step.
+    ! §3.4 [R] (ODEX): order decrease / increase thresholds on the work per step,
+    ! as published for the midpoint base (M).
     real(wp), parameter :: fac3 = 0.8_wp, fac4 = 0.9_wp
+    ! §3.4 [R], base (E): FAC3, FAC4 calibrated on the §8 chain anchor (NB = 8,
+    ! TOL 1e-3..1e-9; published ODEX values 0.8, 0.9).
+    real(wp), parameter :: euler_fac3 = 0.7_wp, euler_fac4 = 0.95_wp
+    ! §3.4 [R], base (E): exponent ϖ of the convergence monitor
+    ! err_{k−1} > (n_{k+1} n_k / n_1²)^ϖ, calibrated on the §8 chain anchor
+    ! (published 1; with 1 the monitor rejects steps whose column k would have
+    ! converged, since err_{k−1}/err_k grows like 1/H for the h-expansion).
+    ! The hope test keeps ϖ = 1.
+    real(wp), parameter :: euler_monitor_power = 3.0_wp
     ! §3.4: the work of column 1 is n_1 + this.
     integer, parameter :: work_offset = 4
     ! §3.4 [R]: start column from -0.6 log10(r_min) + 1.5, (E) within [3, 10].
@@ -54,8 +68,10 @@ module flexmbs_dae_mexax
     integer, parameter :: euler_start_min = 3, euler_start_max = 10
     ! §3.4: the step ends at TFIN when t + 1.01 H passes it.
     real(wp), parameter :: end_factor = 1.01_wp
-    ! §3.3 [R]: divergence when err_j ≥ max(ϱ err_{j−1}, 1); ϱ = 1 (E), 4 (M, ODEX).
-    real(wp), parameter :: divergence_euler = 1.0_wp, divergence_midpoint = 4.0_wp
+    ! §3.3 [R]: divergence when err_j ≥ max(ϱ err_{j−1}, 1); ϱ = 4 for (M) (ODEX).
+    ! For (E) ϱ = 4 too, calibrated on the §8 chain anchor (published 1, which
+    ! restarts where the original never does).
+    real(wp), parameter :: divergence_euler = 4.0_wp, divergence_midpoint = 4.0_wp
     ! §3.5 [R]: stability check ‖v2 − v1‖ > 2 ‖v2‖ in columns 1 and 2.
     real(wp), parameter :: stability_ratio = 2.0_wp
     integer, parameter :: stability_columns = 2
@@ -108,6 +124,7 @@ module flexmbs_dae_mexax
         integer :: nprj_reject = 0  !! rejections by the projection test (native counts 2 each)
         real(wp) :: h_next = 0.0_wp !! proposed next step (classic H on return)
         integer :: column = 0       !! column used next (k)
+        integer :: failed_in = mexax_failed_none !! mexax_failed_step | _projection
         type(mexax_dense_t) :: dense
     contains
         procedure :: integrate => mexax_integrate
@@ -120,6 +137,8 @@ module flexmbs_dae_mexax
     type :: workspace_t
         integer :: nq = 0, nv = 0, nc = 0, na = 0, ny = 0, ne = 0, km = 0
         real(wp) :: varpi = 1.0_wp
+        real(wp) :: order_down = fac3, order_up = fac4 !! FAC3, FAC4 of the base
+        real(wp) :: monitor_power = 1.0_wp         !! ϖ of the convergence monitor
         integer, allocatable :: nj(:), ipiv(:)
         real(wp), allocatable :: rtol(:), atol(:), wt(:), wst(:)
         real(wp), allocatable :: p0(:), v0(:), a0(:), lam0(:), f0(:), pdot0(:)
@@ -205,6 +224,7 @@ contains
         self%nstab = 0
         self%nprj_reject = 0
         self%h_next = 0.0_wp
+        self%failed_in = mexax_failed_none
         stats%t_reached = t
         nstab_nonfinite = 0
         stop_requested = .false.
@@ -286,6 +306,7 @@ contains
         call project(self, problem, w, t, c, status)
         stats%nprj = 1
         if (.not. status%ok()) then
+            self%failed_in = mexax_failed_projection
             status%message = 'mexax: ' // status%message // ' at t0 = ' // real_text(t)
             call finish()
             return
@@ -295,6 +316,7 @@ contains
         call start_point(self, problem, w, t, status)
         if (status%ok()) call consistent_acceleration(self, problem, w, t, status)
         if (.not. status%ok()) then
+            self%failed_in = mexax_failed_step
             call finish()
             return
         end if
@@ -326,7 +348,10 @@ contains
         main: do
             if (need_start) then
                 call start_point(self, problem, w, t, status)
-                if (.not. status%ok()) exit main
+                if (.not. status%ok()) then
+                    self%failed_in = mexax_failed_step
+                    exit main
+                end if
                 need_start = .false.
             end if
             if (abs(h) <= small_step_factor * epmach * max(abs(t), tscale)) then
@@ -379,7 +404,7 @@ contains
                     if (w%err(k - 1) <= 1.0_wp) then
                         decision = do_accept
                     else if (w%err(k - 1) > (real(w%nj(k + 1) * w%nj(k), wp) &
-                                              / real(w%nj(1)**2, wp))**w%varpi) then
+                                              / real(w%nj(1)**2, wp))**w%monitor_power) then
                         decision = do_reject
                     end if
                 end if
@@ -410,7 +435,7 @@ contains
                 k = min(k, kc, km - 1)
                 k = max(k, 2)
                 if (k > 2) then
-                    if (w%work(k - 1) < fac3 * w%work(k)) k = k - 1
+                    if (w%work(k - 1) < w%order_down * w%work(k)) k = k - 1
                 end if
                 self%native%nrejct = self%native%nrejct + 1
                 h = posneg * w%hh(k)
@@ -427,6 +452,7 @@ contains
             call project(self, problem, w, t + h, c, status)
             stats%nprj = stats%nprj + 1
             if (.not. status%ok()) then
+                self%failed_in = mexax_failed_projection
                 status%message = 'mexax: ' // status%message // ' at t = ' // &
                     real_text(t + h) // ' (step from t = ' // real_text(t) // ')'
                 exit main
@@ -446,7 +472,10 @@ contains
             t = t + h
             if (last) t = t_end
             call accept_point(self, problem, w, kc, t_old, t, need_start, status)
-            if (.not. status%ok()) exit main
+            if (.not. status%ok()) then
+                self%failed_in = mexax_failed_step
+                exit main
+            end if
             stats%t_reached = t
             stats%h_last = h
             first = .false.
@@ -465,14 +494,14 @@ contains
                 if (reject) kopt = 2
             else if (kc <= k) then
                 kopt = kc
-                if (w%work(kc - 1) < fac3 * w%work(kc)) kopt = kc - 1
-                if (w%work(kc) < fac4 * w%work(kc - 1)) kopt = min(kc + 1, km - 1)
+                if (w%work(kc - 1) < w%order_down * w%work(kc)) kopt = kc - 1
+                if (w%work(kc) < w%order_up * w%work(kc - 1)) kopt = min(kc + 1, km - 1)
             else
                 kopt = kc - 1
                 if (kc > 3) then
-                    if (w%work(kc - 2) < fac3 * w%work(kc - 1)) kopt = kc - 2
+                    if (w%work(kc - 2) < w%order_down * w%work(kc - 1)) kopt = kc - 2
                 end if
-                if (w%work(kc) < fac4 * w%work(kopt)) kopt = min(kc, km - 1)
+                if (w%work(kc) < w%order_up * w%work(kopt)) kopt = min(kc, km - 1)
             end if
             kopt = max(kopt, 2)
             if (reject) then
@@ -482,7 +511,7 @@ contains
             else
                 if (kopt <= kc) then
                     h = w%hh(kopt)
-                else if (kc < k .and. w%work(kc) < fac4 * w%work(kc - 1)) then
+                else if (kc < k .and. w%work(kc) < w%order_up * w%work(kc - 1)) then
                     h = w%hh(kc) * w%awork(kopt + 1) / w%awork(kc)
                 else
                     h = w%hh(kc) * w%awork(kopt) / w%awork(kc)
@@ -532,6 +561,7 @@ contains
             case (ev_restart)
                 decision = do_restart
             case (ev_stop)
+                self%failed_in = mexax_failed_step
                 status = fst
                 status%message = 'mexax: ' // fst%message // ' at t = ' // real_text(t) // &
                     ' (step H = ' // real_text(h) // ')'
@@ -664,9 +694,13 @@ contains
         if (base == mexax_base_euler) then
             w%nj = euler_sequence(1:km)
             w%varpi = 1.0_wp
+            w%order_down = euler_fac3
+            w%order_up = euler_fac4
+            w%monitor_power = euler_monitor_power
         else
             w%nj = [(2 * j, j = 1, km)]
             w%varpi = 2.0_wp
+            w%monitor_power = w%varpi
         end if
         w%awork(1) = real(w%nj(1) + work_offset, wp)
         do j = 2, km
@@ -823,12 +857,16 @@ contains
                 ti = t + big_h * real(i, wp) / n
                 tn = t + big_h * real(i + 1, wp) / n
                 if (i > 0) then
+                    ! one FPROB call (flags 4, 5): f and T v at (t_i, p_i, v_i)
                     call problem%forces(ti, w%p, w%v, w%f, status)
                     self%native%nfcn = self%native%nfcn + 1
+                    self%native%nfprob = self%native%nfprob + 1
                     if (user_failed(status, 'forces')) exit
+                    call problem%kinematics(ti, w%p, w%v, w%pdot, status)
+                    if (user_failed(status, 'kinematics')) exit
+                else
+                    w%pdot = w%pdot0   ! shared start point (§3.2)
                 end if
-                call problem%kinematics(ti, w%p, w%v, w%pdot, status)
-                if (user_failed(status, 'kinematics')) exit
                 w%pn = w%p + h * w%pdot
                 call problem%mass(tn, w%pn, w%mm, status)
                 if (user_failed(status, 'mass')) exit
@@ -889,8 +927,10 @@ contains
             do i = 1, n - 1
                 ti = t + big_h * real(i, wp) / n
                 tn = t + big_h * real(i + 1, wp) / n
+                ! one FPROB call (flags 1, 4, 5) at (t_i, q_i, v_i), one (2, 8) at q_{i+1}
                 call problem%forces(ti, w%p, w%v, w%f, status)
                 self%native%nfcn = self%native%nfcn + 1
+                self%native%nfprob = self%native%nfprob + 1
                 if (user_failed(status, 'forces')) exit
                 call problem%mass(ti, w%p, w%mm, status)
                 if (user_failed(status, 'mass')) exit
@@ -1035,7 +1075,9 @@ contains
             w%rhs(nv + 1:) = -w%gt
             call dense_lu_solve(w%kmat, w%ipiv, w%rhs)
             self%native%nsol = self%native%nsol + 1
+            ! one FPROB call (flag 5): T(p̃) δ
             call problem%kinematics(t, w%pn, w%rhs(1:nv), w%pdot, status)
+            self%native%nfprob = self%native%nfprob + 1
             if (user_failed(status, 'kinematics')) return
             w%p = w%p + w%pdot
             eps = rms(w%pdot, w%wt(1:nq))
