@@ -1,10 +1,12 @@
 !> MEXAX with KLU: the chain's CSC M and G equal its dense ones; the KLU
 !> path gives the dense trajectory to round-off with the same counters on a
 !> chain of 50 bars (augmented order 250), for both base methods; 'klu'
-!> without sparse interfaces, and 'band', are refused as bad input.
+!> without sparse interfaces, and 'band', are refused as bad input; a
+!> singular augmented matrix stops both paths alike.
 module test_mexax_sparse
     use flexmbs_core_kinds, only: wp
-    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
+        reason_singular_matrix
     use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
@@ -37,7 +39,8 @@ contains
             new_test('chain_sparse_equals_dense', test_chain_sparse), &
             new_test('klu_equals_dense_midpoint', test_klu_midpoint), &
             new_test('klu_equals_dense_euler', test_klu_euler), &
-            new_test('klu_needs_sparse_interfaces', test_bad_input)]
+            new_test('klu_needs_sparse_interfaces', test_bad_input), &
+            new_test('singular_augmented_matrix', test_singular)]
     end function collect_mexax_sparse
 
     !> The chain's CSC M and G, scattered, equal the dense ones at a
@@ -75,7 +78,7 @@ contains
         call check(error, count(gd /= 0.0_wp) == gpat%nnz, 'G pattern has no spare slots')
     end subroutine test_chain_sparse
 
-    !> The chain of `bodies` bars from rest, horizontal, to t = 0.3.
+    !> The chain of `bodies` bars from rest, horizontal, to t = 0.1.
     subroutine chain_run(base, linear_solver, q, v, lam, acc, stats, solver, status)
         integer, intent(in) :: base
         character(len=*), intent(in) :: linear_solver
@@ -95,7 +98,7 @@ contains
         options%h0 = 1.0e-3_wp
         options%linear_solver = linear_solver
         t = 0.0_wp
-        call solver%integrate_mechanical(chain, t, q, v, 0.3_wp, options, stats, status, &
+        call solver%integrate_mechanical(chain, t, q, v, 0.1_wp, options, stats, status, &
             lambda=lam, accel=acc)
     end subroutine chain_run
 
@@ -119,6 +122,7 @@ contains
         write (msg, '(a,7(1x,i0),a,7(1x,i0))') 'counters NST NAC NFE NDEC NSOL NPRJ NMULT: dense', &
             std%nst, std%nac, std%nfe, std%ndec, std%nsol, std%nprj, sd%native%nmult, ' klu', &
             stk%nst, stk%nac, stk%nfe, stk%ndec, stk%nsol, stk%nprj, sk%native%nmult
+        write (*, '(a)') '  mexax_sparse ' // trim(msg)
         call check(error, std%nst == stk%nst .and. std%nac == stk%nac .and. &
             std%nfe == stk%nfe .and. std%ndec == stk%ndec .and. std%nsol == stk%nsol .and. &
             std%nprj == stk%nprj .and. sd%native%nfprob == sk%native%nfprob .and. &
@@ -172,4 +176,34 @@ contains
         call check(error, status%ok() .and. t == 1.0_wp, "'auto' on the pendulum: " // &
             status%text())
     end subroutine test_bad_input
+
+    !> Bars of zero length and inertia: the angles enter neither M nor G, so
+    !> [M Gᵀ; G 0] has zero rows. Dense LU and KLU both stop at t0 with a
+    !> singular-matrix failure.
+    subroutine test_singular(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(pendulum_chain_t) :: chain
+        type(mexax_t) :: solver
+        type(dae_options_t) :: options
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        real(wp), allocatable :: q(:), v(:), lam(:)
+        real(wp) :: t
+        character(len=5), parameter :: names(2) = ['dense', 'klu  ']
+        integer :: s
+        chain = new_pendulum_chain(12)
+        chain%half_length = 0.0_wp
+        chain%inertia = 0.0_wp
+        allocate (q(chain%nq), v(chain%nv), lam(chain%nc))
+        do s = 1, 2
+            call pendulum_chain_initial(chain, q, v, lam)
+            options%linear_solver = trim(names(s))
+            t = 0.0_wp
+            call solver%integrate_mechanical(chain, t, q, v, 1.0_wp, options, stats, status)
+            call check(error, status%code == status_solver_failure .and. &
+                status%reason == reason_singular_matrix .and. &
+                index(status%text(), 'singular') > 0 .and. t == 0.0_wp, &
+                trim(names(s)) // ': ' // status%text())
+        end do
+    end subroutine test_singular
 end module test_mexax_sparse
