@@ -48,8 +48,8 @@ module flexmbs_dae_mexax
     integer, parameter, public :: mexax_max_columns = 12
     !> linear_solver = 'auto' factors [M Gᵀ; G 0] with KLU from this order
     !> nv + nc on (problems with sparse M and G), densely below. KLU is the
-    !> faster from order 25 on (pendulum chain, release: 0.26 against
-    !> 0.77 ms a step at NB = 5, 0.22 against 1.7 ms at NB = 10), but below
+    !> faster from order 25 on (pendulum chain, release: about 0.2 against
+    !> 0.6 ms a step at NB = 5, 0.3 against 1.6 ms at NB = 10), but below
     !> 50 both cost under 2 ms a step, and dense LU there keeps the original's
     !> full LU (JOB = 0) and so the §8 anchor (NB = 8, order 40) exactly: the
     !> round-off difference of KLU moves its TOL 1e-9 counters by ~3 %.
