@@ -15,15 +15,23 @@
 !>
 !> Only the mechanical form is integrated (`integrate_mechanical`); the
 !> generic `integrate` of a `dae_problem_t` is refused (§6).
+!>
+!> The augmented matrix is factored densely (LAPACK LU), or, with
+!> `options%linear_solver = 'klu'` (or 'auto' for a problem with sparse M and
+!> G and nv + nc ≥ `mexax_auto_klu_order`), by KLU on the CSC pattern of
+!> [M Gᵀ; G 0] built once from the patterns of M and G and analysed once;
+!> each substep only refills its values and refactors.
 module flexmbs_dae_mexax
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         status_interrupted, reason_step_too_small, reason_max_steps, reason_singular_matrix, &
         reason_non_finite, reason_projection, reason_user_function
     use flexmbs_core_text, only: real_text, int_text
     use flexmbs_core_timer, only: timer_t
     use flexmbs_linalg_dense, only: dense_lu_factor, dense_lu_solve
+    use flexmbs_linalg_csc, only: csc_matrix_t
+    use flexmbs_linalg_klu, only: klu_factor_t
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_options, only: dae_options_t
@@ -42,6 +50,14 @@ module flexmbs_dae_mexax
         mexax_failed_projection = 2
     !> At most this many extrapolation columns (KDMAX).
     integer, parameter, public :: mexax_max_columns = 12
+    !> linear_solver = 'auto' factors [M Gᵀ; G 0] with KLU from this order
+    !> nv + nc on (problems with sparse M and G), densely below. KLU is the
+    !> faster from order 25 on (pendulum chain, release: about 0.2 against
+    !> 0.6 ms a step at NB = 5, 0.3 against 1.6 ms at NB = 10), but below
+    !> 50 both cost under 2 ms a step, and dense LU there keeps the original's
+    !> full LU (JOB = 0) and so the §8 anchor (NB = 8, order 40) exactly: the
+    !> round-off difference of KLU moves its TOL 1e-9 counters by ~3 %.
+    integer, parameter, public :: mexax_auto_klu_order = 50
 
     ! §3.3 step-number sequence of (E); (M) uses n_j = 2j [R].
     integer, parameter :: euler_sequence(mexax_max_columns) = &
@@ -133,6 +149,13 @@ module flexmbs_dae_mexax
         procedure :: name => mexax_name
     end type mexax_t
 
+    !> M (nv x nv) or G (nc x nv) at one point: dense, or the values in the
+    !> slots of the problem's fixed CSC pattern (KLU path).
+    type :: block_t
+        real(wp), allocatable :: dense(:, :)
+        real(wp), allocatable :: values(:)
+    end type block_t
+
     !> Workspace of one integration, allocated once.
     type :: workspace_t
         integer :: nq = 0, nv = 0, nc = 0, na = 0, ny = 0, ne = 0, km = 0
@@ -142,7 +165,13 @@ module flexmbs_dae_mexax
         integer, allocatable :: nj(:), ipiv(:)
         real(wp), allocatable :: rtol(:), atol(:), wt(:), wst(:)
         real(wp), allocatable :: p0(:), v0(:), a0(:), lam0(:), f0(:), pdot0(:)
-        real(wp), allocatable :: m0(:, :), g0(:, :), mm(:, :), gm(:, :), gn(:, :), kmat(:, :)
+        type(block_t) :: m0, g0, mm, gm, gn
+        ! augmented matrix: dense (LAPACK) in kmat, or sparse (KLU) in kpat, whose
+        ! triplets are M's slots, then Gᵀ's, then G's (see setup_sparse)
+        logical :: sparse = .false.
+        real(wp), allocatable :: kmat(:, :)
+        type(csc_matrix_t) :: mpat, gpat, kpat
+        type(klu_factor_t) :: klu
         real(wp), allocatable :: p(:), pp(:), pn(:), v(:), vp(:), f(:), pdot(:), gt(:)
         real(wp), allocatable :: rhs(:), acc(:), lam(:), x(:), d(:), tab(:, :)
         real(wp), allocatable :: err(:), hh(:), work(:), awork(:)
@@ -269,7 +298,8 @@ contains
             return
         end if
 
-        call setup_workspace(w, problem, self%base, km)
+        call setup_workspace(w, problem, self%base, km, options%linear_solver, status)
+        if (.not. status%ok()) return
         call options%tolerances(w%rtol, w%atol)
         allocate (yout(w%nq + w%nv + w%nc))
         w%p0 = q
@@ -654,7 +684,8 @@ contains
             call status%set(status_bad_input, 'mexax: columns must lie in 1..12')
             return
         end if
-        call setup_workspace(w, problem, self%base, columns)
+        call setup_workspace(w, problem, self%base, columns, 'auto', status)
+        if (.not. status%ok()) return
         w%rtol = 1.0_wp
         w%atol = 1.0_wp
         w%p0 = q
@@ -674,11 +705,14 @@ contains
         end do
     end subroutine mexax_extrapolate
 
-    !> Allocate the workspace for `km` columns.
-    subroutine setup_workspace(w, problem, base, km)
+    !> Allocate the workspace for `km` columns and set up the linear solver
+    !> of the augmented system ('auto' | 'dense' | 'klu').
+    subroutine setup_workspace(w, problem, base, km, linear_solver, status)
         type(workspace_t), intent(out) :: w
-        class(mechanical_problem_t), intent(in) :: problem
+        class(mechanical_problem_t), intent(inout) :: problem
         integer, intent(in) :: base, km
+        character(len=*), intent(in) :: linear_solver
+        type(status_t), intent(out) :: status
         integer :: j, nq, nv, nc
         nq = problem%nq
         nv = problem%nv
@@ -711,11 +745,144 @@ contains
         w%work = 0.0_wp
         allocate (w%rtol(w%ne), w%atol(w%ne), w%wt(w%ne), w%wst(nv), w%ipiv(w%na))
         allocate (w%p0(nq), w%v0(nv), w%a0(nv), w%lam0(nc), w%f0(nv), w%pdot0(nq))
-        allocate (w%m0(nv, nv), w%g0(nc, nv), w%mm(nv, nv), w%gm(nc, nv), w%gn(nc, nv))
-        allocate (w%kmat(w%na, w%na), w%rhs(w%na))
+        allocate (w%rhs(w%na))
         allocate (w%p(nq), w%pp(nq), w%pn(nq), w%v(nv), w%vp(nv), w%f(nv), w%pdot(nq), w%gt(nc))
         allocate (w%acc(nv), w%lam(nc), w%x(w%ny), w%d(w%ny), w%tab(w%ny, km))
+        select case (trim(adjustl(linear_solver)))
+        case ('auto')
+            w%sparse = problem%has_sparse() .and. w%na >= mexax_auto_klu_order
+        case ('dense')
+            w%sparse = .false.
+        case ('klu')
+            if (.not. problem%has_sparse()) then
+                call status%set(status_bad_input, "mexax: linear_solver = 'klu' needs M and " // &
+                    'G in sparse form, which this mechanical problem does not provide ' // &
+                    '(has_sparse, mass_pattern/mass_sparse, constraint_jacobian_pattern/' // &
+                    "constraint_jacobian_sparse); use 'dense' or 'auto'")
+                return
+            end if
+            w%sparse = .true.
+        case default
+            call status%set(status_bad_input, "mexax: linear_solver = '" // &
+                trim(linear_solver) // "': the augmented matrix [M G^T; G 0] is " // &
+                "factored by 'dense' (LAPACK) or 'klu'; use 'auto', 'dense' or 'klu'")
+            return
+        end select
+        if (w%sparse) then
+            call setup_sparse(w, problem, status)
+        else
+            allocate (w%m0%dense(nv, nv), w%g0%dense(nc, nv), w%mm%dense(nv, nv), &
+                w%gm%dense(nc, nv), w%gn%dense(nc, nv))
+            allocate (w%kmat(w%na, w%na))
+        end if
     end subroutine setup_workspace
+
+    !> KLU path: the patterns of M and G from the problem, the pattern of
+    !> K = [M Gᵀ; G 0] built from them once (triplets: M's slots, then Gᵀ's,
+    !> then G's; K's triplet map sends each to its slot, duplicates summed),
+    !> and its symbolic analysis. The (2,2) block has no slots: KLU's
+    !> maximum transversal (BTF) and threshold partial pivoting find nonzero
+    !> pivots for the constraint rows, so the zero block needs no shift.
+    subroutine setup_sparse(w, problem, status)
+        type(workspace_t), intent(inout) :: w
+        class(mechanical_problem_t), intent(inout) :: problem
+        type(status_t), intent(out) :: status
+        integer, allocatable :: rows(:), cols(:)
+        integer(i8) :: nm, ng, p, k
+        integer :: j, nv, nc
+        nv = w%nv
+        nc = w%nc
+        call problem%mass_pattern(w%mpat, status)
+        if (.not. pattern_ok(w%mpat, nv, nv, 'mass_pattern')) return
+        call problem%constraint_jacobian_pattern(w%gpat, status)
+        if (.not. pattern_ok(w%gpat, nc, nv, 'constraint_jacobian_pattern')) return
+        nm = w%mpat%nnz
+        ng = w%gpat%nnz
+        allocate (rows(nm + 2 * ng), cols(nm + 2 * ng))
+        k = 0
+        do j = 1, nv
+            do p = w%mpat%colptr(j) + 1, w%mpat%colptr(j + 1)
+                k = k + 1
+                rows(k) = int(w%mpat%rowind(p)) + 1
+                cols(k) = j
+            end do
+        end do
+        do j = 1, nv
+            do p = w%gpat%colptr(j) + 1, w%gpat%colptr(j + 1)
+                rows(k + 1) = j                               ! Gᵀ(j, i) = G(i, j)
+                cols(k + 1) = nv + int(w%gpat%rowind(p)) + 1
+                rows(k + 1 + ng) = nv + int(w%gpat%rowind(p)) + 1
+                cols(k + 1 + ng) = j
+                k = k + 1
+            end do
+        end do
+        call w%kpat%build(w%na, w%na, rows, cols, status)
+        if (.not. status%ok()) then
+            status%message = 'mexax: pattern of [M G^T; G 0]: ' // status%message
+            return
+        end if
+        call w%klu%analyse(w%na, w%kpat%colptr, w%kpat%rowind, status)
+        if (.not. status%ok()) then
+            status%message = 'mexax: ' // status%message // ' (pattern of [M G^T; G 0])'
+            return
+        end if
+        allocate (w%m0%values(nm), w%mm%values(nm))
+        allocate (w%g0%values(ng), w%gm%values(ng), w%gn%values(ng))
+    contains
+        logical function pattern_ok(pattern, nrow, ncol, what) result(ok)
+            type(csc_matrix_t), intent(in) :: pattern
+            integer, intent(in) :: nrow, ncol
+            character(len=*), intent(in) :: what
+            ok = .false.
+            if (.not. status%ok()) then
+                status%message = 'mexax: ' // what // ': ' // status%message
+            else if (.not. pattern%is_built()) then
+                call status%set(status_bad_input, 'mexax: ' // what // ' built no pattern')
+            else if (pattern%nrow /= nrow .or. pattern%ncol /= ncol) then
+                call status%set(status_bad_input, 'mexax: ' // what // ' is ' // &
+                    int_text(pattern%nrow) // ' x ' // int_text(pattern%ncol) // &
+                    ', expected ' // int_text(nrow) // ' x ' // int_text(ncol))
+            else
+                ok = .true.
+            end if
+        end function pattern_ok
+    end subroutine setup_sparse
+
+    !> M(t, q) into blk (dense or CSC values).
+    subroutine eval_mass(problem, w, t, q, blk, status)
+        class(mechanical_problem_t), intent(inout) :: problem
+        type(workspace_t), intent(in) :: w
+        real(wp), intent(in) :: t, q(:)
+        type(block_t), intent(inout) :: blk
+        type(status_t), intent(inout) :: status
+        if (w%sparse) then
+            call problem%mass_sparse(t, q, blk%values, status)
+        else
+            call problem%mass(t, q, blk%dense, status)
+        end if
+    end subroutine eval_mass
+
+    !> G(t, q) into blk (dense or CSC values).
+    subroutine eval_jacobian(problem, w, t, q, blk, status)
+        class(mechanical_problem_t), intent(inout) :: problem
+        type(workspace_t), intent(in) :: w
+        real(wp), intent(in) :: t, q(:)
+        type(block_t), intent(inout) :: blk
+        type(status_t), intent(inout) :: status
+        if (w%sparse) then
+            call problem%constraint_jacobian_sparse(t, q, blk%values, status)
+        else
+            call problem%constraint_jacobian(t, q, blk%dense, status)
+        end if
+    end subroutine eval_jacobian
+
+    !> dst = src without reallocation.
+    pure subroutine copy_block(dst, src)
+        type(block_t), intent(inout) :: dst
+        type(block_t), intent(in) :: src
+        if (allocated(src%dense)) dst%dense(:, :) = src%dense
+        if (allocated(src%values)) dst%values(:) = src%values
+    end subroutine copy_block
 
     !> f, T v, M and G at the start point of a macro step: shared by every
     !> column and every attempt from this point (§3.2).
@@ -727,8 +894,8 @@ contains
         type(status_t), intent(out) :: status
         call problem%forces(t, w%p0, w%v0, w%f0, status)
         if (status%ok()) call problem%kinematics(t, w%p0, w%v0, w%pdot0, status)
-        if (status%ok()) call problem%mass(t, w%p0, w%m0, status)
-        if (status%ok()) call problem%constraint_jacobian(t, w%p0, w%g0, status)
+        if (status%ok()) call eval_mass(problem, w, t, w%p0, w%m0, status)
+        if (status%ok()) call eval_jacobian(problem, w, t, w%p0, w%g0, status)
         self%native%nfprob = self%native%nfprob + 1
         self%native%nfcn = self%native%nfcn + 1
         if (.not. status%ok()) then
@@ -754,7 +921,7 @@ contains
         call problem%constraint_curvature(t, w%p0, w%v0, w%gt, cst)
         if (.not. cst%ok()) return
         call assemble(w, w%m0, w%g0, w%g0)
-        call dense_lu_factor(w%kmat, w%ipiv, cst)
+        call factor(w, cst)
         if (.not. cst%ok()) then
             call status%set(status_solver_failure, 'mexax: augmented matrix [M G^T; G 0] &
                 &is singular at t0 = ' // real_text(t), reason_singular_matrix)
@@ -763,23 +930,65 @@ contains
         self%native%ndec = self%native%ndec + 1
         w%rhs(1:nv) = w%f0
         w%rhs(nv + 1:) = -w%gt
-        call dense_lu_solve(w%kmat, w%ipiv, w%rhs)
+        call solve(w, w%rhs)
         self%native%nsol = self%native%nsol + 1
         w%a0 = w%rhs(1:nv)
         w%lam0 = w%rhs(nv + 1:)
     end subroutine consistent_acceleration
 
-    !> K = [mtop gtopᵀ; gbot 0] into w%kmat.
+    !> K = [mtop gtopᵀ; gbot 0] into w%kmat, or into the values of w%kpat
+    !> through its triplet map (no allocation).
     subroutine assemble(w, mtop, gtop, gbot)
         type(workspace_t), intent(inout) :: w
-        real(wp), intent(in) :: mtop(:, :), gtop(:, :), gbot(:, :)
+        type(block_t), intent(in) :: mtop, gtop, gbot
         integer :: nv
+        integer(i8) :: k, nm, ng
         nv = w%nv
-        w%kmat(1:nv, 1:nv) = mtop
-        w%kmat(1:nv, nv + 1:) = transpose(gtop)
-        w%kmat(nv + 1:, 1:nv) = gbot
+        if (w%sparse) then
+            nm = size(mtop%values, kind=i8)
+            ng = size(gtop%values, kind=i8)
+            associate (map => w%kpat%triplet_map, kv => w%kpat%values)
+                kv = 0.0_wp
+                do k = 1, nm
+                    kv(map(k)) = kv(map(k)) + mtop%values(k)
+                end do
+                do k = 1, ng
+                    kv(map(nm + k)) = kv(map(nm + k)) + gtop%values(k)
+                    kv(map(nm + ng + k)) = kv(map(nm + ng + k)) + gbot%values(k)
+                end do
+            end associate
+            return
+        end if
+        w%kmat(1:nv, 1:nv) = mtop%dense
+        w%kmat(1:nv, nv + 1:) = transpose(gtop%dense)
+        w%kmat(nv + 1:, 1:nv) = gbot%dense
         w%kmat(nv + 1:, nv + 1:) = 0.0_wp
     end subroutine assemble
+
+    !> LU of the assembled K: LAPACK, or KLU reusing the last pivot order
+    !> while it stays good (klu_factor_t%refactor).
+    subroutine factor(w, status)
+        type(workspace_t), intent(inout) :: w
+        type(status_t), intent(out) :: status
+        if (w%sparse) then
+            call w%klu%refactor(w%kpat%values, status)
+        else
+            call dense_lu_factor(w%kmat, w%ipiv, status)
+        end if
+    end subroutine factor
+
+    !> b ← K⁻¹ b with the factorisation of `factor`.
+    subroutine solve(w, b)
+        type(workspace_t), intent(inout) :: w
+        real(wp), intent(inout) :: b(:)
+        type(status_t) :: lst
+        if (w%sparse) then
+            ! fails only without a factorisation, which `factor` excluded
+            call w%klu%solve(b, lst)
+        else
+            call dense_lu_solve(w%kmat, w%ipiv, b)
+        end if
+    end subroutine solve
 
     !> Factor w%kmat and solve for w%rhs; ev_stop on a singular matrix.
     subroutine factor_solve(self, w, where, ev, status)
@@ -790,15 +999,21 @@ contains
         type(status_t), intent(inout) :: status
         type(status_t) :: lst
         ev = ev_ok
-        call dense_lu_factor(w%kmat, w%ipiv, lst)
-        if (.not. lst%ok()) then
+        call factor(w, lst)
+        if (.not. lst%ok() .and. lst%reason == reason_non_finite) then
+            ! KLU refuses Inf/NaN entries, which LAPACK would pass on: restart
+            call status%set(status_solver_failure, 'non-finite values in the augmented ' // &
+                'matrix ' // where, reason_non_finite)
+            ev = ev_restart
+            return
+        else if (.not. lst%ok()) then
             call status%set(status_solver_failure, 'augmented matrix [M G^T; G 0] is singular ' &
                 // where, reason_singular_matrix)
             ev = ev_stop
             return
         end if
         self%native%ndec = self%native%ndec + 1
-        call dense_lu_solve(w%kmat, w%ipiv, w%rhs)
+        call solve(w, w%rhs)
         self%native%nsol = self%native%nsol + 1
     end subroutine factor_solve
 
@@ -868,14 +1083,14 @@ contains
                     w%pdot = w%pdot0   ! shared start point (§3.2)
                 end if
                 w%pn = w%p + h * w%pdot
-                call problem%mass(tn, w%pn, w%mm, status)
+                call eval_mass(problem, w, tn, w%pn, w%mm, status)
                 if (user_failed(status, 'mass')) exit
-                call problem%constraint_jacobian(tn, w%pn, w%gm, status)
+                call eval_jacobian(problem, w, tn, w%pn, w%gm, status)
                 if (user_failed(status, 'constraint_jacobian')) exit
                 call problem%constraint_time_derivative(tn, w%pn, w%gt, status)
                 if (user_failed(status, 'constraint_time_derivative')) exit
                 self%native%nfprob = self%native%nfprob + 1
-                call matvec(w%mm, w%v, w%rhs(1:nv))
+                call block_times(w, w%mm, w%mpat, w%v, w%rhs(1:nv))
                 w%rhs(1:nv) = w%rhs(1:nv) + h * w%f
                 self%native%nmult = self%native%nmult + 1
                 w%rhs(nv + 1:) = -w%gt
@@ -903,7 +1118,7 @@ contains
             w%pp = w%p0
             w%vp = w%v0
             w%p = w%p0 + h * w%pdot0
-            call problem%constraint_jacobian(tn, w%p, w%gn, status)
+            call eval_jacobian(problem, w, tn, w%p, w%gn, status)
             if (user_failed(status, 'constraint_jacobian')) then
                 ev = ev_stop
                 return
@@ -915,7 +1130,7 @@ contains
             end if
             self%native%nfprob = self%native%nfprob + 1
             w%rhs(1:nv) = w%f0
-            call matvec(w%gn, w%v0, w%rhs(nv + 1:))
+            call block_times(w, w%gn, w%gpat, w%v0, w%rhs(nv + 1:))
             w%rhs(nv + 1:) = -(w%rhs(nv + 1:) + w%gt) / h
             call assemble(w, w%m0, w%g0, w%gn)
             call factor_solve(self, w, 'in a step', ev, status)
@@ -923,7 +1138,7 @@ contains
             w%acc = w%rhs(1:nv)
             w%lam = w%rhs(nv + 1:)
             w%v = w%v0 + h * w%acc
-            w%gm = w%gn
+            call copy_block(w%gm, w%gn)
             do i = 1, n - 1
                 ti = t + big_h * real(i, wp) / n
                 tn = t + big_h * real(i + 1, wp) / n
@@ -932,18 +1147,18 @@ contains
                 self%native%nfcn = self%native%nfcn + 1
                 self%native%nfprob = self%native%nfprob + 1
                 if (user_failed(status, 'forces')) exit
-                call problem%mass(ti, w%p, w%mm, status)
+                call eval_mass(problem, w, ti, w%p, w%mm, status)
                 if (user_failed(status, 'mass')) exit
                 call problem%kinematics(ti, w%p, w%v, w%pdot, status)
                 if (user_failed(status, 'kinematics')) exit
                 w%pn = w%pp + 2.0_wp * h * w%pdot
-                call problem%constraint_jacobian(tn, w%pn, w%gn, status)
+                call eval_jacobian(problem, w, tn, w%pn, w%gn, status)
                 if (user_failed(status, 'constraint_jacobian')) exit
                 call problem%constraint_time_derivative(tn, w%pn, w%gt, status)
                 if (user_failed(status, 'constraint_time_derivative')) exit
                 self%native%nfprob = self%native%nfprob + 1
                 w%rhs(1:nv) = w%f
-                call matvec(w%gn, w%vp, w%rhs(nv + 1:))
+                call block_times(w, w%gn, w%gpat, w%vp, w%rhs(nv + 1:))
                 w%rhs(nv + 1:) = -(w%rhs(nv + 1:) + w%gt) / (2.0_wp * h)
                 call assemble(w, w%mm, w%gm, w%gn)
                 call factor_solve(self, w, 'in a step', ev, status)
@@ -956,7 +1171,7 @@ contains
                 w%f = w%vp + 2.0_wp * h * w%acc
                 w%vp = w%v
                 w%v = w%f
-                w%gm = w%gn
+                call copy_block(w%gm, w%gn)
                 if (unstable(i)) return
             end do
             if (.not. status%ok()) ev = ev_stop
@@ -1052,13 +1267,13 @@ contains
         c = 0.0_wp
         w%pn = w%p   ! p̃
         w%vp = w%v   ! ṽ
-        call problem%mass(t, w%pn, w%mm, status)
+        call eval_mass(problem, w, t, w%pn, w%mm, status)
         if (.not. user_failed(status, 'mass')) &
-            call problem%constraint_jacobian(t, w%pn, w%gm, status)
+            call eval_jacobian(problem, w, t, w%pn, w%gm, status)
         if (user_failed(status, 'constraint_jacobian')) return
         self%native%nfprob = self%native%nfprob + 1
         call assemble(w, w%mm, w%gm, w%gm)
-        call dense_lu_factor(w%kmat, w%ipiv, status)
+        call factor(w, status)
         if (.not. status%ok()) then
             status%message = 'augmented matrix [M C^T; C 0] is singular in the position &
                 &projection'
@@ -1073,7 +1288,7 @@ contains
             if (user_failed(status, 'constraint')) return
             w%rhs(1:nv) = 0.0_wp
             w%rhs(nv + 1:) = -w%gt
-            call dense_lu_solve(w%kmat, w%ipiv, w%rhs)
+            call solve(w, w%rhs)
             self%native%nsol = self%native%nsol + 1
             ! one FPROB call (flag 5): T(p̃) δ
             call problem%kinematics(t, w%pn, w%rhs(1:nv), w%pdot, status)
@@ -1091,15 +1306,15 @@ contains
             end if
             eps_old = eps
         end do
-        call problem%mass(t, w%p, w%mm, status)
+        call eval_mass(problem, w, t, w%p, w%mm, status)
         if (.not. user_failed(status, 'mass')) &
-            call problem%constraint_jacobian(t, w%p, w%gm, status)
+            call eval_jacobian(problem, w, t, w%p, w%gm, status)
         if (.not. user_failed(status, 'constraint_jacobian')) &
             call problem%constraint_time_derivative(t, w%p, w%gt, status)
         if (user_failed(status, 'constraint_time_derivative')) return
         self%native%nfprob = self%native%nfprob + 1
         w%rhs(1:nv) = 0.0_wp
-        call matvec(w%gm, w%vp, w%rhs(nv + 1:))
+        call block_times(w, w%gm, w%gpat, w%vp, w%rhs(nv + 1:))
         w%rhs(nv + 1:) = -(w%rhs(nv + 1:) + w%gt)
         call assemble(w, w%mm, w%gm, w%gm)
         call factor_solve(self, w, 'in the velocity projection', ev, status)
@@ -1162,6 +1377,35 @@ contains
                 // real_text(t), reason_non_finite)
         end if
     end subroutine accept_point
+
+    !> y = B x for a block B (M or G) stored dense or on its pattern `pat`.
+    pure subroutine block_times(w, b, pat, x, y)
+        type(workspace_t), intent(in) :: w
+        type(block_t), intent(in) :: b
+        type(csc_matrix_t), intent(in) :: pat !! w%mpat for M, w%gpat for G
+        real(wp), intent(in) :: x(:)
+        real(wp), intent(out) :: y(:)
+        if (w%sparse) then
+            call sparse_matvec(pat, b%values, x, y)
+        else
+            call matvec(b%dense, x, y)
+        end if
+    end subroutine block_times
+
+    !> y = A x, A the pattern `pat` with the given slot values.
+    pure subroutine sparse_matvec(pat, values, x, y)
+        type(csc_matrix_t), intent(in) :: pat
+        real(wp), intent(in) :: values(:), x(:)
+        real(wp), intent(out) :: y(:)
+        integer :: j
+        integer(i8) :: p
+        y = 0.0_wp
+        do j = 1, pat%ncol
+            do p = pat%colptr(j) + 1, pat%colptr(j + 1)
+                y(pat%rowind(p) + 1) = y(pat%rowind(p) + 1) + values(p) * x(j)
+            end do
+        end do
+    end subroutine sparse_matvec
 
     !> y = a x without temporaries.
     pure subroutine matvec(a, x, y)

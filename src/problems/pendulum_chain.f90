@@ -14,9 +14,13 @@
 !>
 !> M and f are constant, the constraints scleronomic (g_I = 0). The chain
 !> starts horizontal at rest, φ_i = π/2, x_i = (2i - 1) l, y_i = 0.
+!>
+!> M (diagonal, 3 NB slots) and G (8 NB - 4 slots) are also given as CSC,
+!> so that MEXAX can factor [M Gᵀ; G 0] with KLU when NB is large.
 module flexmbs_problems_pendulum_chain
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     implicit none
     private
@@ -42,6 +46,11 @@ module flexmbs_problems_pendulum_chain
         procedure :: constraint => chain_constraint
         procedure :: constraint_jacobian => chain_constraint_jacobian
         procedure :: constraint_curvature => chain_constraint_curvature
+        procedure :: has_sparse => chain_has_sparse
+        procedure :: mass_pattern => chain_mass_pattern
+        procedure :: mass_sparse => chain_mass_sparse
+        procedure :: constraint_jacobian_pattern => chain_constraint_jacobian_pattern
+        procedure :: constraint_jacobian_sparse => chain_constraint_jacobian_sparse
     end type pendulum_chain_t
 
     public :: new_pendulum_chain, pendulum_chain_initial
@@ -179,4 +188,96 @@ contains
             gamma(2 * i) = l * (cos(q(3 * i - 3)) * v(3 * i - 3)**2 + cos(q(3 * i)) * v(3 * i)**2)
         end do
     end subroutine chain_constraint_curvature
+
+    logical function chain_has_sparse(self)
+        class(pendulum_chain_t), intent(in) :: self
+        chain_has_sparse = .true.
+    end function chain_has_sparse
+
+    !> M is diagonal.
+    subroutine chain_mass_pattern(self, pattern, status)
+        class(pendulum_chain_t), intent(inout) :: self
+        type(csc_matrix_t), intent(inout) :: pattern
+        type(status_t), intent(inout) :: status
+        integer :: i
+        call pattern%build(self%nv, self%nv, [(i, i=1, self%nv)], [(i, i=1, self%nv)], status)
+    end subroutine chain_mass_pattern
+
+    !> diag(m, m, m l²/3) per body, in the slots of the diagonal pattern.
+    subroutine chain_mass_sparse(self, t, q, values, status)
+        class(pendulum_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        integer :: i
+        do i = 1, self%bodies
+            values(3 * i - 2) = self%body_mass
+            values(3 * i - 1) = self%body_mass
+            values(3 * i) = self%inertia
+        end do
+    end subroutine chain_mass_sparse
+
+    !> The 8 NB - 4 slots of G, column by column.
+    subroutine chain_constraint_jacobian_pattern(self, pattern, status)
+        class(pendulum_chain_t), intent(inout) :: self
+        type(csc_matrix_t), intent(inout) :: pattern
+        type(status_t), intent(inout) :: status
+        integer, allocatable :: rows(:), cols(:)
+        real(wp), allocatable :: values(:)
+        real(wp), allocatable :: q(:)
+        integer :: nnz
+        nnz = 8 * self%bodies - 4
+        allocate (rows(nnz), cols(nnz), values(nnz), q(self%nq))
+        q = half_pi
+        call jacobian_entries(self, q, values, rows, cols)
+        call pattern%build(self%nc, self%nv, rows, cols, status)
+    end subroutine chain_constraint_jacobian_pattern
+
+    !> Values of G in the slots of its pattern.
+    subroutine chain_constraint_jacobian_sparse(self, t, q, values, status)
+        class(pendulum_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        call jacobian_entries(self, q, values)
+    end subroutine chain_constraint_jacobian_sparse
+
+    !> The nonzeros of G in CSC order (by column, rows ascending), so that
+    !> the pattern built from (rows, cols) has them in exactly these slots.
+    !> Column x_i holds rows 2i-1 (bar i's upper end) and 2i+1 (bar i+1's),
+    !> y_i rows 2i and 2i+2, φ_i all four.
+    subroutine jacobian_entries(self, q, values, rows, cols)
+        class(pendulum_chain_t), intent(in) :: self
+        real(wp), intent(in) :: q(:)
+        real(wp), intent(out) :: values(:)
+        integer, intent(out), optional :: rows(:), cols(:)
+        integer :: i, k, nb
+        real(wp) :: l, lc, ls
+        l = self%half_length
+        nb = self%bodies
+        k = 0
+        do i = 1, nb
+            lc = l * cos(q(3 * i))
+            ls = l * sin(q(3 * i))
+            call put(2 * i - 1, 3 * i - 2, -1.0_wp)
+            if (i < nb) call put(2 * i + 1, 3 * i - 2, 1.0_wp)
+            call put(2 * i, 3 * i - 1, -1.0_wp)
+            if (i < nb) call put(2 * i + 2, 3 * i - 1, 1.0_wp)
+            call put(2 * i - 1, 3 * i, lc)
+            call put(2 * i, 3 * i, ls)
+            if (i < nb) then
+                call put(2 * i + 1, 3 * i, lc)
+                call put(2 * i + 2, 3 * i, ls)
+            end if
+        end do
+    contains
+        subroutine put(row, col, value)
+            integer, intent(in) :: row, col
+            real(wp), intent(in) :: value
+            k = k + 1
+            values(k) = value
+            if (present(rows)) rows(k) = row
+            if (present(cols)) cols(k) = col
+        end subroutine put
+    end subroutine jacobian_entries
 end module flexmbs_problems_pendulum_chain
