@@ -1,78 +1,123 @@
-!> One benchmark run: integrate a problem with RADAU5 and print one line of
-!> figures (counters, CPU and wall time, time per step, peak memory).
+!> One benchmark run: integrate a problem with RADAU5, DDASSL or IDA and
+!> print one line of figures (counters, CPU and wall time, time per step,
+!> peak memory) and the accuracy reached at t_end.
 !>
-!>   flexmbs-bench PROBLEM N SOLVER [MAX_STEPS] [RTOL]
-!>   PROBLEM: vdp | rd1d | rd2d (N: unknowns for rd1d, grid points per side
-!>   for rd2d, ignored for vdp); SOLVER: dense | klu | band | auto.
+!>   flexmbs-bench INTEGRATOR PROBLEM N SOLVER [MAX_STEPS] [RTOL] [REFERENCE]
+!>   flexmbs-bench reference PROBLEM N FILE [RTOL]
+!>
+!> INTEGRATOR: radau5 | ddassl | ddassl-p2 (maximal BDF order 2) | ida.
+!> PROBLEM: vdp | rd1d | rd2d | pend3 | pend2 | pendggl (N: unknowns for
+!> rd1d, grid points per side for rd2d, ignored otherwise); SOLVER: dense |
+!> klu | band | auto. ERR is eq. (13) of `paper_error` at t_end with
+!> atol = rtol: van der Pol against its tight reference, the pendulum
+!> (φ0 = 1, t_end = 3, index 3, index 2 or GGL) over the positions against
+!> the exact solution, the Brusselator against the file REFERENCE written
+!> by the `reference` mode (RADAU5 at rtol = atol = RTOL, default 1e-10).
+!> ERR is '-' when the run stopped early or no reference is at hand.
 !> bench/run.sh runs the grid of configurations; these are figures, not tests.
 program flexmbs_bench
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, reason_max_steps
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_solver, only: dae_solver_t
     use flexmbs_dae_radau5, only: radau5_t
-    use flexmbs_problems_van_der_pol, only: new_van_der_pol, van_der_pol_t
+    use flexmbs_dae_ddassl, only: ddassl_t
+    use flexmbs_dae_ida, only: ida_t
+    use flexmbs_dae_error_measure, only: paper_error
+    use flexmbs_problems_van_der_pol, only: new_van_der_pol
     use flexmbs_problems_reaction_diffusion, only: reaction_diffusion_t, &
         new_reaction_diffusion, reaction_diffusion_initial
+    use flexmbs_problems_pendulum, only: pendulum_t, new_pendulum, pendulum_initial, &
+        pendulum_reference, pendulum_index2, pendulum_index3, pendulum_ggl
     implicit none
-    character(len=32) :: problem_name, solver_name, arg
-    integer :: npar, max_steps
-    real(wp) :: rtol, t, t_end
-    real(wp), allocatable :: y(:)
+
+    real(wp), parameter :: pendulum_phi0 = 1.0_wp   !! start angle [rad], as in test/
+    real(wp), parameter :: pendulum_t_end = 3.0_wp
+    !> van der Pol, ε = 1e-6, y(2) from y(0) = (2, −0.66): RADAU5 at
+    !> rtol = atol = 1e-14, the reference of test/test_radau5.f90 (which
+    !> confirms it by the independent Lobatto IIIC integrator to 1e-11).
+    real(wp), parameter :: vdp_reference(2) = [1.70616743754319988_wp, &
+        -0.892810016551103480_wp]
+
+    character(len=32) :: integrator_name, problem_name, solver_name, arg
+    character(len=256) :: reference_file
+    integer :: npar, max_steps, ios
+    real(wp) :: rtol, t, t_end, err
+    real(wp), allocatable :: y(:), y_ref(:)
+    logical, allocatable :: mask(:)
     class(dae_problem_t), allocatable :: problem
-    type(radau5_t) :: solver
+    class(dae_solver_t), allocatable :: solver
     type(dae_options_t) :: options
     type(dae_stats_t) :: stats
     type(status_t) :: status
     character(len=16) :: outcome
 
-    if (command_argument_count() < 3) then
-        write (*, '(a)') 'usage: flexmbs-bench vdp|rd1d|rd2d N dense|klu|band|auto ' // &
-            '[MAX_STEPS] [RTOL]'
+    if (command_argument_count() < 4) then
+        write (*, '(a)') 'usage: flexmbs-bench radau5|ddassl|ddassl-p2|ida ' // &
+            'vdp|rd1d|rd2d|pend3|pend2|pendggl N dense|klu|band|auto ' // &
+            '[MAX_STEPS] [RTOL] [REFERENCE]', &
+            '       flexmbs-bench reference PROBLEM N FILE [RTOL]'
         error stop 2
     end if
-    call get_command_argument(1, problem_name)
-    call get_command_argument(2, arg)
+    call get_command_argument(1, integrator_name)
+    call get_command_argument(2, problem_name)
+    call get_command_argument(3, arg)
     read (arg, *) npar
-    call get_command_argument(3, solver_name)
+    call get_command_argument(4, solver_name)
     max_steps = 100000
     rtol = 1.0e-6_wp
-    if (command_argument_count() >= 4) then
-        call get_command_argument(4, arg)
-        read (arg, *) max_steps
-    end if
-    if (command_argument_count() >= 5) then
-        call get_command_argument(5, arg)
-        read (arg, *) rtol
+    reference_file = ''
+    if (integrator_name == 'reference') then
+        reference_file = solver_name
+        solver_name = 'auto'
+        rtol = 1.0e-10_wp
+        max_steps = 10000000
+        if (command_argument_count() >= 5) then
+            call get_command_argument(5, arg)
+            read (arg, *) rtol
+        end if
+    else
+        if (command_argument_count() >= 5) then
+            call get_command_argument(5, arg)
+            read (arg, *) max_steps
+        end if
+        if (command_argument_count() >= 6) then
+            call get_command_argument(6, arg)
+            read (arg, *) rtol
+        end if
+        if (command_argument_count() >= 7) call get_command_argument(7, reference_file)
     end if
 
-    select case (trim(problem_name))
-    case ('vdp')
-        allocate (problem, source=new_van_der_pol(1.0e-6_wp))
-        y = [2.0_wp, -0.66_wp]
-        t_end = 2.0_wp
-        options%h0 = 1.0e-6_wp
-    case ('rd1d')
-        allocate (problem, source=new_reaction_diffusion(1, npar / 2))
-        t_end = 10.0_wp
-    case ('rd2d')
-        allocate (problem, source=new_reaction_diffusion(2, npar))
-        t_end = 1.0_wp
-    case default
-        write (*, '(a)') 'unknown problem ' // trim(problem_name)
-        error stop 2
-    end select
-    select type (problem)
-    type is (reaction_diffusion_t)
-        allocate (y(problem%n))
-        call reaction_diffusion_initial(problem, y)
-    end select
-
+    call make_problem(trim(problem_name), npar, trim(solver_name))
     options%rtol = rtol
     options%atol = rtol
     options%max_steps = max_steps
     options%linear_solver = solver_name
+
+    select case (trim(integrator_name))
+    case ('radau5', 'reference')
+        allocate (radau5_t :: solver)
+    case ('ddassl')
+        allocate (ddassl_t :: solver)
+    case ('ddassl-p2')
+        allocate (ddassl_t :: solver)
+        options%pmax = 2
+    case ('ida')
+        allocate (ida_t :: solver)
+        ! IDA offers dense and KLU only; its 'band' would silently be 'auto'.
+        if (solver_name == 'band') then
+            t = 0.0_wp
+            call print_row('unsupported')
+            stop
+        end if
+    case default
+        write (*, '(a)') 'unknown integrator ' // trim(integrator_name)
+        error stop 2
+    end select
+
     t = 0.0_wp
     call solver%integrate(problem, t, y, t_end, options, stats, status)
     if (status%ok()) then
@@ -81,20 +126,128 @@ program flexmbs_bench
         outcome = 'capped'
     else
         outcome = 'failed'
-        write (0, '(a)') status%text()
+        write (0, '(a)') trim(integrator_name) // ' ' // trim(problem_name) // ': ' // &
+            status%text()
     end if
-    ! problem n solver outcome t_reached NST NAC NFE NJE NDEC CPU WALL CPU/step peakMB
-    write (*, '(a,1x,i0,1x,a,1x,a,1x,es10.3,5(1x,i0),3(1x,es10.3),1x,f0.1)') &
-        trim(problem_name), problem%n, trim(solver_name), trim(outcome), t, stats%nst, &
-        stats%nac, stats%nfe, stats%nje, stats%ndec, stats%cpu, stats%wall, &
-        stats%cpu / max(stats%nst, 1), peak_memory_mb()
+    if (integrator_name == 'reference') then
+        call write_reference()
+        stop
+    end if
+    err = ieee_value(err, ieee_quiet_nan)
+    if (outcome == 'done' .and. allocated(y_ref)) then
+        if (allocated(mask)) then
+            err = paper_error(y, y_ref, rtol, rtol, mask)
+        else
+            err = paper_error(y, y_ref, rtol, rtol)
+        end if
+    end if
+    call print_row(outcome)
 
 contains
+
+    !> The problem, its initial values, t_end and (when known) the reference
+    !> at t_end. Sparse storage of the Jacobian (and M) except for dense LU
+    !> on the small problems, where the dense Jacobian is the natural one.
+    subroutine make_problem(name, npar, linear_solver)
+        character(len=*), intent(in) :: name, linear_solver
+        integer, intent(in) :: npar
+        type(status_t) :: st
+        logical :: sparse
+        sparse = linear_solver /= 'dense'
+        select case (name)
+        case ('vdp')
+            allocate (problem, source=new_van_der_pol(1.0e-6_wp, sparse=sparse))
+            y = [2.0_wp, -0.66_wp]
+            t_end = 2.0_wp
+            options%h0 = 1.0e-6_wp
+            y_ref = vdp_reference
+        case ('rd1d')
+            allocate (problem, source=new_reaction_diffusion(1, npar / 2))
+            t_end = 10.0_wp
+        case ('rd2d')
+            allocate (problem, source=new_reaction_diffusion(2, npar))
+            t_end = 1.0_wp
+        case ('pend3')
+            allocate (problem, source=new_pendulum(pendulum_index3, pendulum_phi0, &
+                sparse=sparse, sparse_mass=sparse))
+        case ('pend2')
+            allocate (problem, source=new_pendulum(pendulum_index2, pendulum_phi0, &
+                sparse=sparse, sparse_mass=sparse))
+        case ('pendggl')
+            allocate (problem, source=new_pendulum(pendulum_ggl, pendulum_phi0, &
+                sparse=sparse, sparse_mass=sparse))
+        case default
+            write (*, '(a)') 'unknown problem ' // name
+            error stop 2
+        end select
+        select type (problem)
+        type is (reaction_diffusion_t)
+            allocate (y(problem%n))
+            call reaction_diffusion_initial(problem, y)
+            if (len_trim(reference_file) > 0 .and. integrator_name /= 'reference') &
+                call read_reference()
+        type is (pendulum_t)
+            allocate (y(problem%n), y_ref(problem%n), mask(problem%n))
+            call pendulum_initial(problem, y)
+            t_end = pendulum_t_end
+            call pendulum_reference(problem, t_end, y_ref, st)
+            if (.not. st%ok()) deallocate (y_ref)
+            ! Positions only, as in test/: λ and μ are index-2/3 variables.
+            mask = .false.
+            mask(1:2) = .true.
+        end select
+    end subroutine make_problem
+
+    !> y(t_end) of the reference run, one value a line after n.
+    subroutine write_reference()
+        integer :: unit, i
+        if (outcome /= 'done') then
+            write (0, '(a)') 'reference run did not reach t_end; no file written'
+            error stop 1
+        end if
+        open (newunit=unit, file=trim(reference_file), action='write', status='replace')
+        write (unit, '(i0)') problem%n
+        write (unit, '(es25.17e3)') (y(i), i=1, size(y))
+        close (unit)
+        write (*, '(a,1x,a,1x,i0,a,es8.1,a,i0,a,es10.3,a)') 'reference', trim(problem_name), &
+            problem%n, ': RADAU5 rtol = atol =', rtol, ', NST ', stats%nst, ', CPU ', &
+            stats%cpu, ' s'
+    end subroutine write_reference
+
+    !> Read the reference file if it exists and fits; otherwise no reference.
+    subroutine read_reference()
+        integer :: unit, n_file, i
+        open (newunit=unit, file=trim(reference_file), action='read', status='old', iostat=ios)
+        if (ios /= 0) return
+        read (unit, *, iostat=ios) n_file
+        if (ios == 0 .and. n_file == problem%n) then
+            allocate (y_ref(n_file))
+            read (unit, *, iostat=ios) (y_ref(i), i=1, n_file)
+            if (ios /= 0) deallocate (y_ref)
+        end if
+        close (unit)
+    end subroutine read_reference
+
+    !> integrator problem n solver outcome t_reached NST NAC NFE NJE NDEC CPU
+    !> WALL CPU/step peakMiB ERR
+    subroutine print_row(what)
+        character(len=*), intent(in) :: what
+        character(len=12) :: err_text
+        err_text = '-'
+        if (what == 'done' .and. allocated(y_ref)) then
+            if (.not. ieee_is_nan(err)) write (err_text, '(es10.3)') err
+        end if
+        write (*, '(2(a,1x),i0,2(1x,a),1x,es10.3,5(1x,i0),3(1x,es10.3),1x,f0.1,1x,a)') &
+            trim(integrator_name), trim(problem_name), problem%n, trim(solver_name), &
+            trim(what), t, stats%nst, stats%nac, stats%nfe, stats%nje, stats%ndec, &
+            stats%cpu, stats%wall, stats%cpu / max(stats%nst, 1), peak_memory_mb(), &
+            trim(adjustl(err_text))
+    end subroutine print_row
 
     !> Peak resident set size (VmHWM) of this process in MiB, Linux only.
     real(wp) function peak_memory_mb()
         character(len=256) :: line
-        integer :: unit, ios
+        integer :: unit
         real(wp) :: kb
         peak_memory_mb = -1.0_wp
         open (newunit=unit, file='/proc/self/status', action='read', iostat=ios)

@@ -1,9 +1,14 @@
 #!/usr/bin/env bash
-# `make bench`: RADAU5 on van der Pol and on the sparse reaction-diffusion
-# problems at 1e2..1e5 unknowns, dense and KLU (band LU too in 1-D). Prints
-# figures (CPU, wall, time per step, peak memory, counters), never asserts.
-# Dense LU is capped in steps where it would take minutes, and skipped where
-# it cannot fit.
+# `make bench`: RADAU5, DDASSL (maximal order 5, and 2 where cheap) and IDA
+# on the same problems with the same tolerances (rtol = atol = 1e-6): van der
+# Pol, the planar pendulum (index 3, index 2, GGL) and the sparse
+# reaction-diffusion problems at 1e2..1e5 unknowns, dense LU and KLU (band LU
+# too in 1-D, where the integrator offers it). Prints one row per run:
+# counters, CPU, wall, time per step, peak memory and the error ERR at t_end
+# against a reference; never asserts. Runs that would take minutes are capped
+# in steps (outcome 'capped', ERR '-'); runs that cannot fit or would take far
+# too long are listed as 'skipped' with the reason. A run that fails prints
+# its row with outcome 'failed' (the reason goes to build/bench/errors.txt).
 set -u
 cd "$(dirname "$0")/.."
 FPM=${FPM:-fpm}
@@ -15,38 +20,103 @@ fi
 OUT=build/bench
 mkdir -p "$OUT"
 RESULTS=$OUT/results.txt
+ERRORS=$OUT/errors.txt
+RTOL=1e-6
 : > "$RESULTS"
+: > "$ERRORS"
 
-run() {  # problem size solver [max_steps]
-    "$BIN" "$@" | tee -a "$RESULTS"
+run() {  # integrator problem size solver [max_steps]
+    local line rc
+    line=$("$BIN" "$1" "$2" "$3" "$4" "${5:-100000}" "$RTOL" "$OUT/ref-$2-$3.txt" \
+        2>>"$ERRORS")
+    rc=$?
+    # A crash (not a failed integration, which prints its row) still gets a row.
+    [ -n "$line" ] || line="$1 $2 $3 $4 crashed(exit=$rc)"
+    echo "$line" | tee -a "$RESULTS"
 }
 
-echo "problem n solver outcome t_reached NST NAC NFE NJE NDEC CPU[s] WALL[s] CPU/step[s] peak[MiB]"
-run vdp 2 dense
-run vdp 2 klu
-for n in 100 1000 10000 100000; do
-    case $n in
-        100|1000) run rd1d $n dense ;;
-        10000)    run rd1d $n dense 3 ;;   # ~1 GB of dense matrices: capped at 3 steps
-    esac
-    run rd1d $n klu
-    run rd1d $n band   # bandwidths 2, 2: the case for band LU
+skip() {  # integrator problem n solver reason
+    echo "$1 $2 $3 $4 skipped: $5" | tee -a "$RESULTS"
+}
+
+echo "references at t_end (RADAU5, rtol = atol = 1e-10):"
+for p in "rd1d 100" "rd1d 1000" "rd1d 10000" "rd1d 100000" "rd2d 7" "rd2d 22" "rd2d 71"; do
+    set -- $p
+    "$BIN" reference "$1" "$2" "$OUT/ref-$1-$2.txt" 2>>"$ERRORS" || rm -f "$OUT/ref-$1-$2.txt"
 done
+echo
+echo "integrator problem n solver outcome t_reached NST NAC NFE NJE NDEC CPU[s] WALL[s] CPU/step[s] peak[MiB] ERR"
+
+for integ in radau5 ddassl ddassl-p2 ida; do
+    for p in vdp pend2 pendggl; do
+        run $integ $p 2 dense
+        run $integ $p 2 klu
+    done
+    # Index 3 is RADAU5's; the BDF codes are run to show what they make of it.
+    run $integ pend3 2 dense
+done
+
+DENSE_IDA="SUNDIALS' unblocked dense LU: over 5 min for 10 steps on the periodic grid"
+for integ in radau5 ddassl ddassl-p2 ida; do
+    for n in 100 1000 10000 100000; do
+        case $integ:$n in
+            *:100|*:1000)     run $integ rd1d $n dense ;;
+            radau5:10000)     run $integ rd1d $n dense 1 ;;   # 3.1 GB, ~60 s an LU pair
+            ddassl:10000)     run $integ rd1d $n dense 2 ;;   # one LAPACK LU ~20 s
+            ida:10000)        run $integ rd1d $n dense 10 ;;  # ~1.5 s a step
+            ddassl-p2:10000)  ;;                              # same first steps as ddassl
+            *:100000)         skip $integ rd1d $n dense "80 GB a matrix" ;;
+        esac
+        run $integ rd1d $n klu
+        run $integ rd1d $n band   # bandwidths 2, 2; IDA: 'unsupported'
+    done
+done
+
 # 2-D: 2·N² unknowns for N = 7, 22, 71, 224 (about 1e2, 1e3, 1e4, 1e5).
-for m in 7 22 71 224; do
-    case $m in
-        7|22) run rd2d $m dense ;;
-        71)   run rd2d $m dense 3 ;;
-    esac
-    run rd2d $m klu
+for integ in radau5 ddassl ddassl-p2 ida; do
+    for m in 7 22 71 224; do
+        n=$((2 * m * m))
+        case $integ:$m in
+            *:7|*:22)         run $integ rd2d $m dense ;;
+            radau5:71)        run $integ rd2d $m dense 1 ;;
+            ddassl:71)        run $integ rd2d $m dense 2 ;;
+            ida:71)           skip $integ rd2d $n dense "$DENSE_IDA" ;;
+            *:224)            [ $integ = ddassl-p2 ] || skip $integ rd2d $n dense "80 GB a matrix" ;;
+        esac
+        case $integ:$m in
+            ddassl-p2:224)    ;;                              # same first step as ddassl
+            *:224)            run $integ rd2d $m klu 1 ;;     # KLU fill-in: 10-70 s a step
+            *)                run $integ rd2d $m klu ;;
+        esac
+    done
 done
 
 echo
-echo "time per step growth between successive sizes (KLU): exponent p in t ~ n^p"
-for p in rd1d rd2d; do
-    awk -v p=$p '$1 == p && $3 == "klu" { if (n0 > 0) printf "%s  n %d -> %d: p = %.2f\n", p, n0, $2, log($13/t0)/log($2/n0); n0 = $2; t0 = $13 }' "$RESULTS"
+echo "time per step growth between successive sizes (KLU, runs that reached t_end): p in t ~ n^p"
+for integ in radau5 ddassl ddassl-p2 ida; do
+    for p in rd1d rd2d; do
+        awk -v i=$integ -v p=$p '$1 == i && $2 == p && $4 == "klu" && $5 == "done" {
+            if (n0 > 0) printf "%-7s %s  n %d -> %d: p = %.2f\n", i, p, n0, $3, log($14/t0)/log($3/n0)
+            n0 = $3; t0 = $14 }' "$RESULTS"
+    done
 done
 echo
 echo "KLU speed-up over dense in time per step at equal size:"
-awk '{ key = $1" "$2; if ($3 == "dense") d[key] = $13; else if ($3 == "klu") k[key] = $13 }
-     END { for (key in d) if (key in k && k[key] > 0) printf "%s: %.1fx\n", key, d[key]/k[key] }' "$RESULTS" | sort
+awk '$5 == "done" || $5 == "capped" { key = $1" "$2" "$3
+         if ($4 == "dense") d[key] = $14; else if ($4 == "klu") k[key] = $14 }
+     END { for (key in d) if (key in k && k[key] > 0) printf "%s: %.1fx\n", key, d[key]/k[key] }' \
+    "$RESULTS" | sort -k1,1 -k2,2 -k3,3n
+echo
+echo "CPU time relative to RADAU5 (same problem, size and linear solver, runs that reached t_end"
+echo "and took RADAU5 at least 0.01 s; below that the ratios are timer noise):"
+awk '$5 == "done" { key = $2" "$3" "$4; cpu[$1" "key] = $12; keys[key] = 1 }
+     END { for (key in keys) if (("radau5 " key) in cpu && cpu["radau5 " key] >= 0.01) {
+               line = key ":"
+               split("ddassl ddassl-p2 ida", ii, " ")
+               for (j = 1; j <= 3; j++) if ((ii[j] " " key) in cpu)
+                   line = line sprintf("  %s %.2f", ii[j], cpu[ii[j] " " key] / cpu["radau5 " key])
+               print line } }' "$RESULTS" | sort -k1,1 -k2,2n -k3,3
+if [ -s "$ERRORS" ]; then
+    echo
+    echo "messages of failed runs: $ERRORS"
+fi
