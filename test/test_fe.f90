@@ -10,7 +10,7 @@ module test_fe
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
     private
-    public :: collect_fe, random_element, random_rotation, paper_material
+    public :: collect_fe, random_element, random_rotation, paper_material, strains
 
     ! Relative accuracy asked of analytic stresses and of FD tangents (issue 5).
     real(wp), parameter :: stress_rtol = 1.0e-10_wp
