@@ -17,6 +17,7 @@ program flexmbs_tests
     use test_mexax, only: collect_mexax
     use test_fe, only: collect_fe
     use test_fe_element, only: collect_fe_element
+    use test_fe_body, only: collect_fe_body
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -41,6 +42,7 @@ program flexmbs_tests
     call run_suite('mexax', collect_mexax(), filter, npassed, nfailed)
     call run_suite('fe', collect_fe(), filter, npassed, nfailed)
     call run_suite('fe_element', collect_fe_element(), filter, npassed, nfailed)
+    call run_suite('fe_body', collect_fe_body(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests
