@@ -27,20 +27,22 @@ contains
                  new_test('rigid_motion_zero_force', test_body_rigid), &
                  new_test('tangents_fd', test_body_tangents), &
                  new_test('det_f_names_element', test_body_det_f), &
-                 new_test('bad_fixed_node', test_bad_fixed)]
+                 new_test('bad_fixed_node', test_bad_fixed), &
+                 new_test('momenta_kinetic_energy', test_momenta), &
+                 new_test('strain_energy_gradient', test_strain_energy)]
     end function collect_fe_body
 
-    subroutine make_body(kind, fixed_face, body, status, gravity)
+    subroutine make_body(kind, fixed_face, body, status, gravity, origin)
         integer, intent(in) :: kind
         character(len=*), intent(in) :: fixed_face  !! '' for a free body
         type(flexible_body_t), intent(out) :: body
         type(status_t), intent(out) :: status
-        real(wp), intent(in), optional :: gravity(3)
+        real(wp), intent(in), optional :: gravity(3), origin(3)
         type(mesh_t) :: mesh
         type(neo_hooke_t) :: mat
         integer, allocatable :: fixed(:)
         call paper_material(mat)
-        call box_mesh(mesh, element_kinds(kind), divisions, box, status)
+        call box_mesh(mesh, element_kinds(kind), divisions, box, status, origin)
         if (.not. status%ok()) return
         allocate (fixed(0))
         if (len(fixed_face) > 0) call mesh%node_set(fixed_face, fixed, status)
@@ -203,4 +205,80 @@ contains
         call check(error, .not. status%ok() .and. index(status%text(), 'fixed node 9') > 0, &
                    'fixed node outside the mesh')
     end subroutine test_bad_fixed
+
+    !> Box centred at the origin moving rigidly with ẋ = ω × x + w: linear
+    !> momentum m w, angular momentum I ω with I = m/12 diag(b²+c², a²+c², a²+b²),
+    !> kinetic energy m|w|²/2 + ωᵀIω/2, exactly.
+    subroutine test_momenta(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(flexible_body_t) :: body
+        type(status_t) :: status
+        real(wp), allocatable :: q(:), v(:)
+        real(wp) :: omega(3), w(3), linear(3), angular(3), inertia(3), total
+        integer(i8) :: seed
+        integer :: kind, i
+        seed = 43_i8
+        do kind = 1, 2
+            call make_body(kind, '', body, status, origin=-0.5_wp * box)
+            q = body%free_positions()
+            call fill_random(omega, seed, -3.0_wp, 3.0_wp)
+            call fill_random(w, seed, -2.0_wp, 2.0_wp)
+            allocate (v(body%nv))
+            do i = 1, body%nv / 3
+                associate (x => q(3 * i - 2:3 * i))
+                    v(3 * i - 2:3 * i) = [omega(2) * x(3) - omega(3) * x(2), &
+                                          omega(3) * x(1) - omega(1) * x(3), &
+                                          omega(1) * x(2) - omega(2) * x(1)] + w
+                end associate
+            end do
+            total = body%materials(1)%density * product(box)
+            inertia = total / 12 * [box(2)**2 + box(3)**2, box(1)**2 + box(3)**2, &
+                                    box(1)**2 + box(2)**2]
+            call body%momenta(q, v, linear, angular)
+            call check(error, maxval(abs(linear - total * w)) <= 1.0e-13_wp * total * norm2(w), &
+                       'linear momentum m w')
+            call check(error, maxval(abs(angular - inertia * omega)) <= 1.0e-13_wp &
+                       * maxval(inertia) * norm2(omega), 'angular momentum I omega')
+            call check_close(error, body%kinetic_energy(v), 0.5_wp * total * dot_product(w, w) &
+                             + 0.5_wp * dot_product(omega, inertia * omega), 1.0e-13_wp, &
+                             'kinetic energy', rel=.true.)
+            deallocate (v)
+        end do
+    end subroutine test_momenta
+
+    !> The elastic force is the gradient of the strain energy (v = 0), and the
+    !> strain energy of the reference configuration is zero.
+    subroutine test_strain_energy(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(flexible_body_t) :: body
+        type(status_t) :: status
+        real(wp), allocatable :: q(:), v(:), k(:), dq(:), fd(:)
+        real(wp), parameter :: h = 1.0e-7_wp
+        real(wp) :: qj
+        integer(i8) :: seed
+        integer :: kind, j
+        seed = 44_i8
+        do kind = 1, 2
+            call make_body(kind, 'zmin', body, status)
+            q = body%free_positions()
+            ! W ≈ μ tr E with E of round-off size at the reference state.
+            call check(error, abs(body%strain_energy(q, status)) <= 1.0e-12_wp &
+                       * body%materials(1)%mu * product(box), 'U(X) = 0')
+            allocate (dq(body%nq), v(body%nv), k(body%nv), fd(body%nv), source=0.0_wp)
+            call fill_random(dq, seed, -0.01_wp, 0.01_wp)
+            q = q + dq
+            call body%internal_forces(q, v, k, status)
+            do j = 1, body%nq
+                qj = q(j)
+                q(j) = qj + h
+                fd(j) = body%strain_energy(q, status)
+                q(j) = qj - h
+                fd(j) = (fd(j) - body%strain_energy(q, status)) / (2 * h)
+                q(j) = qj
+            end do
+            call check(error, maxval(abs(fd - k)) <= 1.0e-6_wp * maxval(abs(k)), &
+                       'k_el = dU/dq')
+            deallocate (dq, v, k, fd)
+        end do
+    end subroutine test_strain_energy
 end module test_fe_body

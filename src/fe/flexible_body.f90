@@ -12,8 +12,9 @@ module flexmbs_fe_flexible_body
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    use flexmbs_fe_tensor, only: identity3
     use flexmbs_fe_hexahedron, only: hexahedron_t, new_hexahedron, reference_gradients, &
-        max_nodes
+        deformation_gradient, max_nodes
     use flexmbs_fe_neo_hooke, only: neo_hooke_t
     use flexmbs_fe_element, only: element_mass, element_forces
     use flexmbs_fe_mesh, only: mesh_t
@@ -37,7 +38,7 @@ module flexmbs_fe_flexible_body
         ! Workspace, allocated once: nodal positions and velocities, element
         ! gathers and element results (exact sizes, so no copies on calls).
         real(wp), allocatable :: x(:, :), v(:, :), xe(:, :), ve(:, :), k_el(:, :), &
-            k_v(:, :), ke(:, :), ce(:, :)
+            k_v(:, :), ke(:, :), ce(:, :), me(:, :)
     contains
         procedure :: kinematics => body_kinematics
         procedure :: mass => body_mass
@@ -47,6 +48,9 @@ module flexmbs_fe_flexible_body
         procedure :: internal_forces => body_internal_forces
         procedure :: tangents => body_tangents
         procedure :: free_positions => body_free_positions
+        procedure :: strain_energy => body_strain_energy
+        procedure :: kinetic_energy => body_kinetic_energy
+        procedure :: momenta => body_momenta
     end type flexible_body_t
 
     public :: new_flexible_body
@@ -104,7 +108,8 @@ contains
         allocate (body%xe(3, mesh%nnode_element), body%ve(3, mesh%nnode_element), &
                   body%k_el(3, mesh%nnode_element), body%k_v(3, mesh%nnode_element), &
                   body%ke(3 * mesh%nnode_element, 3 * mesh%nnode_element), &
-                  body%ce(3 * mesh%nnode_element, 3 * mesh%nnode_element))
+                  body%ce(3 * mesh%nnode_element, 3 * mesh%nnode_element), &
+                  body%me(mesh%nnode_element, mesh%nnode_element))
         call build_patterns(body, status)
     end subroutine new_flexible_body
 
@@ -229,10 +234,7 @@ contains
             body%damping%values = 0.0_wp
         end if
         do e = 1, body%mesh%element_count()
-            do a = 1, nn
-                body%xe(:, a) = body%x(:, body%mesh%connectivity(a, e))
-                body%ve(:, a) = body%v(:, body%mesh%connectivity(a, e))
-            end do
+            call gather(body, e)
             associate (mat => body%materials(body%element_material(e)))
                 if (tangents) then
                     call element_forces(body%hex, mat, body%dndx(:, :, :, e), body%wdv(:, e), &
@@ -290,6 +292,85 @@ contains
         type(status_t), intent(out) :: status
         call assemble(self, q, v, k, status, .true.)
     end subroutine body_tangents
+
+    !> Gather element e's nodal positions and velocities into xe, ve.
+    pure subroutine gather(body, e)
+        class(flexible_body_t), intent(inout) :: body
+        integer, intent(in) :: e
+        integer :: a
+        do a = 1, body%hex%nnode
+            body%xe(:, a) = body%x(:, body%mesh%connectivity(a, e))
+            body%ve(:, a) = body%v(:, body%mesh%connectivity(a, e))
+        end do
+    end subroutine gather
+
+    !> Strain energy Σ_e Σ_g W(E) w_g det J_g; det F ≤ 0 fails as in forces.
+    function body_strain_energy(self, q, status) result(energy)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:)
+        type(status_t), intent(out) :: status
+        real(wp) :: energy
+        real(wp) :: f(3, 3), detf
+        integer :: e, g
+        call scatter(self, q, 0.0_wp * q)
+        energy = 0.0_wp
+        do e = 1, self%mesh%element_count()
+            call gather(self, e)
+            do g = 1, self%hex%ngauss
+                call deformation_gradient(self%hex%nnode, self%dndx(:, :, g, e), self%xe, f, &
+                                          detf, status)
+                if (.not. status%ok()) return
+                energy = energy + self%wdv(g, e) * self%materials(self%element_material(e)) &
+                    %strain_energy(0.5_wp * (matmul(transpose(f), f) - identity3))
+            end do
+        end do
+    end function body_strain_energy
+
+    !> Kinetic energy ½ vᵀ M v (fixed nodes are at rest).
+    function body_kinetic_energy(self, v) result(energy)
+        class(flexible_body_t), intent(in) :: self
+        real(wp), intent(in) :: v(:)
+        real(wp) :: energy
+        integer :: j
+        integer(i8) :: p
+        energy = 0.0_wp
+        do j = 1, self%mass_matrix%ncol
+            do p = self%mass_matrix%colptr(j) + 1, self%mass_matrix%colptr(j + 1)
+                energy = energy + v(self%mass_matrix%rowind(p) + 1) * self%mass_matrix%values(p) &
+                    * v(j)
+            end do
+        end do
+        energy = 0.5_wp * energy
+    end function body_kinetic_energy
+
+    !> Linear momentum ∫ ρ ẋ dV and angular momentum about the origin
+    !> ∫ ρ x × ẋ dV, both exact for the isoparametric fields:
+    !> Σ_e Σ_ab m_ab v_b and Σ_e Σ_ab m_ab x_a × v_b (fixed nodes included).
+    subroutine body_momenta(self, q, v, linear, angular)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(out) :: linear(3), angular(3)
+        real(wp) :: mv(3)
+        integer :: e, a, b
+        call scatter(self, q, v)
+        linear = 0.0_wp
+        angular = 0.0_wp
+        do e = 1, self%mesh%element_count()
+            call gather(self, e)
+            call element_mass(self%hex, self%wdv(:, e), &
+                              self%materials(self%element_material(e))%density, self%me)
+            do a = 1, self%hex%nnode
+                mv = 0.0_wp
+                do b = 1, self%hex%nnode
+                    mv = mv + self%me(a, b) * self%ve(:, b)
+                end do
+                linear = linear + mv
+                angular = angular + [self%xe(2, a) * mv(3) - self%xe(3, a) * mv(2), &
+                                     self%xe(3, a) * mv(1) - self%xe(1, a) * mv(3), &
+                                     self%xe(1, a) * mv(2) - self%xe(2, a) * mv(1)]
+            end do
+        end do
+    end subroutine body_momenta
 
     !> q' = v (absolute coordinates: T = I).
     subroutine body_kinematics(self, t, q, w, qdot, status)
