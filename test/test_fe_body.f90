@@ -4,7 +4,7 @@ module test_fe_body
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_solver_failure, reason_det_f
     use flexmbs_fe_hexahedron, only: hex8, hex27
-    use flexmbs_fe_neo_hooke, only: neo_hooke_t
+    use flexmbs_fe_neo_hooke, only: neo_hooke_t, new_neo_hooke
     use flexmbs_fe_mesh, only: mesh_t
     use flexmbs_fe_box_mesh, only: box_mesh
     use flexmbs_fe_flexible_body, only: flexible_body_t, new_flexible_body
@@ -29,7 +29,8 @@ contains
                  new_test('det_f_names_element', test_body_det_f), &
                  new_test('bad_fixed_node', test_bad_fixed), &
                  new_test('momenta_kinetic_energy', test_momenta), &
-                 new_test('strain_energy_gradient', test_strain_energy)]
+                 new_test('strain_energy_gradient', test_strain_energy), &
+                 new_test('tip_layers_and_nodal_loads', test_tip_layers)]
     end function collect_fe_body
 
     subroutine make_body(kind, fixed_face, body, status, gravity, origin)
@@ -47,7 +48,7 @@ contains
         allocate (fixed(0))
         if (len(fixed_face) > 0) call mesh%node_set(fixed_face, fixed, status)
         if (.not. status%ok()) return
-        call new_flexible_body(body, mesh, mat, fixed, status, gravity)
+        call new_flexible_body(body, mesh, [mat], fixed, status, gravity)
     end subroutine make_body
 
     !> Free body: M sums to 3 ρ V (one ρ V per direction), M·1 per direction
@@ -201,7 +202,7 @@ contains
         type(status_t) :: status
         call paper_material(mat)
         call box_mesh(mesh, hex8, [1, 1, 1], [1.0_wp, 1.0_wp, 1.0_wp], status)
-        call new_flexible_body(body, mesh, mat, [1, 9], status)
+        call new_flexible_body(body, mesh, [mat], [1, 9], status)
         call check(error, .not. status%ok() .and. index(status%text(), 'fixed node 9') > 0, &
                    'fixed node outside the mesh')
     end subroutine test_bad_fixed
@@ -281,4 +282,48 @@ contains
             deallocate (dq, v, k, fd)
         end do
     end subroutine test_strain_energy
+
+    !> The paper's two materials: soft body with stiff top and bottom element
+    !> layers; the mass adds up per layer, a wrong material number is bad
+    !> input, and a nodal load enters f at rest.
+    subroutine test_tip_layers(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(flexible_body_t) :: body
+        type(mesh_t) :: mesh
+        type(neo_hooke_t) :: mats(2)
+        type(status_t) :: status
+        integer, allocatable :: which(:), fixed(:)
+        real(wp), allocatable :: q(:), v(:), f(:)
+        integer :: layers
+        call paper_material(mats(1))
+        call new_neo_hooke(mats(2), 1.0e7_wp, 0.3_wp, 1000.0_wp, 1000.0_wp, status)
+        layers = 4
+        call box_mesh(mesh, hex27, [1, 1, layers], [0.1_wp, 0.1_wp, 0.4_wp], status)
+        allocate (which(mesh%element_count()), source=1)
+        ! elements are numbered x fastest, z slowest: first and last layer
+        which(1) = 2
+        which(mesh%element_count()) = 2
+        call mesh%node_set('zmin', fixed, status)
+        call new_flexible_body(body, mesh, mats, fixed, status, element_material=which)
+        call check(error, status%ok(), 'body with tip layers')
+        ! Free mass: the sum of M over free dofs misses the fixed nodes' rows,
+        ! so compare on a free body instead.
+        call new_flexible_body(body, mesh, mats, [integer ::], status, element_material=which)
+        call check_close(error, sum(body%mass_matrix%values), &
+                         3 * 0.1_wp * 0.1_wp * 0.1_wp * (2 * 1000.0_wp + 2 * 920.0_wp), &
+                         1.0e-13_wp, 'layered mass', rel=.true.)
+        q = body%free_positions()
+        allocate (v(body%nv), source=0.0_wp)
+        allocate (f(body%nv))
+        call body%add_nodal_load(mesh%node_count(), [1.0_wp, -2.0_wp, 3.0_wp], status)
+        call body%forces(0.0_wp, q, v, f, status)
+        call check(error, maxval(abs(f(body%nv - 2:) - [1.0_wp, -2.0_wp, 3.0_wp])) < 1.0e-6_wp, &
+                   'nodal load at rest (internal force at X is round-off)')
+        call body%add_nodal_load(0, [1.0_wp, 0.0_wp, 0.0_wp], status)
+        call check(error, .not. status%ok(), 'load on node 0 rejected')
+        which(2) = 3
+        call new_flexible_body(body, mesh, mats, fixed, status, element_material=which)
+        call check(error, .not. status%ok() .and. index(status%text(), '1..2') > 0, &
+                   'material number 3 of 2 rejected')
+    end subroutine test_tip_layers
 end module test_fe_body

@@ -30,7 +30,7 @@ module flexmbs_fe_flexible_body
         real(wp), allocatable :: wdv(:, :)               !! (ngauss, elements)
         integer, allocatable :: dof(:, :)                !! (3, nodes): free dof or 0
         real(wp) :: gravity(3) = 0.0_wp                  !! acceleration of gravity
-        real(wp), allocatable :: gravity_force(:)        !! ∫ ρ N_a dV g on free dofs
+        real(wp), allocatable :: applied_force(:)        !! gravity ∫ ρ N_a dV g + nodal loads, free dofs
         type(csc_matrix_t) :: mass_matrix                !! M on free dofs
         type(csc_matrix_t) :: stiffness                  !! ∂k/∂q, refilled by tangents
         type(csc_matrix_t) :: damping                    !! ∂k/∂v, same pattern
@@ -51,20 +51,25 @@ module flexmbs_fe_flexible_body
         procedure :: strain_energy => body_strain_energy
         procedure :: kinetic_energy => body_kinetic_energy
         procedure :: momenta => body_momenta
+        procedure :: add_nodal_load => body_add_nodal_load
     end type flexible_body_t
 
     public :: new_flexible_body
 
 contains
 
-    !> Body from a mesh, one material for all elements, and fixed nodes.
-    subroutine new_flexible_body(body, mesh, material, fixed_nodes, status, gravity)
+    !> Body from a mesh, its materials, and fixed nodes. With one material it
+    !> applies to all elements; with several, element_material(e) picks the
+    !> material of element e (the paper's stiffer tip layers).
+    subroutine new_flexible_body(body, mesh, materials, fixed_nodes, status, gravity, &
+                                 element_material)
         type(flexible_body_t), intent(out) :: body
         type(mesh_t), intent(in) :: mesh
-        type(neo_hooke_t), intent(in) :: material
+        type(neo_hooke_t), intent(in) :: materials(:)
         integer, intent(in) :: fixed_nodes(:)     !! node numbers held at X
         type(status_t), intent(out) :: status
         real(wp), intent(in), optional :: gravity(3)
+        integer, intent(in), optional :: element_material(:) !! one per element
         integer :: e, n, i, nfree
         character(len=120) :: msg
         body%mesh = mesh
@@ -78,8 +83,23 @@ contains
             call status%set(status_bad_input, trim(msg))
             return
         end if
-        body%materials = [material]
+        body%materials = materials
         allocate (body%element_material(mesh%element_count()), source=1)
+        if (present(element_material)) then
+            if (size(element_material) /= mesh%element_count()) then
+                write (msg, '(a,i0,a,i0,a)') 'flexible body: ', size(element_material), &
+                    ' element materials given for ', mesh%element_count(), ' elements'
+                call status%set(status_bad_input, trim(msg))
+                return
+            end if
+            body%element_material = element_material
+        end if
+        if (any(body%element_material < 1 .or. body%element_material > size(materials))) then
+            write (msg, '(a,i0,a)') 'flexible body: element material numbers must lie in 1..', &
+                size(materials), ' (materials given)'
+            call status%set(status_bad_input, trim(msg))
+            return
+        end if
         allocate (body%dndx(3, body%hex%nnode, body%hex%ngauss, mesh%element_count()), &
                   body%wdv(body%hex%ngauss, mesh%element_count()))
         do e = 1, mesh%element_count()
@@ -147,7 +167,7 @@ contains
         end do
         body%triplet_start(body%mesh%element_count() + 1) = nt + 1
         allocate (rows(nt), cols(nt), mrows(nm), mcols(nm), mvals(nm))
-        allocate (body%gravity_force(body%nv), source=0.0_wp)
+        allocate (body%applied_force(body%nv), source=0.0_wp)
         nt = 0
         nm = 0
         do e = 1, body%mesh%element_count()
@@ -176,7 +196,7 @@ contains
                 if (dofs(p) == 0) cycle
                 a = (p - 1) / 3 + 1
                 i = p - 3 * (a - 1)
-                body%gravity_force(dofs(p)) = body%gravity_force(dofs(p)) &
+                body%applied_force(dofs(p)) = body%applied_force(dofs(p)) &
                     + sum(m(a, :)) * body%gravity(i)
             end do
         end do
@@ -293,6 +313,26 @@ contains
         call assemble(self, q, v, k, status, .true.)
     end subroutine body_tangents
 
+    !> Add a constant force on a node (its fixed components are ignored).
+    subroutine body_add_nodal_load(self, node, force, status)
+        class(flexible_body_t), intent(inout) :: self
+        integer, intent(in) :: node
+        real(wp), intent(in) :: force(3)
+        type(status_t), intent(out) :: status
+        integer :: j
+        character(len=80) :: msg
+        if (node < 1 .or. node > size(self%dof, 2)) then
+            write (msg, '(a,i0,a,i0)') 'flexible body: load on node ', node, ' outside 1..', &
+                size(self%dof, 2)
+            call status%set(status_bad_input, trim(msg))
+            return
+        end if
+        do j = 1, 3
+            if (self%dof(j, node) > 0) self%applied_force(self%dof(j, node)) = &
+                self%applied_force(self%dof(j, node)) + force(j)
+        end do
+    end subroutine body_add_nodal_load
+
     !> Gather element e's nodal positions and velocities into xe, ve.
     pure subroutine gather(body, e)
         class(flexible_body_t), intent(inout) :: body
@@ -390,7 +430,7 @@ contains
         call self%mass_matrix%to_dense(m)
     end subroutine body_mass
 
-    !> f = g − k(q, v): gravity minus internal forces (eq. 7).
+    !> f = g − k(q, v): applied (gravity, nodal) minus internal forces (eq. 7).
     subroutine body_forces(self, t, q, v, f, status)
         class(flexible_body_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:), v(:)
@@ -402,7 +442,7 @@ contains
             status = local
             return
         end if
-        f = self%gravity_force - f
+        f = self%applied_force - f
     end subroutine body_forces
 
     !> No constraints (nc = 0): fixed nodes are removed from q.
