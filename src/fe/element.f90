@@ -20,7 +20,8 @@ module flexmbs_fe_element
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t
     use flexmbs_fe_tensor, only: identity3, voigt_i, voigt_j
-    use flexmbs_fe_hexahedron, only: hexahedron_t, max_nodes, deformation_gradient
+    use flexmbs_fe_hexahedron, only: hexahedron_t, max_nodes, deformation_gradient, &
+        nodal_gradient
     use flexmbs_fe_neo_hooke, only: neo_hooke_t
     implicit none
     private
@@ -56,7 +57,7 @@ contains
         type(status_t), intent(inout) :: status
         real(wp) :: detf
         call deformation_gradient(nn, dndx, x, f, detf, status)
-        fdot = matmul(v, transpose(dndx))
+        call nodal_gradient(nn, dndx, v, fdot)
         e = 0.5_wp * (matmul(transpose(f), f) - identity3)
         edot = 0.5_wp * (matmul(transpose(fdot), f) + matmul(transpose(f), fdot))
     end subroutine kinematics
@@ -101,7 +102,8 @@ contains
         real(wp), intent(out), optional :: damping(3 * hex%nnode, 3 * hex%nnode)   !! ∂k/∂ẋ
         real(wp) :: f(3, 3), fdot(3, 3), e(3, 3), edot(3, 3), s_el(3, 3), s_v(3, 3), &
             d_el(6, 6), d_ve(6, 6), d_vr(6, 6), b(6, 3 * max_nodes), bdot(6, 3 * max_nodes), &
-            db(6, 3 * max_nodes), dr_b(6, 3 * max_nodes), sn(3, max_nodes), geo
+            db(6, 3 * max_nodes), dr_b(6, 3 * max_nodes), sn(3, max_nodes), geo, &
+            fs_el(3, 3), fs_v(3, 3)
         logical :: tangents
         integer :: g, nn, ndof, p, q, a, bn, i
         nn = hex%nnode
@@ -119,15 +121,23 @@ contains
             else
                 call material%stress_tangent(e, edot, s_el, s_v, d_el, d_ve, d_vr)
             end if
-            ! k_ia = Σ_JL F_iJ S_JL N_a,L (eq. 3)
-            k_el = k_el + wdv(g) * matmul(matmul(f, s_el), dndx(:, :, g))
-            k_v = k_v + wdv(g) * matmul(matmul(f, s_v), dndx(:, :, g))
+            ! k_ia = Σ_JL F_iJ S_JL N_a,L (eq. 3); node by node so that every
+            ! temporary has a fixed size (no heap allocation).
+            fs_el = wdv(g) * matmul(f, s_el)
+            fs_v = wdv(g) * matmul(f, s_v)
+            do a = 1, nn
+                k_el(:, a) = k_el(:, a) + matmul(fs_el, dndx(:, a, g))
+                k_v(:, a) = k_v(:, a) + matmul(fs_v, dndx(:, a, g))
+            end do
             if (.not. tangents) cycle
             call strain_matrix(nn, dndx(:, :, g), f, b(:, 1:ndof))
             call strain_matrix(nn, dndx(:, :, g), fdot, bdot(:, 1:ndof))
             ! db = (D_el + D_ve) B + D_vr Ḃ (∂Ŝ/∂x), dr_b = D_vr B (∂Ŝ/∂ẋ)
-            db(:, 1:ndof) = matmul(d_el + d_ve, b(:, 1:ndof)) + matmul(d_vr, bdot(:, 1:ndof))
-            dr_b(:, 1:ndof) = matmul(d_vr, b(:, 1:ndof))
+            d_ve = d_el + d_ve
+            do q = 1, ndof
+                db(:, q) = matmul(d_ve, b(:, q)) + matmul(d_vr, bdot(:, q))
+                dr_b(:, q) = matmul(d_vr, b(:, q))
+            end do
             do q = 1, ndof
                 do p = 1, ndof
                     stiffness(p, q) = stiffness(p, q) + wdv(g) * dot_product(b(:, p), db(:, q))
@@ -135,7 +145,10 @@ contains
                 end do
             end do
             ! Geometric part: (∂N_a/∂X)ᵀ S ∂N_b/∂X on the 3x3 diagonal of block ab.
-            sn(:, 1:nn) = matmul(s_el + s_v, dndx(:, :, g))
+            s_el = s_el + s_v
+            do a = 1, nn
+                sn(:, a) = matmul(s_el, dndx(:, a, g))
+            end do
             do bn = 1, nn
                 do a = 1, nn
                     geo = wdv(g) * dot_product(dndx(:, a, g), sn(:, bn))

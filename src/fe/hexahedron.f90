@@ -44,7 +44,7 @@ module flexmbs_fe_hexahedron
     end type hexahedron_t
 
     public :: new_hexahedron, shape_functions, gauss_rule, reference_gradients, &
-        deformation_gradient
+        deformation_gradient, nodal_gradient
 
 contains
 
@@ -169,9 +169,25 @@ contains
         end do
     end subroutine reference_gradients
 
-    !> Deformation gradient F_iJ = Σ_a x_ia ∂N_a/∂X_J and J = det F. With the
-    !> nodal velocities in place of x it gives Ḟ. det F ≤ 0 is reported as a
-    !> solver failure with reason_det_f (the step must be rejected).
+    !> Material gradient Σ_a u_a ⊗ ∂N_a/∂X of a nodal field u (F for positions,
+    !> Ḟ for velocities), summed node by node without array temporaries.
+    pure subroutine nodal_gradient(nnode, dndx, u, grad)
+        integer, intent(in) :: nnode
+        real(wp), intent(in) :: dndx(3, nnode) !! ∂N_a/∂X at one Gauss point
+        real(wp), intent(in) :: u(3, nnode)    !! nodal values
+        real(wp), intent(out) :: grad(3, 3)    !! grad(i, J) = Σ_a u_ia ∂N_a/∂X_J
+        integer :: a, j
+        grad = 0.0_wp
+        do a = 1, nnode
+            do j = 1, 3
+                grad(:, j) = grad(:, j) + u(:, a) * dndx(j, a)
+            end do
+        end do
+    end subroutine nodal_gradient
+
+    !> Deformation gradient F_iJ = Σ_a x_ia ∂N_a/∂X_J and J = det F.
+    !> det F ≤ 0 is reported as a solver failure with reason_det_f (the step
+    !> must be rejected).
     subroutine deformation_gradient(nnode, dndx, x, f, detf, status)
         integer, intent(in) :: nnode
         real(wp), intent(in) :: dndx(3, nnode) !! ∂N_a/∂X at one Gauss point
@@ -179,7 +195,7 @@ contains
         real(wp), intent(out) :: f(3, 3), detf
         type(status_t), intent(inout) :: status
         character(len=80) :: msg
-        f = matmul(x, transpose(dndx))
+        call nodal_gradient(nnode, dndx, x, f)
         detf = det3(f)
         if (.not. (detf > 0.0_wp)) then
             write (msg, '(a,es10.3)') 'det F = ', detf
