@@ -23,6 +23,11 @@ module flexmbs
     use flexmbs_dae_ddassl, only: ddassl_t, ddassl_dense_t, ddassl_native_t
     use flexmbs_dae_error_measure, only: paper_error
     use flexmbs_dae_bdf_stability, only: bdf_stability_angle, bdf_boundary_locus
+    use flexmbs_fe_hexahedron, only: hexahedron_t, new_hexahedron, hex8, hex27
+    use flexmbs_fe_neo_hooke, only: neo_hooke_t, new_neo_hooke
+    use flexmbs_fe_mesh, only: mesh_t, node_set_t
+    use flexmbs_fe_box_mesh, only: box_mesh
+    use flexmbs_fe_flexible_body, only: flexible_body_t, new_flexible_body
     use flexmbs_io_namelist, only: scene_input_t, read_scene, parse_scene, scene_dae_options
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_table, only: stats_row_t, new_stats_row, table_text, write_table, &

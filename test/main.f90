@@ -16,6 +16,9 @@ program flexmbs_tests
     use test_ddassl, only: collect_ddassl
     use test_mexax, only: collect_mexax
     use test_mexax_sparse, only: collect_mexax_sparse
+    use test_fe, only: collect_fe
+    use test_fe_element, only: collect_fe_element
+    use test_fe_body, only: collect_fe_body
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -39,6 +42,9 @@ program flexmbs_tests
     call run_suite('ddassl', collect_ddassl(), filter, npassed, nfailed)
     call run_suite('mexax', collect_mexax(), filter, npassed, nfailed)
     call run_suite('mexax_sparse', collect_mexax_sparse(), filter, npassed, nfailed)
+    call run_suite('fe', collect_fe(), filter, npassed, nfailed)
+    call run_suite('fe_element', collect_fe_element(), filter, npassed, nfailed)
+    call run_suite('fe_body', collect_fe_body(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests

@@ -19,7 +19,7 @@ module test_problems
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
     private
-    public :: collect_problems
+    public :: collect_problems, fill_random
 
     ! Central differences of quadratic or cubic F are exact up to rounding;
     ! the tolerance covers the rounding of the difference quotient.

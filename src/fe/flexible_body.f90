@@ -1,0 +1,462 @@
+!> A flexible body on its own: a hexahedral mesh of neo-Hookean material in
+!> absolute nodal coordinates, with fixed nodes removed, as a mechanical
+!> problem (q' = v, M v' = g − k(q, v), no constraints).
+!>
+!> q holds the positions of the free nodal dofs (node by node, x y z), v their
+!> velocities; fixed nodes stay at their reference positions. M (constant,
+!> consistent), the tangent stiffness ∂k/∂q and the damping ∂k/∂v live in
+!> CSC patterns fixed at construction; each assembly refills their values in
+!> place through the triplet-to-slot map, element by element in a fixed order.
+module flexmbs_fe_flexible_body
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_linalg_csc, only: csc_matrix_t
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    use flexmbs_fe_tensor, only: identity3
+    use flexmbs_fe_hexahedron, only: hexahedron_t, new_hexahedron, reference_gradients, &
+        deformation_gradient, max_nodes
+    use flexmbs_fe_neo_hooke, only: neo_hooke_t
+    use flexmbs_fe_element, only: element_mass, element_forces
+    use flexmbs_fe_mesh, only: mesh_t
+    implicit none
+    private
+
+    type, extends(mechanical_problem_t), public :: flexible_body_t
+        type(mesh_t) :: mesh
+        type(hexahedron_t) :: hex
+        type(neo_hooke_t), allocatable :: materials(:)   !! one per element set
+        integer, allocatable :: element_material(:)      !! material of each element
+        real(wp), allocatable :: dndx(:, :, :, :)        !! (3, nnode, ngauss, elements)
+        real(wp), allocatable :: wdv(:, :)               !! (ngauss, elements)
+        integer, allocatable :: dof(:, :)                !! (3, nodes): free dof or 0
+        real(wp) :: gravity(3) = 0.0_wp                  !! acceleration of gravity
+        real(wp), allocatable :: applied_force(:)        !! gravity ∫ ρ N_a dV g + nodal loads, free dofs
+        type(csc_matrix_t) :: mass_matrix                !! M on free dofs
+        type(csc_matrix_t) :: stiffness                  !! ∂k/∂q, refilled by tangents
+        type(csc_matrix_t) :: damping                    !! ∂k/∂v, same pattern
+        integer(i8), allocatable :: triplet_start(:)     !! first tangent triplet of element e
+        ! Workspace, allocated once: nodal positions and velocities, element
+        ! gathers and element results (exact sizes, so no copies on calls).
+        real(wp), allocatable :: x(:, :), v(:, :), xe(:, :), ve(:, :), k_el(:, :), &
+            k_v(:, :), ke(:, :), ce(:, :), me(:, :)
+    contains
+        procedure :: kinematics => body_kinematics
+        procedure :: mass => body_mass
+        procedure :: forces => body_forces
+        procedure :: constraint => body_constraint
+        procedure :: constraint_jacobian => body_constraint_jacobian
+        procedure :: internal_forces => body_internal_forces
+        procedure :: tangents => body_tangents
+        procedure :: free_positions => body_free_positions
+        procedure :: strain_energy => body_strain_energy
+        procedure :: kinetic_energy => body_kinetic_energy
+        procedure :: momenta => body_momenta
+        procedure :: add_nodal_load => body_add_nodal_load
+    end type flexible_body_t
+
+    public :: new_flexible_body
+
+contains
+
+    !> Body from a mesh, its materials, and fixed nodes. With one material it
+    !> applies to all elements; with several, element_material(e) picks the
+    !> material of element e (the paper's stiffer tip layers).
+    subroutine new_flexible_body(body, mesh, materials, fixed_nodes, status, gravity, &
+                                 element_material)
+        type(flexible_body_t), intent(out) :: body
+        type(mesh_t), intent(in) :: mesh
+        type(neo_hooke_t), intent(in) :: materials(:)
+        integer, intent(in) :: fixed_nodes(:)     !! node numbers held at X
+        type(status_t), intent(out) :: status
+        real(wp), intent(in), optional :: gravity(3)
+        integer, intent(in), optional :: element_material(:) !! one per element
+        integer :: e, n, i, nfree
+        character(len=120) :: msg
+        body%mesh = mesh
+        n = mesh%node_count()
+        call new_hexahedron(body%hex, mesh%nnode_element, status)
+        if (.not. status%ok()) return
+        if (any(fixed_nodes < 1 .or. fixed_nodes > n)) then
+            i = findloc(fixed_nodes < 1 .or. fixed_nodes > n, .true., dim=1)
+            write (msg, '(a,i0,a,i0)') 'flexible body: fixed node ', fixed_nodes(i), &
+                ' outside 1..', n
+            call status%set(status_bad_input, trim(msg))
+            return
+        end if
+        body%materials = materials
+        allocate (body%element_material(mesh%element_count()), source=1)
+        if (present(element_material)) then
+            if (size(element_material) /= mesh%element_count()) then
+                write (msg, '(a,i0,a,i0,a)') 'flexible body: ', size(element_material), &
+                    ' element materials given for ', mesh%element_count(), ' elements'
+                call status%set(status_bad_input, trim(msg))
+                return
+            end if
+            body%element_material = element_material
+        end if
+        if (any(body%element_material < 1 .or. body%element_material > size(materials))) then
+            write (msg, '(a,i0,a)') 'flexible body: element material numbers must lie in 1..', &
+                size(materials), ' (materials given)'
+            call status%set(status_bad_input, trim(msg))
+            return
+        end if
+        allocate (body%dndx(3, body%hex%nnode, body%hex%ngauss, mesh%element_count()), &
+                  body%wdv(body%hex%ngauss, mesh%element_count()))
+        do e = 1, mesh%element_count()
+            call reference_gradients(body%hex, mesh%x(:, mesh%connectivity(:, e)), &
+                                     body%dndx(:, :, :, e), body%wdv(:, e), status)
+            if (.not. status%ok()) then
+                write (msg, '(a,i0,a)') 'flexible body: element ', e, ': '
+                call status%set(status_bad_input, trim(msg) // ' ' // status%text())
+                return
+            end if
+        end do
+        allocate (body%dof(3, n), source=1)
+        body%dof(:, fixed_nodes) = 0
+        nfree = 0
+        do i = 1, n
+            if (body%dof(1, i) == 0) cycle
+            body%dof(:, i) = nfree + [1, 2, 3]
+            nfree = nfree + 3
+        end do
+        body%nq = nfree
+        body%nv = nfree
+        body%nc = 0
+        if (present(gravity)) body%gravity = gravity
+        body%x = mesh%x
+        allocate (body%v(3, n), source=0.0_wp)
+        allocate (body%xe(3, mesh%nnode_element), body%ve(3, mesh%nnode_element), &
+                  body%k_el(3, mesh%nnode_element), body%k_v(3, mesh%nnode_element), &
+                  body%ke(3 * mesh%nnode_element, 3 * mesh%nnode_element), &
+                  body%ce(3 * mesh%nnode_element, 3 * mesh%nnode_element), &
+                  body%me(mesh%nnode_element, mesh%nnode_element))
+        call build_patterns(body, status)
+    end subroutine new_flexible_body
+
+    !> Free global dofs of element e in local order (0 for fixed ones).
+    pure subroutine element_dofs(body, e, dofs)
+        type(flexible_body_t), intent(in) :: body
+        integer, intent(in) :: e
+        integer, intent(out) :: dofs(3 * body%hex%nnode)
+        integer :: a
+        do a = 1, body%hex%nnode
+            dofs(3 * a - 2:3 * a) = body%dof(:, body%mesh%connectivity(a, e))
+        end do
+    end subroutine element_dofs
+
+    !> Tangent pattern (all free–free pairs of each element, column-major over
+    !> the local dofs), mass pattern and values, and the gravity force.
+    subroutine build_patterns(body, status)
+        type(flexible_body_t), intent(inout) :: body
+        type(status_t), intent(out) :: status
+        integer, allocatable :: rows(:), cols(:), mrows(:), mcols(:)
+        real(wp), allocatable :: mvals(:), m(:, :)
+        integer :: dofs(3 * max_nodes), e, p, q, nd, nf, a, b, i
+        integer(i8) :: nt, nm
+        nd = 3 * body%hex%nnode
+        allocate (m(body%hex%nnode, body%hex%nnode))
+        allocate (body%triplet_start(body%mesh%element_count() + 1))
+        nt = 0
+        nm = 0
+        do e = 1, body%mesh%element_count()
+            call element_dofs(body, e, dofs(1:nd))
+            nf = count(dofs(1:nd) > 0)
+            body%triplet_start(e) = nt + 1
+            nt = nt + nf * nf
+            nm = nm + nf * nf / 3
+        end do
+        body%triplet_start(body%mesh%element_count() + 1) = nt + 1
+        allocate (rows(nt), cols(nt), mrows(nm), mcols(nm), mvals(nm))
+        allocate (body%applied_force(body%nv), source=0.0_wp)
+        nt = 0
+        nm = 0
+        do e = 1, body%mesh%element_count()
+            call element_dofs(body, e, dofs(1:nd))
+            call element_mass(body%hex, body%wdv(:, e), &
+                              body%materials(body%element_material(e))%density, m)
+            do q = 1, nd
+                if (dofs(q) == 0) cycle
+                b = (q - 1) / 3 + 1
+                do p = 1, nd
+                    if (dofs(p) == 0) cycle
+                    nt = nt + 1
+                    rows(nt) = dofs(p)
+                    cols(nt) = dofs(q)
+                    a = (p - 1) / 3 + 1
+                    if (mod(p - q, 3) == 0) then
+                        nm = nm + 1
+                        mrows(nm) = dofs(p)
+                        mcols(nm) = dofs(q)
+                        mvals(nm) = m(a, b)
+                    end if
+                end do
+            end do
+            ! ∫ ρ N_a g dV = Σ_b m_ab g, fixed nodes b included.
+            do p = 1, nd
+                if (dofs(p) == 0) cycle
+                a = (p - 1) / 3 + 1
+                i = p - 3 * (a - 1)
+                body%applied_force(dofs(p)) = body%applied_force(dofs(p)) &
+                    + sum(m(a, :)) * body%gravity(i)
+            end do
+        end do
+        call body%stiffness%build(body%nv, body%nv, rows, cols, status)
+        if (.not. status%ok()) return
+        body%damping = body%stiffness
+        call body%mass_matrix%build(body%nv, body%nv, mrows, mcols, status)
+        if (.not. status%ok()) return
+        call body%mass_matrix%fill(mvals)
+    end subroutine build_patterns
+
+    !> Scatter free positions q and velocities w into the nodal arrays.
+    pure subroutine scatter(body, q, w)
+        class(flexible_body_t), intent(inout) :: body
+        real(wp), intent(in) :: q(:), w(:)
+        integer :: i, j
+        do i = 1, size(body%dof, 2)
+            do j = 1, 3
+                if (body%dof(j, i) == 0) cycle
+                body%x(j, i) = q(body%dof(j, i))
+                body%v(j, i) = w(body%dof(j, i))
+            end do
+        end do
+    end subroutine scatter
+
+    !> The free positions of the reference configuration (the natural q0).
+    pure function body_free_positions(self) result(q)
+        class(flexible_body_t), intent(in) :: self
+        real(wp) :: q(self%nq)
+        integer :: i, j
+        do i = 1, size(self%dof, 2)
+            do j = 1, 3
+                if (self%dof(j, i) > 0) q(self%dof(j, i)) = self%mesh%x(j, i)
+            end do
+        end do
+    end function body_free_positions
+
+    !> Internal force k(q, v) = k_el + k_v on the free dofs; with `tangents`
+    !> also the values of ∂k/∂q and ∂k/∂v. A det F ≤ 0 failure names the element.
+    subroutine assemble(body, q, v, k, status, tangents)
+        class(flexible_body_t), intent(inout) :: body
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(out) :: k(:)
+        type(status_t), intent(out) :: status
+        logical, intent(in) :: tangents
+        integer :: dofs(3 * max_nodes), e, nn, nd, p, qq, a, code, reason
+        integer(i8) :: t, slot
+        character(len=40) :: where
+        nn = body%hex%nnode
+        nd = 3 * nn
+        call scatter(body, q, v)
+        k = 0.0_wp
+        if (tangents) then
+            body%stiffness%values = 0.0_wp
+            body%damping%values = 0.0_wp
+        end if
+        do e = 1, body%mesh%element_count()
+            call gather(body, e)
+            associate (mat => body%materials(body%element_material(e)))
+                if (tangents) then
+                    call element_forces(body%hex, mat, body%dndx(:, :, :, e), body%wdv(:, e), &
+                                        body%xe, body%ve, body%k_el, body%k_v, status, &
+                                        body%ke, body%ce)
+                else
+                    call element_forces(body%hex, mat, body%dndx(:, :, :, e), body%wdv(:, e), &
+                                        body%xe, body%ve, body%k_el, body%k_v, status)
+                end if
+            end associate
+            if (.not. status%ok()) then
+                write (where, '(a,i0,a)') 'flexible body: element ', e, ': '
+                code = status%code
+                reason = status%reason
+                call status%set(code, trim(where) // ' ' // status%text(), reason)
+                return
+            end if
+            call element_dofs(body, e, dofs(1:nd))
+            do a = 1, nn
+                do p = 1, 3
+                    if (dofs(3 * (a - 1) + p) > 0) k(dofs(3 * (a - 1) + p)) = &
+                        k(dofs(3 * (a - 1) + p)) + body%k_el(p, a) + body%k_v(p, a)
+                end do
+            end do
+            if (.not. tangents) cycle
+            ! Same local order as build_patterns.
+            t = body%triplet_start(e)
+            do qq = 1, nd
+                if (dofs(qq) == 0) cycle
+                do p = 1, nd
+                    if (dofs(p) == 0) cycle
+                    slot = body%stiffness%triplet_map(t)
+                    body%stiffness%values(slot) = body%stiffness%values(slot) + body%ke(p, qq)
+                    body%damping%values(slot) = body%damping%values(slot) + body%ce(p, qq)
+                    t = t + 1
+                end do
+            end do
+        end do
+    end subroutine assemble
+
+    !> k(q, v) on the free dofs.
+    subroutine body_internal_forces(self, q, v, k, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(out) :: k(:)
+        type(status_t), intent(out) :: status
+        call assemble(self, q, v, k, status, .false.)
+    end subroutine body_internal_forces
+
+    !> k(q, v), and ∂k/∂q, ∂k/∂v into self%stiffness, self%damping.
+    subroutine body_tangents(self, q, v, k, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(out) :: k(:)
+        type(status_t), intent(out) :: status
+        call assemble(self, q, v, k, status, .true.)
+    end subroutine body_tangents
+
+    !> Add a constant force on a node (its fixed components are ignored).
+    subroutine body_add_nodal_load(self, node, force, status)
+        class(flexible_body_t), intent(inout) :: self
+        integer, intent(in) :: node
+        real(wp), intent(in) :: force(3)
+        type(status_t), intent(out) :: status
+        integer :: j
+        character(len=80) :: msg
+        if (node < 1 .or. node > size(self%dof, 2)) then
+            write (msg, '(a,i0,a,i0)') 'flexible body: load on node ', node, ' outside 1..', &
+                size(self%dof, 2)
+            call status%set(status_bad_input, trim(msg))
+            return
+        end if
+        do j = 1, 3
+            if (self%dof(j, node) > 0) self%applied_force(self%dof(j, node)) = &
+                self%applied_force(self%dof(j, node)) + force(j)
+        end do
+    end subroutine body_add_nodal_load
+
+    !> Gather element e's nodal positions and velocities into xe, ve.
+    pure subroutine gather(body, e)
+        class(flexible_body_t), intent(inout) :: body
+        integer, intent(in) :: e
+        integer :: a
+        do a = 1, body%hex%nnode
+            body%xe(:, a) = body%x(:, body%mesh%connectivity(a, e))
+            body%ve(:, a) = body%v(:, body%mesh%connectivity(a, e))
+        end do
+    end subroutine gather
+
+    !> Strain energy Σ_e Σ_g W(E) w_g det J_g; det F ≤ 0 fails as in forces.
+    function body_strain_energy(self, q, status) result(energy)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:)
+        type(status_t), intent(out) :: status
+        real(wp) :: energy
+        real(wp) :: f(3, 3), detf
+        integer :: e, g
+        call scatter(self, q, 0.0_wp * q)
+        energy = 0.0_wp
+        do e = 1, self%mesh%element_count()
+            call gather(self, e)
+            do g = 1, self%hex%ngauss
+                call deformation_gradient(self%hex%nnode, self%dndx(:, :, g, e), self%xe, f, &
+                                          detf, status)
+                if (.not. status%ok()) return
+                energy = energy + self%wdv(g, e) * self%materials(self%element_material(e)) &
+                    %strain_energy(0.5_wp * (matmul(transpose(f), f) - identity3))
+            end do
+        end do
+    end function body_strain_energy
+
+    !> Kinetic energy ½ vᵀ M v (fixed nodes are at rest).
+    function body_kinetic_energy(self, v) result(energy)
+        class(flexible_body_t), intent(in) :: self
+        real(wp), intent(in) :: v(:)
+        real(wp) :: energy
+        integer :: j
+        integer(i8) :: p
+        energy = 0.0_wp
+        do j = 1, self%mass_matrix%ncol
+            do p = self%mass_matrix%colptr(j) + 1, self%mass_matrix%colptr(j + 1)
+                energy = energy + v(self%mass_matrix%rowind(p) + 1) * self%mass_matrix%values(p) &
+                    * v(j)
+            end do
+        end do
+        energy = 0.5_wp * energy
+    end function body_kinetic_energy
+
+    !> Linear momentum ∫ ρ ẋ dV and angular momentum about the origin
+    !> ∫ ρ x × ẋ dV, both exact for the isoparametric fields:
+    !> Σ_e Σ_ab m_ab v_b and Σ_e Σ_ab m_ab x_a × v_b (fixed nodes included).
+    subroutine body_momenta(self, q, v, linear, angular)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(out) :: linear(3), angular(3)
+        real(wp) :: mv(3)
+        integer :: e, a, b
+        call scatter(self, q, v)
+        linear = 0.0_wp
+        angular = 0.0_wp
+        do e = 1, self%mesh%element_count()
+            call gather(self, e)
+            call element_mass(self%hex, self%wdv(:, e), &
+                              self%materials(self%element_material(e))%density, self%me)
+            do a = 1, self%hex%nnode
+                mv = 0.0_wp
+                do b = 1, self%hex%nnode
+                    mv = mv + self%me(a, b) * self%ve(:, b)
+                end do
+                linear = linear + mv
+                angular = angular + [self%xe(2, a) * mv(3) - self%xe(3, a) * mv(2), &
+                                     self%xe(3, a) * mv(1) - self%xe(1, a) * mv(3), &
+                                     self%xe(1, a) * mv(2) - self%xe(2, a) * mv(1)]
+            end do
+        end do
+    end subroutine body_momenta
+
+    !> q' = v (absolute coordinates: T = I).
+    subroutine body_kinematics(self, t, q, w, qdot, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: qdot(:)
+        type(status_t), intent(inout) :: status
+        qdot = w
+    end subroutine body_kinematics
+
+    !> The constant consistent mass matrix, dense.
+    subroutine body_mass(self, t, q, m, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: m(:, :)
+        type(status_t), intent(inout) :: status
+        call self%mass_matrix%to_dense(m)
+    end subroutine body_mass
+
+    !> f = g − k(q, v): applied (gravity, nodal) minus internal forces (eq. 7).
+    subroutine body_forces(self, t, q, v, f, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: f(:)
+        type(status_t), intent(inout) :: status
+        type(status_t) :: local
+        call assemble(self, q, v, f, local, .false.)
+        if (.not. local%ok()) then
+            status = local
+            return
+        end if
+        f = self%applied_force - f
+    end subroutine body_forces
+
+    !> No constraints (nc = 0): fixed nodes are removed from q.
+    subroutine body_constraint(self, t, q, g, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: g(:)
+        type(status_t), intent(inout) :: status
+    end subroutine body_constraint
+
+    subroutine body_constraint_jacobian(self, t, q, gmat, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: gmat(:, :)
+        type(status_t), intent(inout) :: status
+    end subroutine body_constraint_jacobian
+end module flexmbs_fe_flexible_body
