@@ -15,6 +15,7 @@ program flexmbs_tests
     use test_ida, only: collect_ida
     use test_ddassl, only: collect_ddassl
     use test_mexax, only: collect_mexax
+    use test_rotation, only: collect_rotation
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -37,6 +38,7 @@ program flexmbs_tests
     call run_suite('ida', collect_ida(), filter, npassed, nfailed)
     call run_suite('ddassl', collect_ddassl(), filter, npassed, nfailed)
     call run_suite('mexax', collect_mexax(), filter, npassed, nfailed)
+    call run_suite('rotation', collect_rotation(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests
