@@ -16,6 +16,7 @@ program flexmbs_tests
     use test_ddassl, only: collect_ddassl
     use test_mexax, only: collect_mexax
     use test_rotation, only: collect_rotation
+    use test_dual, only: collect_dual
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -39,6 +40,7 @@ program flexmbs_tests
     call run_suite('ddassl', collect_ddassl(), filter, npassed, nfailed)
     call run_suite('mexax', collect_mexax(), filter, npassed, nfailed)
     call run_suite('rotation', collect_rotation(), filter, npassed, nfailed)
+    call run_suite('dual', collect_dual(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests
