@@ -17,6 +17,7 @@ program flexmbs_tests
     use test_mexax, only: collect_mexax
     use test_rotation, only: collect_rotation
     use test_dual, only: collect_dual
+    use test_constraint_primitives, only: collect_constraint_primitives
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -41,6 +42,8 @@ program flexmbs_tests
     call run_suite('mexax', collect_mexax(), filter, npassed, nfailed)
     call run_suite('rotation', collect_rotation(), filter, npassed, nfailed)
     call run_suite('dual', collect_dual(), filter, npassed, nfailed)
+    call run_suite('constraint_primitives', collect_constraint_primitives(), filter, &
+                   npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests
