@@ -10,17 +10,21 @@ module test_constraint_primitives
     use flexmbs_mbs_rotation_dual, only: rotation_matrix_d => rotation_matrix
     use flexmbs_mbs_primitive_kinds, only: primitive_dot1, primitive_dot2, &
         primitive_spherical, primitive_distance, primitive_angle_driver, &
-        primitive_translation_driver, primitive_rows, primitive_name
+        primitive_translation_driver, primitive_name
     use flexmbs_mbs_constraint_primitives, only: marker_state_t, rigid_marker_state, &
         ground_marker_state, rigid_marker_jacobian, rigid_marker_jacobian_q, &
-        primitive_value, primitive_jacobian, primitive_time_derivative, &
-        primitive_convective, primitive_time_terms
+        primitive_value, joint_value, joint_jacobian, joint_rows
     use flexmbs_mbs_constraint_primitives_dual, only: marker_state_d => marker_state_t, &
         rigid_marker_state_d => rigid_marker_state, &
         ground_marker_state_d => ground_marker_state, &
         rigid_marker_jacobian_d => rigid_marker_jacobian, &
-        primitive_value_d => primitive_value, primitive_jacobian_d => primitive_jacobian, &
-        primitive_time_derivative_d => primitive_time_derivative
+        joint_value_d => joint_value, joint_jacobian_d => joint_jacobian, &
+        joint_rows_d => joint_rows
+    use flexmbs_mbs_joint, only: joint_t, new_joint, new_primitive_joint, joint_name, &
+        joint_spherical, joint_revolute, joint_cylindrical, joint_prismatic, &
+        joint_universal, joint_fixed, joint_primitive, joint_part_time_derivative, &
+        joint_part_convective, joint_part_time_terms
+    use flexmbs_core_status, only: status_t
     use mbs_random, only: random_state_t, uniform, random_vector, random_quaternion
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
@@ -34,6 +38,9 @@ module test_constraint_primitives
     integer, parameter :: kinds(nkinds) = [primitive_dot1, primitive_dot2, &
         primitive_spherical, primitive_distance, primitive_angle_driver, &
         primitive_translation_driver]
+    integer, parameter :: njoints = 6
+    integer, parameter :: joints(njoints) = [joint_spherical, joint_revolute, &
+        joint_cylindrical, joint_prismatic, joint_universal, joint_fixed]
     ! Marker pairings: both on bodies, j on the ground, i on the ground.
     integer, parameter :: rigid_rigid = 1, rigid_ground = 2, ground_rigid = 3
 
@@ -55,7 +62,8 @@ contains
         tests = [new_test('ad_vs_hand_rigid_rigid', test_rigid_rigid), &
                  new_test('ad_vs_hand_rigid_ground', test_rigid_ground), &
                  new_test('ad_vs_hand_ground_rigid', test_ground_rigid), &
-                 new_test('driver_closed_form', test_driver_closed_form)]
+                 new_test('driver_closed_form', test_driver_closed_form), &
+                 new_test('joints_vanish_when_assembled', test_joints_assembled)]
     end function collect_constraint_primitives
 
     ! ---------------------------------------------------------------- helpers
@@ -152,10 +160,11 @@ contains
         end do
     end function identity
 
-    !> One random configuration of primitive `kind`: AD against hand-coded.
-    subroutine compare_once(rng, kind, pairing, err)
+    !> One random configuration of a joint (joint_primitive: of the primitive `kind`
+    !> on random axes): AD against hand-coded.
+    subroutine compare_once(rng, jkind, kind, pairing, err)
         type(random_state_t), intent(inout) :: rng
-        integer, intent(in) :: kind, pairing
+        integer, intent(in) :: jkind, kind, pairing
         type(errors_t), intent(inout) :: err
         type(end_t) :: ei, ej
         type(marker_state_t) :: mi, mj
@@ -167,14 +176,21 @@ contains
         type(dual_t) :: t, drvd(3), pid(4), pjd(4), jxid(3, 6), jaid(3, 6, 3), &
             jxjd(3, 6), jajd(3, 6, 3), cv
         type(dual_t), allocatable :: cd(:), cid(:, :), cjd(:, :), ctd(:)
+        type(joint_t) :: joint
+        type(status_t) :: status
         integer :: nr, ni, nj, ki, kj, k, r
-        nr = primitive_rows(kind)
         ei = random_end(rng, pairing == ground_rigid)
         ej = random_end(rng, pairing == rigid_ground)
         ni = nv_of(ei)
         nj = nv_of(ej)
         ki = 1 + int(uniform(rng, 0.0_wp, 3.0_wp))
         kj = 1 + int(uniform(rng, 0.0_wp, 3.0_wp))
+        if (jkind == joint_primitive) then
+            call new_primitive_joint(joint, kind, ki, kj, status)
+        else
+            call new_joint(joint, jkind, status)
+        end if
+        nr = joint%nrows
         t0 = uniform(rng, -1.0_wp, 1.0_wp)
         allocate (ci(nr, ni), cj(nr, nj), ciq(nr, ni + ni / 6), cjq(nr, nj + nj / 6), &
                   ct(nr), gam(nr), tt(nr), cd(nr), cid(nr, ni), cjd(nr, nj), ctd(nr))
@@ -184,14 +200,14 @@ contains
         ! Hand-coded, real.
         call hand_end(ei, mi, jxi, jai, jxqi, jaqi)
         call hand_end(ej, mj, jxj, jaj, jxqj, jaqj)
-        call primitive_jacobian(kind, ki, kj, mi, jxi(:, 1:ni), jai(:, 1:ni, :), mj, &
-                                jxj(:, 1:nj), jaj(:, 1:nj, :), drv, ci, cj)
-        call primitive_jacobian(kind, ki, kj, mi, jxqi(:, 1:size(ciq, 2)), &
-                                jaqi(:, 1:size(ciq, 2), :), mj, jxqj(:, 1:size(cjq, 2)), &
-                                jaqj(:, 1:size(cjq, 2), :), drv, ciq, cjq)
-        call primitive_time_derivative(kind, ki, kj, mi, mj, drv, ct)
-        call primitive_convective(kind, ki, kj, mi, mj, drv, gam)
-        call primitive_time_terms(kind, ki, kj, mi, mj, drv, tt)
+        call joint_jacobian(joint, mi, jxi(:, 1:ni), jai(:, 1:ni, :), mj, &
+                            jxj(:, 1:nj), jaj(:, 1:nj, :), drv, ci, cj)
+        call joint_jacobian(joint, mi, jxqi(:, 1:size(ciq, 2)), &
+                            jaqi(:, 1:size(ciq, 2), :), mj, jxqj(:, 1:size(cjq, 2)), &
+                            jaqj(:, 1:size(cjq, 2), :), drv, ciq, cjq)
+        call joint_rows(joint_part_time_derivative, joint, mi, mj, drv, ct)
+        call joint_rows(joint_part_convective, joint, mi, mj, drv, gam)
+        call joint_rows(joint_part_time_terms, joint, mi, mj, drv, tt)
 
         ti = quat_rate_matrix(ei%p)
         tj = quat_rate_matrix(ej%p)
@@ -205,7 +221,7 @@ contains
                       reshape([zero34, tj], [4, 6]), mjd, pjd)
         t = dual_variable(t0, 13)
         drvd = driver_d(t)
-        call primitive_value_d(kind, ki, kj, mid, mjd, drvd, cd)
+        call joint_value_d(joint, mid, mjd, drvd, cd)
         do r = 1, nr
             err%c_v = max(err%c_v, rel_err(cd(r)%der(1:ni), ci(r, :)), &
                           rel_err(cd(r)%der(7:6 + nj), cj(r, :)))
@@ -218,7 +234,7 @@ contains
         call dual_end(ej, 8, reshape([identity(3), zero34], [3, 7]), &
                       reshape([zero3(1:1, :), zero3, identity(4)], [4, 7]), mjd, pjd)
         drvd = drv
-        call primitive_value_d(kind, ki, kj, mid, mjd, drvd, cd)
+        call joint_value_d(joint, mid, mjd, drvd, cd)
         do r = 1, nr
             err%c_q = max(err%c_q, rel_err(cd(r)%der(1:size(ciq, 2)), ciq(r, :)), &
                           rel_err(cd(r)%der(8:7 + size(cjq, 2)), cjq(r, :)))
@@ -236,9 +252,9 @@ contains
                                                           dual_axes(ei), jxid, jaid)
         if (.not. ej%ground) call rigid_marker_jacobian_d(pjd, dual_body_offset(ej), &
                                                           dual_axes(ej), jxjd, jajd)
-        call primitive_jacobian_d(kind, ki, kj, mid, jxid(:, 1:ni), jaid(:, 1:ni, :), mjd, &
-                                  jxjd(:, 1:nj), jajd(:, 1:nj, :), drvd, cid, cjd)
-        call primitive_time_derivative_d(kind, ki, kj, mid, mjd, drvd, ctd)
+        call joint_jacobian_d(joint, mid, jxid(:, 1:ni), jaid(:, 1:ni, :), mjd, &
+                              jxjd(:, 1:nj), jajd(:, 1:nj, :), drvd, cid, cjd)
+        call joint_rows_d(joint_part_time_derivative, joint, mid, mjd, drvd, ctd)
         do r = 1, nr
             cv = 0.0_wp
             do k = 1, ni
@@ -281,30 +297,41 @@ contains
         integer, intent(in) :: pairing
         character(len=*), intent(in) :: label
         type(random_state_t) :: rng
-        type(errors_t) :: err
-        integer :: n, trial
-        character(len=16) :: verbose
-        integer :: st
-        call get_environment_variable('FLEXMBS_TEST_VERBOSE', verbose, status=st)
+        integer :: n
         do n = 1, nkinds
-            err = errors_t()
-            do trial = 1, ntrials
-                call compare_once(rng, kinds(n), pairing, err)
-            end do
-            if (st == 0) write (*, '(a,1x,a20,5es10.2)') label, primitive_name(kinds(n)), &
-                err%c_v, err%c_q, err%ct, err%conv, err%time_terms
-            call check_close(error, err%c_v, 0.0_wp, tol_ad, label // ' ' // &
-                             primitive_name(kinds(n)) // ': C = c_q T, AD vs hand')
-            call check_close(error, err%c_q, 0.0_wp, tol_ad, label // ' ' // &
-                             primitive_name(kinds(n)) // ': c_q, AD vs hand')
-            call check_close(error, err%ct, 0.0_wp, tol_ad, label // ' ' // &
-                             primitive_name(kinds(n)) // ': c_t, AD vs hand')
-            call check_close(error, err%conv, 0.0_wp, tol_ad, label // ' ' // &
-                             primitive_name(kinds(n)) // ': (C v)_q T v, AD vs hand')
-            call check_close(error, err%time_terms, 0.0_wp, tol_ad, label // ' ' // &
-                             primitive_name(kinds(n)) // ': 2 C_t v + c_tt, AD vs hand')
+            call run_case(error, rng, joint_primitive, kinds(n), pairing, &
+                          label // ' ' // primitive_name(kinds(n)))
+        end do
+        do n = 1, njoints
+            call run_case(error, rng, joints(n), 0, pairing, &
+                          label // ' ' // joint_name(joints(n)) // ' joint')
         end do
     end subroutine run_pairing
+
+    !> ntrials random configurations of one joint or primitive; FLEXMBS_TEST_VERBOSE
+    !> set prints the worst errors (C, c_q, c_t, (C v)_q T v, 2 C_t v + c_tt).
+    subroutine run_case(error, rng, jkind, kind, pairing, label)
+        type(error_t), allocatable, intent(inout) :: error
+        type(random_state_t), intent(inout) :: rng
+        integer, intent(in) :: jkind, kind, pairing
+        character(len=*), intent(in) :: label
+        type(errors_t) :: err
+        integer :: trial, st
+        character(len=16) :: verbose
+        call get_environment_variable('FLEXMBS_TEST_VERBOSE', verbose, status=st)
+        do trial = 1, ntrials
+            call compare_once(rng, jkind, kind, pairing, err)
+        end do
+        if (st == 0) write (*, '(a40,5es10.2)') label, err%c_v, err%c_q, err%ct, err%conv, &
+            err%time_terms
+        call check_close(error, err%c_v, 0.0_wp, tol_ad, label // ': C = c_q T, AD vs hand')
+        call check_close(error, err%c_q, 0.0_wp, tol_ad, label // ': c_q, AD vs hand')
+        call check_close(error, err%ct, 0.0_wp, tol_ad, label // ': c_t, AD vs hand')
+        call check_close(error, err%conv, 0.0_wp, tol_ad, label // &
+                         ': (C v)_q T v, AD vs hand')
+        call check_close(error, err%time_terms, 0.0_wp, tol_ad, label // &
+                         ': 2 C_t v + c_tt, AD vs hand')
+    end subroutine run_case
 
     ! ------------------------------------------------------------------ tests
 
@@ -350,4 +377,54 @@ contains
         call primitive_value(primitive_dot1, 3, 3, mg, mb, drv, c)
         call check_close(error, c(1), 1.0_wp, 1.0e-15_wp, 'dot-1 of parallel z axes')
     end subroutine test_driver_closed_form
+
+    !> Each joint's rows vanish on a configuration it allows (marker i random; marker j
+    !> moved by the joint's own freedoms) and not on a violating one.
+    subroutine test_joints_assembled(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(random_state_t) :: rng
+        type(marker_state_t) :: mi, mj
+        type(joint_t) :: joint
+        type(status_t) :: status
+        real(wp) :: ai(3, 3), aj(3, 3), xi(3), xj(3), drv(3), c(6), spin(3, 3), ex(3), ez(3)
+        integer :: n
+        ex = [1.0_wp, 0.0_wp, 0.0_wp]
+        ez = [0.0_wp, 0.0_wp, 1.0_wp]
+        drv = 0.0_wp
+        do n = 1, njoints
+            ai = rotation_matrix(random_quaternion(rng))
+            xi = random_vector(rng, 3, -1.0_wp, 1.0_wp)
+            spin = rotation_matrix(quat_from_axis_angle(ez, 0.7_wp))
+            xj = xi
+            aj = ai
+            select case (joints(n))
+            case (joint_spherical)
+                aj = rotation_matrix(random_quaternion(rng))
+            case (joint_revolute)
+                aj = matmul(ai, spin)
+            case (joint_cylindrical)
+                xj = xi + 0.3_wp * ai(:, 3)
+                aj = matmul(ai, spin)
+            case (joint_prismatic)
+                xj = xi + 0.3_wp * ai(:, 3)
+            case (joint_universal)
+                aj = matmul(ai, matmul(rotation_matrix(quat_from_axis_angle(ex, &
+                            2.0_wp * atan(1.0_wp))), spin))
+            end select
+            call new_joint(joint, joints(n), status)
+            call ground_marker_state(xi, ai, mi)
+            call ground_marker_state(xj, aj, mj)
+            call joint_value(joint, mi, mj, drv, c(1:joint%nrows))
+            call check_close(error, maxval(abs(c(1:joint%nrows))), 0.0_wp, 1.0e-15_wp, &
+                             joint_name(joints(n)) // ' joint: rows on an allowed motion')
+            ! Moving j off along x_i violates every joint but the cylindrical and
+            ! prismatic in a direction they forbid as well.
+            call ground_marker_state(xj + 0.1_wp * ai(:, 1), aj, mj)
+            call joint_value(joint, mi, mj, drv, c(1:joint%nrows))
+            call check(error, maxval(abs(c(1:joint%nrows))) > 1.0e-3_wp, &
+                       joint_name(joints(n)) // ' joint: a forbidden offset is seen')
+        end do
+        call new_joint(joint, 99, status)
+        call check(error, .not. status%ok(), 'unknown joint kind is an error')
+    end subroutine test_joints_assembled
 end module test_constraint_primitives
