@@ -19,6 +19,9 @@ program flexmbs_tests
     use test_fe, only: collect_fe
     use test_fe_element, only: collect_fe_element
     use test_fe_body, only: collect_fe_body
+    use test_rotation, only: collect_rotation
+    use test_dual, only: collect_dual
+    use test_constraint_primitives, only: collect_constraint_primitives
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -45,6 +48,10 @@ program flexmbs_tests
     call run_suite('fe', collect_fe(), filter, npassed, nfailed)
     call run_suite('fe_element', collect_fe_element(), filter, npassed, nfailed)
     call run_suite('fe_body', collect_fe_body(), filter, npassed, nfailed)
+    call run_suite('rotation', collect_rotation(), filter, npassed, nfailed)
+    call run_suite('dual', collect_dual(), filter, npassed, nfailed)
+    call run_suite('constraint_primitives', collect_constraint_primitives(), filter, &
+                   npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests

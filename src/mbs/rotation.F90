@@ -1,0 +1,17 @@
+!> Unit quaternions, rotation matrices, the G and L matrices, q' = T(q) w and the
+!> derivative identities of rotated vectors, in real arithmetic. The formulas are in
+!> rotation.inc, shared with flexmbs_mbs_rotation_dual.
+module flexmbs_mbs_rotation
+    use flexmbs_core_kinds, only: wp
+    implicit none
+    private
+    public :: skew, cross, quat_g, quat_l, rotation_matrix, quat_rate_matrix, &
+        quat_product, quat_conjugate, quat_from_axis_angle, quat_normalize, &
+        rotated_vector_jacobian, rotated_vector_transpose_jacobian
+
+contains
+
+#define SCALAR real(wp)
+#include "rotation.inc"
+#undef SCALAR
+end module flexmbs_mbs_rotation

@@ -1,0 +1,49 @@
+!> Reproducible random configurations for the multibody tests: a xorshift64*
+!> generator (Vigna 2016), independent of the intrinsic generator's state.
+module mbs_random
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_mbs_rotation, only: quat_normalize
+    implicit none
+    private
+    public :: random_state_t, uniform, random_vector, random_quaternion
+
+    type :: random_state_t
+        integer(i8) :: s = 88172645463325252_i8
+    end type random_state_t
+
+contains
+
+    !> Uniform in [lo, hi).
+    function uniform(rng, lo, hi) result(x)
+        type(random_state_t), intent(inout) :: rng
+        real(wp), intent(in) :: lo, hi
+        real(wp) :: x
+        rng%s = ieor(rng%s, ishft(rng%s, -12))
+        rng%s = ieor(rng%s, ishft(rng%s, 25))
+        rng%s = ieor(rng%s, ishft(rng%s, -27))
+        x = lo + (hi - lo) * real(ishft(rng%s * 2685821657736338717_i8, -11), wp) / 2.0_wp**53
+    end function uniform
+
+    !> n components uniform in [lo, hi).
+    function random_vector(rng, n, lo, hi) result(x)
+        type(random_state_t), intent(inout) :: rng
+        integer, intent(in) :: n
+        real(wp), intent(in) :: lo, hi
+        real(wp) :: x(n)
+        integer :: i
+        do i = 1, n
+            x(i) = uniform(rng, lo, hi)
+        end do
+    end function random_vector
+
+    !> A unit quaternion away from the degenerate small-norm draws.
+    function random_quaternion(rng) result(p)
+        type(random_state_t), intent(inout) :: rng
+        real(wp) :: p(4)
+        p = random_vector(rng, 4, -1.0_wp, 1.0_wp)
+        do while (norm2(p) < 0.2_wp)
+            p = random_vector(rng, 4, -1.0_wp, 1.0_wp)
+        end do
+        p = quat_normalize(p)
+    end function random_quaternion
+end module mbs_random
