@@ -567,6 +567,11 @@ contains
         options%linear_solver = 'klu'
         call run_vdp(solver, 1.0e-6_wp, y, stats, status, options_in=options)
         call check(error, status%code == status_bad_input, 'klu without CSC accepted')
+        ! No band solver with IDA: refused, not silently replaced.
+        options%linear_solver = 'band'
+        call run_vdp(solver, 1.0e-6_wp, y, stats, status, options_in=options)
+        call check(error, status%code == status_bad_input .and. &
+            index(status%text(), 'band') > 0, 'band accepted: ' // status%text())
         ! A wrong y size.
         problem = new_pendulum(pendulum_index2, phi0)
         options%linear_solver = 'auto'

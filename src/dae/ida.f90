@@ -396,6 +396,10 @@ contains
                 use_klu = .true.
             case ('dense')
                 use_klu = .false.
+            case ('band')
+                call st%set(status_bad_input, "ida: linear_solver = 'band' is not offered " &
+                    // "with IDA (dense or KLU); use 'dense', 'klu' or 'auto'")
+                return
             case default
                 use_klu = data%jac_mode == jac_scatter .and. n >= auto_sparse_threshold
             end select
