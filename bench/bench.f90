@@ -5,9 +5,13 @@
 !>   flexmbs-bench INTEGRATOR PROBLEM N SOLVER [MAX_STEPS] [RTOL] [REFERENCE]
 !>   flexmbs-bench reference PROBLEM N FILE [RTOL]
 !>
-!> INTEGRATOR: radau5 | ddassl | ddassl-p2 (maximal BDF order 2) | ida.
+!> INTEGRATOR: radau5 | ddassl | ddassl-p2 (maximal BDF order 2) | ida |
+!> mexax (midpoint base) | mexax-euler (half-explicit Euler base).
 !> PROBLEM: vdp | rd1d | rd2d | pend3 | pend2 | pendggl (N: unknowns for
-!> rd1d, grid points per side for rd2d, ignored otherwise); SOLVER: dense |
+!> rd1d, grid points per side for rd2d, ignored otherwise); for mexax only,
+!> the mechanical forms pendmech (the same pendulum) and chain (N bars, the
+!> chain of ALGORITHMS.md §8; ERR over (x1, y1, φ1) at t = 1 against the
+!> original's TOL 1e-11 values for N = 8, none otherwise); SOLVER: dense |
 !> klu | band | auto. ERR is eq. (13) of `paper_error` at t_end with
 !> atol = rtol: van der Pol against its tight reference, the pendulum
 !> (φ0 = 1, t_end = 3, index 3, index 2 or GGL) over the positions against
@@ -26,6 +30,13 @@ program flexmbs_bench
     use flexmbs_dae_radau5, only: radau5_t
     use flexmbs_dae_ddassl, only: ddassl_t
     use flexmbs_dae_ida, only: ida_t
+    use flexmbs_dae_mexax, only: mexax_t, mexax_base_euler
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    use flexmbs_problems_pendulum, only: pendulum_mechanical_t, new_pendulum_mechanical, &
+        pendulum_mechanical_initial, pendulum_angle_exact, pendulum_default_gravity, &
+        pendulum_default_length
+    use flexmbs_problems_pendulum_chain, only: pendulum_chain_t, new_pendulum_chain, &
+        pendulum_chain_initial, chain_anchor_t1
     use flexmbs_dae_error_measure, only: paper_error
     use flexmbs_problems_van_der_pol, only: new_van_der_pol
     use flexmbs_problems_reaction_diffusion, only: reaction_diffusion_t, &
@@ -54,10 +65,11 @@ program flexmbs_bench
     type(dae_stats_t) :: stats
     type(status_t) :: status
     character(len=16) :: outcome
+    integer :: n_row   !! unknowns reported in the row
 
     if (command_argument_count() < 4) then
-        write (*, '(a)') 'usage: flexmbs-bench radau5|ddassl|ddassl-p2|ida ' // &
-            'vdp|rd1d|rd2d|pend3|pend2|pendggl N dense|klu|band|auto ' // &
+        write (*, '(a)') 'usage: flexmbs-bench radau5|ddassl|ddassl-p2|ida|mexax|mexax-euler ' &
+            // 'vdp|rd1d|rd2d|pend3|pend2|pendggl|pendmech|chain N dense|klu|band|auto ' // &
             '[MAX_STEPS] [RTOL] [REFERENCE]', &
             '       flexmbs-bench reference PROBLEM N FILE [RTOL]'
         error stop 2
@@ -91,7 +103,12 @@ program flexmbs_bench
         if (command_argument_count() >= 7) call get_command_argument(7, reference_file)
     end if
 
+    if (integrator_name(1:5) == 'mexax') then
+        call run_mexax()
+        stop
+    end if
     call make_problem(trim(problem_name), npar, trim(solver_name))
+    n_row = problem%n
     options%rtol = rtol
     options%atol = rtol
     options%max_steps = max_steps
@@ -144,6 +161,62 @@ program flexmbs_bench
     call print_row(outcome)
 
 contains
+
+    !> MEXAX on a mechanical problem: the pendulum (as pend2/pendggl, phi0 = 1,
+    !> t_end = 3) or the chain of N bars to t = 1.
+    subroutine run_mexax()
+        type(mexax_t) :: mexax
+        class(mechanical_problem_t), allocatable :: mech
+        real(wp), allocatable :: q(:), v(:), lam(:)
+        real(wp) :: phi, dphi
+        type(status_t) :: st
+        if (integrator_name == 'mexax-euler') mexax%base = mexax_base_euler
+        select case (trim(problem_name))
+        case ('pendmech')
+            allocate (mech, source=new_pendulum_mechanical())
+            allocate (q(mech%nq), v(mech%nv), lam(mech%nc))
+            select type (mech)
+            type is (pendulum_mechanical_t)
+                call pendulum_mechanical_initial(mech, pendulum_phi0, q, v, lam)
+            end select
+            t_end = pendulum_t_end
+            call pendulum_angle_exact(pendulum_phi0, sqrt(pendulum_default_gravity / &
+                pendulum_default_length), t_end, phi, dphi, st)
+            y_ref = [sin(phi), -cos(phi)] * pendulum_default_length
+        case ('chain')
+            allocate (mech, source=new_pendulum_chain(npar))
+            allocate (q(mech%nq), v(mech%nv), lam(mech%nc))
+            select type (mech)
+            type is (pendulum_chain_t)
+                call pendulum_chain_initial(mech, q, v, lam)
+            end select
+            t_end = 1.0_wp
+            if (npar == 8) y_ref = chain_anchor_t1
+        case default
+            write (*, '(a)') 'mexax runs the mechanical problems pendmech and chain only'
+            error stop 2
+        end select
+        n_row = mech%nq + mech%nv + mech%nc
+        options%rtol = rtol
+        options%atol = rtol
+        options%max_steps = max_steps
+        options%linear_solver = solver_name
+        t = 0.0_wp
+        call mexax%integrate_mechanical(mech, t, q, v, t_end, options, stats, status, lambda=lam)
+        if (status%ok()) then
+            outcome = 'done'
+        else if (status%reason == reason_max_steps) then
+            outcome = 'capped'
+        else
+            outcome = 'failed'
+            write (0, '(a)') trim(integrator_name) // ' ' // trim(problem_name) // ': ' // &
+                status%text()
+        end if
+        err = ieee_value(err, ieee_quiet_nan)
+        if (outcome == 'done' .and. allocated(y_ref)) err = paper_error(q(1:size(y_ref)), &
+            y_ref, rtol, rtol)
+        call print_row(outcome)
+    end subroutine run_mexax
 
     !> The problem, its initial values, t_end and (when known) the reference
     !> at t_end. Sparse storage of the Jacobian (and M) except for dense LU
@@ -238,7 +311,7 @@ contains
             if (.not. ieee_is_nan(err)) write (err_text, '(es10.3)') err
         end if
         write (*, '(2(a,1x),i0,2(1x,a),1x,es10.3,5(1x,i0),3(1x,es10.3),1x,f0.1,1x,a)') &
-            trim(integrator_name), trim(problem_name), problem%n, trim(solver_name), &
+            trim(integrator_name), trim(problem_name), n_row, trim(solver_name), &
             trim(what), t, stats%nst, stats%nac, stats%nfe, stats%nje, stats%ndec, &
             stats%cpu, stats%wall, stats%cpu / max(stats%nst, 1), peak_memory_mb(), &
             trim(adjustl(err_text))

@@ -55,6 +55,18 @@ for integ in radau5 ddassl ddassl-p2 ida; do
     # Index 3 is RADAU5's; the BDF codes are run to show what they make of it.
     run $integ pend3 2 dense
 done
+# MEXAX integrates the mechanical form of the same pendulum directly, and
+# the planar chain of ALGORITHMS.md §8 (8 bars: ERR against the original's
+# reference; 100 and 1000 bars: dense against KLU on [M Gᵀ; G 0]).
+for integ in mexax mexax-euler; do
+    run $integ pendmech 2 dense
+    run $integ chain 8 dense
+    run $integ chain 8 klu
+    run $integ chain 100 dense 20    # ~0.4 s a step: capped at 20 steps
+    run $integ chain 100 klu
+    skip $integ chain 1000 dense "order 5000: ~2 s an LU, ~100 s a step"
+    run $integ chain 1000 klu 300    # ~25 ms a step: capped at 300 steps
+done
 
 DENSE_IDA="SUNDIALS' unblocked dense LU: over 5 min for 10 steps on the periodic grid"
 for integ in radau5 ddassl ddassl-p2 ida; do
