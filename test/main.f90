@@ -22,6 +22,7 @@ program flexmbs_tests
     use test_rotation, only: collect_rotation
     use test_dual, only: collect_dual
     use test_constraint_primitives, only: collect_constraint_primitives
+    use test_formulation, only: collect_formulation
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -52,6 +53,7 @@ program flexmbs_tests
     call run_suite('dual', collect_dual(), filter, npassed, nfailed)
     call run_suite('constraint_primitives', collect_constraint_primitives(), filter, &
                    npassed, nfailed)
+    call run_suite('formulation', collect_formulation(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests

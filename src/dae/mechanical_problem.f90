@@ -11,6 +11,12 @@
 !> values refilled by `mass_sparse` and `constraint_jacobian_sparse`), which
 !> lets MEXAX factor the augmented matrix [M Gᵀ; G 0] with KLU. The
 !> defaults say "not provided", as `dae_problem_t`'s sparse Jacobian does.
+!>
+!> The formulations (src/mbs/formulation.f90) need the derivatives of these
+!> terms with respect to q and v for their Jacobians. A problem may override
+!> the `*_derivative(s)` bindings with analytic ones; the defaults difference
+!> the base bindings by forward differences (step sqrt(eps) max(1, |x_j|)),
+!> one evaluation per column, so they are accurate to about sqrt(eps).
 module flexmbs_dae_mechanical_problem
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
@@ -35,6 +41,14 @@ module flexmbs_dae_mechanical_problem
         procedure :: mass_sparse => default_mass_sparse
         procedure :: constraint_jacobian_pattern => default_constraint_jacobian_pattern
         procedure :: constraint_jacobian_sparse => default_constraint_jacobian_sparse
+        procedure :: kinematics_derivative => default_kinematics_derivative
+        procedure :: mass_derivative => default_mass_derivative
+        procedure :: force_derivatives => default_force_derivatives
+        procedure :: constraint_position_jacobian => default_constraint_position_jacobian
+        procedure :: constraint_jacobian_derivatives => default_constraint_jacobian_derivatives
+        procedure :: constraint_time_derivative_jacobian => &
+            default_constraint_time_derivative_jacobian
+        procedure :: constraint_curvature_derivatives => default_constraint_curvature_derivatives
     end type mechanical_problem_t
 
     abstract interface
@@ -80,7 +94,169 @@ module flexmbs_dae_mechanical_problem
         end subroutine constraint_jacobian_i
     end interface
 
+    public :: difference_step
+
 contains
+
+    !> Forward-difference step for a variable of value x.
+    pure real(wp) function difference_step(x) result(delta)
+        real(wp), intent(in) :: x
+        delta = sqrt(epsilon(1.0_wp)) * max(1.0_wp, abs(x))
+    end function difference_step
+
+    !> ∂(T(t,q) w)/∂q, nq x nq (default: forward differences).
+    subroutine default_kinematics_derivative(self, t, q, w, dq, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: dq(:, :)
+        type(status_t), intent(inout) :: status
+        real(wp) :: qp(size(q)), base(self%nq), pert(self%nq), delta
+        integer :: j
+        call self%kinematics(t, q, w, base, status)
+        qp = q
+        do j = 1, self%nq
+            delta = difference_step(q(j))
+            qp(j) = q(j) + delta
+            call self%kinematics(t, qp, w, pert, status)
+            dq(:, j) = (pert - base) / delta
+            qp(j) = q(j)
+        end do
+    end subroutine default_kinematics_derivative
+
+    !> ∂(M(t,q) w)/∂q, nv x nq (default: forward differences).
+    subroutine default_mass_derivative(self, t, q, w, dq, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:) !! the vector M acts on (an acceleration)
+        real(wp), intent(out) :: dq(:, :)
+        type(status_t), intent(inout) :: status
+        real(wp) :: qp(size(q)), m(self%nv, self%nv), base(self%nv), delta
+        integer :: j
+        call self%mass(t, q, m, status)
+        base = matmul(m, w)
+        qp = q
+        do j = 1, self%nq
+            delta = difference_step(q(j))
+            qp(j) = q(j) + delta
+            call self%mass(t, qp, m, status)
+            dq(:, j) = (matmul(m, w) - base) / delta
+            qp(j) = q(j)
+        end do
+    end subroutine default_mass_derivative
+
+    !> ∂f/∂q (nv x nq) and ∂f/∂v (nv x nv) (default: forward differences).
+    subroutine default_force_derivatives(self, t, q, v, fq, fv, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: fq(:, :), fv(:, :)
+        type(status_t), intent(inout) :: status
+        real(wp) :: qp(size(q)), vp(size(v)), base(self%nv), pert(self%nv), delta
+        integer :: j
+        call self%forces(t, q, v, base, status)
+        qp = q
+        do j = 1, self%nq
+            delta = difference_step(q(j))
+            qp(j) = q(j) + delta
+            call self%forces(t, qp, v, pert, status)
+            fq(:, j) = (pert - base) / delta
+            qp(j) = q(j)
+        end do
+        vp = v
+        do j = 1, self%nv
+            delta = difference_step(v(j))
+            vp(j) = v(j) + delta
+            call self%forces(t, q, vp, pert, status)
+            fv(:, j) = (pert - base) / delta
+            vp(j) = v(j)
+        end do
+    end subroutine default_force_derivatives
+
+    !> g_q, nc x nq (default: forward differences of g).
+    subroutine default_constraint_position_jacobian(self, t, q, gq, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: gq(:, :)
+        type(status_t), intent(inout) :: status
+        real(wp) :: qp(size(q)), base(self%nc), pert(self%nc), delta
+        integer :: j
+        call self%constraint(t, q, base, status)
+        qp = q
+        do j = 1, self%nq
+            delta = difference_step(q(j))
+            qp(j) = q(j) + delta
+            call self%constraint(t, qp, pert, status)
+            gq(:, j) = (pert - base) / delta
+            qp(j) = q(j)
+        end do
+    end subroutine default_constraint_position_jacobian
+
+    !> ∂(G(t,q) w)/∂q (nc x nq) and ∂(G(t,q)ᵀ λ)/∂q (nv x nq) (default:
+    !> forward differences of G).
+    subroutine default_constraint_jacobian_derivatives(self, t, q, w, lambda, gwq, gtlq, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:), lambda(:)
+        real(wp), intent(out) :: gwq(:, :), gtlq(:, :)
+        type(status_t), intent(inout) :: status
+        real(wp) :: qp(size(q)), gmat(self%nc, self%nv), gw(self%nc), gtl(self%nv), delta
+        integer :: j
+        call self%constraint_jacobian(t, q, gmat, status)
+        gw = matmul(gmat, w)
+        gtl = matmul(lambda, gmat)
+        qp = q
+        do j = 1, self%nq
+            delta = difference_step(q(j))
+            qp(j) = q(j) + delta
+            call self%constraint_jacobian(t, qp, gmat, status)
+            gwq(:, j) = (matmul(gmat, w) - gw) / delta
+            gtlq(:, j) = (matmul(lambda, gmat) - gtl) / delta
+            qp(j) = q(j)
+        end do
+    end subroutine default_constraint_jacobian_derivatives
+
+    !> ∂g_I/∂q, nc x nq (default: forward differences of g_I).
+    subroutine default_constraint_time_derivative_jacobian(self, t, q, dq, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: dq(:, :)
+        type(status_t), intent(inout) :: status
+        real(wp) :: qp(size(q)), base(self%nc), pert(self%nc), delta
+        integer :: j
+        call self%constraint_time_derivative(t, q, base, status)
+        qp = q
+        do j = 1, self%nq
+            delta = difference_step(q(j))
+            qp(j) = q(j) + delta
+            call self%constraint_time_derivative(t, qp, pert, status)
+            dq(:, j) = (pert - base) / delta
+            qp(j) = q(j)
+        end do
+    end subroutine default_constraint_time_derivative_jacobian
+
+    !> ∂γ/∂q (nc x nq) and ∂γ/∂v (nc x nv) (default: forward differences).
+    subroutine default_constraint_curvature_derivatives(self, t, q, v, gq, gv, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: gq(:, :), gv(:, :)
+        type(status_t), intent(inout) :: status
+        real(wp) :: qp(size(q)), vp(size(v)), base(self%nc), pert(self%nc), delta
+        integer :: j
+        call self%constraint_curvature(t, q, v, base, status)
+        qp = q
+        do j = 1, self%nq
+            delta = difference_step(q(j))
+            qp(j) = q(j) + delta
+            call self%constraint_curvature(t, qp, v, pert, status)
+            gq(:, j) = (pert - base) / delta
+            qp(j) = q(j)
+        end do
+        vp = v
+        do j = 1, self%nv
+            delta = difference_step(v(j))
+            vp(j) = v(j) + delta
+            call self%constraint_curvature(t, q, vp, pert, status)
+            gv(:, j) = (pert - base) / delta
+            vp(j) = v(j)
+        end do
+    end subroutine default_constraint_curvature_derivatives
 
     !> g_I = ∂g/∂t; zero for scleronomic constraints.
     subroutine default_constraint_time_derivative(self, t, q, gt, status)

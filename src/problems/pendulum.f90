@@ -96,6 +96,13 @@ module flexmbs_problems_pendulum
         procedure :: constraint => mechanical_constraint
         procedure :: constraint_jacobian => mechanical_constraint_jacobian
         procedure :: constraint_curvature => mechanical_constraint_curvature
+        procedure :: kinematics_derivative => mechanical_zero_nq_derivative
+        procedure :: mass_derivative => mechanical_zero_nq_derivative
+        procedure :: force_derivatives => mechanical_force_derivatives
+        procedure :: constraint_position_jacobian => mechanical_constraint_position_jacobian
+        procedure :: constraint_jacobian_derivatives => mechanical_constraint_jacobian_derivatives
+        procedure :: constraint_time_derivative_jacobian => mechanical_zero_time_jacobian
+        procedure :: constraint_curvature_derivatives => mechanical_curvature_derivatives
     end type pendulum_mechanical_t
 
     public :: new_pendulum, pendulum_initial, pendulum_reference
@@ -626,4 +633,64 @@ contains
         type(status_t), intent(inout) :: status
         gamma(1) = v(1)**2 + v(2)**2
     end subroutine mechanical_constraint_curvature
+
+    !> T = I and M = m I are constant: ∂(T w)/∂q = ∂(M a)/∂q = 0.
+    subroutine mechanical_zero_nq_derivative(self, t, q, w, dq, status)
+        class(pendulum_mechanical_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: dq(:, :)
+        type(status_t), intent(inout) :: status
+        dq = 0.0_wp
+    end subroutine mechanical_zero_nq_derivative
+
+    !> Gravity is constant: f_q = f_v = 0.
+    subroutine mechanical_force_derivatives(self, t, q, v, fq, fv, status)
+        class(pendulum_mechanical_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: fq(:, :), fv(:, :)
+        type(status_t), intent(inout) :: status
+        fq = 0.0_wp
+        fv = 0.0_wp
+    end subroutine mechanical_force_derivatives
+
+    !> g_q = (x, y) = G (T = I).
+    subroutine mechanical_constraint_position_jacobian(self, t, q, gq, status)
+        class(pendulum_mechanical_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: gq(:, :)
+        type(status_t), intent(inout) :: status
+        gq(1, 1:2) = q(1:2)
+    end subroutine mechanical_constraint_position_jacobian
+
+    !> ∂(G w)/∂q = wᵀ and ∂(Gᵀλ)/∂q = λ I.
+    subroutine mechanical_constraint_jacobian_derivatives(self, t, q, w, lambda, gwq, gtlq, &
+                                                          status)
+        class(pendulum_mechanical_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:), lambda(:)
+        real(wp), intent(out) :: gwq(:, :), gtlq(:, :)
+        type(status_t), intent(inout) :: status
+        gwq(1, 1:2) = w(1:2)
+        gtlq = 0.0_wp
+        gtlq(1, 1) = lambda(1)
+        gtlq(2, 2) = lambda(1)
+    end subroutine mechanical_constraint_jacobian_derivatives
+
+    !> Scleronomic: g_I = 0.
+    subroutine mechanical_zero_time_jacobian(self, t, q, dq, status)
+        class(pendulum_mechanical_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: dq(:, :)
+        type(status_t), intent(inout) :: status
+        dq = 0.0_wp
+    end subroutine mechanical_zero_time_jacobian
+
+    !> γ = u² + v²: γ_q = 0, γ_v = 2 vᵀ.
+    subroutine mechanical_curvature_derivatives(self, t, q, v, gq, gv, status)
+        class(pendulum_mechanical_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: gq(:, :), gv(:, :)
+        type(status_t), intent(inout) :: status
+        gq = 0.0_wp
+        gv(1, 1:2) = 2.0_wp * v(1:2)
+    end subroutine mechanical_curvature_derivatives
 end module flexmbs_problems_pendulum

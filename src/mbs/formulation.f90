@@ -1,0 +1,631 @@
+!> The formulations of ALGORITHMS.md §6: any `mechanical_problem_t` turned
+!> into the linearly implicit DAE `M y' = F(t, y)` of `dae_problem_t`.
+!>
+!> Mechanical system (DESIGN.md, our sign of λ): q' = T(q) v,
+!> M(q) v' = f(t,q,v) - Gᵀλ, constraints g(t,q) = 0, G = g_q T,
+!> velocity constraint G v + g_I = 0, acceleration constraint G a + γ = 0.
+!>
+!> Layouts (unknowns y, DAE mass matrix):
+!>   with accelerations:  y = (q, v, a, λ[, μ]),  diag(I, I, 0, 0[, 0]); any M(q)
+!>     q' = T v,  v' = a,  0 = f - M a - Gᵀλ,  constraint rows below;
+!>   constant mass:       y = (q, v, λ[, μ]),     diag(I, M, 0[, 0]); M constant
+!>     q' = T v,  M v' = f - Gᵀλ,  constraint rows below.
+!> Constraint rows and index classes (RADAU5 NIND1/2/3):
+!>   index 3:         0 = g                                  q: 1; v: 2; a, λ: 3
+!>   index 2 (eq. 8): 0 = G v + g_I                          q, v: 1; a, λ: 2
+!>   index 1 (eq. 9): 0 = G a + γ  (+ 2ζω (G v + g_I) + ω² g, Baumgarte)   all 1
+!>                    (constant-mass layout: a = M⁻¹(f - Gᵀλ))
+!>   GGL (eq. 10):    q' = T (v - Gᵀμ),  0 = G v + g_I,  0 = g    q, v: 1; a, λ, μ: 2
+!> GGL's correction is written T Gᵀμ = T Tᵀ g_qᵀ μ rather than g_qᵀ μ: it is
+!> the same for T = I (the pendulum, FE nodes) and keeps the correction in
+!> the range of T, so that invariants of q' = T w (a quaternion's unit length)
+!> are not disturbed by it. On the exact solution μ = 0 either way.
+!>
+!> Jacobians ∂F/∂y are dense and analytic in the unknowns that enter F
+!> linearly (a, λ, μ and T's, G's and M's action on them); the derivatives in
+!> q and v come from the mechanical problem's `*_derivative(s)` bindings,
+!> which are analytic when the problem overrides them and forward differences
+!> (mechanical_problem.f90) otherwise.
+!>
+!> Coordinate projection (eqs. 11-12), the post-step hook: positions by the
+!> simplified Newton iteration of ALGORITHMS.md §3.6 step 1 with
+!> K = [M Gᵀ; G 0] at the step's q̃, q ← q + T(q̃) δ, converged when the
+!> weighted RMS norm of the correction is ≤ EPSREQ; then velocities by one
+!> solve with K at the projected q, every `velocity_interval` calls.
+module flexmbs_mbs_formulation
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
+        reason_singular_matrix, reason_projection
+    use flexmbs_linalg_matrix, only: storage_dense
+    use flexmbs_linalg_lapack, only: dgetrf, dgetrs
+    use flexmbs_dae_problem, only: dae_problem_t
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    implicit none
+    private
+
+    interface solve_mass
+        module procedure solve_mass_matrix, solve_mass_vector
+    end interface solve_mass
+
+    !> Formulation selectors.
+    integer, parameter, public :: formulation_index1 = 1
+    integer, parameter, public :: formulation_index2 = 2
+    integer, parameter, public :: formulation_index3 = 3
+    integer, parameter, public :: formulation_ggl = 4
+
+    ! ALGORITHMS.md §3.6: convergence bound and iteration limit of the
+    ! position projection.
+    real(wp), parameter :: projection_epsreq = 1.0e-2_wp
+    integer, parameter :: projection_itmax = 10
+
+    !> A mechanical problem in one formulation, as a `dae_problem_t`.
+    type, extends(dae_problem_t), public :: formulation_t
+        class(mechanical_problem_t), pointer :: mechanical => null()
+        integer :: form = formulation_index2
+        logical :: accelerations = .true.  !! layout (q, v, a, λ[, μ]) or (q, v, λ[, μ])
+        real(wp) :: baumgarte_zeta = 0.0_wp  !! index 1: damping ratio ζ
+        real(wp) :: baumgarte_omega = 0.0_wp !! index 1: frequency ω (0: no Baumgarte)
+        logical :: projection = .false.      !! offer the projection hook
+        integer :: velocity_interval = 1     !! project velocities every k-th call
+        real(wp) :: projection_rtol = 1.0e-6_wp !! weights rtol |q| + atol of §6
+        real(wp) :: projection_atol = 1.0e-6_wp
+        integer :: projection_calls = 0
+        integer :: nq = 0, nv = 0, nc = 0
+        integer :: oq = 0, ov = 0, oa = 0, ol = 0, om = 0 !! offsets of the blocks in y
+        real(wp), allocatable :: q_mass(:)   !! where the constant M is evaluated
+        ! workspaces, allocated once by the constructor
+        real(wp), allocatable :: m(:, :), gmat(:, :), force(:), w(:), b(:), c(:), ct(:)
+        real(wp), allocatable :: qq(:, :), vq(:, :), vv(:, :), cq(:, :), cq2(:, :), cv(:, :)
+        real(wp), allocatable :: gtlq(:, :), minv_gt(:, :), tq(:), q0(:), mass_lu(:, :)
+        real(wp), allocatable :: kkt(:, :), kkt_rhs(:)
+        integer, allocatable :: mass_pivots(:), kkt_pivots(:)
+        logical :: mass_factored = .false.
+    contains
+        procedure :: rhs => formulation_rhs
+        procedure :: jacobian_storage => formulation_jacobian_storage
+        procedure :: jacobian_dense => formulation_jacobian_dense
+        procedure :: mass_storage => formulation_mass_storage
+        procedure :: mass_dense => formulation_mass_dense
+        procedure :: index_classes => formulation_index_classes
+        procedure :: differential_flags => formulation_differential_flags
+        procedure :: has_projection => formulation_has_projection
+        procedure :: project => formulation_project
+        procedure :: consistent_initial => formulation_consistent_initial
+        procedure :: drift => formulation_drift
+    end type formulation_t
+
+    public :: new_formulation
+
+contains
+
+    !> The mechanical problem `mechanical` (kept by pointer: it must outlive
+    !> the formulation) in formulation `form`. `constant_mass` selects the
+    !> layout y = (q, v, λ[, μ]) with DAE mass diag(I, M, 0), M evaluated at
+    !> q0 (the caller asserts M does not depend on q); otherwise accelerations
+    !> are unknowns. On bad arguments `status` says why and n = 0.
+    function new_formulation(mechanical, form, q0, constant_mass, baumgarte_zeta, &
+                             baumgarte_omega, projection, status) result(self)
+        class(mechanical_problem_t), target, intent(inout) :: mechanical
+        integer, intent(in) :: form                  !! formulation_index1/2/3, formulation_ggl
+        real(wp), intent(in) :: q0(:)                !! a configuration (size nq)
+        logical, intent(in), optional :: constant_mass  !! layout without a (default false)
+        real(wp), intent(in), optional :: baumgarte_zeta  !! index 1 only
+        real(wp), intent(in), optional :: baumgarte_omega !! index 1 only, >= 0
+        logical, intent(in), optional :: projection  !! offer the post-step projection
+        type(status_t), intent(out) :: status
+        type(formulation_t) :: self
+        integer :: nq, nv, nc, nk
+        character(len=160) :: msg
+
+        nq = mechanical%nq
+        nv = mechanical%nv
+        nc = mechanical%nc
+        if (form < formulation_index1 .or. form > formulation_ggl) then
+            write (msg, '(a,i0,a)') 'formulation: form = ', form, &
+                ': must be formulation_index1, _index2, _index3 or formulation_ggl'
+            call status%set(status_bad_input, trim(msg))
+            return
+        end if
+        if (nq < 1 .or. nv < 1 .or. size(q0) /= nq) then
+            write (msg, '(a,3(i0,a))') 'formulation: nq = ', nq, ', nv = ', nv, &
+                ', size(q0) = ', size(q0), ': need nq, nv >= 1 and size(q0) = nq'
+            call status%set(status_bad_input, trim(msg))
+            return
+        end if
+        self%mechanical => mechanical
+        self%form = form
+        if (present(constant_mass)) self%accelerations = .not. constant_mass
+        if (present(baumgarte_zeta)) self%baumgarte_zeta = baumgarte_zeta
+        if (present(baumgarte_omega)) self%baumgarte_omega = baumgarte_omega
+        if (present(projection)) self%projection = projection
+        if (self%baumgarte_omega < 0.0_wp .or. self%baumgarte_zeta < 0.0_wp) then
+            call status%set(status_bad_input, 'formulation: Baumgarte zeta and omega &
+                &must be >= 0')
+            return
+        end if
+        self%nq = nq
+        self%nv = nv
+        self%nc = nc
+        self%oq = 0
+        self%ov = nq
+        self%oa = nq + nv
+        self%ol = nq + nv
+        if (self%accelerations) self%ol = nq + 2 * nv
+        self%om = self%ol + nc
+        self%n = self%om
+        if (form == formulation_ggl) self%n = self%om + nc
+        self%q_mass = q0
+        nk = nv + nc
+        allocate (self%m(nv, nv), self%gmat(nc, nv), self%force(nv), self%w(nv), self%b(nv), &
+                  self%c(nc), self%ct(nc), self%qq(nq, nq), self%vq(nv, nq), self%vv(nv, nv), &
+                  self%cq(nc, nq), self%cq2(nc, nq), self%cv(nc, nv), self%tq(nq), &
+                  self%gtlq(nv, nq), self%minv_gt(nv, nc), &
+                  self%q0(nq), self%mass_lu(nv, nv), self%kkt(nk, nk), self%kkt_rhs(nk), &
+                  self%mass_pivots(nv), self%kkt_pivots(nk))
+    end function new_formulation
+
+    !> Factor the constant M once (constant-mass layout, index 1 needs M⁻¹).
+    subroutine factor_mass(self, t, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        type(status_t), intent(inout) :: status
+        integer :: info
+        call self%mechanical%mass(t, self%q_mass, self%mass_lu, status)
+        call dgetrf(self%nv, self%nv, self%mass_lu, self%nv, self%mass_pivots, info)
+        if (info /= 0) then
+            call status%set(status_solver_failure, 'formulation: mass matrix is singular', &
+                reason_singular_matrix)
+            return
+        end if
+        self%mass_factored = .true.
+    end subroutine factor_mass
+
+    !> x ← M⁻¹ x with the constant M.
+    subroutine solve_mass_vector(self, t, x, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(inout) :: x(:)
+        type(status_t), intent(inout) :: status
+        integer :: info
+        if (.not. self%mass_factored) call factor_mass(self, t, status)
+        if (.not. status%ok()) return
+        call dgetrs('N', self%nv, 1, self%mass_lu, self%nv, self%mass_pivots, x, self%nv, info)
+    end subroutine solve_mass_vector
+
+    !> X ← M⁻¹ X with the constant M.
+    subroutine solve_mass_matrix(self, t, x, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(inout) :: x(:, :)
+        type(status_t), intent(inout) :: status
+        integer :: info
+        if (.not. self%mass_factored) call factor_mass(self, t, status)
+        if (.not. status%ok()) return
+        call dgetrs('N', self%nv, size(x, 2), self%mass_lu, self%nv, self%mass_pivots, x, &
+                    self%nv, info)
+    end subroutine solve_mass_matrix
+
+    subroutine formulation_rhs(self, t, y, f, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: f(:)
+        type(status_t), intent(inout) :: status
+        associate (mech => self%mechanical, nq => self%nq, nv => self%nv, nc => self%nc, &
+                   q => y(self%oq + 1:self%oq + self%nq), v => y(self%ov + 1:self%ov + self%nv), &
+                   lam => y(self%ol + 1:self%ol + self%nc), &
+                   fq => f(self%oq + 1:self%oq + self%nq), fv => f(self%ov + 1:self%ov + self%nv), &
+                   fc => f(self%ol + 1:self%ol + self%nc))
+            call mech%forces(t, q, v, self%force, status)
+            call mech%constraint_jacobian(t, q, self%gmat, status)
+            ! q' = T v, or T (v - Gᵀμ) in GGL
+            self%w = v
+            if (self%form == formulation_ggl) &
+                self%w = v - matmul(y(self%om + 1:self%om + nc), self%gmat)
+            call mech%kinematics(t, q, self%w, fq, status)
+            self%b = self%force - matmul(lam, self%gmat)
+            if (self%accelerations) then
+                associate (a => y(self%oa + 1:self%oa + nv), fa => f(self%oa + 1:self%oa + nv))
+                    fv = a
+                    call mech%mass(t, q, self%m, status)
+                    fa = self%b - matmul(self%m, a)
+                    self%b = a
+                end associate
+            else
+                fv = self%b
+            end if
+            select case (self%form)
+            case (formulation_index3)
+                call mech%constraint(t, q, fc, status)
+            case (formulation_index2)
+                call velocity_constraint(self, t, q, v, fc, status)
+            case (formulation_ggl)
+                call velocity_constraint(self, t, q, v, fc, status)
+                call mech%constraint(t, q, f(self%om + 1:self%om + nc), status)
+            case (formulation_index1)
+                ! b = a, or M⁻¹(f - Gᵀλ) with the constant M
+                if (.not. self%accelerations) call solve_mass(self, t, self%b, status)
+                call mech%constraint_curvature(t, q, v, fc, status)
+                fc = fc + matmul(self%gmat, self%b)
+                if (self%baumgarte_omega > 0.0_wp) then
+                    call velocity_constraint(self, t, q, v, self%c, status)
+                    fc = fc + 2.0_wp * self%baumgarte_zeta * self%baumgarte_omega * self%c
+                    call mech%constraint(t, q, self%c, status)
+                    fc = fc + self%baumgarte_omega**2 * self%c
+                end if
+            end select
+        end associate
+    end subroutine formulation_rhs
+
+    !> G v + g_I with self%gmat = G(t, q) already evaluated.
+    subroutine velocity_constraint(self, t, q, v, c, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: c(:)
+        type(status_t), intent(inout) :: status
+        call self%mechanical%constraint_time_derivative(t, q, self%ct, status)
+        c = matmul(self%gmat, v) + self%ct
+    end subroutine velocity_constraint
+
+    integer function formulation_jacobian_storage(self)
+        class(formulation_t), intent(in) :: self
+        formulation_jacobian_storage = storage_dense
+    end function formulation_jacobian_storage
+
+    !> ∂F/∂y, block by block (module header).
+    subroutine formulation_jacobian_dense(self, t, y, jac, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: jac(:, :)
+        type(status_t), intent(inout) :: status
+        real(wp) :: kz
+        integer :: j, k, rq, rv, ra, rl, rm
+        jac = 0.0_wp
+        rq = self%oq
+        rv = self%ov
+        ra = self%oa
+        rl = self%ol
+        rm = self%om
+        associate (mech => self%mechanical, nq => self%nq, nv => self%nv, nc => self%nc, &
+                   q => y(self%oq + 1:self%oq + self%nq), v => y(self%ov + 1:self%ov + self%nv), &
+                   lam => y(self%ol + 1:self%ol + self%nc))
+            call mech%constraint_jacobian(t, q, self%gmat, status)
+            call mech%forces(t, q, v, self%force, status)
+            ! rows q' = T w, w = v (- Gᵀμ)
+            self%w = v
+            if (self%form == formulation_ggl) &
+                self%w = v - matmul(y(rm + 1:rm + nc), self%gmat)
+            call mech%kinematics_derivative(t, q, self%w, self%qq, status)
+            jac(rq + 1:rq + nq, rq + 1:rq + nq) = self%qq
+            do j = 1, nv
+                self%b = 0.0_wp
+                self%b(j) = 1.0_wp
+                call mech%kinematics(t, q, self%b, self%tq, status)
+                jac(rq + 1:rq + nq, rv + j) = self%tq
+            end do
+            if (self%form == formulation_ggl) then
+                ! -T ∂(Gᵀμ)/∂q and -T Gᵀ
+                call mech%constraint_jacobian_derivatives(t, q, v, y(rm + 1:rm + nc), &
+                                                          self%cq, self%vq, status)
+                do j = 1, nq
+                    call mech%kinematics(t, q, self%vq(:, j), self%tq, status)
+                    jac(rq + 1:rq + nq, rq + j) = jac(rq + 1:rq + nq, rq + j) - self%tq
+                end do
+                do k = 1, nc
+                    call mech%kinematics(t, q, self%gmat(k, :), self%tq, status)
+                    jac(rq + 1:rq + nq, rm + k) = -self%tq
+                end do
+            end if
+            ! force rows: f - M a - Gᵀλ (accelerations) or f - Gᵀλ
+            call mech%force_derivatives(t, q, v, self%vq, self%vv, status)
+            call mech%constraint_jacobian_derivatives(t, q, v, lam, self%cq, self%gtlq &
+                                                      , status)
+            if (self%accelerations) then
+                do j = 1, nv
+                    jac(rv + j, ra + j) = 1.0_wp
+                end do
+                associate (a => y(ra + 1:ra + nv))
+                    jac(ra + 1:ra + nv, rq + 1:rq + nq) = self%vq - self%gtlq
+                    call mech%mass_derivative(t, q, a, self%vq, status)
+                    jac(ra + 1:ra + nv, rq + 1:rq + nq) = jac(ra + 1:ra + nv, rq + 1:rq + nq) &
+                        - self%vq
+                    jac(ra + 1:ra + nv, rv + 1:rv + nv) = self%vv
+                    call mech%mass(t, q, self%m, status)
+                    jac(ra + 1:ra + nv, ra + 1:ra + nv) = -self%m
+                    jac(ra + 1:ra + nv, rl + 1:rl + nc) = -transpose(self%gmat)
+                end associate
+            else
+                jac(rv + 1:rv + nv, rq + 1:rq + nq) = self%vq - self%gtlq
+                jac(rv + 1:rv + nv, rv + 1:rv + nv) = self%vv
+                jac(rv + 1:rv + nv, rl + 1:rl + nc) = -transpose(self%gmat)
+            end if
+            ! constraint rows
+            select case (self%form)
+            case (formulation_index3)
+                call mech%constraint_position_jacobian(t, q, self%cq, status)
+                jac(rl + 1:rl + nc, rq + 1:rq + nq) = self%cq
+            case (formulation_index2, formulation_ggl)
+                call velocity_constraint_derivatives(self, t, q, v, status)
+                jac(rl + 1:rl + nc, rq + 1:rq + nq) = self%cq
+                jac(rl + 1:rl + nc, rv + 1:rv + nv) = self%gmat
+                if (self%form == formulation_ggl) then
+                    call mech%constraint_position_jacobian(t, q, self%cq, status)
+                    jac(rm + 1:rm + nc, rq + 1:rq + nq) = self%cq
+                end if
+            case (formulation_index1)
+                call mech%constraint_curvature_derivatives(t, q, v, self%cq, self%cv, status)
+                jac(rl + 1:rl + nc, rq + 1:rq + nq) = self%cq
+                jac(rl + 1:rl + nc, rv + 1:rv + nv) = self%cv
+                if (self%accelerations) then
+                    associate (a => y(ra + 1:ra + nv))
+                        call mech%constraint_jacobian_derivatives(t, q, a, lam, self%cq, &
+                                                                  self%vq, status)
+                    end associate
+                    jac(rl + 1:rl + nc, rq + 1:rq + nq) = jac(rl + 1:rl + nc, rq + 1:rq + nq) &
+                        + self%cq
+                    jac(rl + 1:rl + nc, ra + 1:ra + nv) = self%gmat
+                else
+                    call index1_constant_mass_rows(self, t, q, lam, jac, status)
+                end if
+                if (self%baumgarte_omega > 0.0_wp) then
+                    kz = 2.0_wp * self%baumgarte_zeta * self%baumgarte_omega
+                    call velocity_constraint_derivatives(self, t, q, v, status)
+                    jac(rl + 1:rl + nc, rq + 1:rq + nq) = jac(rl + 1:rl + nc, rq + 1:rq + nq) &
+                        + kz * self%cq
+                    jac(rl + 1:rl + nc, rv + 1:rv + nv) = jac(rl + 1:rl + nc, rv + 1:rv + nv) &
+                        + kz * self%gmat
+                    call mech%constraint_position_jacobian(t, q, self%cq, status)
+                    jac(rl + 1:rl + nc, rq + 1:rq + nq) = jac(rl + 1:rl + nc, rq + 1:rq + nq) &
+                        + self%baumgarte_omega**2 * self%cq
+                end if
+            end select
+        end associate
+    end subroutine formulation_jacobian_dense
+
+    !> self%cq = ∂(G v + g_I)/∂q.
+    subroutine velocity_constraint_derivatives(self, t, q, v, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        type(status_t), intent(inout) :: status
+        self%c = 0.0_wp
+        call self%mechanical%constraint_jacobian_derivatives(t, q, v, self%c, self%cq, &
+                                                             self%vq, status)
+        call self%mechanical%constraint_time_derivative_jacobian(t, q, self%cq2, status)
+        self%cq = self%cq + self%cq2
+    end subroutine velocity_constraint_derivatives
+
+    !> Index 1, constant M: the G M⁻¹(f - Gᵀλ) part of the constraint rows,
+    !> added to the γ part already in jac. Uses self%vq = f_q - ∂(Gᵀλ)/∂q and
+    !> self%vv = f_v left by the force rows.
+    subroutine index1_constant_mass_rows(self, t, q, lam, jac, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), lam(:)
+        real(wp), intent(inout) :: jac(:, :)
+        type(status_t), intent(inout) :: status
+        integer :: rq, rv, rl
+        rq = self%oq
+        rv = self%ov
+        rl = self%ol
+        associate (nq => self%nq, nv => self%nv, nc => self%nc)
+            ! rows of ∂/∂q and ∂/∂v of M⁻¹(f - Gᵀλ): the force-row blocks times M⁻¹
+            self%vq = jac(rv + 1:rv + nv, rq + 1:rq + nq)
+            call solve_mass(self, t, self%vq, status)
+            self%vv = jac(rv + 1:rv + nv, rv + 1:rv + nv)
+            call solve_mass(self, t, self%vv, status)
+            self%minv_gt = transpose(self%gmat)
+            call solve_mass(self, t, self%minv_gt, status)
+            ! b = M⁻¹(f - Gᵀλ); ∂(G b)/∂q at fixed b
+            self%b = self%force - matmul(lam, self%gmat)
+            call solve_mass(self, t, self%b, status)
+            call self%mechanical%constraint_jacobian_derivatives(t, q, self%b, lam, self%cq, &
+                                                                 self%gtlq, status)
+            jac(rl + 1:rl + nc, rq + 1:rq + nq) = jac(rl + 1:rl + nc, rq + 1:rq + nq) &
+                + self%cq + matmul(self%gmat, self%vq)
+            jac(rl + 1:rl + nc, rv + 1:rv + nv) = jac(rl + 1:rl + nc, rv + 1:rv + nv) &
+                + matmul(self%gmat, self%vv)
+            jac(rl + 1:rl + nc, rl + 1:rl + nc) = -matmul(self%gmat, self%minv_gt)
+        end associate
+    end subroutine index1_constant_mass_rows
+
+    integer function formulation_mass_storage(self)
+        class(formulation_t), intent(in) :: self
+        formulation_mass_storage = storage_dense
+    end function formulation_mass_storage
+
+    !> diag(I, I, 0, ...) or diag(I, M, 0, ...).
+    subroutine formulation_mass_dense(self, m)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(out) :: m(:, :)
+        type(status_t) :: status
+        integer :: i
+        m = 0.0_wp
+        do i = 1, self%nq
+            m(self%oq + i, self%oq + i) = 1.0_wp
+        end do
+        if (self%accelerations) then
+            do i = 1, self%nv
+                m(self%ov + i, self%ov + i) = 1.0_wp
+            end do
+        else
+            call self%mechanical%mass(0.0_wp, self%q_mass, self%m, status)
+            m(self%ov + 1:self%ov + self%nv, self%ov + 1:self%ov + self%nv) = self%m
+        end if
+    end subroutine formulation_mass_dense
+
+    !> ALGORITHMS.md §6.
+    subroutine formulation_index_classes(self, classes)
+        class(formulation_t), intent(in) :: self
+        integer, intent(out) :: classes(:)
+        classes = 1
+        select case (self%form)
+        case (formulation_index3)
+            classes(self%ov + 1:self%ov + self%nv) = 2
+            classes(self%ov + self%nv + 1:) = 3
+        case (formulation_index2, formulation_ggl)
+            classes(self%ov + self%nv + 1:) = 2
+        end select
+    end subroutine formulation_index_classes
+
+    !> q and v differential, a, λ, μ algebraic.
+    subroutine formulation_differential_flags(self, flags)
+        class(formulation_t), intent(in) :: self
+        logical, intent(out) :: flags(:)
+        flags = .false.
+        flags(1:self%nq + self%nv) = .true.
+    end subroutine formulation_differential_flags
+
+    logical function formulation_has_projection(self)
+        class(formulation_t), intent(in) :: self
+        formulation_has_projection = self%projection
+    end function formulation_has_projection
+
+    !> Eqs. (11)-(12) after an accepted step (module header).
+    subroutine formulation_project(self, t, y, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(inout) :: y(:)
+        type(status_t), intent(inout) :: status
+        self%projection_calls = self%projection_calls + 1
+        call project_positions(self, t, y(self%oq + 1:self%oq + self%nq), projection_epsreq, &
+                               status)
+        if (.not. status%ok()) return
+        if (mod(self%projection_calls, max(1, self%velocity_interval)) == 0) &
+            call project_velocities(self, t, y(self%oq + 1:self%oq + self%nq), &
+                                    y(self%ov + 1:self%ov + self%nv), status)
+    end subroutine formulation_project
+
+    !> Factor K = [M Gᵀ; G 0] at q into self%kkt.
+    subroutine factor_kkt(self, t, q, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        type(status_t), intent(inout) :: status
+        integer :: info, nv, nc
+        nv = self%nv
+        nc = self%nc
+        call self%mechanical%mass(t, q, self%m, status)
+        call self%mechanical%constraint_jacobian(t, q, self%gmat, status)
+        self%kkt = 0.0_wp
+        self%kkt(1:nv, 1:nv) = self%m
+        self%kkt(1:nv, nv + 1:nv + nc) = transpose(self%gmat)
+        self%kkt(nv + 1:nv + nc, 1:nv) = self%gmat
+        call dgetrf(nv + nc, nv + nc, self%kkt, nv + nc, self%kkt_pivots, info)
+        if (info /= 0) call status%set(status_solver_failure, &
+            'formulation: projection matrix [M Gᵀ; G 0] is singular (redundant constraints?)', &
+            reason_singular_matrix)
+    end subroutine factor_kkt
+
+    !> self%kkt_rhs ← K⁻¹ self%kkt_rhs.
+    subroutine solve_kkt(self)
+        class(formulation_t), intent(inout) :: self
+        integer :: info, nk
+        nk = self%nv + self%nc
+        call dgetrs('N', nk, 1, self%kkt, nk, self%kkt_pivots, self%kkt_rhs, nk, info)
+    end subroutine solve_kkt
+
+    !> Simplified Newton for g(t, q) = 0 with K at the starting q̃ (§3.6 step 1).
+    subroutine project_positions(self, t, q, epsreq, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, epsreq
+        real(wp), intent(inout) :: q(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: eps, eps_old
+        integer :: it
+        character(len=120) :: msg
+        if (self%nc == 0) return
+        self%q0 = q
+        call factor_kkt(self, t, q, status)
+        if (.not. status%ok()) return
+        eps_old = huge(1.0_wp)
+        do it = 0, projection_itmax - 1
+            call self%mechanical%constraint(t, q, self%c, status)
+            if (.not. status%ok()) return
+            self%kkt_rhs(1:self%nv) = 0.0_wp
+            self%kkt_rhs(self%nv + 1:) = -self%c
+            call solve_kkt(self)
+            call self%mechanical%kinematics(t, self%q0, self%kkt_rhs(1:self%nv), self%tq, status)
+            q = q + self%tq
+            eps = sqrt(sum((self%tq / (self%projection_rtol * abs(self%q0) &
+                + self%projection_atol))**2) / self%nq)
+            if (eps <= epsreq) return
+            if ((it >= 1 .and. eps > 2.0_wp * eps_old) .or. .not. (eps == eps)) exit
+            eps_old = eps
+        end do
+        write (msg, '(a,es10.3,a,es10.3)') 'formulation: position projection did not &
+            &converge at t = ', t, ', last correction norm ', eps
+        call status%set(status_solver_failure, trim(msg), reason_projection)
+    end subroutine project_positions
+
+    !> Eq. (12): v ← v + Δv with K [Δv; μ] = [0; -(G v + g_I)] at q.
+    subroutine project_velocities(self, t, q, v, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(inout) :: v(:)
+        type(status_t), intent(inout) :: status
+        if (self%nc == 0) return
+        call factor_kkt(self, t, q, status)
+        if (.not. status%ok()) return
+        call velocity_constraint(self, t, q, v, self%c, status)
+        self%kkt_rhs(1:self%nv) = 0.0_wp
+        self%kkt_rhs(self%nv + 1:) = -self%c
+        call solve_kkt(self)
+        v = v + self%kkt_rhs(1:self%nv)
+    end subroutine project_velocities
+
+    !> Consistent (y, y'): q and v projected onto g = 0 and G v + g_I = 0
+    !> (iterated to round-off), a and λ from [M Gᵀ; G 0] [a; λ] = [f; -γ],
+    !> μ = 0; y' = (T v, a, 0, ...) (v' = a in both layouts).
+    subroutine formulation_consistent_initial(self, t, y, yp, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(inout) :: y(:), yp(:)
+        type(status_t), intent(inout) :: status
+        ! Three simplified-Newton projections, each with K refactored at its
+        ! start (an outer Newton iteration), reach round-off from any start
+        ! the iteration converges from.
+        integer, parameter :: restarts = 3
+        integer :: nv, nc, k
+        nv = self%nv
+        nc = self%nc
+        associate (q => y(self%oq + 1:self%oq + self%nq), v => y(self%ov + 1:self%ov + nv))
+            do k = 1, restarts
+                call project_positions(self, t, q, projection_epsreq, status)
+                if (.not. status%ok()) return
+            end do
+            call project_velocities(self, t, q, v, status)
+            if (.not. status%ok()) return
+            call self%mechanical%forces(t, q, v, self%force, status)
+            self%kkt_rhs(1:nv) = self%force
+            if (nc > 0) then
+                call self%mechanical%constraint_curvature(t, q, v, self%c, status)
+                self%kkt_rhs(nv + 1:) = -self%c
+            end if
+            if (.not. status%ok()) return
+            call factor_kkt(self, t, q, status)
+            if (.not. status%ok()) return
+            call solve_kkt(self)
+            yp = 0.0_wp
+            call self%mechanical%kinematics(t, q, v, yp(self%oq + 1:self%oq + self%nq), status)
+            yp(self%ov + 1:self%ov + nv) = self%kkt_rhs(1:nv)
+            if (self%accelerations) y(self%oa + 1:self%oa + nv) = self%kkt_rhs(1:nv)
+            y(self%ol + 1:self%ol + nc) = self%kkt_rhs(nv + 1:)
+            if (self%form == formulation_ggl) y(self%om + 1:self%om + nc) = 0.0_wp
+        end associate
+    end subroutine formulation_consistent_initial
+
+    !> Drift of a state: max-norms of g(t, q) and G v + g_I.
+    subroutine formulation_drift(self, t, y, position, velocity, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: position, velocity
+        type(status_t), intent(inout) :: status
+        position = 0.0_wp
+        velocity = 0.0_wp
+        if (self%nc == 0) return
+        associate (q => y(self%oq + 1:self%oq + self%nq), v => y(self%ov + 1:self%ov + self%nv))
+            call self%mechanical%constraint(t, q, self%c, status)
+            position = maxval(abs(self%c))
+            call self%mechanical%constraint_jacobian(t, q, self%gmat, status)
+            call velocity_constraint(self, t, q, v, self%c, status)
+            velocity = maxval(abs(self%c))
+        end associate
+    end subroutine formulation_drift
+end module flexmbs_mbs_formulation
