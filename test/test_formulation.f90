@@ -20,7 +20,7 @@ module test_formulation
     use testing, only: test_case_t, new_test, error_t, check
     implicit none
     private
-    public :: collect_formulation
+    public :: collect_formulation, difference_jacobian
 
     !> Records the drift ‖g‖ after every accepted step, binned in time.
     type, extends(sink_t) :: drift_sink_t
@@ -103,10 +103,9 @@ contains
         type(pendulum_mechanical_t), target :: mech
         type(formulation_t) :: gen
         type(status_t) :: status
-        real(wp), allocatable :: y(:), yp(:), fp(:), fm(:), jac(:, :), jfd(:, :)
+        real(wp), allocatable :: y(:), jac(:, :), jfd(:, :)
         integer, allocatable :: classes(:)
-        integer :: form, n, j
-        real(wp) :: delta
+        integer :: form, n
         character(len=160) :: msg
         integer, parameter :: expected(8, 4) = reshape([1, 1, 1, 1, 1, 1, 1, 0, &
                                                         1, 1, 1, 1, 2, 2, 2, 0, &
@@ -118,19 +117,11 @@ contains
                 baumgarte_omega=merge(3.0_wp, 0.0_wp, form == formulation_index1), &
                 status=status)
             n = gen%n
-            allocate (y(n), yp(n), fp(n), fm(n), jac(n, n), jfd(n, n), classes(n))
+            allocate (y(n), jac(n, n), jfd(n, n), classes(n))
             y = [y_test(1:4), -0.2_wp, 0.5_wp, y_test(5:6)]
             y = y(1:n)
             call gen%jacobian_dense(0.0_wp, y, jac, status)
-            do j = 1, n
-                delta = 1.0e-6_wp
-                yp = y
-                yp(j) = y(j) + delta
-                call gen%rhs(0.0_wp, yp, fp, status)
-                yp(j) = y(j) - delta
-                call gen%rhs(0.0_wp, yp, fm, status)
-                jfd(:, j) = (fp - fm) / (2 * delta)
-            end do
+            call difference_jacobian(gen, y, jfd, status)
             write (msg, '(2a,es10.3)') form_names(form), ': Jacobian vs differences ', &
                 maxval(abs(jac - jfd))
             call check(error, maxval(abs(jac - jfd)) <= 1.0e-8_wp, trim(msg))
@@ -138,9 +129,28 @@ contains
             call check(error, all(classes == expected(1:n, form)), &
                 form_names(form) // ': index classes')
             call check(error, status%ok(), status%text())
-            deallocate (y, yp, fp, fm, jac, jfd, classes)
+            deallocate (y, jac, jfd, classes)
         end do
     end subroutine test_acceleration_jacobian
+
+    !> Central differences of F at t = 0 (step 1e-6), column by column.
+    subroutine difference_jacobian(gen, y, jfd, status)
+        type(formulation_t), intent(inout) :: gen
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: jfd(:, :)
+        type(status_t), intent(inout) :: status
+        real(wp), parameter :: delta = 1.0e-6_wp
+        real(wp) :: yp(size(y)), fp(size(y)), fm(size(y))
+        integer :: j
+        do j = 1, size(y)
+            yp = y
+            yp(j) = y(j) + delta
+            call gen%rhs(0.0_wp, yp, fp, status)
+            yp(j) = y(j) - delta
+            call gen%rhs(0.0_wp, yp, fm, status)
+            jfd(:, j) = (fp - fm) / (2 * delta)
+        end do
+    end subroutine difference_jacobian
 
     !> RADAU5 on the hand-written and the generic constant-mass forms: the
     !> same trajectory to round-off.

@@ -41,6 +41,7 @@ module flexmbs_dae_mechanical_problem
         procedure :: mass_sparse => default_mass_sparse
         procedure :: constraint_jacobian_pattern => default_constraint_jacobian_pattern
         procedure :: constraint_jacobian_sparse => default_constraint_jacobian_sparse
+        procedure :: normalize => default_normalize
         procedure :: kinematics_derivative => default_kinematics_derivative
         procedure :: mass_derivative => default_mass_derivative
         procedure :: force_derivatives => default_force_derivatives
@@ -103,6 +104,15 @@ contains
         real(wp), intent(in) :: x
         delta = sqrt(epsilon(1.0_wp)) * max(1.0_wp, abs(x))
     end function difference_step
+
+    !> Restore invariants of the kinematics that are not constraints (a
+    !> quaternion's unit length: T w is tangent to the unit sphere, so the
+    !> length is an invariant of q' = T w that the integration lets drift).
+    !> Called by the formulations' projection; default: nothing to restore.
+    subroutine default_normalize(self, q)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(inout) :: q(:)
+    end subroutine default_normalize
 
     !> ∂(T(t,q) w)/∂q, nq x nq (default: forward differences).
     subroutine default_kinematics_derivative(self, t, q, w, dq, status)

@@ -31,7 +31,10 @@
 !> simplified Newton iteration of ALGORITHMS.md §3.6 step 1 with
 !> K = [M Gᵀ; G 0] at the step's q̃, q ← q + T(q̃) δ, converged when the
 !> weighted RMS norm of the correction is ≤ EPSREQ; then velocities by one
-!> solve with K at the projected q, every `velocity_interval` calls.
+!> solve with K at the projected q, every `velocity_interval` calls. Before
+!> the positions, the mechanical problem's `normalize` restores invariants of
+!> the kinematics that are not constraints (unit quaternions): with projection
+!> on, the formulation keeps them; without it they drift at tolerance level.
 module flexmbs_mbs_formulation
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
@@ -485,6 +488,7 @@ contains
         real(wp), intent(inout) :: y(:)
         type(status_t), intent(inout) :: status
         self%projection_calls = self%projection_calls + 1
+        call self%mechanical%normalize(y(self%oq + 1:self%oq + self%nq))
         call project_positions(self, t, y(self%oq + 1:self%oq + self%nq), projection_epsreq, &
                                status)
         if (.not. status%ok()) return
@@ -586,6 +590,7 @@ contains
         nv = self%nv
         nc = self%nc
         associate (q => y(self%oq + 1:self%oq + self%nq), v => y(self%ov + 1:self%ov + nv))
+            call self%mechanical%normalize(q)
             do k = 1, restarts
                 call project_positions(self, t, q, projection_epsreq, status)
                 if (.not. status%ok()) return
