@@ -107,8 +107,6 @@ module flexmbs_dae_radau5
         logical :: zero_start = .false.    !! zero Newton starting values (IWORK(4))
         !> Constant step h0, every converged step accepted (order studies).
         logical :: fixed_step = .false.
-        !> Velocity projection only every this many accepted steps (§6).
-        integer :: projection_interval = 1
         ! Results of the last integration.
         type(radau5_native_t) :: native
         real(wp) :: h_opt = 0.0_wp         !! predicted next step (classic H on return)
