@@ -28,6 +28,11 @@ module flexmbs
     use flexmbs_fe_mesh, only: mesh_t, node_set_t
     use flexmbs_fe_box_mesh, only: box_mesh
     use flexmbs_fe_flexible_body, only: flexible_body_t, new_flexible_body
+    use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &
+        formulation_index2, formulation_index3, formulation_ggl
+    use flexmbs_mbs_rigid_body, only: rigid_bodies_t, rigid_body_t, new_rigid_bodies, &
+        rigid_body_energy, rigid_body_momenta
+    use flexmbs_dae_mexax, only: mexax_t
     use flexmbs_io_namelist, only: scene_input_t, read_scene, parse_scene, scene_dae_options
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_table, only: stats_row_t, new_stats_row, table_text, write_table, &
