@@ -26,7 +26,7 @@ SYSLIBS      := -lsundials_fida_mod -lsundials_fnvecserial_mod \
                 -lsundials_ida -lsundials_nvecserial -lsundials_sunmatrixdense \
                 -lsundials_sunmatrixsparse -lsundials_sunlinsoldense -lsundials_sunlinsolklu \
                 -lsundials_generic \
-                -lklu -lamd -lcolamd -lbtf -lsuitesparseconfig \
+                -lklu -lcholmod -lamd -lcolamd -lbtf -lsuitesparseconfig \
                 -lhdf5_serial_fortran -lhdf5_serial -llapack -lblas
 MAIN_INPUT   := inputs/van_der_pol.nml
 

@@ -232,6 +232,9 @@ contains
         call expect(error, status, 'name = ''dassl'': must be ''radau5''')
         status = parse_status('&simulation problem = ''duffing'', t_end = 1 /')
         call expect(error, status, 'problem = ''duffing'': must be one of ''van_der_pol''')
+        status = parse_status(vdp_sim() // '&solver sparse_ordering = ''metis'' /')
+        call expect(error, status, &
+            '&solver: sparse_ordering = ''metis'': must be ''auto'', ''amd'' or ''nd''')
     end subroutine test_other_bad_text
 
     ! ------------------------------------------------------------------

@@ -12,7 +12,7 @@ module test_klu
     use flexmbs_linalg_linear_solver, only: linear_solver_t, auto_sparse_threshold
     use flexmbs_linalg_dense, only: dense_solver_t
     use flexmbs_linalg_klu, only: klu_factor_t, klu_stats_t, klu_part_real, klu_part_complex, &
-        klu_refactor_degrade_ratio
+        klu_refactor_degrade_ratio, klu_ordering_auto, klu_ordering_amd, klu_ordering_nd
     use flexmbs_linalg_klu_solver, only: klu_solver_t
     use flexmbs_linalg_factory, only: new_linear_solver
     use testing, only: test_case_t, new_test, error_t, check, check_close
@@ -41,7 +41,8 @@ contains
                  new_test('laplacian_2d_residual', test_laplacian), &
                  new_test('copies_are_independent', test_copies), &
                  new_test('misuse_and_bad_values_reported', test_bad_use), &
-                 new_test('factory_choice_and_bad_name', test_factory)]
+                 new_test('factory_choice_and_bad_name', test_factory), &
+                 new_test('orderings_auto_amd_nd', test_orderings)]
     end function collect_klu
 
     ! ---------------------------------------------------------------- helpers
@@ -436,6 +437,81 @@ contains
             vals(t) = v
         end subroutine add
     end subroutine test_laplacian
+
+    !> Nested dissection (METIS) and AMD solve the same 2-D system to
+    !> round-off; 'auto' picks ND on the periodic 2-D grid of 10⁴ unknowns
+    !> (AMD predicts much fill) and AMD on the 1-D chain of the same size.
+    subroutine test_orderings(error)
+        type(error_t), allocatable, intent(out) :: error
+        integer, parameter :: m = 100, n = m * m
+        type(csc_matrix_t) :: a2, a1
+        type(klu_factor_t) :: lu
+        type(status_t) :: status
+        integer, allocatable :: rows(:), cols(:)
+        real(wp), allocatable :: vals(:), b(:), x_amd(:), x_nd(:), r(:)
+        integer :: i, j, k, t
+        integer(i8) :: seed
+        allocate (rows(5 * n), cols(5 * n), vals(5 * n), b(n), r(n))
+        t = 0
+        do j = 1, m
+            do i = 1, m
+                k = i + (j - 1) * m
+                ! Periodic, as the Brusselator's grid: more fill than a box.
+                call add(k, k, 4.5_wp)
+                call add(k, modulo(i - 2, m) + 1 + (j - 1) * m, -1.3_wp)
+                call add(k, modulo(i, m) + 1 + (j - 1) * m, -0.7_wp)
+                call add(k, i + modulo(j - 2, m) * m, -1.0_wp)
+                call add(k, i + modulo(j, m) * m, -1.0_wp)
+            end do
+        end do
+        call a2%build(n, n, rows(:t), cols(:t), status)
+        call a2%fill(vals(:t))
+        seed = 7
+        do i = 1, n
+            b(i) = uniform(seed)
+        end do
+        call lu%analyse(n, a2%colptr, a2%rowind, status, klu_ordering_auto)
+        call check(error, status%ok() .and. lu%ordering_used() == klu_ordering_nd, &
+            "'auto' did not choose nested dissection on the 2-D grid: " // status%text())
+        x_nd = b
+        call lu%factor(a2%values, status)
+        if (status%ok()) call lu%solve(x_nd, status)
+        call check(error, status%ok(), 'nd: ' // status%text())
+        call lu%analyse(n, a2%colptr, a2%rowind, status, klu_ordering_amd)
+        call check(error, lu%ordering_used() == klu_ordering_amd, 'amd not used when asked')
+        x_amd = b
+        call lu%factor(a2%values, status)
+        if (status%ok()) call lu%solve(x_amd, status)
+        call check(error, status%ok(), 'amd: ' // status%text())
+        if (allocated(error)) return
+        call a2%matvec(x_nd, r)
+        call check(error, maxval(abs(r - b)) <= 100 * uround_wp * 10.0_wp * maxval(abs(x_nd)), &
+            'nd residual not at round-off')
+        call check(error, maxval(abs(x_nd - x_amd)) <= 1.0e-12_wp * maxval(abs(x_amd)), &
+            'nd and amd solutions differ')
+        ! 1-D chain: little fill, 'auto' keeps AMD.
+        t = 0
+        do k = 1, n
+            call add(k, k, 4.0_wp)
+            if (k > 1) call add(k, k - 1, -1.0_wp)
+            if (k < n) call add(k, k + 1, -1.0_wp)
+        end do
+        call a1%build(n, n, rows(:t), cols(:t), status)
+        call lu%analyse(n, a1%colptr, a1%rowind, status)
+        call check(error, status%ok() .and. lu%ordering_used() == klu_ordering_amd, &
+            "'auto' left AMD on the 1-D chain")
+        call lu%analyse(n, a1%colptr, a1%rowind, status, 5)
+        call check(error, status%code == status_bad_input, 'unknown ordering accepted')
+    contains
+        subroutine add(r1, c1, v1)
+            integer, intent(in) :: r1, c1
+            real(wp), intent(in) :: v1
+            t = t + 1
+            rows(t) = r1
+            cols(t) = c1
+            vals(t) = v1
+        end subroutine add
+    end subroutine test_orderings
 
     !> A copy made by assignment owns no KLU objects: it reports 'not
     !> analysed' instead of sharing the original's, finalising it frees

@@ -20,13 +20,15 @@ contains
     function collect_radau5_sparse() result(tests)
         type(test_case_t), allocatable :: tests(:)
         tests = [new_test('klu_equals_dense_brusselator_2000', test_brusselator), &
-                 new_test('klu_equals_dense_pendulum_ggl', test_pendulum)]
+                 new_test('klu_equals_dense_pendulum_ggl', test_pendulum), &
+                 new_test('nested_dissection_equals_amd_brusselator_2d', test_orderings)]
     end function collect_radau5_sparse
 
-    subroutine run(problem, y0, t_end, linear_solver, y, stats, status)
+    subroutine run(problem, y0, t_end, linear_solver, y, stats, status, ordering)
         class(dae_problem_t), intent(inout) :: problem
         real(wp), intent(in) :: y0(:), t_end
         character(len=*), intent(in) :: linear_solver
+        character(len=*), intent(in), optional :: ordering !! KLU's sparse_ordering
         real(wp), intent(out) :: y(:)
         type(dae_stats_t), intent(out) :: stats
         type(status_t), intent(out) :: status
@@ -36,6 +38,7 @@ contains
         options%rtol = 1.0e-6_wp
         options%atol = 1.0e-6_wp
         options%linear_solver = linear_solver
+        if (present(ordering)) options%sparse_ordering = ordering
         t = 0.0_wp
         y = y0
         call solver%integrate(problem, t, y, t_end, options, stats, status)
@@ -74,6 +77,24 @@ contains
         call check(error, status%ok(), 'klu run: ' // status%text())
         call compare(error, y_dense, y_klu, s_dense, s_klu)
     end subroutine test_pendulum
+
+    !> 2-D Brusselator on a 32 x 32 periodic grid (2048 unknowns): KLU with
+    !> nested dissection and with AMD give one trajectory.
+    subroutine test_orderings(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(reaction_diffusion_t) :: problem
+        type(dae_stats_t) :: s_amd, s_nd
+        type(status_t) :: status
+        real(wp), allocatable :: y0(:), y_amd(:), y_nd(:)
+        problem = new_reaction_diffusion(2, 32)
+        allocate (y0(problem%n), y_amd(problem%n), y_nd(problem%n))
+        call reaction_diffusion_initial(problem, y0)
+        call run(problem, y0, 0.2_wp, 'klu', y_amd, s_amd, status, 'amd')
+        call check(error, status%ok(), 'amd run: ' // status%text())
+        call run(problem, y0, 0.2_wp, 'klu', y_nd, s_nd, status, 'nd')
+        call check(error, status%ok(), 'nd run: ' // status%text())
+        call compare(error, y_amd, y_nd, s_amd, s_nd)
+    end subroutine test_orderings
 
     !> Same steps and counters; states equal to round-off (1e-10 relative,
     !> far below the tolerance 1e-6: pivoting differs, the method does not).

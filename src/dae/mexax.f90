@@ -31,7 +31,8 @@ module flexmbs_dae_mexax
     use flexmbs_core_timer, only: timer_t
     use flexmbs_linalg_dense, only: dense_lu_factor, dense_lu_solve
     use flexmbs_linalg_csc, only: csc_matrix_t
-    use flexmbs_linalg_klu, only: klu_factor_t
+    use flexmbs_linalg_klu, only: klu_factor_t, klu_ordering_auto
+    use flexmbs_linalg_factory, only: klu_ordering_code
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_options, only: dae_options_t
@@ -159,6 +160,7 @@ module flexmbs_dae_mexax
     !> Workspace of one integration, allocated once.
     type :: workspace_t
         integer :: nq = 0, nv = 0, nc = 0, na = 0, ny = 0, ne = 0, km = 0
+        integer :: klu_ordering = klu_ordering_auto !! KLU's fill-reducing ordering
         real(wp) :: varpi = 1.0_wp
         real(wp) :: order_down = fac3, order_up = fac4 !! FAC3, FAC4 of the base
         real(wp) :: monitor_power = 1.0_wp         !! ϖ of the convergence monitor
@@ -298,7 +300,8 @@ contains
             return
         end if
 
-        call setup_workspace(w, problem, self%base, km, options%linear_solver, status)
+        call setup_workspace(w, problem, self%base, km, options%linear_solver, status, &
+            options%sparse_ordering)
         if (.not. status%ok()) return
         call options%tolerances(w%rtol, w%atol)
         allocate (yout(w%nq + w%nv + w%nc))
@@ -707,12 +710,13 @@ contains
 
     !> Allocate the workspace for `km` columns and set up the linear solver
     !> of the augmented system ('auto' | 'dense' | 'klu').
-    subroutine setup_workspace(w, problem, base, km, linear_solver, status)
+    subroutine setup_workspace(w, problem, base, km, linear_solver, status, ordering)
         type(workspace_t), intent(out) :: w
         class(mechanical_problem_t), intent(inout) :: problem
         integer, intent(in) :: base, km
         character(len=*), intent(in) :: linear_solver
         type(status_t), intent(out) :: status
+        character(len=*), intent(in), optional :: ordering !! 'auto' | 'amd' | 'nd'
         integer :: j, nq, nv, nc
         nq = problem%nq
         nv = problem%nv
@@ -769,6 +773,7 @@ contains
             return
         end select
         if (w%sparse) then
+            if (present(ordering)) w%klu_ordering = klu_ordering_code(ordering)
             call setup_sparse(w, problem, status)
         else
             allocate (w%m0%dense(nv, nv), w%g0%dense(nc, nv), w%mm%dense(nv, nv), &
@@ -821,7 +826,7 @@ contains
             status%message = 'mexax: pattern of [M G^T; G 0]: ' // status%message
             return
         end if
-        call w%klu%analyse(w%na, w%kpat%colptr, w%kpat%rowind, status)
+        call w%klu%analyse(w%na, w%kpat%colptr, w%kpat%rowind, status, w%klu_ordering)
         if (.not. status%ok()) then
             status%message = 'mexax: ' // status%message // ' (pattern of [M G^T; G 0])'
             return

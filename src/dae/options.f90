@@ -20,6 +20,9 @@ module flexmbs_dae_options
         integer :: band_lower = -1
         integer :: band_upper = -1
         character(len=8) :: jacobian = 'analytic'  !! 'analytic' | 'fd'
+        !> Fill-reducing ordering of KLU: 'auto' (AMD, nested dissection for
+        !> large matrices on which AMD predicts much fill), 'amd' or 'nd'.
+        character(len=8) :: sparse_ordering = 'auto'
         real(wp), allocatable :: output_times(:)   !! dense output at these times
         logical :: output_steps = .false.          !! also every accepted step
     contains
@@ -82,6 +85,9 @@ contains
         else if (all(self%jacobian /= [character(len=8) :: 'analytic', 'fd'])) then
             call status%set(status_bad_input, "options: jacobian = '" // &
                 trim(self%jacobian) // "': must be 'analytic' or 'fd'")
+        else if (all(self%sparse_ordering /= [character(len=8) :: 'auto', 'amd', 'nd'])) then
+            call status%set(status_bad_input, "options: sparse_ordering = '" // &
+                trim(self%sparse_ordering) // "': must be 'auto', 'amd' or 'nd'")
         end if
     end subroutine options_validate
 

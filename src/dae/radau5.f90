@@ -277,7 +277,7 @@ contains
             return
         end if
         call new_linear_solver(options%linear_solver, n, jac%storage, ls, status, &
-            options%band_lower, options%band_upper)
+            options%band_lower, options%band_upper, options%sparse_ordering)
         if (.not. status%ok()) return
         call ls%init(mass, jac, status)
         if (.not. status%ok()) return

@@ -49,6 +49,7 @@ module flexmbs_io_namelist
         var_spec_t('solver', 'hmax', kind_real), &
         var_spec_t('solver', 'max_steps', kind_integer), &
         var_spec_t('solver', 'linear_solver', kind_string), &
+        var_spec_t('solver', 'sparse_ordering', kind_string), &
         var_spec_t('solver', 'jacobian', kind_string), &
         var_spec_t('solver', 'nit', kind_integer), &
         var_spec_t('solver', 'thet', kind_real), &
@@ -111,6 +112,7 @@ module flexmbs_io_namelist
         real(wp) :: hmax = 0.0_wp             !! s, 0 = |t_end - t_start|
         integer :: max_steps = 100000
         character(len=len_name) :: linear_solver = 'auto'
+        character(len=len_name) :: sparse_ordering = 'auto' !! KLU: 'auto' | 'amd' | 'nd'
         character(len=len_name) :: jacobian = 'analytic'
         integer :: nit = 7
         real(wp) :: thet = 0.001_wp
@@ -631,7 +633,7 @@ contains
         ! Namelist variables carry the schema's names, so they are local.
         character(len=len_title) :: title
         character(len=len_name) :: problem, pendulum_formulation, name, linear_solver, &
-            jacobian, controller, mexax_base
+            jacobian, controller, mexax_base, sparse_ordering
         character(len=len_path) :: file, table
         real(wp) :: t_start, t_end, vdp_eps, vdp_y1, vdp_y2, pendulum_length, pendulum_mass, &
             pendulum_angle, gravity, rtol, atol, h0, hmax, thet, fnewt, &
@@ -642,7 +644,8 @@ contains
         namelist /simulation/ title, problem, t_start, t_end, vdp_eps, vdp_y1, vdp_y2, &
             pendulum_formulation, pendulum_length, pendulum_mass, pendulum_angle, &
             pendulum_projection, gravity, npoints
-        namelist /solver/ name, rtol, atol, h0, hmax, max_steps, linear_solver, jacobian, &
+        namelist /solver/ name, rtol, atol, h0, hmax, max_steps, linear_solver, &
+            sparse_ordering, jacobian, &
             nit, thet, fnewt, quot1, quot2, safe, fac_min, fac_max, controller, zero_start, pmax, &
             initial_derivative, exclude_index23, netlib, max_extrapolation, mexax_base
         namelist /output/ file, n_output, every_step, table, progress
@@ -689,6 +692,7 @@ contains
             hmax = scene%hmax
             max_steps = scene%max_steps
             linear_solver = scene%linear_solver
+            sparse_ordering = scene%sparse_ordering
             jacobian = scene%jacobian
             nit = scene%nit
             thet = scene%thet
@@ -714,6 +718,7 @@ contains
             scene%hmax = hmax
             scene%max_steps = max_steps
             scene%linear_solver = linear_solver
+            scene%sparse_ordering = sparse_ordering
             scene%jacobian = jacobian
             scene%nit = nit
             scene%thet = thet
@@ -790,6 +795,7 @@ contains
         scene%pendulum_formulation = lower(scene%pendulum_formulation)
         scene%solver_name = lower(scene%solver_name)
         scene%linear_solver = lower(scene%linear_solver)
+        scene%sparse_ordering = lower(scene%sparse_ordering)
         scene%jacobian = lower(scene%jacobian)
         scene%controller = lower(scene%controller)
         scene%mexax_base = lower(scene%mexax_base)
@@ -848,6 +854,8 @@ contains
         else if (all([character(len=8) :: 'auto', 'dense', 'klu', 'band'] &
                      /= scene%linear_solver)) then
             call bad(sol, 'linear_solver', 'must be ''auto'', ''dense'', ''klu'' or ''band''')
+        else if (all([character(len=8) :: 'auto', 'amd', 'nd'] /= scene%sparse_ordering)) then
+            call bad(sol, 'sparse_ordering', 'must be ''auto'', ''amd'' or ''nd''')
         else if (all([character(len=8) :: 'analytic', 'fd'] /= scene%jacobian)) then
             call bad(sol, 'jacobian', 'must be ''analytic'' or ''fd''')
         else if (scene%nit < 1) then
@@ -956,6 +964,7 @@ contains
         options%max_steps = scene%max_steps
         options%pmax = min(scene%pmax, 12)
         options%linear_solver = trim(scene%linear_solver)
+        options%sparse_ordering = trim(scene%sparse_ordering)
         options%jacobian = trim(scene%jacobian)
         options%output_steps = scene%every_step
         m = max(scene%n_output, 2)

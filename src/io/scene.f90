@@ -205,7 +205,8 @@ contains
         if (status%ok()) then
             ! the linear solver must exist before any file is created
             call new_linear_solver(options%linear_solver, problem%n, &
-                                   problem%jacobian_storage(), linear_solver, status)
+                                   problem%jacobian_storage(), linear_solver, status, &
+                                   ordering=options%sparse_ordering)
         end if
         if (.not. status%ok()) then
             status%message = scene%path // ': &solver: ' // status%message

@@ -6,10 +6,11 @@ module flexmbs_linalg_factory
     use flexmbs_linalg_dense, only: dense_solver_t
     use flexmbs_linalg_klu_solver, only: klu_solver_t
     use flexmbs_linalg_band, only: band_solver_t
+    use flexmbs_linalg_klu, only: klu_ordering_auto, klu_ordering_amd, klu_ordering_nd
     implicit none
     private
 
-    public :: new_linear_solver
+    public :: new_linear_solver, klu_ordering_code
 
 contains
 
@@ -17,8 +18,9 @@ contains
     !> which picks dense for n < auto_sparse_threshold or a J that is not
     !> sparse, and KLU otherwise. For 'band', `lower` and `upper` (both or
     !> neither; negative = found by init) fix the bandwidths. Call
-    !> `solver%init(mass, jac, status)` next.
-    subroutine new_linear_solver(name, n, jac_storage, solver, status, lower, upper)
+    !> `solver%init(mass, jac, status)` next. `ordering` ('auto' | 'amd' | 'nd',
+    !> default 'auto') is KLU's fill-reducing ordering.
+    subroutine new_linear_solver(name, n, jac_storage, solver, status, lower, upper, ordering)
         character(len=*), intent(in) :: name        !! 'auto' | 'dense' | 'klu' | 'band'
         integer, intent(in) :: n                    !! order of the iteration matrix
         integer, intent(in) :: jac_storage          !! storage_* of the Jacobian
@@ -26,7 +28,10 @@ contains
         type(status_t), intent(out) :: status
         integer, intent(in), optional :: lower      !! lower bandwidth for 'band'
         integer, intent(in), optional :: upper      !! upper bandwidth for 'band'
+        character(len=*), intent(in), optional :: ordering !! KLU: 'auto' | 'amd' | 'nd'
         type(band_solver_t), allocatable :: band
+        type(klu_solver_t), allocatable :: klu
+        integer :: order
         character(len=160) :: msg
 
         if (n <= 0) then
@@ -34,10 +39,21 @@ contains
             call status%set(status_bad_input, trim(msg))
             return
         end if
+        order = klu_ordering_auto
+        if (present(ordering)) then
+            order = klu_ordering_code(ordering)
+            if (order < 0) then
+                call status%set(status_bad_input, "sparse_ordering = '" // trim(ordering) // &
+                    "': unknown; use 'auto', 'amd' or 'nd'")
+                return
+            end if
+        end if
+        allocate (klu)
+        klu%ordering = order
         select case (trim(adjustl(name)))
         case ('auto')
             if (jac_storage == storage_sparse .and. n >= auto_sparse_threshold) then
-                allocate (klu_solver_t :: solver)
+                call move_alloc(klu, solver)
             else
                 allocate (dense_solver_t :: solver)
             end if
@@ -50,7 +66,7 @@ contains
                     "Jacobian in sparse (or dense) storage; use 'dense' or 'auto'")
                 return
             end if
-            allocate (klu_solver_t :: solver)
+            call move_alloc(klu, solver)
         case ('band')
             allocate (band)
             if (present(lower)) band%lower = lower
@@ -61,4 +77,15 @@ contains
                 "': unknown; use 'auto', 'dense', 'klu' or 'band'")
         end select
     end subroutine new_linear_solver
+
+    !> klu_ordering_* of 'auto', 'amd' or 'nd'; -1 for anything else.
+    pure integer function klu_ordering_code(name) result(code)
+        character(len=*), intent(in) :: name
+        select case (trim(adjustl(name)))
+        case ('auto'); code = klu_ordering_auto
+        case ('amd'); code = klu_ordering_amd
+        case ('nd'); code = klu_ordering_nd
+        case default; code = -1
+        end select
+    end function klu_ordering_code
 end module flexmbs_linalg_factory

@@ -30,6 +30,10 @@ module flexmbs_linalg_klu
     integer(c_int), parameter :: code_invalid = -3
     integer(c_int), parameter :: code_too_large = -4
     integer(c_int), parameter :: code_not_analysed = -10
+    ! Orderings, as in klu_shim.c.
+    integer, parameter, public :: klu_ordering_amd = 0
+    integer, parameter, public :: klu_ordering_nd = 1
+    integer, parameter, public :: klu_ordering_auto = 2
     integer(c_int), parameter :: code_not_factored = -11
     integer(c_int), parameter :: code_not_finite = -12
 
@@ -55,6 +59,7 @@ module flexmbs_linalg_klu
         integer(i8) :: nnz = 0
     contains
         procedure :: analyse => klu_analyse
+        procedure :: ordering_used => klu_ordering_used
         procedure, private :: factor_real => klu_factor_real
         procedure, private :: factor_complex => klu_factor_complex
         generic :: factor => factor_real, factor_complex
@@ -85,14 +90,22 @@ module flexmbs_linalg_klu
             type(c_ptr), intent(inout) :: handle
         end subroutine shim_free
 
-        function shim_analyse(handle, n, colptr, rowind) bind(C, name='flexmbs_klu_analyse') &
-            result(code)
+        function shim_analyse(handle, n, colptr, rowind, ordering) &
+            bind(C, name='flexmbs_klu_analyse') result(code)
             import :: c_ptr, c_int, c_int64_t
             type(c_ptr), value :: handle
             integer(c_int64_t), value :: n
             integer(c_int64_t), intent(in) :: colptr(*), rowind(*)
+            integer(c_int), value :: ordering
             integer(c_int) :: code
         end function shim_analyse
+
+        function shim_ordering_used(handle) bind(C, name='flexmbs_klu_ordering_used') &
+            result(ordering)
+            import :: c_ptr, c_int
+            type(c_ptr), value :: handle
+            integer(c_int) :: ordering
+        end function shim_ordering_used
 
         function shim_factor(handle, values) bind(C, name='flexmbs_klu_factor') result(code)
             import :: c_ptr, c_int, c_double
@@ -163,14 +176,26 @@ contains
 
     !> Analyse the pattern of n x n matrices in CSC form (0-based, no
     !> duplicates). Replaces any earlier pattern and factorisations.
-    subroutine klu_analyse(self, n, colptr, rowind, status)
+    !> `ordering`: klu_ordering_amd, _nd (nested dissection by METIS) or
+    !> _auto (the default: ND for large matrices on which AMD predicts much
+    !> fill, see klu_shim.c).
+    subroutine klu_analyse(self, n, colptr, rowind, status, ordering)
         class(klu_factor_t), intent(inout) :: self
         integer, intent(in) :: n                  !! matrix order
         integer(i8), intent(in) :: colptr(:)      !! size n+1, 0-based offsets
         integer(i8), intent(in) :: rowind(:)      !! size >= colptr(n+1), 0-based rows
         type(status_t), intent(out) :: status
-        integer(c_int) :: code
+        integer, intent(in), optional :: ordering
+        integer(c_int) :: code, order
         character(len=160) :: msg
+
+        order = klu_ordering_auto
+        if (present(ordering)) order = int(ordering, c_int)
+        if (order < klu_ordering_amd .or. order > klu_ordering_auto) then
+            write (msg, '(a,i0,a)') 'klu analyse: ordering = ', order, ': unknown'
+            call status%set(status_bad_input, trim(msg))
+            return
+        end if
 
         if (n <= 0) then
             write (msg, '(a,i0,a)') 'klu analyse: n = ', n, ': must be positive'
@@ -200,7 +225,7 @@ contains
         end if
         self%n = 0
         self%nnz = 0
-        code = shim_analyse(self%handle, int(n, c_int64_t), colptr, rowind)
+        code = shim_analyse(self%handle, int(n, c_int64_t), colptr, rowind, order)
         if (code /= code_ok) then
             call set_error(status, code, 'klu analyse')
             return
@@ -208,6 +233,13 @@ contains
         self%n = n
         self%nnz = colptr(n + 1)
     end subroutine klu_analyse
+
+    !> The ordering the last analysis used: klu_ordering_amd or _nd (-1: none).
+    integer function klu_ordering_used(self)
+        class(klu_factor_t), intent(in) :: self
+        klu_ordering_used = -1
+        if (self%is_analysed()) klu_ordering_used = int(shim_ordering_used(self%handle))
+    end function klu_ordering_used
 
     !> Factor afresh (new pivot order) the matrix with the analysed pattern.
     subroutine klu_factor_real(self, values, status)

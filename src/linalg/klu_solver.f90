@@ -20,13 +20,15 @@ module flexmbs_linalg_klu_solver
     use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_identity, storage_dense, &
         storage_sparse
     use flexmbs_linalg_linear_solver, only: linear_solver_t
-    use flexmbs_linalg_klu, only: klu_factor_t, klu_stats_t
+    use flexmbs_linalg_klu, only: klu_factor_t, klu_stats_t, klu_ordering_auto
     implicit none
     private
 
     !> KLU factorisations of c*M - J (real c) and c*M - J (complex c).
     type, extends(linear_solver_t), public :: klu_solver_t
         private
+        !> klu_ordering_auto | _amd | _nd (set before init).
+        integer, public :: ordering = klu_ordering_auto
         type(klu_factor_t) :: lu                 !! pattern, real and complex factors
         logical :: full_pattern = .false.        !! union pattern is all n² slots
         integer :: jac_storage = storage_none    !! storages seen at init
@@ -85,7 +87,7 @@ contains
             if (.not. status%ok()) return
         end if
         allocate (self%values(colptr(n + 1)), self%zvalues(colptr(n + 1)))
-        call self%lu%analyse(n, colptr, rowind, status)
+        call self%lu%analyse(n, colptr, rowind, status, self%ordering)
     end subroutine klu_solver_init
 
     !> Orders and storages must agree; KLU needs J itself, not a difference
