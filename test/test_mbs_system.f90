@@ -39,7 +39,8 @@ contains
                  new_test('hanging_reaction', test_hanging_reaction), &
                  new_test('spherical_pendulum_invariants', test_spherical_pendulum), &
                  new_test('planar_pendulum_matches_point_mass', test_planar_pendulum), &
-                 new_test('double_pendulum_energy', test_double_pendulum)]
+                 new_test('double_pendulum_energy', test_double_pendulum), &
+                 new_test('reactions_balance_newton_euler', test_reactions_balance)]
     end function collect_mbs_system
 
     ! ---------------------------------------------------------------- helpers
@@ -435,41 +436,49 @@ contains
     !> Two bodies, revolute joints ground-1 and 1-2 (axes z, offset markers,
     !> full inertias), undamped: the energy drift is proportional to the
     !> tolerance (index 2 with projection, RADAU5, two tolerances).
+    !> Two bodies on revolute joints about z: ground-1 (body 1's upper end,
+    !> 0.5 above its centre) and 1-2 (body 1's lower end, body 2 at (0.1, 0.4,
+    !> 0)); gravity -y. y is a start near consistency (body 1 turned by 1.2,
+    !> spinning at 1.5, body 2 unturned), fixed up by the projection.
+    subroutine double_pendulum(sys, y, status)
+        type(mbs_system_t), intent(out) :: sys
+        real(wp), intent(out) :: y(48)
+        type(status_t), intent(out) :: status
+        type(marker_t) :: markers(4)
+        markers(1)%body = 0
+        markers(2) = marker_t(1, [0.0_wp, 0.5_wp, 0.0_wp])
+        markers(3) = marker_t(1, [0.0_wp, -0.5_wp, 0.0_wp])
+        markers(4) = marker_t(2, [0.1_wp, 0.4_wp, 0.0_wp])
+        sys = new_mbs_system([test_body(1.0_wp, 0.05_wp), test_body(0.7_wp, 0.03_wp)], &
+                             markers, [mbs_joint_t(joint_revolute, 1, 2), &
+                                       mbs_joint_t(joint_revolute, 3, 4)], &
+                             gravity=[0.0_wp, -g_earth, 0.0_wp], status=status)
+        y = 0.0_wp
+        y(4:7) = quat_from_axis_angle([0.0_wp, 0.0_wp, 1.0_wp], 1.2_wp)
+        y(1:3) = -matmul(rotation_matrix(y(4:7)), markers(2)%position)
+        y(11:14) = [1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+        y(8:10) = y(1:3) + matmul(rotation_matrix(y(4:7)), markers(3)%position) &
+            - markers(4)%position
+        y(20) = 1.5_wp
+    end subroutine double_pendulum
+
     subroutine test_double_pendulum(error)
         type(error_t), allocatable, intent(out) :: error
         type(mbs_system_t), target :: sys
         type(formulation_t) :: gen
         type(dae_stats_t) :: stats
         type(status_t) :: status
-        type(marker_t) :: markers(3)
-        real(wp) :: y(48), yp(48), e0, e1, drift(2), dc, dv, scale
+        real(wp) :: y(48), yp(48), y0(48), e0, e1, drift(2), dc, dv, scale
         real(wp), parameter :: t_end = 3.0_wp
         real(wp), parameter :: rtols(2) = [1.0e-6_wp, 1.0e-8_wp]
         integer :: k
         character(len=220) :: msg
-        ! ground pivot; body 1's upper end (0.5 above its centre) and lower end
-        markers(1)%body = 0
-        markers(2)%body = 1
-        markers(2)%position = [0.0_wp, 0.5_wp, 0.0_wp]
-        markers(3)%body = 1
-        markers(3)%position = [0.0_wp, -0.5_wp, 0.0_wp]
-        sys = new_mbs_system([test_body(1.0_wp, 0.05_wp), test_body(0.7_wp, 0.03_wp)], &
-                             [markers, marker_t(2, [0.1_wp, 0.4_wp, 0.0_wp])], &
-                             [mbs_joint_t(joint_revolute, 1, 2), &
-                              mbs_joint_t(joint_revolute, 3, 4)], &
-                             gravity=[0.0_wp, -g_earth, 0.0_wp], status=status)
+        call double_pendulum(sys, y0, status)
         call check(error, status%ok(), status%text())
         if (allocated(error)) return
         scale = (1.0_wp + 0.7_wp) * g_earth
         do k = 1, 2
-            y = 0.0_wp
-            ! body 1 horizontal-ish, body 2 hanging; positions fixed up by the projection
-            y(4:7) = quat_from_axis_angle([0.0_wp, 0.0_wp, 1.0_wp], 1.2_wp)
-            y(1:3) = -matmul(rotation_matrix(y(4:7)), markers(2)%position)
-            y(11:14) = [1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
-            y(8:10) = y(1:3) + matmul(rotation_matrix(y(4:7)), markers(3)%position) &
-                - [0.1_wp, 0.4_wp, 0.0_wp]
-            y(20) = 1.5_wp
+            y = y0
             gen = new_formulation(sys, formulation_index2, y(1:14), projection=.true., &
                                   status=status)
             gen%projection_rtol = rtols(k)
@@ -490,4 +499,56 @@ contains
             call check(error, drift(k) <= 10.0_wp * rtols(k), trim(msg))
         end do
     end subroutine test_double_pendulum
+
+    !> Newton-Euler per body at a consistent moving state of the double
+    !> pendulum, from the reported reactions: m a = m g + Σ F and
+    !> J ω̇′ + ω′ × J ω′ = Σ Aᵀ(n + A s_m × F) (s_m the marker's body position).
+    !> The revolute joints must supply the x and y torques of the gyroscopic
+    !> terms (full inertias).
+    subroutine test_reactions_balance(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(mbs_system_t), target :: sys
+        type(formulation_t) :: gen
+        type(status_t) :: status
+        real(wp) :: y(48), yp(48), force(3, 2), torque(3, 2), a(3, 3), fsum(3, 2), nsum(3, 2)
+        real(wp) :: res_f, res_n
+        integer :: k, side, b, mk, iq, iv
+        character(len=200) :: msg
+        call double_pendulum(sys, y, status)
+        y(26) = -0.8_wp
+        gen = new_formulation(sys, formulation_index2, y(1:14), status=status)
+        call gen%consistent_initial(0.0_wp, y, yp, status)
+        call check(error, status%ok(), status%text())
+        if (allocated(error)) return
+        fsum = 0.0_wp
+        nsum = 0.0_wp
+        do k = 1, 2
+            call sys%joint_reaction(k, 0.0_wp, y(1:14), y(gen%ol + 1:gen%ol + 10), force, torque)
+            do side = 1, 2
+                mk = merge(2 * k - 1, 2 * k, side == 1)
+                b = sys%markers(mk)%body
+                if (b == 0) cycle
+                a = rotation_matrix(y(7 * b - 3:7 * b))
+                fsum(:, b) = fsum(:, b) + force(:, side)
+                nsum(:, b) = nsum(:, b) + matmul(transpose(a), torque(:, side)) &
+                    + cross(sys%markers(mk)%position, matmul(transpose(a), force(:, side)))
+            end do
+        end do
+        res_f = 0.0_wp
+        res_n = 0.0_wp
+        do b = 1, 2
+            iq = 7 * (b - 1)
+            iv = gen%ov + 6 * (b - 1)
+            associate (body => sys%rigid%bodies(b), w => y(iv + 4:iv + 6))
+                res_f = max(res_f, maxval(abs(body%mass * yp(iv + 1:iv + 3) - body%mass * &
+                            [0.0_wp, -g_earth, 0.0_wp] - fsum(:, b))))
+                res_n = max(res_n, maxval(abs(matmul(body%inertia, yp(iv + 4:iv + 6)) + &
+                            cross(w, matmul(body%inertia, w)) - nsum(:, b))))
+            end associate
+        end do
+        write (msg, '(2(a,es10.3))') 'Newton residual ', res_f, ', Euler residual ', res_n
+        print '(a)', '    ' // trim(msg)
+        call check(error, res_f <= 1.0e-12_wp * g_earth .and. res_n <= 1.0e-12_wp * g_earth &
+                   .and. maxval(abs(nsum(1:2, :))) > 1.0e-3_wp, trim(msg))
+    end subroutine test_reactions_balance
 end module test_mbs_system
