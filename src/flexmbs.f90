@@ -32,6 +32,10 @@ module flexmbs
         formulation_index2, formulation_index3, formulation_ggl
     use flexmbs_mbs_rigid_body, only: rigid_bodies_t, rigid_body_t, new_rigid_bodies, &
         rigid_body_energy, rigid_body_momenta
+    use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
+        constraint_derivatives_analytic, constraint_derivatives_ad
+    use flexmbs_mbs_joint, only: joint_spherical, joint_revolute, joint_cylindrical, &
+        joint_prismatic, joint_universal, joint_fixed
     use flexmbs_dae_mexax, only: mexax_t
     use flexmbs_io_namelist, only: scene_input_t, read_scene, parse_scene, scene_dae_options
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t

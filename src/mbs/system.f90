@@ -1,0 +1,821 @@
+!> The assembled multibody system (DESIGN.md, the mechanical model): rigid
+!> bodies in absolute coordinates and joints between markers on them (or on
+!> the ground), as one `mechanical_problem_t`.
+!>
+!> Coordinates: q = (r₁, p₁, r₂, p₂, ...), v = (ṙ₁, ω′₁, ...) as in
+!> flexmbs_mbs_rigid_body (q' = T v, M = diag(m I₃, J) per body, gravity,
+!> gyroscopic terms, applied force and torque), which the system delegates
+!> to. Joint k (flexmbs_mbs_joint: a list of constraint primitives between
+!> marker i and marker j) owns the rows row0+1 .. row0+nrows of
+!>
+!>   c(t, q) = 0,   G = c_q T (velocity space),   c_t,
+!>   γ = (G v)_q T v + 2 G_t v + c_tt   (index 1, eq. 9).
+!>
+!> `constraint_derivatives` selects how the joint rows' first derivatives G,
+!> c_q, c_t and γ are evaluated: 'analytic' by the hand-coded formulas of
+!> constraint_primitives.inc, 'ad' by the same formulas' values on dual
+!> numbers (forward-mode AD; γ as AD of the hand-coded G v along q' = T v).
+!> The second derivatives the formulations' Newton Jacobians need —
+!> ∂(G w)/∂q, ∂(Gᵀλ)/∂q, ∂c_t/∂q, ∂γ/∂q, ∂γ/∂v — are always AD of the
+!> hand-coded first derivatives (exact, one dual pass per joint and block),
+!> in place of the forward-difference defaults of mechanical_problem_t.
+!>
+!> Storage is dense for now (M, G and all their derivatives as full arrays;
+!> no `has_sparse`): the patterns are block-sparse (a joint touches the
+!> columns of at most two bodies) and a CSC assembly is future work.
+!> Drivers (∂c/∂t) are not yet declared by the system: every joint's driver
+!> values are zero, but the time derivatives are wired through (dual time
+!> direction), so that c_t and the time terms of γ appear once drivers do.
+!>
+!> Joint reactions (`joint_reaction`), our sign of λ (DESIGN.md: M v' =
+!> f − Gᵀλ): the generalised force of joint k on a body is −C_bᵀλ_k, C_b
+!> the joint's columns of G for that body; it is reported as the force F
+!> (global) and the torque n (global) about the marker's origin that the
+!> joint exerts on the body. A body hanging at rest from a spherical joint
+!> is held up: F = −m g (upwards, for gravity g).
+module flexmbs_mbs_system
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_text, only: int_text
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    use flexmbs_mbs_rotation, only: rotation_matrix, quat_rate_matrix, cross
+    use flexmbs_mbs_dual, only: dual_t, operator(+), assignment(=), dot_product
+    use flexmbs_mbs_rigid_body, only: rigid_body_t, rigid_bodies_t, new_rigid_bodies, &
+        rigid_body_nq, rigid_body_nv, rigid_body_energy, rigid_body_momenta
+    use flexmbs_mbs_joint, only: joint_t, new_joint, joint_part_time_derivative, &
+        joint_part_convective, joint_part_time_terms
+    use flexmbs_mbs_constraint_primitives, only: marker_state_t, rigid_marker_state, &
+        ground_marker_state, rigid_marker_jacobian, rigid_marker_jacobian_q, joint_value, &
+        joint_jacobian, joint_rows
+    use flexmbs_mbs_constraint_primitives_dual, only: marker_state_d => marker_state_t, &
+        rigid_marker_state_d => rigid_marker_state, &
+        ground_marker_state_d => ground_marker_state, &
+        rigid_marker_jacobian_d => rigid_marker_jacobian, joint_value_d => joint_value, &
+        joint_jacobian_d => joint_jacobian, joint_rows_d => joint_rows
+    implicit none
+    private
+
+    !> constraint_derivatives: hand-coded first derivatives of the joint rows.
+    integer, parameter, public :: constraint_derivatives_analytic = 1
+    !> constraint_derivatives: the same formulas' values on dual numbers.
+    integer, parameter, public :: constraint_derivatives_ad = 2
+
+    ! The most rows of a joint (fixed: spherical + 3 dot-1).
+    integer, parameter :: max_rows = 6
+    ! Marker axes must be orthonormal to this (max |UᵀU - I|).
+    real(wp), parameter :: axes_tolerance = 1.0e-10_wp
+    ! Dual seeds of one marker's body (directions used): velocity-space
+    ! tangents T e_l (6), position unit vectors e_l (7), velocity unit vectors
+    ! (6), the rate q' = T v (1).
+    integer, parameter :: seed_velocity_space = 1, seed_position = 2, seed_velocity = 3, &
+        seed_rate = 4
+
+    real(wp), parameter :: identity3(3, 3) = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
+        1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
+
+    !> A frame fixed in a body (body >= 1) or in the ground (body = 0).
+    type, public :: marker_t
+        integer :: body = 0 !! body number, 0 for the ground
+        real(wp) :: position(3) = 0.0_wp !! origin: body coordinates (ground: global)
+        real(wp) :: axes(3, 3) = identity3 !! orthonormal axes as columns, same frame
+    end type marker_t
+
+    !> A joint of kind `kind` (joint_spherical ... joint_fixed) between two markers.
+    type, public :: mbs_joint_t
+        integer :: kind = 0
+        integer :: marker_i = 0
+        integer :: marker_j = 0
+    end type mbs_joint_t
+
+    type :: assembled_joint_t
+        type(joint_t) :: joint
+        integer :: marker_i = 0, marker_j = 0
+        integer :: row0 = 0 !! rows row0+1 .. row0+joint%nrows of c
+    end type assembled_joint_t
+
+    !> Rigid bodies, markers and joints as a mechanical problem (module header).
+    type, extends(mechanical_problem_t), public :: mbs_system_t
+        type(rigid_bodies_t) :: rigid
+        type(marker_t), allocatable :: markers(:)
+        type(assembled_joint_t), allocatable :: joints(:)
+        integer :: derivatives = constraint_derivatives_analytic
+        integer :: nq_rigid = 0, nv_rigid = 0
+        real(wp), allocatable :: zero_v(:) !! v = 0 for position-only evaluations
+    contains
+        procedure :: kinematics => system_kinematics
+        procedure :: mass => system_mass
+        procedure :: forces => system_forces
+        procedure :: normalize => system_normalize
+        procedure :: kinematics_derivative => system_kinematics_derivative
+        procedure :: mass_derivative => system_mass_derivative
+        procedure :: force_derivatives => system_force_derivatives
+        procedure :: constraint => system_constraint
+        procedure :: constraint_jacobian => system_constraint_jacobian
+        procedure :: constraint_time_derivative => system_constraint_time_derivative
+        procedure :: constraint_curvature => system_constraint_curvature
+        procedure :: constraint_position_jacobian => system_constraint_position_jacobian
+        procedure :: constraint_jacobian_derivatives => system_constraint_jacobian_derivatives
+        procedure :: constraint_time_derivative_jacobian => &
+            system_constraint_time_derivative_jacobian
+        procedure :: constraint_curvature_derivatives => system_constraint_curvature_derivatives
+        procedure :: joint_first_row => system_joint_first_row
+        procedure :: joint_reaction => system_joint_reaction
+        procedure :: energy => system_energy
+        procedure :: momenta => system_momenta
+    end type mbs_system_t
+
+    public :: new_mbs_system
+
+contains
+
+    !> The system of `bodies` under `gravity`, with `markers` and `joints`;
+    !> `constraint_derivatives` is 'analytic' (default) or 'ad'. On bad input
+    !> `status` says which item is wrong and why.
+    function new_mbs_system(bodies, markers, joints, gravity, constraint_derivatives, &
+                            status) result(self)
+        type(rigid_body_t), intent(in) :: bodies(:)
+        type(marker_t), intent(in) :: markers(:)
+        type(mbs_joint_t), intent(in) :: joints(:)
+        real(wp), intent(in), optional :: gravity(3)
+        character(len=*), intent(in), optional :: constraint_derivatives !! 'analytic' | 'ad'
+        type(status_t), intent(out) :: status
+        type(mbs_system_t) :: self
+        integer :: k, row0
+        character(len=:), allocatable :: where
+
+        self%rigid = new_rigid_bodies(bodies, gravity, status)
+        if (.not. status%ok()) return
+        if (present(constraint_derivatives)) then
+            select case (constraint_derivatives)
+            case ('analytic')
+                self%derivatives = constraint_derivatives_analytic
+            case ('ad')
+                self%derivatives = constraint_derivatives_ad
+            case default
+                call status%set(status_bad_input, 'mbs system: constraint_derivatives = ''' &
+                                // constraint_derivatives // ''': use ''analytic'' or ''ad''')
+                return
+            end select
+        end if
+        do k = 1, size(markers)
+            where = 'mbs system: marker ' // int_text(k)
+            if (markers(k)%body < 0 .or. markers(k)%body > size(bodies)) then
+                call status%set(status_bad_input, where // ': body = ' // &
+                                int_text(markers(k)%body) // ': must be 0 (ground) .. ' // &
+                                int_text(size(bodies)))
+                return
+            end if
+            if (maxval(abs(matmul(transpose(markers(k)%axes), markers(k)%axes) - identity3)) &
+                > axes_tolerance) then
+                call status%set(status_bad_input, where // ': axes are not orthonormal')
+                return
+            end if
+        end do
+        allocate (self%joints(size(joints)))
+        row0 = 0
+        do k = 1, size(joints)
+            where = 'mbs system: joint ' // int_text(k)
+            associate (ji => joints(k), jt => self%joints(k))
+                if (min(ji%marker_i, ji%marker_j) < 1 .or. &
+                    max(ji%marker_i, ji%marker_j) > size(markers)) then
+                    call status%set(status_bad_input, where // ': markers ' // &
+                                    int_text(ji%marker_i) // ', ' // int_text(ji%marker_j) // &
+                                    ': must name markers 1 .. ' // int_text(size(markers)))
+                    return
+                end if
+                if (markers(ji%marker_i)%body == markers(ji%marker_j)%body) then
+                    call status%set(status_bad_input, where // ': both markers are on body ' &
+                                    // int_text(markers(ji%marker_i)%body) // &
+                                    ': a joint connects two different bodies (or a body &
+                                    &and the ground)')
+                    return
+                end if
+                call new_joint(jt%joint, ji%kind, status)
+                if (.not. status%ok()) then
+                    call status%set(status_bad_input, where // ': ' // status%text())
+                    return
+                end if
+                jt%marker_i = ji%marker_i
+                jt%marker_j = ji%marker_j
+                jt%row0 = row0
+                row0 = row0 + jt%joint%nrows
+            end associate
+        end do
+        self%markers = markers
+        self%nq_rigid = self%rigid%nq
+        self%nv_rigid = self%rigid%nv
+        self%nq = self%nq_rigid
+        self%nv = self%nv_rigid
+        self%nc = row0
+        allocate (self%zero_v(self%nv))
+        self%zero_v = 0.0_wp
+    end function new_mbs_system
+
+    !> First row of joint k in c (rows joint_first_row(k) + 0 .. nrows - 1).
+    pure integer function system_joint_first_row(self, k) result(row)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k
+        row = self%joints(k)%row0 + 1
+    end function system_joint_first_row
+
+    ! ------------------------------------------------ bodies (delegated)
+
+    subroutine system_kinematics(self, t, q, w, qdot, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: qdot(:)
+        type(status_t), intent(inout) :: status
+        call self%rigid%kinematics(t, q(1:self%nq_rigid), w(1:self%nv_rigid), &
+                                   qdot(1:self%nq_rigid), status)
+    end subroutine system_kinematics
+
+    subroutine system_kinematics_derivative(self, t, q, w, dq, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: dq(:, :)
+        type(status_t), intent(inout) :: status
+        dq = 0.0_wp
+        call self%rigid%kinematics_derivative(t, q(1:self%nq_rigid), w(1:self%nv_rigid), &
+                                              dq(1:self%nq_rigid, 1:self%nq_rigid), status)
+    end subroutine system_kinematics_derivative
+
+    subroutine system_mass(self, t, q, m, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: m(:, :)
+        type(status_t), intent(inout) :: status
+        m = 0.0_wp
+        call self%rigid%mass(t, q(1:self%nq_rigid), m(1:self%nv_rigid, 1:self%nv_rigid), status)
+    end subroutine system_mass
+
+    subroutine system_mass_derivative(self, t, q, w, dq, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: dq(:, :)
+        type(status_t), intent(inout) :: status
+        dq = 0.0_wp
+    end subroutine system_mass_derivative
+
+    subroutine system_forces(self, t, q, v, f, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: f(:)
+        type(status_t), intent(inout) :: status
+        call self%rigid%forces(t, q(1:self%nq_rigid), v(1:self%nv_rigid), &
+                               f(1:self%nv_rigid), status)
+    end subroutine system_forces
+
+    subroutine system_force_derivatives(self, t, q, v, fq, fv, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: fq(:, :), fv(:, :)
+        type(status_t), intent(inout) :: status
+        fq = 0.0_wp
+        fv = 0.0_wp
+        call self%rigid%force_derivatives(t, q(1:self%nq_rigid), v(1:self%nv_rigid), &
+                                          fq(1:self%nv_rigid, 1:self%nq_rigid), &
+                                          fv(1:self%nv_rigid, 1:self%nv_rigid), status)
+    end subroutine system_force_derivatives
+
+    subroutine system_normalize(self, q)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(inout) :: q(:)
+        call self%rigid%normalize(q(1:self%nq_rigid))
+    end subroutine system_normalize
+
+    !> Kinetic plus potential energy.
+    real(wp) function system_energy(self, q, v) result(e)
+        class(mbs_system_t), intent(in) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        e = rigid_body_energy(self%rigid, q(1:self%nq_rigid), v(1:self%nv_rigid))
+    end function system_energy
+
+    !> Total linear momentum and angular momentum about the global origin.
+    subroutine system_momenta(self, q, v, linear, angular)
+        class(mbs_system_t), intent(in) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(out) :: linear(3), angular(3)
+        call rigid_body_momenta(self%rigid, q(1:self%nq_rigid), v(1:self%nv_rigid), linear, &
+                                angular)
+    end subroutine system_momenta
+
+    ! ------------------------------------------------ markers, real and dual
+
+    !> Offsets of marker k's body in q and v; ground: body = 0.
+    pure subroutine marker_offsets(self, k, body, iq, iv)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k
+        integer, intent(out) :: body, iq, iv
+        body = self%markers(k)%body
+        iq = rigid_body_nq * (body - 1)
+        iv = rigid_body_nv * (body - 1)
+    end subroutine marker_offsets
+
+    !> Columns of marker k's body in velocity space (6) or position space (7); 0 on ground.
+    pure integer function marker_columns(self, k, position_space) result(n)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k
+        logical, intent(in) :: position_space
+        n = 0
+        if (self%markers(k)%body > 0) n = merge(rigid_body_nq, rigid_body_nv, position_space)
+    end function marker_columns
+
+    !> Real frame and motion of marker k at (q, v).
+    pure subroutine marker_state(self, k, q, v, m)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: q(:), v(:)
+        type(marker_state_t), intent(out) :: m
+        integer :: b, iq, iv
+        call marker_offsets(self, k, b, iq, iv)
+        associate (mk => self%markers(k))
+            if (b == 0) then
+                call ground_marker_state(mk%position, mk%axes, m)
+            else
+                call rigid_marker_state(q(iq + 1:iq + 3), q(iq + 4:iq + 7), v(iv + 1:iv + 3), &
+                                        v(iv + 4:iv + 6), mk%position, mk%axes, m)
+            end if
+        end associate
+    end subroutine marker_state
+
+    !> Hand-coded marker Jacobians of marker k: velocity space (3 x 6) or
+    !> position space (3 x 7) in the leading columns of jx, ja; n columns.
+    pure subroutine marker_jacobian(self, k, q, position_space, jx, ja, n)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: q(:)
+        logical, intent(in) :: position_space
+        real(wp), intent(out) :: jx(3, rigid_body_nq), ja(3, rigid_body_nq, 3)
+        integer, intent(out) :: n
+        real(wp) :: jx6(3, 6), ja6(3, 6, 3)
+        integer :: b, iq, iv
+        call marker_offsets(self, k, b, iq, iv)
+        n = marker_columns(self, k, position_space)
+        jx = 0.0_wp
+        ja = 0.0_wp
+        if (b == 0) return
+        associate (mk => self%markers(k))
+            if (position_space) then
+                call rigid_marker_jacobian_q(q(iq + 4:iq + 7), mk%position, mk%axes, jx, ja)
+            else
+                call rigid_marker_jacobian(q(iq + 4:iq + 7), mk%position, mk%axes, jx6, ja6)
+                jx(:, 1:6) = jx6
+                ja(:, 1:6, :) = ja6
+            end if
+        end associate
+    end subroutine marker_jacobian
+
+    !> Dual frame and motion of marker k at (q, v) with its body's tangents
+    !> `seed` in directions first, first+1, ...; p the dual quaternion (for the
+    !> dual marker Jacobians); n the directions used (0 on the ground).
+    pure subroutine marker_state_dual(self, k, q, v, seed, first, m, p, n)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k, seed, first
+        real(wp), intent(in) :: q(:), v(:)
+        type(marker_state_d), intent(out) :: m
+        type(dual_t), intent(out) :: p(4)
+        integer, intent(out) :: n
+        type(dual_t) :: r(3), rd(3), wb(3), sb(3), ub(3, 3), x(3), a(3, 3)
+        real(wp) :: tp(4, 3)
+        integer :: b, iq, iv, l
+        call marker_offsets(self, k, b, iq, iv)
+        n = 0
+        associate (mk => self%markers(k))
+            if (b == 0) then
+                x = mk%position
+                a = mk%axes
+                p = 0.0_wp
+                call ground_marker_state_d(x, a, m)
+                return
+            end if
+            r = q(iq + 1:iq + 3)
+            p = q(iq + 4:iq + 7)
+            rd = v(iv + 1:iv + 3)
+            wb = v(iv + 4:iv + 6)
+            sb = mk%position
+            ub = mk%axes
+            tp = quat_rate_matrix(q(iq + 4:iq + 7))
+            select case (seed)
+            case (seed_velocity_space)
+                n = rigid_body_nv
+                do l = 1, 3
+                    r(l)%der(first + l - 1) = 1.0_wp
+                    p%der(first + 2 + l) = tp(:, l)
+                end do
+            case (seed_position)
+                n = rigid_body_nq
+                do l = 1, 3
+                    r(l)%der(first + l - 1) = 1.0_wp
+                end do
+                do l = 1, 4
+                    p(l)%der(first + 2 + l) = 1.0_wp
+                end do
+            case (seed_velocity)
+                n = rigid_body_nv
+                do l = 1, 3
+                    rd(l)%der(first + l - 1) = 1.0_wp
+                    wb(l)%der(first + 2 + l) = 1.0_wp
+                end do
+            case (seed_rate)
+                n = 1
+                r%der(first) = v(iv + 1:iv + 3)
+                p%der(first) = matmul(tp, v(iv + 4:iv + 6))
+            end select
+            call rigid_marker_state_d(r, p, rd, wb, sb, ub, m)
+        end associate
+    end subroutine marker_state_dual
+
+    !> Dual velocity-space Jacobians of marker k from its dual quaternion p.
+    pure subroutine marker_jacobian_dual(self, k, p, jx, ja)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k
+        type(dual_t), intent(in) :: p(4)
+        type(dual_t), intent(out) :: jx(3, 6), ja(3, 6, 3)
+        type(dual_t) :: sb(3), ub(3, 3)
+        if (self%markers(k)%body == 0) then
+            jx = 0.0_wp
+            ja = 0.0_wp
+            return
+        end if
+        sb = self%markers(k)%position
+        ub = self%markers(k)%axes
+        call rigid_marker_jacobian_d(p, sb, ub, jx, ja)
+    end subroutine marker_jacobian_dual
+
+    !> Driver values (s, s', s'') of joint k at t: none declared yet (module header).
+    pure function joint_driver(self, k, t) result(drv)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: t
+        real(wp) :: drv(3)
+        drv = 0.0_wp
+    end function joint_driver
+
+    !> Dual driver values, with the time tangent in direction td (none if td = 0).
+    pure function driver_dual(drv, td) result(d)
+        real(wp), intent(in) :: drv(3)
+        integer, intent(in) :: td
+        type(dual_t) :: d(3)
+        d = drv
+        if (td > 0) then
+            d(1)%der(td) = drv(2)
+            d(2)%der(td) = drv(3)
+        end if
+    end function driver_dual
+
+    !> out(:, columns of marker k's body) += block (velocity or position space).
+    pure subroutine add_columns(self, k, position_space, block, out)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k
+        logical, intent(in) :: position_space
+        real(wp), intent(in) :: block(:, :)
+        real(wp), intent(inout) :: out(:, :)
+        integer :: b, iq, iv, off
+        call marker_offsets(self, k, b, iq, iv)
+        if (b == 0) return
+        off = merge(iq, iv, position_space)
+        out(:, off + 1:off + size(block, 2)) = out(:, off + 1:off + size(block, 2)) + block
+    end subroutine add_columns
+
+    ! ------------------------------------------------ joint rows, first derivatives
+
+    !> Joint k's blocks ci, cj of G (velocity space) or c_q (position space),
+    !> and its c_t, by the selected constraint_derivatives; ni, nj columns.
+    subroutine joint_first_derivatives(self, k, t, q, position_space, ci, cj, ni, nj, ct)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: t, q(:)
+        logical, intent(in) :: position_space
+        real(wp), intent(out) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq)
+        integer, intent(out) :: ni, nj
+        real(wp), intent(out) :: ct(max_rows)
+        type(marker_state_t) :: mi, mj
+        type(marker_state_d) :: mid, mjd
+        real(wp) :: jxi(3, rigid_body_nq), jai(3, rigid_body_nq, 3), jxj(3, rigid_body_nq), &
+            jaj(3, rigid_body_nq, 3), drv(3)
+        type(dual_t) :: pd(4), cd(max_rows)
+        integer :: seed, nr, r, td
+        ci = 0.0_wp
+        cj = 0.0_wp
+        ct = 0.0_wp
+        associate (jt => self%joints(k))
+            nr = jt%joint%nrows
+            drv = joint_driver(self, k, t)
+            if (self%derivatives == constraint_derivatives_analytic) then
+                call marker_state(self, jt%marker_i, q, self%zero_v, mi)
+                call marker_state(self, jt%marker_j, q, self%zero_v, mj)
+                call marker_jacobian(self, jt%marker_i, q, position_space, jxi, jai, ni)
+                call marker_jacobian(self, jt%marker_j, q, position_space, jxj, jaj, nj)
+                call joint_jacobian(jt%joint, mi, jxi(:, 1:ni), jai(:, 1:ni, :), mj, &
+                                    jxj(:, 1:nj), jaj(:, 1:nj, :), drv, ci(1:nr, 1:ni), &
+                                    cj(1:nr, 1:nj))
+                call joint_rows(joint_part_time_derivative, jt%joint, mi, mj, drv, ct(1:nr))
+            else
+                seed = merge(seed_position, seed_velocity_space, position_space)
+                call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed, 1, mid, pd, ni)
+                call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed, 1 + ni, mjd, &
+                                       pd, nj)
+                td = ni + nj + 1
+                call joint_value_d(jt%joint, mid, mjd, driver_dual(drv, td), cd(1:nr))
+                do r = 1, nr
+                    ci(r, 1:ni) = cd(r)%der(1:ni)
+                    cj(r, 1:nj) = cd(r)%der(ni + 1:ni + nj)
+                    ct(r) = cd(r)%der(td)
+                end do
+            end if
+        end associate
+    end subroutine joint_first_derivatives
+
+    subroutine system_constraint(self, t, q, g, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: g(:)
+        type(status_t), intent(inout) :: status
+        type(marker_state_t) :: mi, mj
+        integer :: k
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                call marker_state(self, jt%marker_i, q, self%zero_v, mi)
+                call marker_state(self, jt%marker_j, q, self%zero_v, mj)
+                call joint_value(jt%joint, mi, mj, joint_driver(self, k, t), &
+                                 g(jt%row0 + 1:jt%row0 + jt%joint%nrows))
+            end associate
+        end do
+    end subroutine system_constraint
+
+    !> G = c_q T, nc x nv.
+    subroutine system_constraint_jacobian(self, t, q, gmat, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: gmat(:, :)
+        type(status_t), intent(inout) :: status
+        call assemble_first_derivative(self, t, q, .false., gmat)
+    end subroutine system_constraint_jacobian
+
+    !> c_q, nc x nq.
+    subroutine system_constraint_position_jacobian(self, t, q, gq, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: gq(:, :)
+        type(status_t), intent(inout) :: status
+        call assemble_first_derivative(self, t, q, .true., gq)
+    end subroutine system_constraint_position_jacobian
+
+    subroutine assemble_first_derivative(self, t, q, position_space, out)
+        class(mbs_system_t), intent(in) :: self
+        real(wp), intent(in) :: t, q(:)
+        logical, intent(in) :: position_space
+        real(wp), intent(out) :: out(:, :)
+        real(wp) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq), ct(max_rows)
+        integer :: k, ni, nj, r0, nr
+        out = 0.0_wp
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                r0 = jt%row0
+                nr = jt%joint%nrows
+                call joint_first_derivatives(self, k, t, q, position_space, ci, cj, ni, nj, ct)
+                call add_columns(self, jt%marker_i, position_space, ci(1:nr, 1:ni), &
+                                 out(r0 + 1:r0 + nr, :))
+                call add_columns(self, jt%marker_j, position_space, cj(1:nr, 1:nj), &
+                                 out(r0 + 1:r0 + nr, :))
+            end associate
+        end do
+    end subroutine assemble_first_derivative
+
+    !> c_t = ∂c/∂t.
+    subroutine system_constraint_time_derivative(self, t, q, gt, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: gt(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq), ct(max_rows)
+        integer :: k, ni, nj
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                call joint_first_derivatives(self, k, t, q, .false., ci, cj, ni, nj, ct)
+                gt(jt%row0 + 1:jt%row0 + jt%joint%nrows) = ct(1:jt%joint%nrows)
+            end associate
+        end do
+    end subroutine system_constraint_time_derivative
+
+    !> γ = (G v)_q T v + 2 G_t v + c_tt: hand-coded (convective accelerations
+    !> of the markers), or AD of the hand-coded G v along q' = T v (direction
+    !> 1) and t (direction 2).
+    subroutine system_constraint_curvature(self, t, q, v, gamma, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: gamma(:)
+        type(status_t), intent(inout) :: status
+        type(marker_state_t) :: mi, mj
+        type(marker_state_d) :: mid, mjd
+        type(dual_t) :: pi(4), pj(4), jxi(3, 6), jai(3, 6, 3), jxj(3, 6), jaj(3, 6, 3), &
+            cid(max_rows, 6), cjd(max_rows, 6), ctd(max_rows), drvd(3), cv
+        real(wp) :: drv(3), tt(max_rows)
+        integer :: k, r0, nr, ni, nj, r, bi, bj, iqi, iqj, ivi, ivj
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                r0 = jt%row0
+                nr = jt%joint%nrows
+                drv = joint_driver(self, k, t)
+                if (self%derivatives == constraint_derivatives_analytic) then
+                    call marker_state(self, jt%marker_i, q, v, mi)
+                    call marker_state(self, jt%marker_j, q, v, mj)
+                    call joint_rows(joint_part_convective, jt%joint, mi, mj, drv, &
+                                    gamma(r0 + 1:r0 + nr))
+                    call joint_rows(joint_part_time_terms, jt%joint, mi, mj, drv, tt(1:nr))
+                    gamma(r0 + 1:r0 + nr) = gamma(r0 + 1:r0 + nr) + tt(1:nr)
+                else
+                    call marker_state_dual(self, jt%marker_i, q, v, seed_rate, 1, mid, pi, ni)
+                    call marker_state_dual(self, jt%marker_j, q, v, seed_rate, 1, mjd, pj, nj)
+                    call marker_jacobian_dual(self, jt%marker_i, pi, jxi, jai)
+                    call marker_jacobian_dual(self, jt%marker_j, pj, jxj, jaj)
+                    ni = marker_columns(self, jt%marker_i, .false.)
+                    nj = marker_columns(self, jt%marker_j, .false.)
+                    drvd = driver_dual(drv, 2)
+                    call joint_jacobian_d(jt%joint, mid, jxi(:, 1:ni), jai(:, 1:ni, :), mjd, &
+                                          jxj(:, 1:nj), jaj(:, 1:nj, :), drvd, &
+                                          cid(1:nr, 1:ni), cjd(1:nr, 1:nj))
+                    call joint_rows_d(joint_part_time_derivative, jt%joint, mid, mjd, drvd, &
+                                      ctd(1:nr))
+                    call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
+                    call marker_offsets(self, jt%marker_j, bj, iqj, ivj)
+                    do r = 1, nr
+                        cv = dot_product(cid(r, 1:ni), v(ivi + 1:ivi + ni)) &
+                             + dot_product(cjd(r, 1:nj), v(ivj + 1:ivj + nj))
+                        gamma(r0 + r) = cv%der(1) + 2.0_wp * cv%der(2) + ctd(r)%der(2)
+                    end do
+                end if
+            end associate
+        end do
+    end subroutine system_constraint_curvature
+
+    ! ------------------------------------------------ second derivatives (AD)
+
+    !> ∂(G w)/∂q (nc x nq) and ∂(Gᵀλ)/∂q (nv x nq): AD of the hand-coded G
+    !> along the position unit vectors of the joint's two bodies.
+    subroutine system_constraint_jacobian_derivatives(self, t, q, w, lambda, gwq, gtlq, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:), lambda(:)
+        real(wp), intent(out) :: gwq(:, :), gtlq(:, :)
+        type(status_t), intent(inout) :: status
+        type(marker_state_d) :: mid, mjd
+        type(dual_t) :: pi(4), pj(4), jxi(3, 6), jai(3, 6, 3), jxj(3, 6), jaj(3, 6, 3), &
+            cid(max_rows, 6), cjd(max_rows, 6), s
+        integer :: k, r0, nr, qi, qj, ni, nj, r, l, bi, bj, iqi, iqj, ivi, ivj
+        gwq = 0.0_wp
+        gtlq = 0.0_wp
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                r0 = jt%row0
+                nr = jt%joint%nrows
+                call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed_position, 1, &
+                                       mid, pi, qi)
+                call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed_position, &
+                                       1 + qi, mjd, pj, qj)
+                call marker_jacobian_dual(self, jt%marker_i, pi, jxi, jai)
+                call marker_jacobian_dual(self, jt%marker_j, pj, jxj, jaj)
+                ni = marker_columns(self, jt%marker_i, .false.)
+                nj = marker_columns(self, jt%marker_j, .false.)
+                call joint_jacobian_d(jt%joint, mid, jxi(:, 1:ni), jai(:, 1:ni, :), mjd, &
+                                      jxj(:, 1:nj), jaj(:, 1:nj, :), &
+                                      driver_dual(joint_driver(self, k, t), 0), &
+                                      cid(1:nr, 1:ni), cjd(1:nr, 1:nj))
+                call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
+                call marker_offsets(self, jt%marker_j, bj, iqj, ivj)
+                do r = 1, nr
+                    s = dot_product(cid(r, 1:ni), w(ivi + 1:ivi + ni)) &
+                        + dot_product(cjd(r, 1:nj), w(ivj + 1:ivj + nj))
+                    call add_tangents(gwq, r0 + r, s, qi, iqi, qj, iqj)
+                end do
+                do l = 1, ni
+                    call add_tangents(gtlq, ivi + l, &
+                                      dot_product(cid(1:nr, l), lambda(r0 + 1:r0 + nr)), &
+                                      qi, iqi, qj, iqj)
+                end do
+                do l = 1, nj
+                    call add_tangents(gtlq, ivj + l, &
+                                      dot_product(cjd(1:nr, l), lambda(r0 + 1:r0 + nr)), &
+                                      qi, iqi, qj, iqj)
+                end do
+            end associate
+        end do
+    end subroutine system_constraint_jacobian_derivatives
+
+    !> out(row, q columns of body i and j) += tangents of s (directions 1..qi
+    !> for body i at offset iqi, qi+1..qi+qj for body j at offset iqj).
+    pure subroutine add_tangents(out, row, s, qi, iqi, qj, iqj)
+        real(wp), intent(inout) :: out(:, :)
+        integer, intent(in) :: row, qi, iqi, qj, iqj
+        type(dual_t), intent(in) :: s
+        out(row, iqi + 1:iqi + qi) = out(row, iqi + 1:iqi + qi) + s%der(1:qi)
+        out(row, iqj + 1:iqj + qj) = out(row, iqj + 1:iqj + qj) + s%der(qi + 1:qi + qj)
+    end subroutine add_tangents
+
+    !> ∂c_t/∂q: AD of the hand-coded c_t.
+    subroutine system_constraint_time_derivative_jacobian(self, t, q, dq, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: dq(:, :)
+        type(status_t), intent(inout) :: status
+        type(marker_state_d) :: mid, mjd
+        type(dual_t) :: pd(4), ctd(max_rows)
+        integer :: k, nr, qi, qj, r, bi, bj, iqi, iqj, ivi, ivj
+        dq = 0.0_wp
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                nr = jt%joint%nrows
+                call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed_position, 1, &
+                                       mid, pd, qi)
+                call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed_position, &
+                                       1 + qi, mjd, pd, qj)
+                call joint_rows_d(joint_part_time_derivative, jt%joint, mid, mjd, &
+                                  driver_dual(joint_driver(self, k, t), 0), ctd(1:nr))
+                call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
+                call marker_offsets(self, jt%marker_j, bj, iqj, ivj)
+                do r = 1, nr
+                    call add_tangents(dq, jt%row0 + r, ctd(r), qi, iqi, qj, iqj)
+                end do
+            end associate
+        end do
+    end subroutine system_constraint_time_derivative_jacobian
+
+    !> ∂γ/∂q and ∂γ/∂v: AD of the hand-coded γ, one pass along the positions
+    !> and one along the velocities of the joint's two bodies.
+    subroutine system_constraint_curvature_derivatives(self, t, q, v, gq, gv, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: gq(:, :), gv(:, :)
+        type(status_t), intent(inout) :: status
+        type(marker_state_d) :: mid, mjd
+        type(dual_t) :: pd(4), conv(max_rows), tt(max_rows), drvd(3)
+        integer :: k, nr, ni, nj, r, bi, bj, iqi, iqj, ivi, ivj, pass, seed
+        gq = 0.0_wp
+        gv = 0.0_wp
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                nr = jt%joint%nrows
+                drvd = driver_dual(joint_driver(self, k, t), 0)
+                call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
+                call marker_offsets(self, jt%marker_j, bj, iqj, ivj)
+                do pass = 1, 2
+                    seed = merge(seed_position, seed_velocity, pass == 1)
+                    call marker_state_dual(self, jt%marker_i, q, v, seed, 1, mid, pd, ni)
+                    call marker_state_dual(self, jt%marker_j, q, v, seed, 1 + ni, mjd, pd, nj)
+                    call joint_rows_d(joint_part_convective, jt%joint, mid, mjd, drvd, &
+                                      conv(1:nr))
+                    call joint_rows_d(joint_part_time_terms, jt%joint, mid, mjd, drvd, tt(1:nr))
+                    do r = 1, nr
+                        if (pass == 1) then
+                            call add_tangents(gq, jt%row0 + r, conv(r) + tt(r), ni, iqi, nj, &
+                                              iqj)
+                        else
+                            call add_tangents(gv, jt%row0 + r, conv(r) + tt(r), ni, ivi, nj, &
+                                              ivj)
+                        end if
+                    end do
+                end do
+            end associate
+        end do
+    end subroutine system_constraint_curvature_derivatives
+
+    ! ------------------------------------------------ reactions
+
+    !> The force and torque joint k exerts on the body of marker i (column 1)
+    !> and of marker j (column 2), global components, the torque about the
+    !> marker's origin: the generalised force −C_bᵀλ_k of the equations of
+    !> motion M v' = f − Gᵀλ (module header). A ground side reports zeros
+    !> (the ground's share is the opposite of the body's for joints whose
+    !> markers' origins coincide).
+    subroutine system_joint_reaction(self, k, t, q, lambda, force, torque)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(in) :: lambda(:) !! all nc multipliers
+        real(wp), intent(out) :: force(3, 2), torque(3, 2)
+        real(wp) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq), ct(max_rows)
+        real(wp) :: gen(6), a(3, 3)
+        integer :: ni, nj, side, b, iq, iv, mk, r0, nr
+        force = 0.0_wp
+        torque = 0.0_wp
+        associate (jt => self%joints(k))
+            r0 = jt%row0
+            nr = jt%joint%nrows
+            call joint_first_derivatives(self, k, t, q, .false., ci, cj, ni, nj, ct)
+            do side = 1, 2
+                mk = merge(jt%marker_i, jt%marker_j, side == 1)
+                call marker_offsets(self, mk, b, iq, iv)
+                if (b == 0) cycle
+                if (side == 1) then
+                    gen = -matmul(lambda(r0 + 1:r0 + nr), ci(1:nr, 1:6))
+                else
+                    gen = -matmul(lambda(r0 + 1:r0 + nr), cj(1:nr, 1:6))
+                end if
+                a = rotation_matrix(q(iq + 4:iq + 7))
+                force(:, side) = gen(1:3)
+                ! gen(4:6) = s_b × Aᵀ F + n′ (body-fixed moment about the centre)
+                torque(:, side) = matmul(a, gen(4:6) - cross(self%markers(mk)%position, &
+                                                              matmul(transpose(a), gen(1:3))))
+            end do
+        end associate
+    end subroutine system_joint_reaction
+end module flexmbs_mbs_system
