@@ -28,6 +28,7 @@ module flexmbs
     use flexmbs_fe_mesh, only: mesh_t, node_set_t
     use flexmbs_fe_box_mesh, only: box_mesh
     use flexmbs_fe_flexible_body, only: flexible_body_t, new_flexible_body
+    use flexmbs_fe_statics, only: solve_static, static_options_t, static_report_t
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &
         formulation_index2, formulation_index3, formulation_ggl
     use flexmbs_mbs_rigid_body, only: rigid_bodies_t, rigid_body_t, new_rigid_bodies, &

@@ -62,7 +62,7 @@ contains
     !> applies to all elements; with several, element_material(e) picks the
     !> material of element e (the paper's stiffer tip layers).
     subroutine new_flexible_body(body, mesh, materials, fixed_nodes, status, gravity, &
-                                 element_material)
+                                 element_material, fixed_components)
         type(flexible_body_t), intent(out) :: body
         type(mesh_t), intent(in) :: mesh
         type(neo_hooke_t), intent(in) :: materials(:)
@@ -70,7 +70,10 @@ contains
         type(status_t), intent(out) :: status
         real(wp), intent(in), optional :: gravity(3)
         integer, intent(in), optional :: element_material(:) !! one per element
-        integer :: e, n, i, nfree
+        !> Further supports by component (3, nodes): .true. holds that
+        !> coordinate at X (symmetry planes, rollers).
+        logical, intent(in), optional :: fixed_components(:, :)
+        integer :: e, n, i, j, nfree
         character(len=120) :: msg
         body%mesh = mesh
         n = mesh%node_count()
@@ -113,11 +116,23 @@ contains
         end do
         allocate (body%dof(3, n), source=1)
         body%dof(:, fixed_nodes) = 0
+        if (present(fixed_components)) then
+            if (size(fixed_components, 1) /= 3 .or. size(fixed_components, 2) /= n) then
+                write (msg, '(a,i0,a,i0,a,i0,a)') 'flexible body: fixed components given as (', &
+                    size(fixed_components, 1), ', ', size(fixed_components, 2), &
+                    '), expected (3, ', n, ')'
+                call status%set(status_bad_input, trim(msg))
+                return
+            end if
+            where (fixed_components) body%dof = 0
+        end if
         nfree = 0
         do i = 1, n
-            if (body%dof(1, i) == 0) cycle
-            body%dof(:, i) = nfree + [1, 2, 3]
-            nfree = nfree + 3
+            do j = 1, 3
+                if (body%dof(j, i) == 0) cycle
+                nfree = nfree + 1
+                body%dof(j, i) = nfree
+            end do
         end do
         body%nq = nfree
         body%nv = nfree
@@ -163,7 +178,9 @@ contains
             nf = count(dofs(1:nd) > 0)
             body%triplet_start(e) = nt + 1
             nt = nt + nf * nf
-            nm = nm + nf * nf / 3
+            do a = 1, 3 ! mass couples equal directions only
+                nm = nm + count(dofs(a:nd:3) > 0)**2
+            end do
         end do
         body%triplet_start(body%mesh%element_count() + 1) = nt + 1
         allocate (rows(nt), cols(nt), mrows(nm), mcols(nm), mvals(nm))

@@ -1,0 +1,268 @@
+!> Static equilibrium of a flexible body: k(q, 0) = λ g for the load factor
+!> λ = 1, g the applied force (gravity and nodal loads) on the free dofs.
+!>
+!> Newton's method with the tangent stiffness ∂k/∂q in the body's fixed CSC
+!> pattern, factorised by KLU (one symbolic analysis, a numeric factorisation
+!> per iteration), and a backtracking line search on ‖r‖∞. Load stepping:
+!> λ rises from 0 to 1 in increments that halve when Newton fails (no
+!> convergence, no descent, det F ≤ 0 at a quadrature point) and double
+!> after quick convergence; each increment starts from the secant predictor
+!> through the last two equilibria.
+!>
+!> Convergence of one load step: ‖Δq‖∞ ≤ increment_tolerance · (size of the
+!> body) and either ‖r‖∞ ≤ residual_tolerance · λ ‖g‖∞ or ‖r‖∞ at the level
+!> of round-off in k (100 ε (2μ + λ) times the largest element area, since
+!> the stresses lose absolute, not relative, accuracy near C = I). When the
+!> line search finds no descent, a negligible Newton correction also counts
+!> as converged.
+module flexmbs_fe_statics
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
+        reason_newton_failure, reason_step_too_small
+    use flexmbs_core_text, only: real_text, int_text
+    use flexmbs_linalg_klu, only: klu_factor_t
+    use flexmbs_fe_flexible_body, only: flexible_body_t
+    implicit none
+    private
+
+    type, public :: static_options_t
+        real(wp) :: residual_tolerance = 1.0e-10_wp  !! on ‖r‖∞ / ‖g‖∞
+        real(wp) :: increment_tolerance = 1.0e-10_wp !! on ‖Δq‖∞ / body size
+        integer :: max_iterations = 20       !! Newton iterations per load step
+        real(wp) :: initial_increment = 1.0_wp  !! first Δλ
+        real(wp) :: min_increment = 1.0e-6_wp   !! smallest Δλ before giving up
+        integer :: max_load_steps = 10000
+        integer :: max_backtracks = 8        !! line-search halvings
+    end type static_options_t
+
+    !> What a solve cost and reached.
+    type, public :: static_report_t
+        integer :: load_steps = 0          !! accepted load increments
+        integer :: failed_steps = 0        !! increments retried with half the size
+        integer :: newton_iterations = 0   !! all iterations, failed steps included
+        integer :: factorizations = 0
+        real(wp) :: load_factor = 0.0_wp   !! λ reached (1 on success)
+        real(wp) :: residual = 0.0_wp      !! final ‖r‖∞
+        !> ‖r‖∞ before each iteration of the last accepted load step (then final).
+        real(wp), allocatable :: residual_history(:)
+    end type static_report_t
+
+    public :: solve_static
+
+contains
+
+    !> Equilibrium under the body's applied force; q in: initial guess
+    !> (usually body%free_positions()), out: the equilibrium, or on failure
+    !> the last equilibrium reached (load factor in the report).
+    subroutine solve_static(body, q, status, options, report)
+        class(flexible_body_t), intent(inout) :: body
+        real(wp), intent(inout) :: q(:)
+        type(status_t), intent(out) :: status
+        type(static_options_t), intent(in), optional :: options
+        type(static_report_t), intent(out), optional :: report
+        type(static_options_t) :: opt
+        type(static_report_t) :: rep
+        type(klu_factor_t) :: klu
+        real(wp), allocatable :: zero_v(:), q_last(:), q_prev(:), q_trial(:), r(:), dq(:), &
+            k(:), history(:)
+        real(wp) :: lambda_last, lambda_prev, dlambda, lambda, gnorm, size_scale, floor
+        integer :: e
+        logical :: converged
+        integer :: nhist
+        character(len=:), allocatable :: why
+
+        if (present(options)) opt = options
+        if (size(q) /= body%nq) then
+            call status%set(status_bad_input, 'static equilibrium: q has ' // &
+                            int_text(size(q)) // ' entries, the body ' // int_text(body%nq))
+            if (present(report)) report = rep
+            return
+        end if
+        if (.not. (opt%min_increment > 0.0_wp .and. opt%initial_increment >= opt%min_increment &
+                   .and. opt%residual_tolerance > 0.0_wp .and. opt%max_iterations > 0)) then
+            call status%set(status_bad_input, 'static equilibrium: options need 0 < ' // &
+                'min_increment <= initial_increment, residual_tolerance > 0, max_iterations > 0')
+            if (present(report)) report = rep
+            return
+        end if
+        allocate (zero_v(body%nv), source=0.0_wp)
+        allocate (q_last, source=q)
+        allocate (q_prev, q_trial, r, dq, k, mold=q)
+        allocate (history(opt%max_iterations + 1))
+        q_prev = q
+        gnorm = 0.0_wp
+        if (body%nv > 0) gnorm = maxval(abs(body%applied_force))
+        size_scale = maxval(body%mesh%x) - minval(body%mesh%x)
+        if (size_scale <= 0.0_wp) size_scale = 1.0_wp
+        ! Round-off level of k: the stresses carry absolute errors of about
+        ! ε (2μ + λ) (from I − C⁻¹ and J − 1), times an element's area.
+        floor = 0.0_wp
+        do e = 1, body%mesh%element_count()
+            associate (mat => body%materials(body%element_material(e)))
+                floor = max(floor, (2.0_wp * mat%mu + mat%lambda) &
+                                   * sum(body%wdv(:, e))**(2.0_wp / 3))
+            end associate
+        end do
+        floor = 1.0e2_wp * epsilon(1.0_wp) * floor
+
+        if (body%nq == 0) then
+            rep%load_factor = 1.0_wp
+            call finish()
+            return
+        end if
+        call klu%analyse(body%nv, body%stiffness%colptr, body%stiffness%rowind, status)
+        if (.not. status%ok()) then
+            call finish()
+            return
+        end if
+
+        lambda_last = 0.0_wp
+        lambda_prev = 0.0_wp
+        dlambda = min(1.0_wp, opt%initial_increment)
+        do while (lambda_last < 1.0_wp)
+            if (rep%load_steps + rep%failed_steps >= opt%max_load_steps) then
+                call status%set(status_solver_failure, 'static equilibrium: ' // &
+                    int_text(opt%max_load_steps) // ' load steps reached at load factor ' // &
+                    real_text(lambda_last), reason_step_too_small)
+                exit
+            end if
+            lambda = min(1.0_wp, lambda_last + dlambda)
+            ! Secant predictor through the last two equilibria.
+            if (lambda_last > lambda_prev) then
+                q_trial = q_last + (lambda - lambda_last) / (lambda_last - lambda_prev) &
+                          * (q_last - q_prev)
+            else
+                q_trial = q_last
+            end if
+            call newton(lambda, converged, why)
+            if (.not. status%ok()) exit
+            if (.not. converged) then
+                ! The predictor may be what failed: retry from the last state.
+                if (lambda_last > lambda_prev) then
+                    q_trial = q_last
+                    call newton(lambda, converged, why)
+                    if (.not. status%ok()) exit
+                end if
+            end if
+            if (converged) then
+                rep%load_steps = rep%load_steps + 1
+                q_prev = q_last
+                lambda_prev = lambda_last
+                q_last = q_trial
+                lambda_last = lambda
+                rep%residual_history = history(1:nhist)
+                if (nhist <= 5) dlambda = min(1.0_wp, 2.0_wp * dlambda)
+            else
+                rep%failed_steps = rep%failed_steps + 1
+                dlambda = 0.5_wp * dlambda
+                if (dlambda < opt%min_increment) then
+                    call status%set(status_solver_failure, 'static equilibrium: load ' // &
+                        'increment below ' // real_text(opt%min_increment) // &
+                        ' at load factor ' // real_text(lambda_last) // ' (last failure: ' // &
+                        why // ')', reason_newton_failure)
+                    exit
+                end if
+            end if
+        end do
+        q = q_last
+        rep%load_factor = lambda_last
+        call finish()
+
+    contains
+
+        !> Newton from q_trial for load factor lam; q_trial is the solution
+        !> when converged. Hard errors (bad input, KLU misuse) go to status.
+        subroutine newton(lam, converged, why)
+            real(wp), intent(in) :: lam
+            logical, intent(out) :: converged
+            character(len=:), allocatable, intent(out) :: why
+            type(status_t) :: st
+            real(wp) :: rnorm, rtrial, alpha, dqnorm
+            integer :: it, ib
+            converged = .false.
+            nhist = 0
+            call residual(q_trial, lam, rnorm, st)
+            if (.not. st%ok()) then
+                why = st%text()
+                return
+            end if
+            do it = 1, opt%max_iterations
+                nhist = nhist + 1
+                history(nhist) = rnorm
+                rep%newton_iterations = rep%newton_iterations + 1
+                call body%tangents(q_trial, zero_v, k, st)
+                if (.not. st%ok()) then
+                    why = st%text()
+                    return
+                end if
+                call klu%factor(body%stiffness%values, st)
+                rep%factorizations = rep%factorizations + 1
+                if (.not. st%ok()) then
+                    why = 'tangent stiffness: ' // st%text()
+                    return
+                end if
+                dq = -r
+                call klu%solve(dq, st)
+                if (.not. st%ok()) then
+                    why = 'tangent stiffness solve: ' // st%text()
+                    return
+                end if
+                dqnorm = maxval(abs(dq))
+                ! Backtracking on ‖r‖∞ (Armijo with a small slope factor).
+                alpha = 1.0_wp
+                do ib = 0, opt%max_backtracks
+                    q_trial = q_trial + alpha * dq
+                    call residual(q_trial, lam, rtrial, st)
+                    if (st%ok() .and. rtrial <= (1.0_wp - 1.0e-4_wp * alpha) * rnorm) exit
+                    q_trial = q_trial - alpha * dq
+                    if (.not. st%ok()) why = st%text()
+                    alpha = 0.5_wp * alpha
+                end do
+                if (ib > opt%max_backtracks) then
+                    ! No descent: converged if r is at round-off level or the
+                    ! Newton correction itself is negligible.
+                    if (rnorm <= max(opt%residual_tolerance * lam * gnorm, floor) .or. &
+                        dqnorm <= opt%increment_tolerance * size_scale) then
+                        call residual(q_trial, lam, rnorm, st)
+                        converged = st%ok()
+                        nhist = nhist + 1
+                        history(nhist) = rnorm
+                        rep%residual = rnorm
+                        return
+                    end if
+                    if (.not. allocated(why)) why = 'no descent along the Newton direction'
+                    call residual(q_trial, lam, rnorm, st)
+                    return
+                end if
+                rnorm = rtrial
+                if ((rnorm <= opt%residual_tolerance * lam * gnorm .or. rnorm <= floor) .and. &
+                    alpha * dqnorm <= opt%increment_tolerance * size_scale) then
+                    converged = .true.
+                    nhist = nhist + 1
+                    history(nhist) = rnorm
+                    rep%residual = rnorm
+                    return
+                end if
+            end do
+            why = 'no convergence in ' // int_text(opt%max_iterations) // ' iterations'
+        end subroutine newton
+
+        !> r = k(q, 0) − lam g and its ∞-norm; st fails on det F ≤ 0.
+        subroutine residual(qq, lam, rnorm, st)
+            real(wp), intent(in) :: qq(:), lam
+            real(wp), intent(out) :: rnorm
+            type(status_t), intent(out) :: st
+            call body%internal_forces(qq, zero_v, r, st)
+            if (.not. st%ok()) then
+                rnorm = huge(1.0_wp)
+                return
+            end if
+            r = r - lam * body%applied_force
+            rnorm = maxval(abs(r))
+        end subroutine residual
+
+        subroutine finish()
+            if (present(report)) report = rep
+        end subroutine finish
+    end subroutine solve_static
+end module flexmbs_fe_statics
