@@ -25,8 +25,9 @@ module flexmbs
     use flexmbs_dae_bdf_stability, only: bdf_stability_angle, bdf_boundary_locus
     use flexmbs_fe_hexahedron, only: hexahedron_t, new_hexahedron, hex8, hex27
     use flexmbs_fe_neo_hooke, only: neo_hooke_t, new_neo_hooke
-    use flexmbs_fe_mesh, only: mesh_t, node_set_t
+    use flexmbs_fe_mesh, only: mesh_t, node_set_t, element_set_t
     use flexmbs_fe_box_mesh, only: box_mesh
+    use flexmbs_fe_mesh_file, only: read_mesh, write_mesh
     use flexmbs_fe_flexible_body, only: flexible_body_t, new_flexible_body
     use flexmbs_fe_statics, only: solve_static, static_options_t, static_report_t
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &

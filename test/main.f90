@@ -21,6 +21,7 @@ program flexmbs_tests
     use test_fe_body, only: collect_fe_body
     use test_fe_dynamics, only: collect_fe_dynamics
     use test_fe_statics, only: collect_fe_statics
+    use test_fe_mesh, only: collect_fe_mesh
     use test_rotation, only: collect_rotation
     use test_dual, only: collect_dual
     use test_constraint_primitives, only: collect_constraint_primitives
@@ -55,6 +56,7 @@ program flexmbs_tests
     call run_suite('fe_body', collect_fe_body(), filter, npassed, nfailed)
     call run_suite('fe_dynamics', collect_fe_dynamics(), filter, npassed, nfailed)
     call run_suite('fe_statics', collect_fe_statics(), filter, npassed, nfailed)
+    call run_suite('fe_mesh', collect_fe_mesh(), filter, npassed, nfailed)
     call run_suite('rotation', collect_rotation(), filter, npassed, nfailed)
     call run_suite('dual', collect_dual(), filter, npassed, nfailed)
     call run_suite('constraint_primitives', collect_constraint_primitives(), filter, &

@@ -1,9 +1,9 @@
-!> Numbers as text for status messages.
+!> Numbers as text for status messages, and small string helpers.
 module flexmbs_core_text
     use flexmbs_core_kinds, only: wp
     implicit none
     private
-    public :: real_text, int_text
+    public :: real_text, int_text, lower
 
 contains
 
@@ -24,4 +24,16 @@ contains
         write (buf, '(i0)') i
         text = trim(buf)
     end function int_text
+
+    !> s in lower case (ASCII).
+    pure function lower(s) result(t)
+        character(len=*), intent(in) :: s
+        character(len=len(s)) :: t
+        integer :: i, c
+        t = s
+        do i = 1, len(s)
+            c = iachar(s(i:i))
+            if (c >= iachar('A') .and. c <= iachar('Z')) t(i:i) = achar(c + 32)
+        end do
+    end function lower
 end module flexmbs_core_text

@@ -1,11 +1,16 @@
 !> Structured meshes of a box [origin, origin + lengths] by nx × ny × nz
-!> hexahedra of either type, with the six faces as node sets
-!> 'xmin', 'xmax', 'ymin', 'ymax', 'zmin', 'zmax'.
+!> hexahedra of either type, with named sets:
+!> - node sets: the six faces 'xmin', 'xmax', 'ymin', 'ymax', 'zmin', 'zmax';
+!>   the twelve edges, named by their two faces in x, y, z order
+!>   ('xmin_ymin', 'xmin_zmax', 'ymax_zmin', …), nodes ordered along the edge;
+!> - element sets: 'all', and the boundary element layers 'xmin_layer',
+!>   'xmax_layer', 'ymin_layer', … (the elements touching that face; for a
+!>   bar along x the paper's stiffer tips are 'xmin_layer' and 'xmax_layer').
 module flexmbs_fe_box_mesh
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_fe_hexahedron, only: hex8, hex27, hex_node_xi
-    use flexmbs_fe_mesh, only: mesh_t, node_set_t
+    use flexmbs_fe_mesh, only: mesh_t, node_set_t, element_set_t
     implicit none
     private
 
@@ -22,7 +27,7 @@ contains
         real(wp), intent(in) :: lengths(3)    !! box edge lengths
         type(status_t), intent(out) :: status
         real(wp), intent(in), optional :: origin(3) !! lower corner (default 0)
-        integer :: p, grid(3), i, j, k, e, a, ex, ey, ez, idx(3), d
+        integer :: p, grid(3), i, j, k, e, a, ex, ey, ez, idx(3), d, d2, b, n
         real(wp) :: x0(3)
         character(len=120) :: msg
         character(len=4), parameter :: face_names(2, 3) = reshape( &
@@ -65,11 +70,32 @@ contains
                 end do
             end do
         end do
-        allocate (mesh%node_sets(6))
+        allocate (mesh%node_sets(18), mesh%element_sets(7))
         do d = 1, 3
             do a = 1, 2
-                mesh%node_sets(2 * (d - 1) + a) = face_set(face_names(a, d), d, &
-                                                           merge(0, grid(d) - 1, a == 1))
+                mesh%node_sets(2 * (d - 1) + a) = grid_set(face_names(a, d), [d], &
+                                                           [merge(0, grid(d) - 1, a == 1)])
+            end do
+        end do
+        n = 6
+        do d = 1, 2
+            do d2 = d + 1, 3
+                do a = 1, 2
+                    do b = 1, 2
+                        n = n + 1
+                        mesh%node_sets(n) = grid_set(face_names(a, d) // '_' // &
+                            face_names(b, d2), [d, d2], [merge(0, grid(d) - 1, a == 1), &
+                            merge(0, grid(d2) - 1, b == 1)])
+                    end do
+                end do
+            end do
+        end do
+        mesh%element_sets(1)%name = 'all'
+        mesh%element_sets(1)%elements = [(e, e = 1, product(divisions))]
+        do d = 1, 3
+            do a = 1, 2
+                mesh%element_sets(1 + 2 * (d - 1) + a) = layer_set(face_names(a, d) // &
+                    '_layer', d, merge(0, divisions(d) - 1, a == 1))
             end do
         end do
 
@@ -80,26 +106,52 @@ contains
             grid_node = 1 + i + grid(1) * (j + grid(2) * k)
         end function grid_node
 
-        !> Nodes whose grid index in direction d equals level.
-        function face_set(name, d, level) result(set)
+
+        !> Nodes whose grid indices in the directions dirs equal levels, in
+        !> grid order (x fastest).
+        function grid_set(name, dirs, levels) result(set)
             character(len=*), intent(in) :: name
-            integer, intent(in) :: d, level
+            integer, intent(in) :: dirs(:), levels(:)
             type(node_set_t) :: set
             integer :: i, j, k, n, ijk(3)
             set%name = name
-            allocate (set%nodes(product(grid) / grid(d)))
+            allocate (set%nodes(product(grid) / product(grid(dirs))))
             n = 0
             do k = 0, grid(3) - 1
                 do j = 0, grid(2) - 1
                     do i = 0, grid(1) - 1
                         ijk = [i, j, k]
-                        if (ijk(d) == level) then
+                        if (all(ijk(dirs) == levels)) then
                             n = n + 1
                             set%nodes(n) = grid_node(i, j, k)
                         end if
                     end do
                 end do
             end do
-        end function face_set
+        end function grid_set
+
+        !> Elements whose index in direction d equals level.
+        function layer_set(name, d, level) result(set)
+            character(len=*), intent(in) :: name
+            integer, intent(in) :: d, level
+            type(element_set_t) :: set
+            integer :: ex, ey, ez, e, n, exyz(3)
+            set%name = name
+            allocate (set%elements(product(divisions) / divisions(d)))
+            n = 0
+            e = 0
+            do ez = 0, divisions(3) - 1
+                do ey = 0, divisions(2) - 1
+                    do ex = 0, divisions(1) - 1
+                        e = e + 1
+                        exyz = [ex, ey, ez]
+                        if (exyz(d) == level) then
+                            n = n + 1
+                            set%elements(n) = e
+                        end if
+                    end do
+                end do
+            end do
+        end function layer_set
     end subroutine box_mesh
 end module flexmbs_fe_box_mesh

@@ -1,8 +1,10 @@
 !> A solid mesh: reference nodal positions, hexahedral connectivity (VTK node
-!> order, see flexmbs_fe_hexahedron) and named node sets (faces, edges, ...).
+!> order, see flexmbs_fe_hexahedron), named node sets (faces, edges, ...) and
+!> named element sets (material regions such as the paper's tip layers).
 module flexmbs_fe_mesh
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_text, only: int_text
     implicit none
     private
 
@@ -12,15 +14,24 @@ module flexmbs_fe_mesh
         integer, allocatable :: nodes(:)
     end type node_set_t
 
+    !> A named set of element numbers.
+    type, public :: element_set_t
+        character(len=:), allocatable :: name
+        integer, allocatable :: elements(:)
+    end type element_set_t
+
     type, public :: mesh_t
         integer :: nnode_element = 0                 !! 8 or 27
         real(wp), allocatable :: x(:, :)             !! (3, nodes) reference positions
         integer, allocatable :: connectivity(:, :)   !! (nnode_element, elements)
         type(node_set_t), allocatable :: node_sets(:)
+        type(element_set_t), allocatable :: element_sets(:)
     contains
         procedure :: node_count => mesh_node_count
         procedure :: element_count => mesh_element_count
         procedure :: node_set => mesh_node_set
+        procedure :: element_set => mesh_element_set
+        procedure :: check => mesh_check
     end type mesh_t
 
 contains
@@ -55,4 +66,95 @@ contains
         allocate (nodes(0))
         call status%set(status_bad_input, 'mesh: no node set named ''' // name // '''')
     end subroutine mesh_node_set
+
+    !> The elements of the set called `name`; bad input naming the set if absent.
+    subroutine mesh_element_set(self, name, elements, status)
+        class(mesh_t), intent(in) :: self
+        character(len=*), intent(in) :: name
+        integer, allocatable, intent(out) :: elements(:)
+        type(status_t), intent(out) :: status
+        integer :: i
+        if (allocated(self%element_sets)) then
+            do i = 1, size(self%element_sets)
+                if (self%element_sets(i)%name == name) then
+                    elements = self%element_sets(i)%elements
+                    return
+                end if
+            end do
+        end if
+        allocate (elements(0))
+        call status%set(status_bad_input, 'mesh: no element set named ''' // name // '''')
+    end subroutine mesh_element_set
+
+    !> Consistency: 8 or 27 nodes per element, connectivity within the nodes
+    !> and without repeats, set members in range, set names unique per kind.
+    subroutine mesh_check(self, status)
+        class(mesh_t), intent(in) :: self
+        type(status_t), intent(out) :: status
+        integer :: e, a, i, j, n, ne
+        if (self%nnode_element /= 8 .and. self%nnode_element /= 27) then
+            call status%set(status_bad_input, 'mesh: ' // int_text(self%nnode_element) // &
+                            ' nodes per element; 8 or 27 expected')
+            return
+        end if
+        n = self%node_count()
+        ne = self%element_count()
+        if (.not. allocated(self%connectivity)) then
+            call status%set(status_bad_input, 'mesh: no elements')
+            return
+        end if
+        if (size(self%connectivity, 1) /= self%nnode_element) then
+            call status%set(status_bad_input, 'mesh: connectivity rows differ from nodes per element')
+            return
+        end if
+        do e = 1, ne
+            do a = 1, self%nnode_element
+                if (self%connectivity(a, e) < 1 .or. self%connectivity(a, e) > n) then
+                    call status%set(status_bad_input, 'mesh: element ' // int_text(e) // &
+                        ' names node ' // int_text(self%connectivity(a, e)) // &
+                        ', outside 1..' // int_text(n))
+                    return
+                end if
+                if (any(self%connectivity(a + 1:, e) == self%connectivity(a, e))) then
+                    call status%set(status_bad_input, 'mesh: element ' // int_text(e) // &
+                        ' names node ' // int_text(self%connectivity(a, e)) // ' twice')
+                    return
+                end if
+            end do
+        end do
+        if (allocated(self%node_sets)) then
+            do i = 1, size(self%node_sets)
+                if (any(self%node_sets(i)%nodes < 1 .or. self%node_sets(i)%nodes > n)) then
+                    call status%set(status_bad_input, 'mesh: node set ''' // &
+                        self%node_sets(i)%name // ''' has a node outside 1..' // int_text(n))
+                    return
+                end if
+                do j = i + 1, size(self%node_sets)
+                    if (self%node_sets(j)%name == self%node_sets(i)%name) then
+                        call status%set(status_bad_input, 'mesh: two node sets named ''' // &
+                                        self%node_sets(i)%name // '''')
+                        return
+                    end if
+                end do
+            end do
+        end if
+        if (allocated(self%element_sets)) then
+            do i = 1, size(self%element_sets)
+                if (any(self%element_sets(i)%elements < 1 .or. &
+                        self%element_sets(i)%elements > ne)) then
+                    call status%set(status_bad_input, 'mesh: element set ''' // &
+                        self%element_sets(i)%name // ''' has an element outside 1..' // &
+                        int_text(ne))
+                    return
+                end if
+                do j = i + 1, size(self%element_sets)
+                    if (self%element_sets(j)%name == self%element_sets(i)%name) then
+                        call status%set(status_bad_input, 'mesh: two element sets named ''' &
+                                        // self%element_sets(i)%name // '''')
+                        return
+                    end if
+                end do
+            end do
+        end if
+    end subroutine mesh_check
 end module flexmbs_fe_mesh

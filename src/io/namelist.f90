@@ -12,7 +12,9 @@ module flexmbs_io_namelist
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use, intrinsic :: ieee_exceptions, only: ieee_status_type, ieee_get_status, ieee_set_status
     use flexmbs_core_kinds, only: wp
-    use flexmbs_core_status, only: status_t, status_bad_input, status_io_error
+    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_files, only: read_text_file
+    use flexmbs_core_text, only: lower
     use flexmbs_dae_options, only: dae_options_t
     implicit none
     private
@@ -162,34 +164,8 @@ contains
         type(scene_input_t), intent(out) :: scene !! defaults plus the file's values
         type(status_t), intent(out) :: status
         character(len=:), allocatable :: text
-        logical :: exists
-        integer :: unit, ios, nbytes
-        character(len=256) :: msg
-
-        inquire (file=path, exist=exists)
-        if (.not. exists) then
-            call status%set(status_bad_input, path // ': no such file')
-            return
-        end if
-        open (newunit=unit, file=path, access='stream', form='unformatted', &
-              action='read', status='old', iostat=ios, iomsg=msg)
-        if (ios /= 0) then
-            call status%set(status_io_error, path // ': cannot open: ' // trim(msg))
-            return
-        end if
-        inquire (unit=unit, size=nbytes)
-        if (nbytes < 0) then
-            close (unit)
-            call status%set(status_io_error, path // ': cannot determine its size')
-            return
-        end if
-        allocate (character(len=nbytes) :: text)
-        if (nbytes > 0) read (unit, iostat=ios, iomsg=msg) text
-        close (unit)
-        if (ios /= 0) then
-            call status%set(status_io_error, path // ': cannot read: ' // trim(msg))
-            return
-        end if
+        call read_text_file(path, text, status)
+        if (.not. status%ok()) return
         call parse_scene(text, path, scene, status)
     end subroutine read_scene
 
@@ -1067,17 +1043,6 @@ contains
             i = i + 1
         end do
     end function unquote
-
-    pure function lower(s) result(t)
-        character(len=*), intent(in) :: s
-        character(len=len(s)) :: t
-        integer :: i, c
-        t = s
-        do i = 1, len(s)
-            c = iachar(s(i:i))
-            if (c >= iachar('A') .and. c <= iachar('Z')) t(i:i) = achar(c + 32)
-        end do
-    end function lower
 
     pure logical function is_letter(c)
         character, intent(in) :: c
