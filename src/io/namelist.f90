@@ -1,4 +1,5 @@
-!> Scene input: the namelist groups `&simulation`, `&solver` and `&output`.
+!> Scene input: the namelist groups `&simulation`, `&solver`, `&output`, and
+!> for a flexible body `&flexible_body` with one or more `&material` groups.
 !>
 !> The text is checked before Fortran namelist I/O reads it, because the
 !> compiler's own namelist errors name neither the variable nor the value.
@@ -22,11 +23,17 @@ module flexmbs_io_namelist
     integer, parameter :: kind_string = 1, kind_real = 2, kind_integer = 3, kind_logical = 4
     integer, parameter :: len_title = 256, len_name = 32, len_path = 512
 
+    !> At most this many node-set names in `&flexible_body fixed`.
+    integer, parameter, public :: max_fixed_sets = 6
+
     !> One variable of the schema.
     type :: var_spec_t
-        character(len=12) :: group
+        character(len=16) :: group
         character(len=24) :: name
         integer :: kind
+        !> values: 1 for a scalar; an array of reals or integers takes
+        !> exactly `count`, an array of strings 1..count
+        integer :: count = 1
     end type var_spec_t
 
     type(var_spec_t), parameter :: schema(*) = [ &
@@ -73,19 +80,72 @@ module flexmbs_io_namelist
         var_spec_t('output', 'n_output', kind_integer), &
         var_spec_t('output', 'every_step', kind_logical), &
         var_spec_t('output', 'table', kind_string), &
-        var_spec_t('output', 'progress', kind_logical)]
+        var_spec_t('output', 'progress', kind_logical), &
+        var_spec_t('flexible_body', 'name', kind_string), &
+        var_spec_t('flexible_body', 'element', kind_string), &
+        var_spec_t('flexible_body', 'mesh_file', kind_string), &
+        var_spec_t('flexible_body', 'divisions', kind_integer, 3), &
+        var_spec_t('flexible_body', 'lengths', kind_real, 3), &
+        var_spec_t('flexible_body', 'origin', kind_real, 3), &
+        var_spec_t('flexible_body', 'fixed', kind_string, max_fixed_sets), &
+        var_spec_t('flexible_body', 'load_set', kind_string), &
+        var_spec_t('flexible_body', 'load', kind_real, 3), &
+        var_spec_t('flexible_body', 'gravity', kind_real, 3), &
+        var_spec_t('flexible_body', 'initial_velocity', kind_real, 3), &
+        var_spec_t('flexible_body', 'initial_angular_velocity', kind_real, 3), &
+        var_spec_t('flexible_body', 'formulation', kind_string), &
+        var_spec_t('material', 'name', kind_string), &
+        var_spec_t('material', 'youngs_modulus', kind_real), &
+        var_spec_t('material', 'poisson_ratio', kind_real), &
+        var_spec_t('material', 'density', kind_real), &
+        var_spec_t('material', 'viscosity', kind_real), &
+        var_spec_t('material', 'elements', kind_string)]
 
-    character(len=12), parameter :: group_names(*) = [character(len=12) :: &
-        'simulation', 'solver', 'output']
+    character(len=16), parameter :: group_names(*) = [character(len=16) :: &
+        'simulation', 'solver', 'output', 'flexible_body', 'material']
+    !> The one group that may be given several times (one material each).
+    character(len=*), parameter :: repeatable_group = 'material'
 
     !> Problem names the schema accepts (the scene builder says which exist).
     character(len=16), parameter, public :: problem_names(*) = [character(len=16) :: &
-        'van_der_pol', 'pendulum', 'robertson', 'brusselator_1d', 'brusselator_2d']
+        'van_der_pol', 'pendulum', 'robertson', 'brusselator_1d', 'brusselator_2d', &
+        'flexible_body']
     character(len=8), parameter, public :: formulation_names(*) = [character(len=8) :: &
         'index3', 'index2', 'index1', 'ggl']
 
     !> π/2: the pendulum starts horizontal by default.
     real(wp), parameter :: half_pi = 1.5707963267948966_wp
+
+    !> One `&material`: the paper's neo-Hookean law with damping, on an
+    !> element set of the body's mesh.
+    type, public :: material_input_t
+        character(len=len_name) :: name = ''     !! for messages ('' = 'material N')
+        real(wp) :: youngs_modulus = 0.0_wp      !! E [Pa], required, > 0
+        real(wp) :: poisson_ratio = 0.3_wp       !! ν, in (−1, 0.5)
+        real(wp) :: density = 0.0_wp             !! ρ [kg/m³], required, > 0
+        real(wp) :: viscosity = 0.0_wp           !! η [Pa·s], ≥ 0 (0: undamped)
+        !> element set it covers; '' = every element no other material names
+        character(len=len_name) :: elements = ''
+        integer :: line = 0                      !! where the group starts
+    end type material_input_t
+
+    !> The `&flexible_body` group: mesh, supports, loads, initial velocity.
+    type, public :: body_input_t
+        character(len=len_name) :: name = 'body'
+        character(len=len_name) :: element = 'hex8'       !! 'hex8' | 'hex27'
+        character(len=len_path) :: mesh_file = ''         !! '' = a box mesh
+        integer :: divisions(3) = 1                       !! box: elements per direction
+        real(wp) :: lengths(3) = 0.0_wp                   !! box: edge lengths [m], required
+        real(wp) :: origin(3) = 0.0_wp                    !! box: lower corner [m]
+        character(len=len_name) :: fixed(max_fixed_sets) = '' !! node sets held at X
+        character(len=len_name) :: load_set = ''          !! node set carrying `load`
+        real(wp) :: load(3) = 0.0_wp                      !! total force on load_set [N]
+        real(wp) :: gravity(3) = 0.0_wp                   !! [m/s²]
+        real(wp) :: initial_velocity(3) = 0.0_wp          !! [m/s], rigid field
+        real(wp) :: initial_angular_velocity(3) = 0.0_wp  !! [rad/s] about the centroid
+        character(len=len_name) :: formulation = 'index2'
+        integer :: line = 0                               !! where the group starts
+    end type body_input_t
 
     !> Everything a scene file says, with defaults for what it leaves out.
     type, public :: scene_input_t
@@ -139,18 +199,34 @@ module flexmbs_io_namelist
         logical :: every_step = .false.
         character(len=len_path) :: table = ''
         logical :: progress = .true.
+        ! &flexible_body and &material
+        logical :: has_body = .false.                 !! a &flexible_body group was given
+        type(body_input_t) :: body
+        type(material_input_t), allocatable :: materials(:) !! in the order given
     end type scene_input_t
 
-    !> One `name = value` of the text.
+    !> One value of a variable's list.
+    type :: item_t
+        character(len=:), allocatable :: text
+        logical :: quoted = .false.
+    end type item_t
+
+    !> One `name = value[, value ...]` of the text; `value` is the list as
+    !> written (for messages), `items` its values.
     type :: entry_t
         character(len=:), allocatable :: group, name, value
         integer :: line = 0
         logical :: quoted = .false.
+        integer :: instance = 1  !! which occurrence of a repeatable group
+        type(item_t), allocatable :: items(:)
     end type entry_t
 
-    !> Text span [first, last] of a group, from '&name' to its closing '/'.
+    !> Text span [first, last] of one group, from '&name' to its closing '/'.
     type :: span_t
+        integer :: group = 0     !! index in group_names
+        integer :: instance = 1  !! occurrence of that group
         integer :: first = 0, last = 0
+        integer :: line = 0      !! line of '&name'
     end type span_t
 
     public :: read_scene, parse_scene, scene_dae_options, controller_code
@@ -177,9 +253,9 @@ contains
         type(scene_input_t), intent(out) :: scene
         type(status_t), intent(out) :: status
         type(entry_t), allocatable :: entries(:)
-        type(span_t) :: spans(size(group_names))
+        type(span_t), allocatable :: spans(:)
         character(len=:), allocatable :: clean
-        integer :: g
+        integer :: i, g
 
         scene%path = path
         scene%text = text
@@ -187,14 +263,29 @@ contains
         if (.not. status%ok()) return
         call check_types(entries, path, status)
         if (.not. status%ok()) return
-        do g = 1, size(group_names)
-            if (spans(g)%first == 0) cycle
-            call read_group(clean(spans(g)%first:spans(g)%last), trim(group_names(g)), &
-                            path, scene, status)
+        allocate (scene%materials(count(spans%group == find_group(repeatable_group))))
+        do i = 1, size(spans)
+            g = spans(i)%group
+            associate (group_text => clean(spans(i)%first:spans(i)%last))
+                select case (trim(group_names(g)))
+                case ('flexible_body')
+                    scene%has_body = .true.
+                    scene%body%line = spans(i)%line
+                    call read_body_group(group_text, path, scene%body, status)
+                case ('material')
+                    scene%materials(spans(i)%instance)%line = spans(i)%line
+                    call read_material_group(group_text, path, &
+                                             scene%materials(spans(i)%instance), status)
+                case default
+                    call read_group(group_text, trim(group_names(g)), path, scene, status)
+                end select
+            end associate
             if (.not. status%ok()) return
         end do
-        call normalise(scene)
+        call normalise(scene, entries)
         call check_ranges(scene, entries, path, status)
+        if (.not. status%ok()) return
+        call check_body(scene, entries, path, status)
         if (.not. status%ok()) return
         call resolve_output(scene, entries, path, status)
     end subroutine parse_scene
@@ -208,14 +299,15 @@ contains
     subroutine tokenise(text, path, entries, spans, clean, status)
         character(len=*), intent(in) :: text, path
         type(entry_t), allocatable, intent(out) :: entries(:)
-        type(span_t), intent(inout) :: spans(:)
+        type(span_t), allocatable, intent(out) :: spans(:)
         character(len=:), allocatable, intent(out) :: clean
         type(status_t), intent(inout) :: status
-        integer :: pos, line, g, n, first, vline
+        integer :: pos, line, g, n, first, first_line, vline, instance, spec
         character(len=:), allocatable :: word, group, name, value, previous
         logical :: quoted
+        type(item_t), allocatable :: items(:)
 
-        allocate (entries(0))
+        allocate (entries(0), spans(0))
         clean = blank_comments(text)
         n = len(clean)
         pos = 1
@@ -231,15 +323,23 @@ contains
                 return
             end if
             first = pos
+            first_line = line
             pos = pos + 1
             group = lower(name_word(clean, pos))
             g = find_group(group)
             if (g == 0) then
                 call status%set(status_bad_input, path // ': &' // group // &
-                    ': unknown group (expected &simulation, &solver or &output)' // at(line))
+                    ': unknown group (expected &simulation, &solver, &output, &
+                    &&flexible_body or &material)' // at(line))
                 return
             end if
-            if (spans(g)%first /= 0) then
+            instance = count(spans%group == g) + 1
+            if (instance > 1 .and. group == 'flexible_body') then
+                call status%set(status_bad_input, path // ': &' // group // &
+                    ': group given more than once (one flexible body per scene for now)' &
+                    // at(line))
+                return
+            else if (instance > 1 .and. group /= repeatable_group) then
                 call status%set(status_bad_input, path // ': &' // group // &
                     ': group given more than once' // at(line))
                 return
@@ -287,7 +387,7 @@ contains
                         ': unknown variable (known: ' // known_vars(group) // ')' // at(line))
                     return
                 end if
-                if (has_entry(entries, group, name)) then
+                if (has_entry(entries, group, name, instance)) then
                     call status%set(status_bad_input, path // ': &' // group // ': ' // name // &
                         ': given more than once' // at(line))
                     return
@@ -323,13 +423,78 @@ contains
                         ': has no value' // at(vline))
                     return
                 end if
-                entries = [entries, entry_t(group, name, value, vline, quoted)]
+                items = [item_t(value, quoted)]
+                spec = find_var(group, name)
+                if (schema(spec)%count > 1) then
+                    call more_values(clean, pos, line, items, status)
+                    value = joined(items)
+                    if (.not. status%ok()) then
+                        call status%set(status_bad_input, path // ': &' // group // ': ' // &
+                            name // ' = ' // value // ': unterminated string' // at(vline))
+                        return
+                    end if
+                    if (schema(spec)%kind /= kind_string .and. &
+                        size(items) /= schema(spec)%count) then
+                        call status%set(status_bad_input, path // ': &' // group // ': ' // &
+                            name // ' = ' // value // ': needs ' // itoa(schema(spec)%count) &
+                            // ' values' // at(vline))
+                        return
+                    else if (size(items) > schema(spec)%count) then
+                        call status%set(status_bad_input, path // ': &' // group // ': ' // &
+                            name // ' = ' // value // ': at most ' // &
+                            itoa(schema(spec)%count) // ' values' // at(vline))
+                        return
+                    end if
+                end if
+                entries = [entries, entry_t(group, name, value, vline, &
+                                            all(items%quoted), instance, items)]
                 previous = name
             end do
-            spans(g)%first = first
-            spans(g)%last = pos - 1
+            spans = [spans, span_t(g, instance, first, pos - 1, first_line)]
         end do
     end subroutine tokenise
+
+    !> Further values of an array variable: each a quoted string or a token
+    !> starting like a number, after blanks or a comma. Stops (leaving pos
+    !> at the comma) before anything else, e.g. the next `name =`.
+    subroutine more_values(text, pos, line, items, status)
+        character(len=*), intent(in) :: text
+        integer, intent(inout) :: pos, line
+        type(item_t), allocatable, intent(inout) :: items(:)
+        type(status_t), intent(inout) :: status
+        integer :: p, l
+        character(len=:), allocatable :: value
+        logical :: quoted
+        do
+            p = pos
+            l = line
+            call skip_blank(text, p, l)
+            if (p <= len(text)) then
+                if (text(p:p) == ',') then
+                    p = p + 1
+                    call skip_blank(text, p, l)
+                end if
+            end if
+            if (p > len(text)) return
+            if (scan(text(p:p), '0123456789+-.''"') == 0) return
+            pos = p
+            line = l
+            call value_word(text, pos, value, quoted, status)
+            items = [items, item_t(value, quoted)]
+            if (.not. status%ok()) return
+        end do
+    end subroutine more_values
+
+    !> The values of a list as one text, for messages.
+    pure function joined(items) result(text)
+        type(item_t), intent(in) :: items(:)
+        character(len=:), allocatable :: text
+        integer :: i
+        text = items(1)%text
+        do i = 2, size(items)
+            text = text // ', ' // items(i)%text
+        end do
+    end function joined
 
     !> The text with every comment ('!' outside a string, to the end of
     !> its line) replaced by blanks; positions and newlines are kept.
@@ -471,57 +636,69 @@ contains
         type(entry_t), intent(in) :: entries(:)
         character(len=*), intent(in) :: path
         type(status_t), intent(inout) :: status
-        integer :: i, k, ios
-        real(wp) :: x
-        integer :: m
+        integer :: i, j, k
         character(len=:), allocatable :: reason
-        type(ieee_status_type) :: fp_status
 
         do i = 1, size(entries)
             associate (e => entries(i))
                 k = schema(find_var(e%group, e%name))%kind
-                reason = ''
-                select case (k)
-                case (kind_string)
-                    if (.not. e%quoted) then
-                        reason = 'must be a quoted string, e.g. ' // e%name // ' = ''' // &
-                                 e%value // ''''
-                    else if (len(unquote(e%value)) > string_length(e%name)) then
-                        reason = 'longer than ' // itoa(string_length(e%name)) // ' characters'
-                    end if
-                case (kind_real)
-                    if (e%quoted .or. .not. is_real_text(e%value)) then
-                        reason = 'must be a real number'
-                    else
-                        ! an overflowing value must not leave the overflow flag raised
-                        call ieee_get_status(fp_status)
-                        read (e%value, *, iostat=ios) x
-                        call ieee_set_status(fp_status)
-                        if (ios /= 0) then
-                            reason = 'is out of the range of real numbers'
-                        else if (.not. ieee_is_finite(x)) then
-                            reason = 'is out of the range of real numbers'
-                        end if
-                    end if
-                case (kind_integer)
-                    if (e%quoted .or. .not. is_integer_text(e%value)) then
-                        reason = 'must be an integer'
-                    else
-                        read (e%value, *, iostat=ios) m
-                        if (ios /= 0) reason = 'is out of the range of integers'
-                    end if
-                case (kind_logical)
-                    if (e%quoted .or. .not. is_logical_text(e%value)) then
-                        reason = 'must be .true. or .false.'
-                    end if
-                end select
-                if (len(reason) > 0) then
+                do j = 1, size(e%items)
+                    reason = type_reason(k, e%name, e%items(j))
+                    if (len(reason) == 0) cycle
+                    ! in a list, say which value is wrong
+                    if (size(e%items) > 1) reason = 'value ' // itoa(j) // ' (' // &
+                        e%items(j)%text // ') ' // reason
                     call fail(status, path, e, reason)
                     return
-                end if
+                end do
             end associate
         end do
     end subroutine check_types
+
+    !> Why one value does not fit the kind of variable `name` ('' if it does).
+    function type_reason(kind, name, item) result(reason)
+        integer, intent(in) :: kind
+        character(len=*), intent(in) :: name
+        type(item_t), intent(in) :: item
+        character(len=:), allocatable :: reason
+        integer :: ios, m
+        real(wp) :: x
+        type(ieee_status_type) :: fp_status
+        reason = ''
+        select case (kind)
+        case (kind_string)
+            if (.not. item%quoted) then
+                reason = 'must be a quoted string, e.g. ' // name // ' = ''' // item%text // ''''
+            else if (len(unquote(item%text)) > string_length(name)) then
+                reason = 'longer than ' // itoa(string_length(name)) // ' characters'
+            end if
+        case (kind_real)
+            if (item%quoted .or. .not. is_real_text(item%text)) then
+                reason = 'must be a real number'
+            else
+                ! an overflowing value must not leave the overflow flag raised
+                call ieee_get_status(fp_status)
+                read (item%text, *, iostat=ios) x
+                call ieee_set_status(fp_status)
+                if (ios /= 0) then
+                    reason = 'is out of the range of real numbers'
+                else if (.not. ieee_is_finite(x)) then
+                    reason = 'is out of the range of real numbers'
+                end if
+            end if
+        case (kind_integer)
+            if (item%quoted .or. .not. is_integer_text(item%text)) then
+                reason = 'must be an integer'
+            else
+                read (item%text, *, iostat=ios) m
+                if (ios /= 0) reason = 'is out of the range of integers'
+            end if
+        case (kind_logical)
+            if (item%quoted .or. .not. is_logical_text(item%text)) then
+                reason = 'must be .true. or .false.'
+            end if
+        end select
+    end function type_reason
 
     pure logical function is_integer_text(s)
         character(len=*), intent(in) :: s
@@ -589,7 +766,7 @@ contains
         character(len=*), intent(in) :: name
         select case (name)
         case ('title'); string_length = len_title
-        case ('file', 'table'); string_length = len_path
+        case ('file', 'table', 'mesh_file'); string_length = len_path
         case default; string_length = len_name
         end select
     end function string_length
@@ -731,6 +908,88 @@ contains
         end if
     end subroutine read_group
 
+    !> `&flexible_body` through namelist I/O; defaults are the current values.
+    subroutine read_body_group(text, path, body, status)
+        character(len=*), intent(in) :: text  !! '&flexible_body ... /', comments blanked
+        character(len=*), intent(in) :: path
+        type(body_input_t), intent(inout) :: body
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: lines(:)
+        integer :: ios
+        character(len=256) :: msg
+        character(len=len_name) :: name, element, load_set, formulation
+        character(len=len_name) :: fixed(max_fixed_sets)
+        character(len=len_path) :: mesh_file
+        integer :: divisions(3)
+        real(wp), dimension(3) :: lengths, origin, load, gravity, initial_velocity, &
+            initial_angular_velocity
+        namelist /flexible_body/ name, element, mesh_file, divisions, lengths, origin, fixed, &
+            load_set, load, gravity, initial_velocity, initial_angular_velocity, formulation
+
+        name = body%name
+        element = body%element
+        mesh_file = body%mesh_file
+        divisions = body%divisions
+        lengths = body%lengths
+        origin = body%origin
+        fixed = body%fixed
+        load_set = body%load_set
+        load = body%load
+        gravity = body%gravity
+        initial_velocity = body%initial_velocity
+        initial_angular_velocity = body%initial_angular_velocity
+        formulation = body%formulation
+        msg = ''
+        lines = split_lines(text)
+        read (lines, nml=flexible_body, iostat=ios, iomsg=msg)
+        body%name = name
+        body%element = element
+        body%mesh_file = mesh_file
+        body%divisions = divisions
+        body%lengths = lengths
+        body%origin = origin
+        body%fixed = fixed
+        body%load_set = load_set
+        body%load = load
+        body%gravity = gravity
+        body%initial_velocity = initial_velocity
+        body%initial_angular_velocity = initial_angular_velocity
+        body%formulation = formulation
+        ! Not expected after validation; report what the compiler says.
+        if (ios /= 0) call status%set(status_bad_input, path // ': &flexible_body: ' // trim(msg))
+    end subroutine read_body_group
+
+    !> One `&material` through namelist I/O.
+    subroutine read_material_group(text, path, input, status)
+        character(len=*), intent(in) :: text  !! '&material ... /', comments blanked
+        character(len=*), intent(in) :: path
+        type(material_input_t), intent(inout) :: input
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: lines(:)
+        integer :: ios
+        character(len=256) :: msg
+        character(len=len_name) :: name, elements
+        real(wp) :: youngs_modulus, poisson_ratio, density, viscosity
+        namelist /material/ name, youngs_modulus, poisson_ratio, density, viscosity, elements
+
+        name = input%name
+        youngs_modulus = input%youngs_modulus
+        poisson_ratio = input%poisson_ratio
+        density = input%density
+        viscosity = input%viscosity
+        elements = input%elements
+        msg = ''
+        lines = split_lines(text)
+        read (lines, nml=material, iostat=ios, iomsg=msg)
+        input%name = name
+        input%youngs_modulus = youngs_modulus
+        input%poisson_ratio = poisson_ratio
+        input%density = density
+        input%viscosity = viscosity
+        input%elements = elements
+        if (ios /= 0) call status%set(status_bad_input, path // ': &material: ' // trim(msg))
+    end subroutine read_material_group
+
     !> Split text at newlines into records of equal length.
     pure function split_lines(text) result(lines)
         character(len=*), intent(in) :: text
@@ -764,9 +1023,20 @@ contains
     ! Ranges: check the typed values, quoting the text they came from.
     ! ------------------------------------------------------------------
 
-    !> Lower-case the choice variables (names compare case-insensitively).
-    subroutine normalise(scene)
+    !> Lower-case the choice variables (names compare case-insensitively);
+    !> a `&flexible_body` without `problem` selects it.
+    subroutine normalise(scene, entries)
         type(scene_input_t), intent(inout) :: scene
+        type(entry_t), intent(in) :: entries(:)
+        integer :: i
+        if (scene%has_body .and. .not. has_entry(entries, 'simulation', 'problem')) &
+            scene%problem = 'flexible_body'
+        scene%body%element = lower(scene%body%element)
+        scene%body%formulation = lower(scene%body%formulation)
+        do i = 1, size(scene%materials)
+            if (len_trim(scene%materials(i)%name) == 0) &
+                scene%materials(i)%name = 'material ' // itoa(i)
+        end do
         scene%problem = lower(scene%problem)
         scene%pendulum_formulation = lower(scene%pendulum_formulation)
         scene%solver_name = lower(scene%solver_name)
@@ -786,7 +1056,7 @@ contains
         character(len=:), allocatable :: ext
 
         ! &simulation
-        if (.not. has_entry(entries, sim, 'problem')) then
+        if (.not. has_entry(entries, sim, 'problem') .and. .not. scene%has_body) then
             call missing(sim, 'problem', 'one of ' // choices(problem_names))
         else if (all(problem_names /= scene%problem)) then
             call bad(sim, 'problem', 'must be one of ' // choices(problem_names))
@@ -811,10 +1081,11 @@ contains
         else if (all([character(len=8) :: 'radau5', 'ddassl', 'ida', 'mexax'] &
                      /= scene%solver_name)) then
             call bad(sol, 'name', 'must be ''radau5'', ''ddassl'', ''ida'' or ''mexax''')
-        else if (scene%solver_name == 'mexax' .and. scene%problem /= 'pendulum') then
+        else if (scene%solver_name == 'mexax' .and. scene%problem /= 'pendulum' .and. &
+                 scene%problem /= 'flexible_body') then
             ! ALGORITHMS.md §6: MEXAX integrates the mechanical form only.
             call bad(sol, 'name', '''mexax'' integrates mechanical problems only: &
-                &problem must be ''pendulum''')
+                &problem must be ''pendulum'' or ''flexible_body''')
         else if (.not. scene%rtol > 0.0_wp) then
             call bad(sol, 'rtol', 'must be positive')
         else if (.not. scene%rtol < 1.0_wp) then
@@ -893,6 +1164,140 @@ contains
                 ': required (' // what // ')')
         end subroutine missing
     end subroutine check_ranges
+
+    !> The `&flexible_body` and `&material` groups: presence, choices and
+    !> ranges. Set names are checked against the mesh when the body is built.
+    subroutine check_body(scene, entries, path, status)
+        type(scene_input_t), intent(in) :: scene
+        type(entry_t), intent(in) :: entries(:)
+        character(len=*), intent(in) :: path
+        type(status_t), intent(inout) :: status
+        character(len=*), parameter :: fb = 'flexible_body', mat = 'material'
+        integer :: i, j
+
+        if (scene%problem /= 'flexible_body') then
+            if (scene%has_body) then
+                call status%set(status_bad_input, path // ': &flexible_body: given, but &
+                    &problem = ''' // trim(scene%problem) // ''' (a scene builds only what &
+                    &it declares)' // at(scene%body%line))
+            else if (size(scene%materials) > 0) then
+                call status%set(status_bad_input, path // ': &material: given without &
+                    &&flexible_body' // at(scene%materials(1)%line))
+            end if
+            return
+        end if
+        associate (b => scene%body)
+            if (.not. scene%has_body) then
+                call status%set(status_bad_input, path // ': &simulation: problem = &
+                    &''flexible_body'': needs a &flexible_body group')
+            else if (all([character(len=8) :: 'hex8', 'hex27'] /= b%element)) then
+                call bad(fb, 'element', 1, 'must be ''hex8'' or ''hex27''')
+            else if (all(formulation_names /= b%formulation)) then
+                call bad(fb, 'formulation', 1, 'must be one of ' // choices(formulation_names))
+            else if (len_trim(b%mesh_file) > 0 .and. has_entry(entries, fb, 'divisions')) then
+                call bad(fb, 'divisions', 1, 'not used with mesh_file (the file gives the mesh)')
+            else if (len_trim(b%mesh_file) > 0 .and. has_entry(entries, fb, 'lengths')) then
+                call bad(fb, 'lengths', 1, 'not used with mesh_file (the file gives the mesh)')
+            else if (len_trim(b%mesh_file) > 0 .and. has_entry(entries, fb, 'origin')) then
+                call bad(fb, 'origin', 1, 'not used with mesh_file (the file gives the mesh)')
+            else if (len_trim(b%mesh_file) == 0 .and. .not. has_entry(entries, fb, 'lengths')) &
+                then
+                call status%set(status_bad_input, path // ': &flexible_body: lengths: required &
+                    &(the box edge lengths in m), or mesh_file' // at(b%line))
+            else if (len_trim(b%mesh_file) == 0 .and. any(.not. b%lengths > 0.0_wp)) then
+                call bad(fb, 'lengths', 1, 'must be positive')
+            else if (len_trim(b%mesh_file) == 0 .and. any(b%divisions < 1)) then
+                call bad(fb, 'divisions', 1, 'must be at least 1 in every direction')
+            else if (has_entry(entries, fb, 'fixed') .and. &
+                     any(b%fixed(1:count_values(fb, 'fixed')) == '')) then
+                call bad(fb, 'fixed', 1, 'node-set names must not be empty')
+            else if (has_entry(entries, fb, 'load') .and. len_trim(b%load_set) == 0) then
+                call bad(fb, 'load', 1, 'needs load_set (the node set that carries it)')
+            else if (has_entry(entries, fb, 'load_set') .and. .not. has_entry(entries, fb, &
+                     'load')) then
+                call bad(fb, 'load_set', 1, 'needs load = fx, fy, fz (the total force in N)')
+            else if (size(scene%materials) == 0) then
+                call status%set(status_bad_input, path // ': &flexible_body: needs a &
+                    &&material group (youngs_modulus, density, ...)' // at(b%line))
+            end if
+        end associate
+        if (.not. status%ok()) return
+        do i = 1, size(scene%materials)
+            associate (m => scene%materials(i))
+                if (.not. has_entry(entries, mat, 'youngs_modulus', i)) then
+                    call missing_in(i, 'youngs_modulus', 'Young''s modulus E in Pa')
+                else if (.not. m%youngs_modulus > 0.0_wp) then
+                    call bad(mat, 'youngs_modulus', i, 'must be positive')
+                else if (.not. (m%poisson_ratio > -1.0_wp .and. m%poisson_ratio < 0.5_wp)) then
+                    call bad(mat, 'poisson_ratio', i, 'must lie in (-1, 0.5)')
+                else if (.not. has_entry(entries, mat, 'density', i)) then
+                    call missing_in(i, 'density', 'the mass density in kg/m^3')
+                else if (.not. m%density > 0.0_wp) then
+                    call bad(mat, 'density', i, 'must be positive')
+                else if (.not. m%viscosity >= 0.0_wp) then
+                    call bad(mat, 'viscosity', i, 'must not be negative (0: undamped)')
+                else if (has_entry(entries, mat, 'elements', i) .and. &
+                         len_trim(m%elements) == 0) then
+                    call bad(mat, 'elements', i, 'must name an element set (leave it out &
+                        &for the elements no other material names)')
+                end if
+                if (.not. status%ok()) return
+                do j = 1, i - 1
+                    if (scene%materials(j)%name == m%name) then
+                        call bad(mat, 'name', i, 'also the name of the &material' // &
+                                 at(scene%materials(j)%line))
+                    else if (scene%materials(j)%elements == m%elements .and. &
+                             len_trim(m%elements) > 0) then
+                        call bad(mat, 'elements', i, 'the same set as &material ''' // &
+                            trim(scene%materials(j)%name) // '''' // at(scene%materials(j)%line))
+                    else if (scene%materials(j)%elements == m%elements) then
+                        call status%set(status_bad_input, path // ': &material ''' // &
+                            trim(m%name) // ''': elements: not given here nor in &material ''' &
+                            // trim(scene%materials(j)%name) // ''': only one material may &
+                            &cover the elements no other names' // at(m%line))
+                    end if
+                    if (.not. status%ok()) return
+                end do
+            end associate
+        end do
+
+    contains
+
+        !> 'path: &group: name = value: reason (line n)' for occurrence
+        !> `instance`, or '(default)' in place of the value when not given.
+        subroutine bad(group, name, instance, reason)
+            character(len=*), intent(in) :: group, name, reason
+            integer, intent(in) :: instance
+            integer :: e
+            do e = 1, size(entries)
+                if (entries(e)%group == group .and. entries(e)%name == name .and. &
+                    entries(e)%instance == instance) then
+                    call fail(status, path, entries(e), reason)
+                    return
+                end if
+            end do
+            call status%set(status_bad_input, path // ': &' // group // ': ' // name // &
+                ' (default): ' // reason)
+        end subroutine bad
+
+        subroutine missing_in(instance, name, what)
+            integer, intent(in) :: instance
+            character(len=*), intent(in) :: name, what
+            call status%set(status_bad_input, path // ': &material ''' // &
+                trim(scene%materials(instance)%name) // ''': ' // name // ': required (' // &
+                what // ')' // at(scene%materials(instance)%line))
+        end subroutine missing_in
+
+        integer function count_values(group, name)
+            character(len=*), intent(in) :: group, name
+            integer :: e
+            count_values = 0
+            do e = 1, size(entries)
+                if (entries(e)%group == group .and. entries(e)%name == name) &
+                    count_values = size(entries(e)%items)
+            end do
+        end function count_values
+    end subroutine check_body
 
     !> RADAU5's controller switch: 1 predictive (Gustafsson), 2 classical; 0 unknown.
     pure integer function controller_code(name)
@@ -1002,13 +1407,19 @@ contains
         end do
     end function known_vars
 
-    pure logical function has_entry(entries, group, name)
+    !> Whether `name` is given in `group` (in occurrence `instance` if present).
+    pure logical function has_entry(entries, group, name, instance)
         type(entry_t), intent(in) :: entries(:)
         character(len=*), intent(in) :: group, name
+        integer, intent(in), optional :: instance
         integer :: i
         has_entry = .false.
         do i = 1, size(entries)
-            if (entries(i)%group == group .and. entries(i)%name == name) has_entry = .true.
+            if (entries(i)%group /= group .or. entries(i)%name /= name) cycle
+            if (present(instance)) then
+                if (entries(i)%instance /= instance) cycle
+            end if
+            has_entry = .true.
         end do
     end function has_entry
 
