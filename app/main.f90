@@ -104,6 +104,12 @@ contains
         end do
         if (n > max_printed) write (output_unit, '(a,i0,a)') '... (', n, &
             ' components; all of them are in the HDF5 file)'
+        if (result%has_energy) then
+            write (output_unit, '(a,3es14.6)') 'energy at t_start [J]: strain, kinetic, total', &
+                result%energy_start
+            write (output_unit, '(a,3es14.6)') 'energy at t_end   [J]: strain, kinetic, total', &
+                result%energy_end
+        end if
         if (len(scene%output_file) > 0) write (output_unit, '(a)') &
             'trajectory: ' // scene%output_file
         if (len_trim(scene%table) > 0) write (output_unit, '(a)') 'table: ' // trim(scene%table)
@@ -148,7 +154,8 @@ contains
             '  flexmbs --help                   show this text', &
             '  flexmbs --version                show the version', &
             '', &
-            'FILE.nml holds the namelist groups &simulation, &solver and &output', &
+            'FILE.nml holds the namelist groups &simulation, &solver and &output,', &
+            'and for a flexible body &flexible_body with one or more &material', &
             '(see README.md for every variable, its type, unit and default).', &
             '--quiet turns the progress display on standard error off.', &
             '', &

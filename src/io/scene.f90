@@ -7,6 +7,7 @@ module flexmbs_io_scene
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_dae_problem, only: dae_problem_t
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_solver, only: dae_solver_t
@@ -20,10 +21,14 @@ module flexmbs_io_scene
     use flexmbs_problems_robertson, only: robertson_t, new_robertson, robertson_initial
     use flexmbs_problems_pendulum, only: pendulum_t, new_pendulum, pendulum_initial, &
         pendulum_index1, pendulum_index2, pendulum_index3, pendulum_ggl, &
-        pendulum_mechanical_t, new_pendulum_mechanical
+        new_pendulum_mechanical
     use flexmbs_problems_reaction_diffusion, only: reaction_diffusion_t, &
         new_reaction_diffusion, reaction_diffusion_initial
+    use flexmbs_fe_flexible_body, only: flexible_body_t
+    use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &
+        formulation_index2, formulation_index3, formulation_ggl
     use flexmbs_io_namelist, only: scene_input_t, scene_dae_options, controller_code
+    use flexmbs_io_flexible_scene, only: build_flexible_body, body_energies
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_progress, only: progress_t, new_progress
     use flexmbs_io_multi_sink, only: multi_sink_t
@@ -44,6 +49,10 @@ module flexmbs_io_scene
         type(dae_stats_t) :: stats
         character(len=:), allocatable :: solver_name
         logical :: hdf5_written = .false.     !! an HDF5 file was created (and kept)
+        !> A flexible body: strain, kinetic and total energy (with the
+        !> potential of gravity and loads) at the start and at the end [J].
+        logical :: has_energy = .false.
+        real(wp) :: energy_start(3) = 0.0_wp, energy_end(3) = 0.0_wp
     end type run_result_t
 
     public :: build_problem, build_solver, scene_stab, run_scene
@@ -53,15 +62,23 @@ contains
     !> The problem the scene names, its initial value and its named blocks.
     !> Small problems report a CSC Jacobian only when KLU is asked for; the
     !> Brusselator reports CSC unless the dense solver is forced.
-    subroutine build_problem(scene, problem, y0, blocks, status)
+    !> A mechanical scene (pendulum with MEXAX, flexible body) also returns
+    !> its mechanical problem in `mechanical`, which the formulation in
+    !> `problem` points to: it must stay in place while `problem` is used.
+    !> Its y = (q, v, λ) is the layout MEXAX integrates.
+    subroutine build_problem(scene, problem, y0, blocks, status, mechanical)
         type(scene_input_t), intent(in) :: scene
         class(dae_problem_t), allocatable, intent(out) :: problem
         real(wp), allocatable, intent(out) :: y0(:)
         type(block_spec_t), allocatable, intent(out) :: blocks(:)
         type(status_t), intent(out) :: status
+        class(mechanical_problem_t), allocatable, target, intent(inout), optional :: mechanical
         type(robertson_t) :: robertson
         type(pendulum_t) :: pendulum
         type(reaction_diffusion_t) :: bruss
+        type(formulation_t) :: formulation
+        real(wp), allocatable :: q0(:), v0(:)
+        integer :: nq
         logical :: klu
         klu = scene%linear_solver == 'klu'
         allocate (blocks(0))
@@ -92,6 +109,36 @@ contains
             blocks = [block_spec_t('q', 1, 2), block_spec_t('v', 3, 4), &
                       block_spec_t('lambda', 5, 5)]
             allocate (problem, source=pendulum)
+            if (scene%solver_name == 'mexax' .and. present(mechanical)) then
+                allocate (mechanical, source=new_pendulum_mechanical(mass=scene%pendulum_mass, &
+                    length=scene%pendulum_length, gravity=scene%gravity, status=status))
+            end if
+        case ('flexible_body')
+            if (.not. present(mechanical)) then
+                call status%set(status_bad_input, scene%path // ': &simulation: problem = &
+                    &''flexible_body'': build_problem needs its `mechanical` argument')
+                return
+            end if
+            allocate (flexible_body_t :: mechanical)
+            select type (body => mechanical)
+            type is (flexible_body_t)
+                call build_flexible_body(scene, body, q0, v0, status)
+            end select
+            if (.not. status%ok()) return
+            ! M is constant in absolute nodal coordinates: y = (q, v[, λ]).
+            formulation = new_formulation(mechanical, &
+                mechanical_formulation(scene%body%formulation), q0, constant_mass=.true., &
+                status=status)
+            if (.not. status%ok()) then
+                status%message = scene%path // ': &flexible_body: ' // status%message
+                return
+            end if
+            nq = size(q0)
+            allocate (y0(formulation%n), source=0.0_wp)
+            y0(1:nq) = q0
+            y0(nq + 1:2 * nq) = v0
+            blocks = [block_spec_t('q', 1, nq), block_spec_t('v', nq + 1, 2 * nq)]
+            allocate (problem, source=formulation)
         case ('brusselator_1d', 'brusselator_2d')
             bruss = new_reaction_diffusion(merge(1, 2, scene%problem == 'brusselator_1d'), &
                 scene%npoints, sparse=scene%linear_solver /= 'dense', status=status)
@@ -118,6 +165,16 @@ contains
         case default; formulation_code = 0
         end select
     end function formulation_code
+
+    pure integer function mechanical_formulation(name)
+        character(len=*), intent(in) :: name
+        select case (trim(name))
+        case ('index1'); mechanical_formulation = formulation_index1
+        case ('index3'); mechanical_formulation = formulation_index3
+        case ('ggl'); mechanical_formulation = formulation_ggl
+        case default; mechanical_formulation = formulation_index2
+        end select
+    end function mechanical_formulation
 
     !> The solver the scene names, with its own settings.
     subroutine build_solver(scene, solver, status)
@@ -168,6 +225,8 @@ contains
             stab = 'mech'
         else if (scene%problem == 'pendulum') then
             stab = trim(scene%pendulum_formulation)
+        else if (scene%problem == 'flexible_body') then
+            stab = trim(scene%body%formulation)
         else
             stab = '-'
         end if
@@ -183,6 +242,7 @@ contains
         type(run_result_t), intent(out) :: result
         type(status_t), intent(out) :: status
         class(dae_problem_t), allocatable :: problem
+        class(mechanical_problem_t), allocatable, target :: mechanical
         class(dae_solver_t), allocatable, target :: solver
         type(block_spec_t), allocatable :: blocks(:)
         type(dae_options_t) :: options
@@ -193,8 +253,9 @@ contains
         type(status_t) :: io_status
         integer :: i
         character(len=:), allocatable :: outcome
+        real(wp), allocatable :: y_start(:)
 
-        call build_problem(scene, problem, result%y, blocks, status)
+        call build_problem(scene, problem, result%y, blocks, status, mechanical)
         if (.not. status%ok()) return
         call build_solver(scene, solver, status)
         if (.not. status%ok()) return
@@ -243,13 +304,17 @@ contains
         end select
         call sinks%attach(progress)
 
+        y_start = result%y
+        call record_energy(y_start, result%energy_start)
         select type (solver)
         type is (mexax_t)
-            call integrate_pendulum_mechanical(solver)
+            call integrate_mechanical(solver)
         class default
             call solver%integrate(problem, result%t, result%y, scene%t_end, options, &
                                   result%stats, status, sinks)
         end select
+        if (status%ok()) call record_energy(result%y, result%energy_end)
+        result%has_energy = result%has_energy .and. status%ok()
 
         if (h5%is_open) then
             outcome = 'ok'
@@ -272,17 +337,40 @@ contains
 
     contains
 
-        !> MEXAX on the mechanical pendulum; y = (x, y, u, v, λ) as for the
-        !> index formulations (the namelist admits only the pendulum).
-        subroutine integrate_pendulum_mechanical(mexax)
+        !> MEXAX on the mechanical problem; y = (q, v, λ) as built by
+        !> build_problem (the namelist admits mechanical scenes only).
+        subroutine integrate_mechanical(mexax)
             type(mexax_t), intent(inout) :: mexax
-            type(pendulum_mechanical_t) :: mech
-            mech = new_pendulum_mechanical(mass=scene%pendulum_mass, &
-                length=scene%pendulum_length, gravity=scene%gravity, status=status)
-            if (.not. status%ok()) return
-            call mexax%integrate_mechanical(mech, result%t, result%y(1:2), result%y(3:4), &
-                scene%t_end, options, result%stats, status, sinks, lambda=result%y(5:5))
-        end subroutine integrate_pendulum_mechanical
+            integer :: nq, nv, nc
+            if (.not. allocated(mechanical)) then
+                call status%set(status_bad_input, scene%path // ': &solver: name = ''mexax'': &
+                    &problem = ''' // trim(scene%problem) // ''' has no mechanical form')
+                return
+            end if
+            nq = mechanical%nq
+            nv = mechanical%nv
+            nc = mechanical%nc
+            call mexax%integrate_mechanical(mechanical, result%t, result%y(1:nq), &
+                result%y(nq + 1:nq + nv), scene%t_end, options, result%stats, status, sinks, &
+                lambda=result%y(nq + nv + 1:nq + nv + nc))
+        end subroutine integrate_mechanical
+
+        !> Energies of a flexible body at y = (q, v, ...).
+        subroutine record_energy(y, energies)
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(out) :: energies(3)
+            type(status_t) :: energy_status
+            energies = 0.0_wp
+            if (.not. allocated(mechanical)) return
+            select type (body => mechanical)
+            type is (flexible_body_t)
+                associate (nq => body%nq)
+                    call body_energies(body, y(1:nq), y(nq + 1:2 * nq), y_start(1:nq), &
+                                       energies, energy_status)
+                end associate
+                result%has_energy = energy_status%ok()
+            end select
+        end subroutine record_energy
     end subroutine run_scene
 
     subroutine delete_file(path)
