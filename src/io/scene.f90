@@ -82,6 +82,9 @@ contains
         logical :: klu
         klu = scene%linear_solver == 'klu'
         allocate (blocks(0))
+        if (present(mechanical)) then
+            if (allocated(mechanical)) deallocate (mechanical)
+        end if
         select case (trim(scene%problem))
         case ('van_der_pol')
             allocate (problem, source=new_van_der_pol(scene%vdp_eps, sparse=klu))
