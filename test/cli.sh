@@ -125,6 +125,20 @@ printf '%s\n&solver max_steps = 5 /\n%s\n' "$sim" "$out" > fails.nml
 kept solver-failure 3 "maximum number of steps" out/run.h5 run fails.nml --quiet
 kept solver-failure-statistics 3 "statistics so far: NST=" out/run.h5 run fails.nml --quiet
 
+# the flexible-body example with every solver: exit 0, statistics, energies
+example="$root/inputs/flexible_cantilever.nml"
+for solver in radau5 ddassl ida mexax; do
+    sed "s/name = 'radau5'/name = '$solver'/" "$example" > "cantilever_$solver.nml"
+    kept "flexible-body-$solver" 0 "$solver: NST=" "cantilever_$solver.h5" \
+        run "cantilever_$solver.nml" --quiet
+done
+kept flexible-body-energy 0 "energy at t_end" cantilever_radau5.h5 run cantilever_radau5.nml --quiet
+
+# a set the mesh lacks: exit 2 before any file exists
+sed "s/fixed     = 'xmin'/fixed = 'xmim'/" "$example" > bad_set.nml
+bad flexible-body-unknown-set "bad_set.nml: &flexible_body: fixed = 'xmim': no such node set" \
+    bad_set.nml
+
 # I/O error: the output directory does not exist
 printf "%s\n&output file = 'no/such/dir/x.h5' /\n" "$sim" > io_error.nml
 expect io-error 4 "no/such/dir/x.h5: HDF5 cannot create the file" run io_error.nml --quiet
