@@ -148,7 +148,8 @@ contains
             '  flexmbs --help                   show this text', &
             '  flexmbs --version                show the version', &
             '', &
-            'FILE.nml holds the namelist groups &simulation, &solver and &output', &
+            'FILE.nml holds the namelist groups &simulation, &solver and &output,', &
+            'and for a flexible body &flexible_body and &material', &
             '(see README.md for every variable, its type, unit and default).', &
             '--quiet turns the progress display on standard error off.', &
             '', &

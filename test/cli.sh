@@ -129,5 +129,29 @@ kept solver-failure-statistics 3 "statistics so far: NST=" out/run.h5 run fails.
 printf "%s\n&output file = 'no/such/dir/x.h5' /\n" "$sim" > io_error.nml
 expect io-error 4 "no/such/dir/x.h5: HDF5 cannot create the file" run io_error.nml --quiet
 
+# A flexible body (inputs/flexible_cantilever.nml, shortened) with every solver
+for s in radau5 ddassl ida mexax; do
+    sed -e "s/name = 'radau5'/name = '$s'/" -e "s/t_end   = 0.5 /t_end   = 0.02/" \
+        -e "s/^&output/\&output file = 'out\/run.h5',/" \
+        "$root/inputs/flexible_cantilever.nml" > "fc_$s.nml"
+    kept "flexible-body-$s" 0 "$s: NST=" out/run.h5 run "fc_$s.nml" --quiet
+done
+fb="&simulation problem = 'flexible_body', t_end = 0.01 /"
+mat="&material young = 7e5, density = 920 /"
+printf "%s\n&flexible_body fixed = 'xmn' /\n%s\n" "$fb" "$mat" > fb_set.nml
+bad flexible-body-unknown-set "fb_set.nml: &flexible_body: fixed = 'xmn': mesh: no node set named 'xmn' (sets: xmin," fb_set.nml
+printf "%s\n&flexible_body divisions = 2, 1 /\n%s\n" "$fb" "$mat" > fb_count.nml
+bad flexible-body-array-count "fb_count.nml: &flexible_body: divisions: needs 3 values separated by commas" fb_count.nml
+printf "%s\n&flexible_body /\n%s\n&material young = -1, density = 920 /\n" "$fb" "$mat" > fb_young.nml
+bad material-negative-young "fb_young.nml: &material #2: young = -1: must be positive (line 4)" fb_young.nml
+printf "%s\n&flexible_body /\n" "$fb" > fb_nomat.nml
+bad material-missing "fb_nomat.nml: &material: at least one required" fb_nomat.nml
+printf "%s\n&flexible_body /\n&material young = 7e5, density = 920, elements = 'tip' /\n" "$fb" > fb_eset.nml
+bad material-unknown-element-set "fb_eset.nml: &material #1 ('material 1'): elements = 'tip': mesh: no element set named 'tip' (sets: all, xmin_layer" fb_eset.nml
+printf "%s\n&flexible_body /\n&material young = 7e5, density = 920, elements = 'xmax_layer' /\n" "$fb" > fb_cover.nml
+bad material-not-covering "fb_cover.nml: &material: element 1 has no material" fb_cover.nml
+printf "&simulation problem = 'pendulum', t_end = 1 /\n&flexible_body /\n" > fb_problem.nml
+bad flexible-body-wrong-problem "fb_problem.nml: &flexible_body: given, but &simulation problem = 'pendulum'" fb_problem.nml
+
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

@@ -47,6 +47,8 @@ contains
                  new_test('progress_line', test_progress), &
                  new_test('run_scene_van_der_pol', test_run_scene), &
                  new_test('run_scene_pendulum_blocks', test_run_pendulum), &
+                 new_test('flexible_body_groups', test_body_groups), &
+                 new_test('run_scene_flexible_body_falls', test_run_body), &
                  new_test('run_scene_bad_linear_solver_no_file', test_run_bad_solver)]
     end function collect_io
 
@@ -208,7 +210,7 @@ contains
         status = parse_status(vdp_sim() // '! the solver' // nl // '&solvers rtol = 1e-4 /')
         call check(error, status%code == status_bad_input, 'code')
         call expect(error, status, 'in.nml: &solvers: unknown group (expected &simulation, ' // &
-                    '&solver or &output) (line 3)')
+                    '&solver, &output, &flexible_body or &material) (line 3)')
     end subroutine test_unknown_group
 
     subroutine test_other_bad_text(error)
@@ -561,6 +563,80 @@ contains
         end do
         call delete(h5)
     end subroutine test_run_pendulum
+
+    !> &flexible_body arrays and repeated &material groups reach the scene.
+    subroutine test_body_groups(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_input_t) :: scene
+        type(status_t) :: status
+        call parse_scene('&simulation problem = ''flexible_body'', t_end = 1 /' // nl // &
+            '&flexible_body element = ''HEX27'', divisions = 3, 2, 1,' // nl // &
+            '  lengths = 0.3 , 0.2,0.1, gravity = 0, 0, -9.81, fixed = ''xmin'' /' // nl // &
+            '&material name = ''soft'', young = 7e5, density = 920, viscosity = 1000 /' // nl &
+            // '&material name = ''tip'', young = 7e6, poisson = 0.25, density = 920,' // nl &
+            // '  elements = ''xmax_layer'' /', 'fb.nml', scene, status)
+        call check(error, status%ok(), 'parse: ' // status%text())
+        if (allocated(error)) return
+        call check(error, scene%body%element == 'hex27', 'element lower-cased')
+        call check(error, all(scene%body%divisions == [3, 2, 1]), 'divisions')
+        call check(error, all(scene%body%lengths == [0.3_wp, 0.2_wp, 0.1_wp]), 'lengths')
+        call check(error, all(scene%body%gravity == [0.0_wp, 0.0_wp, -9.81_wp]), 'gravity')
+        call check(error, size(scene%materials) == 2, 'two materials')
+        if (allocated(error)) return
+        call check(error, scene%materials(1)%name == 'soft' .and. &
+                   scene%materials(1)%elements == 'all' .and. &
+                   scene%materials(1)%poisson == 0.3_wp, 'material 1 and its defaults')
+        call check(error, scene%materials(2)%young == 7.0e6_wp .and. &
+                   scene%materials(2)%poisson == 0.25_wp .and. &
+                   scene%materials(2)%elements == 'xmax_layer', 'material 2')
+        status = parse_status('&simulation problem = ''flexible_body'', t_end = 1 /' // nl // &
+            '&flexible_body lengths = 1, 1, x /' // nl // '&material young = 1, density = 1 /')
+        call expect(error, status, 'in.nml: &flexible_body: lengths = 1, 1, x: must be a ' // &
+                    'real number (line 2)')
+        status = parse_status('&simulation problem = ''flexible_body'', t_end = 1 /' // nl // &
+            '&flexible_body /' // nl // '&material young = 1, density = 1, poisson = 0.5 /')
+        call expect(error, status, 'in.nml: &material #1: poisson = 0.5: must lie in (-1, 0.5)')
+        status = parse_status('&simulation problem = ''flexible_body'', t_end = 1 /' // nl // &
+            '&flexible_body /' // nl // '&flexible_body /')
+        call expect(error, status, 'in.nml: &flexible_body: group given more than once (line 3)')
+    end subroutine test_body_groups
+
+    !> A free body falling under gravity with an initial velocity translates
+    !> rigidly (no internal force): q = X + v0 t + g t²/2 at every node, which
+    !> RADAU5 (order 5) integrates exactly.
+    subroutine test_run_body(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(scene_input_t) :: scene
+        type(status_t) :: status
+        type(run_result_t) :: result
+        real(wp), parameter :: t = 0.1_wp, g(3) = [0.0_wp, 0.0_wp, -9.81_wp], &
+            v0(3) = [0.5_wp, 0.0_wp, 1.0_wp]
+        real(wp) :: worst, x(3)
+        integer :: i, k
+        call parse_scene('&simulation problem = ''flexible_body'', t_end = 0.1 /' // nl // &
+            '&flexible_body divisions = 2, 1, 1, lengths = 0.2, 0.05, 0.05,' // nl // &
+            '  gravity = 0, 0, -9.81, velocity = 0.5, 0, 1 /' // nl // &
+            '&material young = 7e5, density = 920, viscosity = 1000 /' // nl // &
+            '&solver rtol = 1e-8, atol = 1e-8 /' // nl // '&output file = ''none'' /', &
+            'fall.nml', scene, status)
+        call check(error, status%ok(), 'parse: ' // status%text())
+        if (allocated(error)) return
+        call run_scene(scene, .true., result, status)
+        call check(error, status%ok(), 'run: ' // status%text())
+        if (allocated(error)) return
+        call check(error, size(result%y) == 2 * 3 * 12, 'y = (q, v) of 12 free nodes')
+        if (allocated(error)) return
+        worst = 0.0_wp
+        do i = 1, 12
+            ! box nodes x fastest on a 3 × 2 × 2 grid
+            x = [0.1_wp * mod(i - 1, 3), 0.05_wp * mod((i - 1) / 3, 2), 0.05_wp * ((i - 1) / 6)]
+            x = x + v0 * t + 0.5_wp * g * t**2
+            do k = 1, 3
+                worst = max(worst, abs(result%y(3 * (i - 1) + k) - x(k)))
+            end do
+        end do
+        call check(error, worst < 1.0e-9_wp, 'rigid fall: nodes off the parabola')
+    end subroutine test_run_body
 
     !> A linear solver that does not exist is bad input: no file is left.
     subroutine test_run_bad_solver(error)

@@ -1,4 +1,5 @@
-!> Scene input: the namelist groups `&simulation`, `&solver` and `&output`.
+!> Scene input: the namelist groups `&simulation`, `&solver`, `&output`,
+!> and for a flexible body `&flexible_body` and `&material` (repeatable).
 !>
 !> The text is checked before Fortran namelist I/O reads it, because the
 !> compiler's own namelist errors name neither the variable nor the value.
@@ -24,9 +25,10 @@ module flexmbs_io_namelist
 
     !> One variable of the schema.
     type :: var_spec_t
-        character(len=12) :: group
+        character(len=16) :: group
         character(len=24) :: name
         integer :: kind
+        integer :: count = 1 !! values: 1, or the fixed size of an array
     end type var_spec_t
 
     type(var_spec_t), parameter :: schema(*) = [ &
@@ -73,19 +75,69 @@ module flexmbs_io_namelist
         var_spec_t('output', 'n_output', kind_integer), &
         var_spec_t('output', 'every_step', kind_logical), &
         var_spec_t('output', 'table', kind_string), &
-        var_spec_t('output', 'progress', kind_logical)]
+        var_spec_t('output', 'progress', kind_logical), &
+        var_spec_t('flexible_body', 'name', kind_string), &
+        var_spec_t('flexible_body', 'element', kind_string), &
+        var_spec_t('flexible_body', 'mesh_file', kind_string), &
+        var_spec_t('flexible_body', 'divisions', kind_integer, 3), &
+        var_spec_t('flexible_body', 'lengths', kind_real, 3), &
+        var_spec_t('flexible_body', 'origin', kind_real, 3), &
+        var_spec_t('flexible_body', 'fixed', kind_string), &
+        var_spec_t('flexible_body', 'load_set', kind_string), &
+        var_spec_t('flexible_body', 'load', kind_real, 3), &
+        var_spec_t('flexible_body', 'gravity', kind_real, 3), &
+        var_spec_t('flexible_body', 'velocity', kind_real, 3), &
+        var_spec_t('flexible_body', 'angular_velocity', kind_real, 3), &
+        var_spec_t('material', 'name', kind_string), &
+        var_spec_t('material', 'young', kind_real), &
+        var_spec_t('material', 'poisson', kind_real), &
+        var_spec_t('material', 'density', kind_real), &
+        var_spec_t('material', 'viscosity', kind_real), &
+        var_spec_t('material', 'elements', kind_string)]
 
-    character(len=12), parameter :: group_names(*) = [character(len=12) :: &
-        'simulation', 'solver', 'output']
+    character(len=16), parameter :: group_names(*) = [character(len=16) :: &
+        'simulation', 'solver', 'output', 'flexible_body', 'material']
+    !> Groups that may be given more than once (one entry each).
+    character(len=16), parameter :: repeatable_groups(*) = [character(len=16) :: 'material']
 
     !> Problem names the schema accepts (the scene builder says which exist).
     character(len=16), parameter, public :: problem_names(*) = [character(len=16) :: &
-        'van_der_pol', 'pendulum', 'robertson', 'brusselator_1d', 'brusselator_2d']
+        'van_der_pol', 'pendulum', 'robertson', 'brusselator_1d', 'brusselator_2d', &
+        'flexible_body']
     character(len=8), parameter, public :: formulation_names(*) = [character(len=8) :: &
         'index3', 'index2', 'index1', 'ggl']
 
     !> π/2: the pendulum starts horizontal by default.
     real(wp), parameter :: half_pi = 1.5707963267948966_wp
+
+    !> One `&material` group: the paper's neo-Hookean law with damping.
+    type, public :: material_input_t
+        character(len=len_name) :: name = ''
+        real(wp) :: young = 0.0_wp      !! E [Pa], required
+        real(wp) :: poisson = 0.3_wp    !! ν
+        real(wp) :: density = 0.0_wp    !! ρ [kg/m³], required
+        real(wp) :: viscosity = 0.0_wp  !! η [Pa·s]
+        character(len=len_name) :: elements = 'all' !! element set it applies to
+        integer :: line = 0             !! where the group starts (messages)
+    end type material_input_t
+
+    !> The `&flexible_body` group: a box mesh or a mesh file, supports,
+    !> loads and a rigid initial velocity field.
+    type, public :: body_input_t
+        logical :: given = .false.
+        character(len=len_name) :: name = 'body'
+        character(len=len_name) :: element = 'hex8'
+        character(len=len_path) :: mesh_file = ''       !! '' = box mesh
+        integer :: divisions(3) = [4, 1, 1]
+        real(wp) :: lengths(3) = [1.0_wp, 0.1_wp, 0.1_wp] !! m
+        real(wp) :: origin(3) = 0.0_wp                    !! m
+        character(len=len_name) :: fixed = ''             !! node set held at X
+        character(len=len_name) :: load_set = ''          !! node set carrying `load`
+        real(wp) :: load(3) = 0.0_wp                      !! N, total, equal per node
+        real(wp) :: gravity(3) = 0.0_wp                   !! m/s²
+        real(wp) :: velocity(3) = 0.0_wp                  !! m/s, of the centroid
+        real(wp) :: angular_velocity(3) = 0.0_wp          !! rad/s, about the centroid
+    end type body_input_t
 
     !> Everything a scene file says, with defaults for what it leaves out.
     type, public :: scene_input_t
@@ -139,18 +191,23 @@ module flexmbs_io_namelist
         logical :: every_step = .false.
         character(len=len_path) :: table = ''
         logical :: progress = .true.
+        ! &flexible_body, &material
+        type(body_input_t) :: body
+        type(material_input_t), allocatable :: materials(:)
     end type scene_input_t
 
     !> One `name = value` of the text.
     type :: entry_t
         character(len=:), allocatable :: group, name, value
         integer :: line = 0
-        logical :: quoted = .false.
+        logical :: quoted = .false.  !! (of every value, for arrays)
+        integer :: occurrence = 1    !! which instance of a repeatable group
     end type entry_t
 
     !> Text span [first, last] of a group, from '&name' to its closing '/'.
     type :: span_t
-        integer :: first = 0, last = 0
+        integer :: group = 0, first = 0, last = 0, line = 0
+        integer :: occurrence = 1
     end type span_t
 
     public :: read_scene, parse_scene, scene_dae_options, controller_code
@@ -177,24 +234,34 @@ contains
         type(scene_input_t), intent(out) :: scene
         type(status_t), intent(out) :: status
         type(entry_t), allocatable :: entries(:)
-        type(span_t) :: spans(size(group_names))
+        type(span_t), allocatable :: spans(:)
         character(len=:), allocatable :: clean
-        integer :: g
+        integer :: k
 
         scene%path = path
         scene%text = text
+        allocate (scene%materials(0))
         call tokenise(text, path, entries, spans, clean, status)
         if (.not. status%ok()) return
         call check_types(entries, path, status)
         if (.not. status%ok()) return
-        do g = 1, size(group_names)
-            if (spans(g)%first == 0) cycle
-            call read_group(clean(spans(g)%first:spans(g)%last), trim(group_names(g)), &
-                            path, scene, status)
+        do k = 1, size(spans)
+            select case (group_names(spans(k)%group))
+            case ('flexible_body')
+                call read_body_group(clean(spans(k)%first:spans(k)%last), path, scene, status)
+            case ('material')
+                call read_material_group(clean(spans(k)%first:spans(k)%last), path, &
+                                         spans(k)%line, scene, status)
+            case default
+                call read_group(clean(spans(k)%first:spans(k)%last), &
+                                trim(group_names(spans(k)%group)), path, scene, status)
+            end select
             if (.not. status%ok()) return
         end do
         call normalise(scene)
         call check_ranges(scene, entries, path, status)
+        if (.not. status%ok()) return
+        call check_body_ranges(scene, entries, path, status)
         if (.not. status%ok()) return
         call resolve_output(scene, entries, path, status)
     end subroutine parse_scene
@@ -208,14 +275,14 @@ contains
     subroutine tokenise(text, path, entries, spans, clean, status)
         character(len=*), intent(in) :: text, path
         type(entry_t), allocatable, intent(out) :: entries(:)
-        type(span_t), intent(inout) :: spans(:)
+        type(span_t), allocatable, intent(out) :: spans(:)
         character(len=:), allocatable, intent(out) :: clean
         type(status_t), intent(inout) :: status
-        integer :: pos, line, g, n, first, vline
-        character(len=:), allocatable :: word, group, name, value, previous
-        logical :: quoted
+        integer :: pos, line, g, n, first, vline, occurrence, glines, k, nvalues
+        character(len=:), allocatable :: word, group, name, value, previous, more
+        logical :: quoted, more_quoted
 
-        allocate (entries(0))
+        allocate (entries(0), spans(0))
         clean = blank_comments(text)
         n = len(clean)
         pos = 1
@@ -236,14 +303,16 @@ contains
             g = find_group(group)
             if (g == 0) then
                 call status%set(status_bad_input, path // ': &' // group // &
-                    ': unknown group (expected &simulation, &solver or &output)' // at(line))
+                    ': unknown group (expected ' // group_list() // ')' // at(line))
                 return
             end if
-            if (spans(g)%first /= 0) then
+            occurrence = count(spans%group == g) + 1
+            if (occurrence > 1 .and. all(repeatable_groups /= group)) then
                 call status%set(status_bad_input, path // ': &' // group // &
                     ': group given more than once' // at(line))
                 return
             end if
+            glines = line
             previous = ''
             do
                 ! inside group `group`
@@ -287,7 +356,7 @@ contains
                         ': unknown variable (known: ' // known_vars(group) // ')' // at(line))
                     return
                 end if
-                if (has_entry(entries, group, name)) then
+                if (has_entry(entries, group, name, occurrence)) then
                     call status%set(status_bad_input, path // ': &' // group // ': ' // name // &
                         ': given more than once' // at(line))
                     return
@@ -323,11 +392,35 @@ contains
                         ': has no value' // at(vline))
                     return
                 end if
-                entries = [entries, entry_t(group, name, value, vline, quoted)]
+                ! An array variable takes exactly its count of values.
+                nvalues = schema(find_var(group, name))%count
+                do k = 2, nvalues
+                    call skip_blank(clean, pos, line)
+                    more = ''
+                    if (pos <= n) then
+                        if (clean(pos:pos) == ',') then
+                            pos = pos + 1
+                            call skip_blank(clean, pos, line)
+                            if (pos <= n) then
+                                if (scan(clean(pos:pos), ',/&') == 0) &
+                                    call value_word(clean, pos, more, more_quoted, status)
+                            end if
+                        end if
+                    end if
+                    if (.not. status%ok() .or. len(more) == 0) then
+                        call status%clear()
+                        call status%set(status_bad_input, path // ': &' // group // ': ' // &
+                            name // ': needs ' // itoa(nvalues) // ' values separated by ' // &
+                            'commas' // at(vline))
+                        return
+                    end if
+                    value = value // ', ' // more
+                    quoted = quoted .and. more_quoted
+                end do
+                entries = [entries, entry_t(group, name, value, vline, quoted, occurrence)]
                 previous = name
             end do
-            spans(g)%first = first
-            spans(g)%last = pos - 1
+            spans = [spans, span_t(g, first, pos - 1, glines, occurrence)]
         end do
     end subroutine tokenise
 
@@ -471,50 +564,28 @@ contains
         type(entry_t), intent(in) :: entries(:)
         character(len=*), intent(in) :: path
         type(status_t), intent(inout) :: status
-        integer :: i, k, ios
-        real(wp) :: x
-        integer :: m
+        integer :: i, first, comma, k
         character(len=:), allocatable :: reason
-        type(ieee_status_type) :: fp_status
 
         do i = 1, size(entries)
             associate (e => entries(i))
                 k = schema(find_var(e%group, e%name))%kind
-                reason = ''
-                select case (k)
-                case (kind_string)
-                    if (.not. e%quoted) then
-                        reason = 'must be a quoted string, e.g. ' // e%name // ' = ''' // &
-                                 e%value // ''''
-                    else if (len(unquote(e%value)) > string_length(e%name)) then
-                        reason = 'longer than ' // itoa(string_length(e%name)) // ' characters'
-                    end if
-                case (kind_real)
-                    if (e%quoted .or. .not. is_real_text(e%value)) then
-                        reason = 'must be a real number'
+                ! Array values were joined as 'a, b, c' (numbers only).
+                first = 1
+                do
+                    comma = 0
+                    if (schema(find_var(e%group, e%name))%count > 1) &
+                        comma = index(e%value(first:), ',')
+                    if (comma == 0) then
+                        reason = value_reason(k, e%name, trim(adjustl(e%value(first:))), &
+                                              e%quoted)
                     else
-                        ! an overflowing value must not leave the overflow flag raised
-                        call ieee_get_status(fp_status)
-                        read (e%value, *, iostat=ios) x
-                        call ieee_set_status(fp_status)
-                        if (ios /= 0) then
-                            reason = 'is out of the range of real numbers'
-                        else if (.not. ieee_is_finite(x)) then
-                            reason = 'is out of the range of real numbers'
-                        end if
+                        reason = value_reason(k, e%name, &
+                            trim(adjustl(e%value(first:first + comma - 2))), e%quoted)
                     end if
-                case (kind_integer)
-                    if (e%quoted .or. .not. is_integer_text(e%value)) then
-                        reason = 'must be an integer'
-                    else
-                        read (e%value, *, iostat=ios) m
-                        if (ios /= 0) reason = 'is out of the range of integers'
-                    end if
-                case (kind_logical)
-                    if (e%quoted .or. .not. is_logical_text(e%value)) then
-                        reason = 'must be .true. or .false.'
-                    end if
-                end select
+                    if (len(reason) > 0 .or. comma == 0) exit
+                    first = first + comma
+                end do
                 if (len(reason) > 0) then
                     call fail(status, path, e, reason)
                     return
@@ -522,6 +593,51 @@ contains
             end associate
         end do
     end subroutine check_types
+
+    !> Why one raw value does not fit its variable's kind ('' if it does).
+    function value_reason(k, name, value, quoted) result(reason)
+        integer, intent(in) :: k
+        character(len=*), intent(in) :: name, value
+        logical, intent(in) :: quoted
+        character(len=:), allocatable :: reason
+        integer :: ios, m
+        real(wp) :: x
+        type(ieee_status_type) :: fp_status
+        reason = ''
+        select case (k)
+        case (kind_string)
+            if (.not. quoted) then
+                reason = 'must be a quoted string, e.g. ' // name // ' = ''' // value // ''''
+            else if (len(unquote(value)) > string_length(name)) then
+                reason = 'longer than ' // itoa(string_length(name)) // ' characters'
+            end if
+        case (kind_real)
+            if (quoted .or. .not. is_real_text(value)) then
+                reason = 'must be a real number'
+            else
+                ! an overflowing value must not leave the overflow flag raised
+                call ieee_get_status(fp_status)
+                read (value, *, iostat=ios) x
+                call ieee_set_status(fp_status)
+                if (ios /= 0) then
+                    reason = 'is out of the range of real numbers'
+                else if (.not. ieee_is_finite(x)) then
+                    reason = 'is out of the range of real numbers'
+                end if
+            end if
+        case (kind_integer)
+            if (quoted .or. .not. is_integer_text(value)) then
+                reason = 'must be an integer'
+            else
+                read (value, *, iostat=ios) m
+                if (ios /= 0) reason = 'is out of the range of integers'
+            end if
+        case (kind_logical)
+            if (quoted .or. .not. is_logical_text(value)) then
+                reason = 'must be .true. or .false.'
+            end if
+        end select
+    end function value_reason
 
     pure logical function is_integer_text(s)
         character(len=*), intent(in) :: s
@@ -589,7 +705,7 @@ contains
         character(len=*), intent(in) :: name
         select case (name)
         case ('title'); string_length = len_title
-        case ('file', 'table'); string_length = len_path
+        case ('file', 'table', 'mesh_file'); string_length = len_path
         case default; string_length = len_name
         end select
     end function string_length
@@ -731,6 +847,161 @@ contains
         end if
     end subroutine read_group
 
+    !> `&flexible_body` through namelist I/O (its own locals: `gravity` is a
+    !> vector here, a scalar in &simulation).
+    subroutine read_body_group(text, path, scene, status)
+        character(len=*), intent(in) :: text, path
+        type(scene_input_t), intent(inout) :: scene
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: lines(:)
+        integer :: ios
+        character(len=256) :: msg
+        character(len=len_name) :: name, element, fixed, load_set
+        character(len=len_path) :: mesh_file
+        integer :: divisions(3)
+        real(wp) :: lengths(3), origin(3), load(3), gravity(3), velocity(3), &
+            angular_velocity(3)
+        namelist /flexible_body/ name, element, mesh_file, divisions, lengths, origin, fixed, &
+            load_set, load, gravity, velocity, angular_velocity
+        associate (b => scene%body)
+            name = b%name
+            element = b%element
+            mesh_file = b%mesh_file
+            divisions = b%divisions
+            lengths = b%lengths
+            origin = b%origin
+            fixed = b%fixed
+            load_set = b%load_set
+            load = b%load
+            gravity = b%gravity
+            velocity = b%velocity
+            angular_velocity = b%angular_velocity
+            lines = split_lines(text)
+            read (lines, nml=flexible_body, iostat=ios, iomsg=msg)
+            b%given = .true.
+            b%name = name
+            b%element = lower(element)
+            b%mesh_file = mesh_file
+            b%divisions = divisions
+            b%lengths = lengths
+            b%origin = origin
+            b%fixed = fixed
+            b%load_set = load_set
+            b%load = load
+            b%gravity = gravity
+            b%velocity = velocity
+            b%angular_velocity = angular_velocity
+        end associate
+        if (ios /= 0) call status%set(status_bad_input, path // ': &flexible_body: ' // trim(msg))
+    end subroutine read_body_group
+
+    !> One `&material` group, appended to scene%materials.
+    subroutine read_material_group(text, path, line, scene, status)
+        character(len=*), intent(in) :: text, path
+        integer, intent(in) :: line  !! where the group starts
+        type(scene_input_t), intent(inout) :: scene
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: lines(:)
+        integer :: ios
+        character(len=256) :: msg
+        type(material_input_t) :: m
+        character(len=len_name) :: name, elements
+        real(wp) :: young, poisson, density, viscosity
+        namelist /material/ name, young, poisson, density, viscosity, elements
+        name = m%name
+        young = m%young
+        poisson = m%poisson
+        density = m%density
+        viscosity = m%viscosity
+        elements = m%elements
+        lines = split_lines(text)
+        read (lines, nml=material, iostat=ios, iomsg=msg)
+        m%name = name
+        m%young = young
+        m%poisson = poisson
+        m%density = density
+        m%viscosity = viscosity
+        m%elements = elements
+        m%line = line
+        if (len_trim(m%name) == 0) m%name = 'material ' // itoa(size(scene%materials) + 1)
+        scene%materials = [scene%materials, m]
+        if (ios /= 0) call status%set(status_bad_input, path // ': &material: ' // trim(msg))
+    end subroutine read_material_group
+
+    !> &flexible_body and &material: present exactly when the problem is a
+    !> flexible body; values in range. Set names are checked against the
+    !> mesh when the body is built (before any output file exists).
+    subroutine check_body_ranges(scene, entries, path, status)
+        type(scene_input_t), intent(in) :: scene
+        type(entry_t), intent(in) :: entries(:)
+        character(len=*), intent(in) :: path
+        type(status_t), intent(inout) :: status
+        character(len=*), parameter :: fb = 'flexible_body', mat = 'material'
+        integer :: k
+        if (scene%problem /= 'flexible_body') then
+            if (scene%body%given .or. size(scene%materials) > 0) &
+                call status%set(status_bad_input, path // ': &' // &
+                    trim(merge(fb // '   ', mat // '        ', scene%body%given)) // &
+                    ': given, but &simulation problem = ''' // trim(scene%problem) // &
+                    ''' (a flexible body needs problem = ''flexible_body'')')
+            return
+        end if
+        if (.not. scene%body%given) then
+            call status%set(status_bad_input, path // ': &flexible_body: required by ' // &
+                            'problem = ''flexible_body''')
+        else if (size(scene%materials) == 0) then
+            call status%set(status_bad_input, path // ': &material: at least one required ' // &
+                            'by problem = ''flexible_body'' (young, density, ...)')
+        else if (all([character(len=8) :: 'hex8', 'hex27'] /= scene%body%element)) then
+            call bad(fb, 'element', 'must be ''hex8'' or ''hex27''', 1)
+        else if (len_trim(scene%body%mesh_file) == 0 .and. any(scene%body%divisions < 1)) then
+            call bad(fb, 'divisions', 'must be positive (elements along x, y, z)', 1)
+        else if (len_trim(scene%body%mesh_file) == 0 .and. &
+                 any(.not. scene%body%lengths > 0.0_wp)) then
+            call bad(fb, 'lengths', 'must be positive (box edges along x, y, z in m)', 1)
+        else if (len_trim(scene%body%load_set) == 0 .and. any(scene%body%load /= 0.0_wp)) then
+            call bad(fb, 'load', 'needs load_set, the node set that carries it', 1)
+        end if
+        if (.not. status%ok()) return
+        do k = 1, size(scene%materials)
+            associate (m => scene%materials(k))
+                if (.not. has_entry(entries, mat, 'young', k)) then
+                    call status%set(status_bad_input, path // ': &material #' // itoa(k) // &
+                        ': young: required (Young''s modulus in Pa)' // at(m%line))
+                else if (.not. has_entry(entries, mat, 'density', k)) then
+                    call status%set(status_bad_input, path // ': &material #' // itoa(k) // &
+                        ': density: required (in kg/m³)' // at(m%line))
+                else if (.not. m%young > 0.0_wp) then
+                    call bad(mat, 'young', 'must be positive', k)
+                else if (.not. (m%poisson > -1.0_wp .and. m%poisson < 0.5_wp)) then
+                    call bad(mat, 'poisson', 'must lie in (-1, 0.5)', k)
+                else if (.not. m%density > 0.0_wp) then
+                    call bad(mat, 'density', 'must be positive', k)
+                else if (m%viscosity < 0.0_wp) then
+                    call bad(mat, 'viscosity', 'must not be negative (Pa s; 0 = undamped)', k)
+                end if
+            end associate
+            if (.not. status%ok()) return
+        end do
+
+    contains
+
+        subroutine bad(group, name, reason, occurrence)
+            character(len=*), intent(in) :: group, name, reason
+            integer, intent(in) :: occurrence
+            integer :: i
+            do i = 1, size(entries)
+                if (entries(i)%group == group .and. entries(i)%name == name .and. &
+                    entries(i)%occurrence == occurrence) then
+                    call fail(status, path, entries(i), reason)
+                    return
+                end if
+            end do
+            call status%set(status_bad_input, path // ': &' // group // ': ' // name // &
+                ' (default): ' // reason)
+        end subroutine bad
+    end subroutine check_body_ranges
+
     !> Split text at newlines into records of equal length.
     pure function split_lines(text) result(lines)
         character(len=*), intent(in) :: text
@@ -811,10 +1082,11 @@ contains
         else if (all([character(len=8) :: 'radau5', 'ddassl', 'ida', 'mexax'] &
                      /= scene%solver_name)) then
             call bad(sol, 'name', 'must be ''radau5'', ''ddassl'', ''ida'' or ''mexax''')
-        else if (scene%solver_name == 'mexax' .and. scene%problem /= 'pendulum') then
+        else if (scene%solver_name == 'mexax' .and. scene%problem /= 'pendulum' .and. &
+                 scene%problem /= 'flexible_body') then
             ! ALGORITHMS.md §6: MEXAX integrates the mechanical form only.
             call bad(sol, 'name', '''mexax'' integrates mechanical problems only: &
-                &problem must be ''pendulum''')
+                &problem must be ''pendulum'' or ''flexible_body''')
         else if (.not. scene%rtol > 0.0_wp) then
             call bad(sol, 'rtol', 'must be positive')
         else if (.not. scene%rtol < 1.0_wp) then
@@ -962,7 +1234,10 @@ contains
         character(len=*), intent(in) :: path
         type(entry_t), intent(in) :: e
         character(len=*), intent(in) :: reason
-        call status%set(status_bad_input, path // ': &' // e%group // ': ' // e%name // &
+        character(len=:), allocatable :: label
+        label = e%group
+        if (any(repeatable_groups == e%group)) label = label // ' #' // itoa(e%occurrence)
+        call status%set(status_bad_input, path // ': &' // label // ': ' // e%name // &
             ' = ' // e%value // ': ' // reason // at(e%line))
     end subroutine fail
 
@@ -1002,15 +1277,33 @@ contains
         end do
     end function known_vars
 
-    pure logical function has_entry(entries, group, name)
+    !> An entry group/name exists (in the given occurrence of the group, if any).
+    pure logical function has_entry(entries, group, name, occurrence)
         type(entry_t), intent(in) :: entries(:)
         character(len=*), intent(in) :: group, name
+        integer, intent(in), optional :: occurrence
         integer :: i
         has_entry = .false.
         do i = 1, size(entries)
-            if (entries(i)%group == group .and. entries(i)%name == name) has_entry = .true.
+            if (entries(i)%group == group .and. entries(i)%name == name) then
+                if (present(occurrence)) then
+                    if (entries(i)%occurrence /= occurrence) cycle
+                end if
+                has_entry = .true.
+            end if
         end do
     end function has_entry
+
+    !> '&simulation, &solver, … or &material'.
+    pure function group_list() result(list)
+        character(len=:), allocatable :: list
+        integer :: g
+        list = ''
+        do g = 1, size(group_names)
+            if (g > 1) list = list // trim(merge(' or', ',  ', g == size(group_names))) // ' '
+            list = list // '&' // trim(group_names(g))
+        end do
+    end function group_list
 
     pure function choices(names) result(list)
         character(len=*), intent(in) :: names(:)

@@ -28,8 +28,17 @@ module flexmbs_io_scene
     use flexmbs_io_progress, only: progress_t, new_progress
     use flexmbs_io_multi_sink, only: multi_sink_t
     use flexmbs_io_table, only: new_stats_row, write_table
+    use flexmbs_io_body_input, only: build_flexible_body
+    use flexmbs_fe_flexible_body, only: flexible_body_t
+    use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index2
     implicit none
     private
+
+    !> A flexible body and its formulation, kept together so that the
+    !> formulation's pointer to the body lives as long as the problem.
+    type, extends(formulation_t) :: body_formulation_t
+        type(flexible_body_t) :: body
+    end type body_formulation_t
 
     !> A named slice of y written as its own HDF5 dataset (/q, /v, /lambda).
     type, public :: block_spec_t
@@ -55,10 +64,12 @@ contains
     !> Brusselator reports CSC unless the dense solver is forced.
     subroutine build_problem(scene, problem, y0, blocks, status)
         type(scene_input_t), intent(in) :: scene
-        class(dae_problem_t), allocatable, intent(out) :: problem
+        class(dae_problem_t), allocatable, target, intent(out) :: problem
         real(wp), allocatable, intent(out) :: y0(:)
         type(block_spec_t), allocatable, intent(out) :: blocks(:)
         type(status_t), intent(out) :: status
+        real(wp), allocatable :: q0(:), v0(:)
+        integer :: nq
         type(robertson_t) :: robertson
         type(pendulum_t) :: pendulum
         type(reaction_diffusion_t) :: bruss
@@ -102,6 +113,26 @@ contains
             allocate (y0(bruss%n))
             call reaction_diffusion_initial(bruss, y0)
             allocate (problem, source=bruss)
+        case ('flexible_body')
+            ! No constraints: y = (q, v) with the constant-mass layout
+            ! diag(I, M); MEXAX takes the body itself (run_scene).
+            allocate (body_formulation_t :: problem)
+            select type (problem)
+            type is (body_formulation_t)
+                call build_flexible_body(scene, problem%body, q0, v0, status)
+                if (.not. status%ok()) return
+                problem%formulation_t = new_formulation(problem%body, formulation_index2, q0, &
+                    constant_mass=.true., status=status)
+                if (.not. status%ok()) then
+                    status%message = scene%path // ': &flexible_body: ' // status%message
+                    return
+                end if
+                nq = problem%body%nq
+                allocate (y0(problem%n), source=0.0_wp)
+                y0(1:nq) = q0
+                y0(nq + 1:2 * nq) = v0
+                blocks = [block_spec_t('q', 1, nq), block_spec_t('v', nq + 1, 2 * nq)]
+            end select
         case default
             call status%set(status_bad_input, scene%path // ': &simulation: problem = ''' // &
                 trim(scene%problem) // ''': not available in this build')
@@ -168,6 +199,8 @@ contains
             stab = 'mech'
         else if (scene%problem == 'pendulum') then
             stab = trim(scene%pendulum_formulation)
+        else if (scene%problem == 'flexible_body') then
+            stab = 'index2'
         else
             stab = '-'
         end if
@@ -182,7 +215,7 @@ contains
         logical, intent(in) :: quiet             !! no progress display
         type(run_result_t), intent(out) :: result
         type(status_t), intent(out) :: status
-        class(dae_problem_t), allocatable :: problem
+        class(dae_problem_t), allocatable, target :: problem
         class(dae_solver_t), allocatable, target :: solver
         type(block_spec_t), allocatable :: blocks(:)
         type(dae_options_t) :: options
@@ -245,7 +278,16 @@ contains
 
         select type (solver)
         type is (mexax_t)
-            call integrate_pendulum_mechanical(solver)
+            select type (problem)
+            type is (body_formulation_t)
+                associate (nq => problem%body%nq)
+                    call solver%integrate_mechanical(problem%body, result%t, result%y(1:nq), &
+                        result%y(nq + 1:2 * nq), scene%t_end, options, result%stats, status, &
+                        sinks)
+                end associate
+            class default
+                call integrate_pendulum_mechanical(solver)
+            end select
         class default
             call solver%integrate(problem, result%t, result%y, scene%t_end, options, &
                                   result%stats, status, sinks)
