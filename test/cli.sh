@@ -134,10 +134,24 @@ for solver in radau5 ddassl ida mexax; do
 done
 kept flexible-body-energy 0 "energy at t_end" cantilever_radau5.h5 run cantilever_radau5.nml --quiet
 
-# a set the mesh lacks: exit 2 before any file exists
+# bad flexible-body input: exit 2 before any file exists
 sed "s/fixed     = 'xmin'/fixed = 'xmim'/" "$example" > bad_set.nml
 bad flexible-body-unknown-set "bad_set.nml: &flexible_body: fixed = 'xmim': no such node set" \
     bad_set.nml
+fb="&simulation t_end = 0.01 /"
+mat="&material youngs_modulus = 7e5, density = 920 /"
+printf "%s\n&flexible_body lengths = 1, 1, 1, divisions = 2, 1 /\n%s\n" "$fb" "$mat" > fb_count.nml
+bad flexible-body-array-count "fb_count.nml: &flexible_body: divisions = 2, 1: needs 3 values (line 2)" \
+    fb_count.nml
+printf "%s\n&flexible_body lengths = 1, 1, 1 /\n" "$fb" > fb_nomat.nml
+bad material-missing "fb_nomat.nml: &flexible_body: needs a &material group" fb_nomat.nml
+printf "%s\n&flexible_body lengths = 1, 1, 1 /\n%s\n&material youngs_modulus = -1, density = 1, elements = 'all' /\n" \
+    "$fb" "$mat" > fb_young.nml
+bad material-negative-modulus "fb_young.nml: &material: youngs_modulus = -1: must be positive (line 4)" \
+    fb_young.nml
+printf "%s\n&flexible_body lengths = 1, 1, 1, divisions = 2, 1, 1 /\n&material youngs_modulus = 1, density = 1, elements = 'xmax_layer' /\n" \
+    "$fb" > fb_cover.nml
+bad material-not-covering "fb_cover.nml: &material: elements: element 1 has no material" fb_cover.nml
 
 # I/O error: the output directory does not exist
 printf "%s\n&output file = 'no/such/dir/x.h5' /\n" "$sim" > io_error.nml

@@ -22,6 +22,7 @@ program flexmbs_tests
     use test_fe_dynamics, only: collect_fe_dynamics
     use test_fe_statics, only: collect_fe_statics
     use test_fe_mesh, only: collect_fe_mesh
+    use test_fe_detf, only: collect_fe_detf
     use test_rotation, only: collect_rotation
     use test_dual, only: collect_dual
     use test_constraint_primitives, only: collect_constraint_primitives
@@ -57,6 +58,7 @@ program flexmbs_tests
     call run_suite('fe_dynamics', collect_fe_dynamics(), filter, npassed, nfailed)
     call run_suite('fe_statics', collect_fe_statics(), filter, npassed, nfailed)
     call run_suite('fe_mesh', collect_fe_mesh(), filter, npassed, nfailed)
+    call run_suite('fe_detf', collect_fe_detf(), filter, npassed, nfailed)
     call run_suite('rotation', collect_rotation(), filter, npassed, nfailed)
     call run_suite('dual', collect_dual(), filter, npassed, nfailed)
     call run_suite('constraint_primitives', collect_constraint_primitives(), filter, &

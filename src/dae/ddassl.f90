@@ -13,7 +13,7 @@ module flexmbs_dae_ddassl
     use flexmbs_core_text, only: real_text, int_text
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         status_interrupted, reason_step_too_small, reason_max_steps, reason_singular_matrix, &
-        reason_newton_failure, reason_user_function, reason_non_finite
+        reason_newton_failure, reason_user_function, reason_non_finite, reason_det_f
     use flexmbs_core_timer, only: timer_t
     use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_dense, storage_identity
     use flexmbs_linalg_linear_solver, only: linear_solver_t
@@ -541,6 +541,7 @@ contains
         type(matrix_t), allocatable :: amat, bmat
         class(linear_solver_t), allocatable :: ls
         type(status_t) :: st
+        type(status_t) :: model_failure !! the model's last refusal in this step
         integer :: n, pmax, k, kold, ns, iphase, jcalc, nef, ncf, nsf, knew
         real(wp) :: tn, h, hold, cj, cjlast, cjold, s, hmin, hmax, dir, uround
         real(wp) :: t0, h_fixed, est, erkm1, terkm1, terk, r
@@ -932,6 +933,7 @@ contains
             call res%residual(tn, y, yp, delta, fst)
             ! IRES = −2 of the classic code: the residual asks to stop.
             if (fst%code == status_interrupted) ires_stop = .true.
+            if (.not. fst%ok()) model_failure = fst
             residual_ok = fst%ok()
             if (residual_ok) residual_ok = all(ieee_is_finite(delta))
         end function residual_ok
@@ -998,10 +1000,12 @@ contains
             real(wp) :: temp1, temp2, alphas, alpha0, ck, pnorm, enrm, erk, err, r, hnew
             real(wp) :: erkm2, terkm2, erkp1, terkp1
             logical :: converged, singular, early, passed
+            type(status_t) :: refusal
 
             nef = 0
             ncf = 0
             nsf = 0
+            call model_failure%clear()
             attempt: do
                 ! ---- §2.2: coefficients ----
                 if (h /= hold .or. k /= kold) ns = 0
@@ -1055,6 +1059,15 @@ contains
                     jcalc = -1
                 end do
                 jcalc = 1
+                ! A corrected state the model cannot hold (det F <= 0) is a
+                ! corrector failure: h/4, as for IRES = -1.
+                if (converged) then
+                    call res%admissible(tn, y, refusal)
+                    if (.not. refusal%ok()) then
+                        converged = .false.
+                        model_failure = refusal
+                    end if
+                end if
                 if (converged .and. self%nonnegative) then
                     delta = min(y, 0.0_wp)
                     if (vnorm(delta) > conv_tol) then
@@ -1160,6 +1173,12 @@ contains
                                     real_text(tn) // ' (h = ' // real_text(h) // ')', &
                                     reason_newton_failure)
                                 self%work%failure = ddassl_fail_after_error_test
+                            else if (model_failure%reason == reason_det_f) then
+                                call st%set(status_solver_failure, 'ddassl: step size too ' // &
+                                    'small at t = ' // real_text(tn) // ' (h = ' // &
+                                    real_text(h) // '): the model refused every corrected ' // &
+                                    'state: ' // model_failure%text(), reason_det_f)
+                                self%work%failure = ddassl_fail_residual
                             else if (early) then
                                 call st%set(status_solver_failure, 'ddassl: residual failed ' // &
                                     'repeatedly at t = ' // real_text(tn) // ' (h = ' // &
@@ -1256,6 +1275,7 @@ contains
             ysave = y
             ypsave = yp
             ynorm = vnorm(y)
+            call model_failure%clear()
             nefi = 0
             ncfi = 0
             nsfi = 0
@@ -1342,6 +1362,9 @@ contains
                         call st%set(status_solver_failure, 'ddassl: initial derivative ' // &
                             '(DDAINI): Newton iteration failed at t = ' // real_text(t0), &
                             reason_newton_failure)
+                        if (model_failure%reason == reason_det_f) call st%set( &
+                            status_solver_failure, st%message // ': ' // &
+                            model_failure%text(), reason_det_f)
                         exit
                     end if
                 end if

@@ -38,7 +38,7 @@ module flexmbs_dae_ida
     use flexmbs_core_text, only: real_text, int_text
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         status_interrupted, reason_step_too_small, reason_max_steps, reason_singular_matrix, &
-        reason_newton_failure, reason_user_function, reason_non_finite
+        reason_newton_failure, reason_user_function, reason_non_finite, reason_det_f
     use flexmbs_core_timer, only: timer_t
     use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_identity, storage_dense, &
@@ -482,8 +482,13 @@ contains
                 ypw = 0.0_wp
             else
                 call problem%consistent_initial(x, yw, ypw, fst)
-                if (.not. fst%ok()) call st%set(status_bad_input, 'ida: no initial y'': ' // &
-                    fst%text() // '; pass yp or set calc_ic = .true.')
+                if (fst%reason == reason_det_f) then
+                    call st%set(status_solver_failure, 'ida: the initial state is refused ' // &
+                        'at t = ' // real_text(x) // ': ' // fst%text(), reason_det_f)
+                else if (.not. fst%ok()) then
+                    call st%set(status_bad_input, 'ida: no initial y'': ' // &
+                        fst%text() // '; pass yp or set calc_ic = .true.')
+                end if
             end if
         end subroutine initial_derivative
 
@@ -562,6 +567,7 @@ contains
                     call map_failure(retval_solve, 'step failed')
                     return
                 end if
+                if (.not. admissible()) return
                 if (present(sink)) then
                     do while (iout <= nout)
                         if (options%output_times(iout) /= tout) exit
@@ -595,6 +601,7 @@ contains
                     return
                 end if
                 x = tret(1)
+                if (.not. admissible()) return
                 do while (iout <= nout)
                     if ((options%output_times(iout) - x) * posneg > 0.0_wp) exit
                     if (options%output_times(iout) == x) then
@@ -617,6 +624,17 @@ contains
                 x_old = x
             end do
         end subroutine step_by_step
+
+        !> IDA cannot take back a step: a state the model refuses (det F <= 0)
+        !> ends the run there, with that reason, before it is output.
+        logical function admissible()
+            type(status_t) :: st
+            call problem%admissible(x, yw, st)
+            admissible = st%ok()
+            if (.not. admissible) call status%set(status_solver_failure, 'ida: the model ' // &
+                'refuses the state reached at t = ' // real_text(x) // ': ' // st%text(), &
+                st%reason)
+        end function admissible
 
         integer function accepted_steps()
             integer(c_long) :: count(1)
@@ -750,7 +768,7 @@ contains
         call data%problem%rhs(t, y, data%f, st)
         if (.not. st%ok()) then
             call record(data, status_solver_failure, 'right-hand side failed at t = ' // &
-                real_text(t) // ': ' // st%text(), reason_user_function)
+                real_text(t) // ': ' // st%text(), callback_reason(st))
             ierr = 1
             return
         end if
@@ -845,7 +863,7 @@ contains
             ierr = 1
             if (.not. st%ok()) then
                 call record(data, status_solver_failure, 'Jacobian failed at t = ' // &
-                    real_text(t) // ': ' // st%text(), reason_user_function)
+                    real_text(t) // ': ' // st%text(), callback_reason(st))
                 return
             end if
             if (data%jac_mode == jac_dense) then
@@ -914,6 +932,14 @@ contains
         character(len=*), intent(in) :: message
         if (data%failure%ok()) call data%failure%set(code, message, reason)
     end subroutine record
+
+    !> The reason a failed callback is recorded with: det F <= 0 stays itself
+    !> (the model refusing the trial state), anything else is the user's.
+    pure integer function callback_reason(st)
+        type(status_t), intent(in) :: st
+        callback_reason = reason_user_function
+        if (st%reason == reason_det_f) callback_reason = reason_det_f
+    end function callback_reason
 
     real(wp) function ieee_nan()
         use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan

@@ -42,6 +42,7 @@ module flexmbs_dae_mechanical_problem
         procedure :: constraint_jacobian_pattern => default_constraint_jacobian_pattern
         procedure :: constraint_jacobian_sparse => default_constraint_jacobian_sparse
         procedure :: normalize => default_normalize
+        procedure :: admissible => default_admissible
         procedure :: kinematics_derivative => default_kinematics_derivative
         procedure :: mass_derivative => default_mass_derivative
         procedure :: force_derivatives => default_force_derivatives
@@ -113,6 +114,15 @@ contains
         class(mechanical_problem_t), intent(inout) :: self
         real(wp), intent(inout) :: q(:)
     end subroutine default_normalize
+
+    !> Whether positions q are a state the model can hold (see
+    !> dae_problem_t%admissible); default: always.
+    subroutine default_admissible(self, q, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:)
+        type(status_t), intent(out) :: status
+        call status%clear()
+    end subroutine default_admissible
 
     !> ∂(T(t,q) w)/∂q, nq x nq (default: forward differences).
     subroutine default_kinematics_derivative(self, t, q, w, dq, status)

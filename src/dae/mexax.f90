@@ -26,7 +26,7 @@ module flexmbs_dae_mexax
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         status_interrupted, reason_step_too_small, reason_max_steps, reason_singular_matrix, &
-        reason_non_finite, reason_projection, reason_user_function
+        reason_non_finite, reason_projection, reason_user_function, reason_det_f
     use flexmbs_core_text, only: real_text, int_text
     use flexmbs_core_timer, only: timer_t
     use flexmbs_linalg_dense, only: dense_lu_factor, dense_lu_solve
@@ -245,6 +245,7 @@ contains
         type(workspace_t) :: w
         type(timer_t) :: timer
         type(status_t) :: fst
+        type(status_t) :: refusal !! the model's last refusal since an accepted step
         real(wp), allocatable :: yout(:)
         integer :: k, kc, kopt, km, decision, j, iout, nout, nstab_nonfinite
         real(wp) :: h, hmax, posneg, tscale, rmin, c, t_old
@@ -393,6 +394,10 @@ contains
                         // real_text(h) // ', at t = ' // real_text(t) // ' after ' // &
                         int_text(nstab_nonfinite) // ' steps with non-finite values (NaN/Inf)', &
                         reason_non_finite)
+                else if (refusal%reason == reason_det_f) then
+                    call status%set(status_solver_failure, 'mexax: step size too small, H = ' &
+                        // real_text(h) // ', at t = ' // real_text(t) // &
+                        '; the model refused the last attempt: ' // refusal%text(), reason_det_f)
                 else
                     call status%set(status_solver_failure, 'mexax: step size too small, H = ' &
                         // real_text(h) // ', at t = ' // real_text(t), reason_step_too_small)
@@ -490,6 +495,13 @@ contains
                     real_text(t + h) // ' (step from t = ' // real_text(t) // ')'
                 exit main
             end if
+            ! A state the model cannot hold (det F <= 0) is rejected like a
+            ! projection that moved too far.
+            call problem%admissible(w%p, fst)
+            if (.not. fst%ok()) then
+                refusal = fst
+                c = huge(1.0_wp)
+            end if
             if (c > 1.0_wp) then
                 self%nprj_reject = self%nprj_reject + 1
                 self%native%nrejct = self%native%nrejct + 1
@@ -501,6 +513,7 @@ contains
             end if
 
             self%native%naccpt = self%native%naccpt + 1
+            call refusal%clear()
             t_old = t
             t = t + h
             if (last) t = t_end
@@ -589,6 +602,8 @@ contains
                     nstab_nonfinite = nstab_nonfinite + 1
             else if (ev == ev_restart .and. fst%reason == reason_non_finite) then
                 nstab_nonfinite = nstab_nonfinite + 1
+            else if (ev == ev_restart .and. fst%reason == reason_det_f) then
+                refusal = fst
             end if
             select case (ev)
             case (ev_restart)
@@ -907,7 +922,7 @@ contains
             status%message = 'mexax: user function failed at the step start t = ' // &
                 real_text(t) // ': ' // status%text()
             status%code = status_solver_failure
-            status%reason = reason_user_function
+            if (status%reason /= reason_det_f) status%reason = reason_user_function
         end if
     end subroutine start_point
 
@@ -1030,7 +1045,9 @@ contains
         if (failed) then
             status%message = 'user function ' // what // ' failed: ' // status%text()
             status%code = status_solver_failure
-            status%reason = reason_user_function
+            ! det F <= 0 is the model refusing the trial state: a restart
+            ! with H/2 (base_column), not a stop.
+            if (status%reason /= reason_det_f) status%reason = reason_user_function
         end if
     end function user_failed
 
@@ -1109,7 +1126,7 @@ contains
                 w%p = w%pn
                 if (unstable(i)) return
             end do
-            if (.not. status%ok()) ev = ev_stop
+            if (.not. status%ok()) ev = merge(ev_restart, ev_stop, status%reason == reason_det_f)
         end subroutine euler_substeps
 
         !> (M), §3.2: an explicit start step, then q_{i+1} = q_{i−1} + 2h T v_i,
@@ -1179,7 +1196,7 @@ contains
                 call copy_block(w%gm, w%gn)
                 if (unstable(i)) return
             end do
-            if (.not. status%ok()) ev = ev_stop
+            if (.not. status%ok()) ev = merge(ev_restart, ev_stop, status%reason == reason_det_f)
         end subroutine midpoint_substeps
 
         !> Non-finite values, or the §3.5 check after the second substep

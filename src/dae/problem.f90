@@ -28,6 +28,7 @@ module flexmbs_dae_problem
         procedure :: has_projection => default_has_projection
         procedure :: project => default_project
         procedure :: consistent_initial => default_consistent_initial
+        procedure :: admissible => default_admissible
     end type dae_problem_t
 
     abstract interface
@@ -126,6 +127,16 @@ contains
         class(dae_problem_t), intent(in) :: self
         default_has_projection = .false.
     end function default_has_projection
+
+    !> Acceptance test of a step's new state: a state that the model cannot
+    !> hold (an inverted finite element: reason_det_f) fails with a reason,
+    !> and the solver rejects the step. Default: every state is admissible.
+    subroutine default_admissible(self, t, y, status)
+        class(dae_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        type(status_t), intent(out) :: status
+        call status%clear()
+    end subroutine default_admissible
 
     !> Post-step hook: project y onto the constraint manifold.
     subroutine default_project(self, t, y, status)

@@ -15,6 +15,7 @@ module flexmbs_dae_radau5
     use flexmbs_core_status, only: status_t, status_ok, status_bad_input, &
         status_solver_failure, status_interrupted, reason_step_too_small, reason_max_steps, &
         reason_singular_matrix, reason_non_finite, reason_newton_failure, reason_projection, &
+        reason_det_f, &
         reason_user_function
     use flexmbs_core_timer, only: timer_t
     use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_identity, storage_dense, &
@@ -169,6 +170,7 @@ contains
         class(linear_solver_t), allocatable :: ls
         type(timer_t) :: timer
         type(status_t) :: fstatus
+        type(status_t) :: rejection  !! why the last step since an acceptance failed
 
         integer :: n, nind1, nind2, nind3, nit, newt, block, i, nout, iout
         real(wp) :: x, h, xend, posneg, hmaxn, hhfac, faccon, theta, thet, thq, thqold
@@ -359,7 +361,8 @@ contains
         self%native%nfcn = self%native%nfcn + 1
         if (.not. fstatus%ok()) then
             call status%set(status_solver_failure, 'radau5: right-hand side failed at t = ' &
-                // real_text(x) // ': ' // fstatus%text(), reason_user_function)
+                // real_text(x) // ': ' // fstatus%text(), merge(reason_det_f, &
+                reason_user_function, fstatus%reason == reason_det_f))
             call finish()
             return
         end if
@@ -419,6 +422,10 @@ contains
                 if (0.1_wp * abs(h) <= abs(x) * uround) then
                     call status%set(status_solver_failure, 'radau5: step size too small, h = ' &
                         // real_text(h) // ' at t = ' // real_text(x), reason_step_too_small)
+                    ! A model failure that forced the step down is the reason.
+                    if (rejection%reason == reason_det_f) call status%set( &
+                        status_solver_failure, status%message // '; the last rejected ' // &
+                        'step failed: ' // rejection%text(), reason_det_f)
                     exit main
                 end if
                 ! §1.4: cumulative index scaling of the weights.
@@ -578,15 +585,17 @@ contains
                         call problem%project(x, y, fstatus)
                         stats%nprj = stats%nprj + 1
                         if (.not. fstatus%ok() .or. .not. all(ieee_is_finite(y))) then
-                            ! Undo the step and retry with h/2, counted like R8.
-                            y = cont
-                            x = xold
-                            hold = hold_saved
-                            self%native%naccpt = self%native%naccpt - 1
-                            call unexpected_failure()
+                            call undo_step()
                             cycle main
                         end if
                     end if
+                    ! A state the model cannot hold (det F <= 0) is never accepted.
+                    call problem%admissible(x, y, fstatus)
+                    if (.not. fstatus%ok()) then
+                        call undo_step()
+                        cycle main
+                    end if
+                    call rejection%clear()
                     self%dense%cont(:, 0) = y
                     self%dense%x = x
                     self%dense%h = h
@@ -705,7 +714,17 @@ contains
         end subroutine compute_scal
 
         !> R8: h/2 after Newton failure, singular matrix or non-finite value.
+        !> Take back the step just accepted and retry with h/2, counted like R8.
+        subroutine undo_step()
+            y = cont
+            x = xold
+            hold = hold_saved
+            self%native%naccpt = self%native%naccpt - 1
+            call unexpected_failure()
+        end subroutine undo_step
+
         subroutine unexpected_failure()
+            if (.not. fstatus%ok()) rejection = fstatus
             h = h * failure_factor
             hhfac = failure_factor
             reject = .true.

@@ -23,6 +23,7 @@ module flexmbs_dae_residual_problem
         procedure :: differential_flags => residual_differential_flags
         procedure :: has_iteration_matrix => residual_has_iteration_matrix
         procedure :: iteration_matrix => residual_iteration_matrix
+        procedure :: admissible => residual_admissible
     end type residual_problem_t
 
     abstract interface
@@ -65,9 +66,19 @@ module flexmbs_dae_residual_problem
         procedure :: partials => wrapper_partials
         procedure :: index_classes => wrapper_index_classes
         procedure :: differential_flags => wrapper_differential_flags
+        procedure :: admissible => wrapper_admissible
     end type dae_residual_t
 
 contains
+
+    !> Acceptance test of a corrected state (dae_problem_t%admissible);
+    !> default: every state.
+    subroutine residual_admissible(self, t, y, status)
+        class(residual_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        type(status_t), intent(out) :: status
+        call status%clear()
+    end subroutine residual_admissible
 
     !> Default: every component of index 1.
     subroutine residual_index_classes(self, classes)
@@ -185,4 +196,11 @@ contains
         logical, intent(out) :: flags(:)
         call self%problem%differential_flags(flags)
     end subroutine wrapper_differential_flags
+
+    subroutine wrapper_admissible(self, t, y, status)
+        class(dae_residual_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        type(status_t), intent(out) :: status
+        call self%problem%admissible(t, y, status)
+    end subroutine wrapper_admissible
 end module flexmbs_dae_residual_problem

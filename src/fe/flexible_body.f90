@@ -52,6 +52,7 @@ module flexmbs_fe_flexible_body
         procedure :: kinetic_energy => body_kinetic_energy
         procedure :: momenta => body_momenta
         procedure :: add_nodal_load => body_add_nodal_load
+        procedure :: admissible => body_admissible
     end type flexible_body_t
 
     public :: new_flexible_body
@@ -382,6 +383,32 @@ contains
             end do
         end do
     end function body_strain_energy
+
+    !> det F > 0 at every quadrature point of every element; otherwise a
+    !> solver failure with reason_det_f naming the element.
+    subroutine body_admissible(self, q, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:)
+        type(status_t), intent(out) :: status
+        real(wp) :: f(3, 3), detf
+        integer :: e, g, code, reason
+        character(len=40) :: where
+        call scatter(self, q, 0.0_wp * q)
+        do e = 1, self%mesh%element_count()
+            call gather(self, e)
+            do g = 1, self%hex%ngauss
+                call deformation_gradient(self%hex%nnode, self%dndx(:, :, g, e), self%xe, f, &
+                                          detf, status)
+                if (.not. status%ok()) then
+                    write (where, '(a,i0,a)') 'flexible body: element ', e, ': '
+                    code = status%code
+                    reason = status%reason
+                    call status%set(code, trim(where) // ' ' // status%text(), reason)
+                    return
+                end if
+            end do
+        end do
+    end subroutine body_admissible
 
     !> Kinetic energy ½ vᵀ M v (fixed nodes are at rest).
     function body_kinetic_energy(self, v) result(energy)

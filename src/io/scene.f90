@@ -28,7 +28,7 @@ module flexmbs_io_scene
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &
         formulation_index2, formulation_index3, formulation_ggl
     use flexmbs_io_namelist, only: scene_input_t, scene_dae_options, controller_code
-    use flexmbs_io_flexible_scene, only: build_flexible_body, body_energies
+    use flexmbs_io_body_input, only: build_flexible_body, body_energies
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_progress, only: progress_t, new_progress
     use flexmbs_io_multi_sink, only: multi_sink_t

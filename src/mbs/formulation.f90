@@ -95,6 +95,7 @@ module flexmbs_mbs_formulation
         procedure :: project => formulation_project
         procedure :: consistent_initial => formulation_consistent_initial
         procedure :: drift => formulation_drift
+        procedure :: admissible => formulation_admissible
     end type formulation_t
 
     public :: new_formulation
@@ -633,4 +634,12 @@ contains
             velocity = maxval(abs(self%c))
         end associate
     end subroutine formulation_drift
+
+    !> The mechanical problem's test of the positions in y.
+    subroutine formulation_admissible(self, t, y, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        type(status_t), intent(out) :: status
+        call self%mechanical%admissible(y(self%oq + 1:self%oq + self%nq), status)
+    end subroutine formulation_admissible
 end module flexmbs_mbs_formulation

@@ -9,7 +9,7 @@
 !> shared equally by the set's nodes that are not fixed. The initial
 !> velocity is rigid: v = v₀ + ω × (X − X̄), X̄ the mean of the nodes.
 !> Every error names the file, the group, the variable and the reason.
-module flexmbs_io_flexible_scene
+module flexmbs_io_body_input
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_text, only: int_text
@@ -227,4 +227,4 @@ contains
         character(len=:), allocatable :: text
         text = ' (line ' // int_text(line) // ')'
     end function at
-end module flexmbs_io_flexible_scene
+end module flexmbs_io_body_input
