@@ -4,6 +4,7 @@
 #   make test    install what is missing, build (debug, bounds checks), run every suite
 #   make bench   install what is missing, build (release), run the benchmarks
 #   make install PREFIX=...   install library, modules and the classic faces
+#   OPENMP=1     (with any of them) thread the finite-element assembly
 
 SHELL := /bin/bash
 .DEFAULT_GOAL := run
@@ -15,6 +16,12 @@ VENV         := $(BUILD)/venv
 # One set of flags for every fpm call: changing them makes fpm rebuild everything.
 export FPM_FFLAGS := -I/usr/include/hdf5/serial -I/usr/include/sundials/fortran
 export FPM_CFLAGS := -I/usr/include/suitesparse
+# OPENMP=1 threads the finite-element assembly (results bitwise identical).
+ifeq ($(OPENMP),1)
+export FPM_FFLAGS := $(FPM_FFLAGS) -fopenmp
+export FPM_LDFLAGS := -fopenmp
+OMP_LINK := -fopenmp
+endif
 FPM          = $(shell command -v fpm 2>/dev/null || echo $(VENV)/bin/fpm)
 PREFIX_DEBUG   := $(BUILD)/prefix-debug
 PREFIX_RELEASE := $(BUILD)/prefix-release
@@ -98,7 +105,7 @@ legacy-test:
 	        *) flags="-std=f2018 -I$(PREFIX_USED)/include -J$(BUILD)/legacy-test" ;; \
 	    esac; \
 	    echo "== $$src"; \
-	    gfortran $$flags -o $$exe $$src -L$(PREFIX_USED)/lib \
+	    gfortran $$flags $(OMP_LINK) -o $$exe $$src -L$(PREFIX_USED)/lib \
 	        -lflexmbs-legacy -lflexmbs $(SYSLIBS) \
 	        || { echo "FAIL compile $$src"; continue; }; \
 	    ( cd $(BUILD)/legacy-test && $$exe ) || echo "FAIL run $$src (exit $$?)"; \

@@ -4,6 +4,7 @@
 !>
 !>   flexmbs-bench INTEGRATOR PROBLEM N SOLVER [MAX_STEPS] [RTOL] [REFERENCE]
 !>   flexmbs-bench reference PROBLEM N FILE [RTOL]
+!>   flexmbs-bench assembly hex8|hex27 NDOF
 !>
 !> INTEGRATOR: radau5 | ddassl | ddassl-p2 (maximal BDF order 2) | ida |
 !> mexax (midpoint base) | mexax-euler (half-explicit Euler base).
@@ -18,6 +19,11 @@
 !> the exact solution, the Brusselator against the file REFERENCE written
 !> by the `reference` mode (RADAU5 at rtol = atol = RTOL, default 1e-10).
 !> ERR is '-' when the run stopped early or no reference is at hand.
+!> The assembly mode builds a clamped cube of the element type with about
+!> NDOF free dofs and prints the time of one internal-force + tangent
+!> assembly (and of the force alone), per element, the nonzeros of the
+!> tangent pattern, the growth of the peak resident memory (VmHWM) over
+!> building the body and assembling once, per dof, and the thread count.
 !> bench/run.sh runs the grid of configurations; these are figures, not tests.
 program flexmbs_bench
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
@@ -43,6 +49,12 @@ program flexmbs_bench
         new_reaction_diffusion, reaction_diffusion_initial
     use flexmbs_problems_pendulum, only: pendulum_t, new_pendulum, pendulum_initial, &
         pendulum_reference, pendulum_index2, pendulum_index3, pendulum_ggl
+    use flexmbs_fe_hexahedron, only: hex8, hex27
+    use flexmbs_fe_neo_hooke, only: neo_hooke_t, new_neo_hooke
+    use flexmbs_fe_mesh, only: mesh_t
+    use flexmbs_fe_box_mesh, only: box_mesh
+    use flexmbs_fe_flexible_body, only: flexible_body_t, new_flexible_body
+    !$ use omp_lib, only: omp_get_max_threads
     implicit none
 
     real(wp), parameter :: pendulum_phi0 = 1.0_wp   !! start angle [rad], as in test/
@@ -67,11 +79,19 @@ program flexmbs_bench
     character(len=16) :: outcome
     integer :: n_row   !! unknowns reported in the row
 
+    if (command_argument_count() == 3) then
+        call get_command_argument(1, integrator_name)
+        if (integrator_name == 'assembly') then
+            call run_assembly()
+            stop
+        end if
+    end if
     if (command_argument_count() < 4) then
         write (*, '(a)') 'usage: flexmbs-bench radau5|ddassl|ddassl-p2|ida|mexax|mexax-euler ' &
             // 'vdp|rd1d|rd2d|pend3|pend2|pendggl|pendmech|chain N dense|klu|band|auto ' // &
             '[MAX_STEPS] [RTOL] [REFERENCE]', &
-            '       flexmbs-bench reference PROBLEM N FILE [RTOL]'
+            '       flexmbs-bench reference PROBLEM N FILE [RTOL]', &
+            '       flexmbs-bench assembly hex8|hex27 NDOF'
         error stop 2
     end if
     call get_command_argument(1, integrator_name)
@@ -316,6 +336,72 @@ contains
             stats%cpu, stats%wall, stats%cpu / max(stats%nst, 1), peak_memory_mb(), &
             trim(adjustl(err_text))
     end subroutine print_row
+
+    !> `assembly KIND NDOF`: one row of assembly figures (module header).
+    subroutine run_assembly()
+        type(mesh_t) :: mesh
+        type(neo_hooke_t) :: mat
+        type(flexible_body_t) :: body
+        integer, allocatable :: fixed(:)
+        real(wp), allocatable :: q(:), v(:), k(:)
+        real(wp) :: mem0, mem1, t_tangent, t_force
+        integer :: kind, m, p, ndof, repeats, threads
+        call get_command_argument(2, arg)
+        kind = merge(hex8, hex27, trim(arg) == 'hex8')
+        call get_command_argument(3, arg)
+        read (arg, *) ndof
+        ! m³ elements, (p m + 1)² (p m) free nodes with the xmin face clamped
+        p = merge(1, 2, kind == hex8)
+        m = max(1, nint((ndof / 3.0_wp)**(1.0_wp / 3) / p))
+        mem0 = peak_memory_mb()
+        call new_neo_hooke(mat, 7.0e5_wp, 0.3_wp, 920.0_wp, 1000.0_wp, status)
+        if (status%ok()) call box_mesh(mesh, kind, [m, m, m], [1.0_wp, 1.0_wp, 1.0_wp], status)
+        if (status%ok()) call mesh%node_set('xmin', fixed, status)
+        if (status%ok()) call new_flexible_body(body, mesh, [mat], fixed, status)
+        if (.not. status%ok()) then
+            write (*, '(a)') 'assembly: ' // status%text()
+            error stop 1
+        end if
+        q = body%free_positions()
+        allocate (v(body%nv), source=0.01_wp, k(body%nv))
+        q = q * 1.01_wp   ! a uniform stretch: every element works
+        call body%tangents(q, v, k, status)
+        mem1 = peak_memory_mb()
+        ! repeat to about 0.5 s of assembly (at least twice)
+        t_tangent = seconds_per_call(body, q, v, k, .true., 2)
+        repeats = max(2, nint(0.5_wp / max(t_tangent, 1.0e-6_wp)))
+        t_tangent = seconds_per_call(body, q, v, k, .true., repeats)
+        t_force = seconds_per_call(body, q, v, k, .false., repeats)
+        threads = 1
+        !$ threads = omp_get_max_threads()
+        write (*, '(a,1x,a,4(1x,i0),4(1x,es10.3),1x,f0.1,1x,i0)') 'assembly', &
+            merge('hex8 ', 'hex27', kind == hex8), body%nv, mesh%element_count(), &
+            body%stiffness%nnz, repeats, t_tangent, 1.0e6_wp * t_tangent / mesh%element_count(), &
+            t_force, 1.0e6_wp * t_force / mesh%element_count(), &
+            (mem1 - mem0) * 1048576.0_wp / body%nv, threads
+
+    end subroutine run_assembly
+
+    !> Wall seconds per assembly of `body` (with tangents or the force alone).
+    real(wp) function seconds_per_call(body, q, v, k, tangents, n)
+        type(flexible_body_t), intent(inout) :: body
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(inout) :: k(:)
+        logical, intent(in) :: tangents
+        integer, intent(in) :: n
+        integer(8) :: c0, c1, rate
+        integer :: j
+        call system_clock(c0, rate)
+        do j = 1, n
+            if (tangents) then
+                call body%tangents(q, v, k, status)
+            else
+                call body%internal_forces(q, v, k, status)
+            end if
+        end do
+        call system_clock(c1)
+        seconds_per_call = real(c1 - c0, wp) / real(rate, wp) / n
+    end function seconds_per_call
 
     !> Peak resident set size (VmHWM) of this process in MiB, Linux only.
     real(wp) function peak_memory_mb()

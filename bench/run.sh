@@ -68,6 +68,21 @@ for integ in mexax mexax-euler; do
     run $integ chain 1000 klu 300    # ~25 ms a step: capped at 300 steps
 done
 
+# Finite-element assembly: clamped cubes of 1e3..1e5 free dofs, both elements.
+echo
+echo "assembly element ndof elements nnz repeats t_tangent[s] us/element t_force[s] us/element bytes/dof threads"
+for kind in hex8 hex27; do
+    for n in 1000 10000 100000; do
+        "$BIN" assembly $kind $n 2>>"$ERRORS" | tee -a "$RESULTS"
+    done
+done
+echo "assembly cost growth with the number of elements (1 = linear): p in t ~ elements^p"
+awk '$1 == "assembly" { if ($2 == kind && e0 > 0)
+         printf "%-5s elements %d -> %d: tangent p = %.2f, force p = %.2f\n", $2, e0, $4,
+                log($7/t0)/log($4/e0), log($9/f0)/log($4/e0)
+     kind = $2; e0 = $4; t0 = $7; f0 = $9 }' "$RESULTS"
+echo
+
 DENSE_IDA="SUNDIALS' unblocked dense LU: over 5 min for 10 steps on the periodic grid"
 for integ in radau5 ddassl ddassl-p2 ida; do
     for n in 100 1000 10000 100000; do

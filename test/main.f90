@@ -23,6 +23,7 @@ program flexmbs_tests
     use test_fe_statics, only: collect_fe_statics
     use test_fe_mesh, only: collect_fe_mesh
     use test_fe_detf, only: collect_fe_detf
+    use test_fe_assembly, only: collect_fe_assembly
     use test_rotation, only: collect_rotation
     use test_dual, only: collect_dual
     use test_constraint_primitives, only: collect_constraint_primitives
@@ -59,6 +60,7 @@ program flexmbs_tests
     call run_suite('fe_statics', collect_fe_statics(), filter, npassed, nfailed)
     call run_suite('fe_mesh', collect_fe_mesh(), filter, npassed, nfailed)
     call run_suite('fe_detf', collect_fe_detf(), filter, npassed, nfailed)
+    call run_suite('fe_assembly', collect_fe_assembly(), filter, npassed, nfailed)
     call run_suite('rotation', collect_rotation(), filter, npassed, nfailed)
     call run_suite('dual', collect_dual(), filter, npassed, nfailed)
     call run_suite('constraint_primitives', collect_constraint_primitives(), filter, &

@@ -49,8 +49,12 @@ contains
             grid = p * divisions + 1
             call mesh%check(status)
             call check(error, status%ok(), 'box: check: ' // status%text())
-            call check(error, size(mesh%node_sets) == 18 .and. size(mesh%element_sets) == 7, &
-                       'box: 6 faces + 12 edges, all + 6 layers expected')
+            call check(error, size(mesh%node_sets) == 24 .and. size(mesh%element_sets) == 7, &
+                       'box: 6 faces + 12 edges + 6 layers, all + 6 layers expected')
+            call mesh%node_set('xmax_layer', nodes, status)
+            call check(error, status%ok() .and. size(nodes) == (p + 1) * grid(2) * grid(3) &
+                       .and. all(mesh%x(1, nodes) >= lengths(1) * (1.0_wp - 1.0_wp / &
+                       divisions(1)) - 1.0e-14_wp), 'box: xmax_layer nodes')
             call mesh%node_set('ymax_zmin', nodes, status)
             call check(error, status%ok() .and. size(nodes) == grid(1), 'box: ymax_zmin size')
             if (allocated(error)) return

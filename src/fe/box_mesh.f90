@@ -3,6 +3,7 @@
 !> - node sets: the six faces 'xmin', 'xmax', 'ymin', 'ymax', 'zmin', 'zmax';
 !>   the twelve edges, named by their two faces in x, y, z order
 !>   ('xmin_ymin', 'xmin_zmax', 'ymax_zmin', …), nodes ordered along the edge;
+!>   and the nodes of each boundary element layer ('xmin_layer', …);
 !> - element sets: 'all', and the boundary element layers 'xmin_layer',
 !>   'xmax_layer', 'ymin_layer', … (the elements touching that face; for a
 !>   bar along x the paper's stiffer tips are 'xmin_layer' and 'xmax_layer').
@@ -27,7 +28,7 @@ contains
         real(wp), intent(in) :: lengths(3)    !! box edge lengths
         type(status_t), intent(out) :: status
         real(wp), intent(in), optional :: origin(3) !! lower corner (default 0)
-        integer :: p, grid(3), i, j, k, e, a, ex, ey, ez, idx(3), d, d2, b, n
+        integer :: p, grid(3), i, j, k, e, a, ex, ey, ez, idx(3), d, d2, b, n, level, lv(2)
         real(wp) :: x0(3)
         character(len=120) :: msg
         character(len=4), parameter :: face_names(2, 3) = reshape( &
@@ -70,11 +71,15 @@ contains
                 end do
             end do
         end do
-        allocate (mesh%node_sets(18), mesh%element_sets(7))
+        allocate (mesh%node_sets(24), mesh%element_sets(7))
         do d = 1, 3
             do a = 1, 2
-                mesh%node_sets(2 * (d - 1) + a) = grid_set(face_names(a, d), [d], &
-                                                           [merge(0, grid(d) - 1, a == 1)])
+                level = merge(0, grid(d) - 1, a == 1)
+                mesh%node_sets(2 * (d - 1) + a) = grid_set(face_names(a, d), [d], [level], &
+                                                           [level])
+                ! the nodes of the boundary element layer
+                mesh%node_sets(18 + 2 * (d - 1) + a) = grid_set(face_names(a, d) // '_layer', &
+                    [d], [merge(0, grid(d) - 1 - p, a == 1)], [merge(p, grid(d) - 1, a == 1)])
             end do
         end do
         n = 6
@@ -83,9 +88,9 @@ contains
                 do a = 1, 2
                     do b = 1, 2
                         n = n + 1
+                        lv = [merge(0, grid(d) - 1, a == 1), merge(0, grid(d2) - 1, b == 1)]
                         mesh%node_sets(n) = grid_set(face_names(a, d) // '_' // &
-                            face_names(b, d2), [d, d2], [merge(0, grid(d) - 1, a == 1), &
-                            merge(0, grid(d2) - 1, b == 1)])
+                            face_names(b, d2), [d, d2], lv, lv)
                     end do
                 end do
             end do
@@ -107,26 +112,32 @@ contains
         end function grid_node
 
 
-        !> Nodes whose grid indices in the directions dirs equal levels, in
+        !> Nodes whose grid indices in the directions dirs lie in [lo, hi], in
         !> grid order (x fastest).
-        function grid_set(name, dirs, levels) result(set)
+        function grid_set(name, dirs, lo, hi) result(set)
             character(len=*), intent(in) :: name
-            integer, intent(in) :: dirs(:), levels(:)
+            integer, intent(in) :: dirs(:), lo(:), hi(:)
             type(node_set_t) :: set
-            integer :: i, j, k, n, ijk(3)
+            integer :: i, j, k, n, ijk(3), pass
             set%name = name
-            allocate (set%nodes(product(grid) / product(grid(dirs))))
-            n = 0
-            do k = 0, grid(3) - 1
-                do j = 0, grid(2) - 1
-                    do i = 0, grid(1) - 1
-                        ijk = [i, j, k]
-                        if (all(ijk(dirs) == levels)) then
-                            n = n + 1
-                            set%nodes(n) = grid_node(i, j, k)
-                        end if
+            allocate (set%nodes(0))
+            do pass = 1, 2 ! count, then fill
+                n = 0
+                do k = 0, grid(3) - 1
+                    do j = 0, grid(2) - 1
+                        do i = 0, grid(1) - 1
+                            ijk = [i, j, k]
+                            if (all(ijk(dirs) >= lo .and. ijk(dirs) <= hi)) then
+                                n = n + 1
+                                if (pass == 2) set%nodes(n) = grid_node(i, j, k)
+                            end if
+                        end do
                     end do
                 end do
+                if (pass == 1) then
+                    deallocate (set%nodes)
+                    allocate (set%nodes(n))
+                end if
             end do
         end function grid_set
 

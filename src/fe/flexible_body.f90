@@ -10,6 +10,8 @@
 module flexmbs_fe_flexible_body
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_text, only: int_text
+    !$ use omp_lib, only: omp_get_max_threads, omp_get_thread_num
     use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_fe_tensor, only: identity3
@@ -20,6 +22,13 @@ module flexmbs_fe_flexible_body
     use flexmbs_fe_mesh, only: mesh_t
     implicit none
     private
+
+    !> One thread's element workspace: gathers and element results, each
+    !> its own allocation (no cache lines shared between threads).
+    type :: element_work_t
+        real(wp), allocatable :: xe(:, :), ve(:, :), k_el(:, :), k_v(:, :), ke(:, :), ce(:, :)
+        type(status_t) :: status
+    end type element_work_t
 
     type, extends(mechanical_problem_t), public :: flexible_body_t
         type(mesh_t) :: mesh
@@ -37,8 +46,11 @@ module flexmbs_fe_flexible_body
         integer(i8), allocatable :: triplet_start(:)     !! first tangent triplet of element e
         ! Workspace, allocated once: nodal positions and velocities, element
         ! gathers and element results (exact sizes, so no copies on calls).
-        real(wp), allocatable :: x(:, :), v(:, :), xe(:, :), ve(:, :), k_el(:, :), &
-            k_v(:, :), ke(:, :), ce(:, :), me(:, :)
+        real(wp), allocatable :: x(:, :), v(:, :), me(:, :)
+        type(element_work_t), allocatable :: work(:)     !! one per thread
+        !> Elements colour by colour: colour c is colour_elements(colour_start(c)
+        !> : colour_start(c+1)-1), no two of them sharing a node.
+        integer, allocatable :: colour_start(:), colour_elements(:)
     contains
         procedure :: kinematics => body_kinematics
         procedure :: mass => body_mass
@@ -74,7 +86,7 @@ contains
         !> Further supports by component (3, nodes): .true. holds that
         !> coordinate at X (symmetry planes, rollers).
         logical, intent(in), optional :: fixed_components(:, :)
-        integer :: e, n, i, j, nfree
+        integer :: e, n, i, j, nfree, nthreads
         character(len=120) :: msg
         body%mesh = mesh
         n = mesh%node_count()
@@ -141,11 +153,11 @@ contains
         if (present(gravity)) body%gravity = gravity
         body%x = mesh%x
         allocate (body%v(3, n), source=0.0_wp)
-        allocate (body%xe(3, mesh%nnode_element), body%ve(3, mesh%nnode_element), &
-                  body%k_el(3, mesh%nnode_element), body%k_v(3, mesh%nnode_element), &
-                  body%ke(3 * mesh%nnode_element, 3 * mesh%nnode_element), &
-                  body%ce(3 * mesh%nnode_element, 3 * mesh%nnode_element), &
-                  body%me(mesh%nnode_element, mesh%nnode_element))
+        allocate (body%me(mesh%nnode_element, mesh%nnode_element))
+        nthreads = 1
+        !$ nthreads = omp_get_max_threads()
+        call allocate_workspace(body, nthreads)
+        call colour_elements(body)
         call build_patterns(body, status)
     end subroutine new_flexible_body
 
@@ -253,65 +265,175 @@ contains
     end function body_free_positions
 
     !> Internal force k(q, v) = k_el + k_v on the free dofs; with `tangents`
-    !> also the values of ∂k/∂q and ∂k/∂v. A det F ≤ 0 failure names the element.
+    !> also the values of ∂k/∂q and ∂k/∂v. A det F ≤ 0 failure names the
+    !> element (the lowest-numbered failing one of the first failing colour).
+    !>
+    !> Elements go colour by colour (no two elements of a colour share a
+    !> node), so every entry of k, ∂k/∂q and ∂k/∂v receives its element
+    !> contributions in the same order whatever the number of threads: the
+    !> results are bitwise identical with and without OpenMP.
     subroutine assemble(body, q, v, k, status, tangents)
         class(flexible_body_t), intent(inout) :: body
         real(wp), intent(in) :: q(:), v(:)
         real(wp), intent(out) :: k(:)
         type(status_t), intent(out) :: status
         logical, intent(in) :: tangents
-        integer :: dofs(3 * max_nodes), e, nn, nd, p, qq, a, code, reason
-        integer(i8) :: t, slot
-        character(len=40) :: where
-        nn = body%hex%nnode
-        nd = 3 * nn
+        integer :: c, i, e, tid, failed_element, nthreads
+        type(status_t) :: failure
         call scatter(body, q, v)
         k = 0.0_wp
         if (tangents) then
             body%stiffness%values = 0.0_wp
             body%damping%values = 0.0_wp
         end if
-        do e = 1, body%mesh%element_count()
-            call gather(body, e)
-            associate (mat => body%materials(body%element_material(e)))
-                if (tangents) then
-                    call element_forces(body%hex, mat, body%dndx(:, :, :, e), body%wdv(:, e), &
-                                        body%xe, body%ve, body%k_el, body%k_v, status, &
-                                        body%ke, body%ce)
-                else
-                    call element_forces(body%hex, mat, body%dndx(:, :, :, e), body%wdv(:, e), &
-                                        body%xe, body%ve, body%k_el, body%k_v, status)
+        nthreads = 1
+        !$ nthreads = omp_get_max_threads()
+        if (nthreads > size(body%work)) call allocate_workspace(body, nthreads)
+        failed_element = huge(1)
+        do c = 1, size(body%colour_start) - 1
+            !$omp parallel do default(shared) private(i, e, tid) schedule(static)
+            do i = body%colour_start(c), body%colour_start(c + 1) - 1
+                e = body%colour_elements(i)
+                tid = 1
+                !$ tid = omp_get_thread_num() + 1
+                call element_contribution(body, e, tid, k, tangents, body%work(tid)%status)
+                if (.not. body%work(tid)%status%ok()) then
+                    !$omp critical (flexmbs_fe_assembly_failure)
+                    if (e < failed_element) then
+                        failed_element = e
+                        failure = body%work(tid)%status
+                    end if
+                    !$omp end critical (flexmbs_fe_assembly_failure)
                 end if
-            end associate
-            if (.not. status%ok()) then
-                write (where, '(a,i0,a)') 'flexible body: element ', e, ': '
-                code = status%code
-                reason = status%reason
-                call status%set(code, trim(where) // ' ' // status%text(), reason)
+            end do
+            !$omp end parallel do
+            if (failed_element < huge(1)) then
+                status = failure
+                call name_element(status, failed_element)
                 return
             end if
-            call element_dofs(body, e, dofs(1:nd))
-            do a = 1, nn
-                do p = 1, 3
-                    if (dofs(3 * (a - 1) + p) > 0) k(dofs(3 * (a - 1) + p)) = &
-                        k(dofs(3 * (a - 1) + p)) + body%k_el(p, a) + body%k_v(p, a)
-                end do
-            end do
-            if (.not. tangents) cycle
-            ! Same local order as build_patterns.
-            t = body%triplet_start(e)
-            do qq = 1, nd
-                if (dofs(qq) == 0) cycle
-                do p = 1, nd
-                    if (dofs(p) == 0) cycle
-                    slot = body%stiffness%triplet_map(t)
-                    body%stiffness%values(slot) = body%stiffness%values(slot) + body%ke(p, qq)
-                    body%damping%values(slot) = body%damping%values(slot) + body%ce(p, qq)
-                    t = t + 1
-                end do
-            end do
         end do
     end subroutine assemble
+
+    !> Element e's forces (and tangents) added into k and the CSC values,
+    !> with the workspace of thread tid.
+    subroutine element_contribution(body, e, tid, k, tangents, status)
+        class(flexible_body_t), intent(inout) :: body
+        integer, intent(in) :: e, tid
+        real(wp), intent(inout) :: k(:)
+        logical, intent(in) :: tangents
+        type(status_t), intent(out) :: status
+        integer :: dofs(3 * max_nodes), nn, nd, p, qq, a
+        integer(i8) :: t, slot
+        nn = body%hex%nnode
+        nd = 3 * nn
+        call gather(body, e, tid)
+        associate (mat => body%materials(body%element_material(e)))
+            if (tangents) then
+                call element_forces(body%hex, mat, body%dndx(:, :, :, e), body%wdv(:, e), &
+                                    body%work(tid)%xe, body%work(tid)%ve, &
+                                    body%work(tid)%k_el, body%work(tid)%k_v, status, &
+                                    body%work(tid)%ke, body%work(tid)%ce)
+            else
+                call element_forces(body%hex, mat, body%dndx(:, :, :, e), body%wdv(:, e), &
+                                    body%work(tid)%xe, body%work(tid)%ve, &
+                                    body%work(tid)%k_el, body%work(tid)%k_v, status)
+            end if
+        end associate
+        if (.not. status%ok()) return
+        call element_dofs(body, e, dofs(1:nd))
+        do a = 1, nn
+            do p = 1, 3
+                if (dofs(3 * (a - 1) + p) > 0) k(dofs(3 * (a - 1) + p)) = &
+                    k(dofs(3 * (a - 1) + p)) + body%work(tid)%k_el(p, a) + body%work(tid)%k_v(p, a)
+            end do
+        end do
+        if (.not. tangents) return
+        ! Same local order as build_patterns.
+        t = body%triplet_start(e)
+        do qq = 1, nd
+            if (dofs(qq) == 0) cycle
+            do p = 1, nd
+                if (dofs(p) == 0) cycle
+                slot = body%stiffness%triplet_map(t)
+                body%stiffness%values(slot) = body%stiffness%values(slot) + body%work(tid)%ke(p, qq)
+                body%damping%values(slot) = body%damping%values(slot) + body%work(tid)%ce(p, qq)
+                t = t + 1
+            end do
+        end do
+    end subroutine element_contribution
+
+    !> Prefix a failure's message with its element.
+    pure subroutine name_element(status, e)
+        type(status_t), intent(inout) :: status
+        integer, intent(in) :: e
+        integer :: code, reason
+        ! copies: set must not see its own components as arguments
+        code = status%code
+        reason = status%reason
+        call status%set(code, 'flexible body: element ' // int_text(e) // ': ' // &
+                        status%text(), reason)
+    end subroutine name_element
+
+    !> Greedy colouring: each element takes the lowest colour not used by an
+    !> element sharing one of its nodes (colours as bits per node, 64 per
+    !> word); the elements are then listed colour by colour, in element order.
+    subroutine colour_elements(body)
+        class(flexible_body_t), intent(inout) :: body
+        integer(i8), allocatable :: used(:, :)
+        integer, allocatable :: colour(:)
+        integer(i8) :: mask
+        integer :: e, a, w, b, nwords, ncolour, ne, node
+        ne = body%mesh%element_count()
+        nwords = 1
+        allocate (colour(ne))
+        do
+            allocate (used(nwords, body%mesh%node_count()), source=0_i8)
+            ncolour = 0
+            elements: do e = 1, ne
+                do w = 1, nwords
+                    mask = 0_i8
+                    do a = 1, body%hex%nnode
+                        mask = ior(mask, used(w, body%mesh%connectivity(a, e)))
+                    end do
+                    if (mask == not(0_i8)) cycle
+                    b = trailz(not(mask))
+                    colour(e) = 64 * (w - 1) + b + 1
+                    ncolour = max(ncolour, colour(e))
+                    do a = 1, body%hex%nnode
+                        node = body%mesh%connectivity(a, e)
+                        used(w, node) = ibset(used(w, node), b)
+                    end do
+                    cycle elements
+                end do
+                exit
+            end do elements
+            if (e > ne) exit
+            deallocate (used)
+            nwords = 2 * nwords
+        end do
+        allocate (body%colour_start(ncolour + 1), body%colour_elements(ne))
+        body%colour_start(1) = 1
+        do a = 1, ncolour
+            body%colour_start(a + 1) = body%colour_start(a) + count(colour == a)
+        end do
+        body%colour_elements = [(pack([(e, e = 1, ne)], colour == a), a = 1, ncolour)]
+    end subroutine colour_elements
+
+    !> Element workspaces for n threads (gathers and element results).
+    subroutine allocate_workspace(body, n)
+        class(flexible_body_t), intent(inout) :: body
+        integer, intent(in) :: n
+        integer :: nn, i
+        nn = body%hex%nnode
+        if (allocated(body%work)) deallocate (body%work)
+        allocate (body%work(n))
+        do i = 1, n
+            allocate (body%work(i)%xe(3, nn), body%work(i)%ve(3, nn), body%work(i)%k_el(3, nn), &
+                      body%work(i)%k_v(3, nn), body%work(i)%ke(3 * nn, 3 * nn), &
+                      body%work(i)%ce(3 * nn, 3 * nn))
+        end do
+    end subroutine allocate_workspace
 
     !> k(q, v) on the free dofs.
     subroutine body_internal_forces(self, q, v, k, status)
@@ -351,14 +473,15 @@ contains
         end do
     end subroutine body_add_nodal_load
 
-    !> Gather element e's nodal positions and velocities into xe, ve.
-    pure subroutine gather(body, e)
+    !> Gather element e's nodal positions and velocities into thread tid's
+    !> xe, ve (serial callers use tid = 1).
+    pure subroutine gather(body, e, tid)
         class(flexible_body_t), intent(inout) :: body
-        integer, intent(in) :: e
+        integer, intent(in) :: e, tid
         integer :: a
         do a = 1, body%hex%nnode
-            body%xe(:, a) = body%x(:, body%mesh%connectivity(a, e))
-            body%ve(:, a) = body%v(:, body%mesh%connectivity(a, e))
+            body%work(tid)%xe(:, a) = body%x(:, body%mesh%connectivity(a, e))
+            body%work(tid)%ve(:, a) = body%v(:, body%mesh%connectivity(a, e))
         end do
     end subroutine gather
 
@@ -373,9 +496,10 @@ contains
         call scatter(self, q, 0.0_wp * q)
         energy = 0.0_wp
         do e = 1, self%mesh%element_count()
-            call gather(self, e)
+            call gather(self, e, 1)
             do g = 1, self%hex%ngauss
-                call deformation_gradient(self%hex%nnode, self%dndx(:, :, g, e), self%xe, f, &
+                call deformation_gradient(self%hex%nnode, self%dndx(:, :, g, e), &
+                                          self%work(1)%xe, f, &
                                           detf, status)
                 if (.not. status%ok()) return
                 energy = energy + self%wdv(g, e) * self%materials(self%element_material(e)) &
@@ -391,19 +515,16 @@ contains
         real(wp), intent(in) :: q(:)
         type(status_t), intent(out) :: status
         real(wp) :: f(3, 3), detf
-        integer :: e, g, code, reason
-        character(len=40) :: where
+        integer :: e, g
         call scatter(self, q, 0.0_wp * q)
         do e = 1, self%mesh%element_count()
-            call gather(self, e)
+            call gather(self, e, 1)
             do g = 1, self%hex%ngauss
-                call deformation_gradient(self%hex%nnode, self%dndx(:, :, g, e), self%xe, f, &
+                call deformation_gradient(self%hex%nnode, self%dndx(:, :, g, e), &
+                                          self%work(1)%xe, f, &
                                           detf, status)
                 if (.not. status%ok()) then
-                    write (where, '(a,i0,a)') 'flexible body: element ', e, ': '
-                    code = status%code
-                    reason = status%reason
-                    call status%set(code, trim(where) // ' ' // status%text(), reason)
+                    call name_element(status, e)
                     return
                 end if
             end do
@@ -440,18 +561,20 @@ contains
         linear = 0.0_wp
         angular = 0.0_wp
         do e = 1, self%mesh%element_count()
-            call gather(self, e)
+            call gather(self, e, 1)
             call element_mass(self%hex, self%wdv(:, e), &
                               self%materials(self%element_material(e))%density, self%me)
             do a = 1, self%hex%nnode
                 mv = 0.0_wp
                 do b = 1, self%hex%nnode
-                    mv = mv + self%me(a, b) * self%ve(:, b)
+                    mv = mv + self%me(a, b) * self%work(1)%ve(:, b)
                 end do
                 linear = linear + mv
-                angular = angular + [self%xe(2, a) * mv(3) - self%xe(3, a) * mv(2), &
-                                     self%xe(3, a) * mv(1) - self%xe(1, a) * mv(3), &
-                                     self%xe(1, a) * mv(2) - self%xe(2, a) * mv(1)]
+                associate (x => self%work(1)%xe(:, a))
+                    angular = angular + [x(2) * mv(3) - x(3) * mv(2), &
+                                         x(3) * mv(1) - x(1) * mv(3), &
+                                         x(1) * mv(2) - x(2) * mv(1)]
+                end associate
             end do
         end do
     end subroutine body_momenta
