@@ -241,13 +241,15 @@ contains
     !> Scatter free positions q and velocities w into the nodal arrays.
     pure subroutine scatter(body, q, w)
         class(flexible_body_t), intent(inout) :: body
-        real(wp), intent(in) :: q(:), w(:)
+        real(wp), intent(in) :: q(:)
+        real(wp), intent(in), optional :: w(:) !! absent: velocities zero
         integer :: i, j
         do i = 1, size(body%dof, 2)
             do j = 1, 3
                 if (body%dof(j, i) == 0) cycle
                 body%x(j, i) = q(body%dof(j, i))
-                body%v(j, i) = w(body%dof(j, i))
+                body%v(j, i) = 0.0_wp
+                if (present(w)) body%v(j, i) = w(body%dof(j, i))
             end do
         end do
     end subroutine scatter
@@ -493,7 +495,7 @@ contains
         real(wp) :: energy
         real(wp) :: f(3, 3), detf
         integer :: e, g
-        call scatter(self, q, 0.0_wp * q)
+        call scatter(self, q)
         energy = 0.0_wp
         do e = 1, self%mesh%element_count()
             call gather(self, e, 1)
@@ -516,7 +518,7 @@ contains
         type(status_t), intent(out) :: status
         real(wp) :: f(3, 3), detf
         integer :: e, g
-        call scatter(self, q, 0.0_wp * q)
+        call scatter(self, q)
         do e = 1, self%mesh%element_count()
             call gather(self, e, 1)
             do g = 1, self%hex%ngauss
