@@ -10,6 +10,7 @@ module test_fe_body
     use flexmbs_fe_flexible_body, only: flexible_body_t, new_flexible_body
     use test_problems, only: fill_random
     use test_fe, only: random_rotation, paper_material
+    use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index2
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
     private
@@ -30,7 +31,8 @@ contains
                  new_test('bad_fixed_node', test_bad_fixed), &
                  new_test('momenta_kinetic_energy', test_momenta), &
                  new_test('strain_energy_gradient', test_strain_energy), &
-                 new_test('tip_layers_and_nodal_loads', test_tip_layers)]
+                 new_test('tip_layers_and_nodal_loads', test_tip_layers), &
+                 new_test('formulation_jacobian_fd', test_formulation_jacobian)]
     end function collect_fe_body
 
     subroutine make_body(kind, fixed_face, body, status, gravity, origin)
@@ -326,4 +328,47 @@ contains
         call check(error, .not. status%ok() .and. index(status%text(), '1..2') > 0, &
                    'material number 3 of 2 rejected')
     end subroutine test_tip_layers
+    !> The body's analytic force derivatives (−∂k/∂q, −∂k/∂v, zero kinematic
+    !> and mass derivatives) make the formulation's dense Jacobian equal
+    !> central differences of its right-hand side (≤ 1e-6 relative).
+    subroutine test_formulation_jacobian(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(flexible_body_t), target :: body
+        type(formulation_t) :: dae
+        type(status_t) :: status
+        real(wp), allocatable :: y(:), jac(:, :), fd(:, :), fp(:), fm(:), yp(:), dq(:)
+        real(wp) :: h
+        integer(i8) :: seed
+        integer :: kind, j, n, nq
+        seed = 11_i8
+        do kind = 1, 2
+            call make_body(kind, 'xmin', body, status, gravity=[0.0_wp, 0.0_wp, -9.81_wp])
+            nq = body%nq
+            dae = new_formulation(body, formulation_index2, body%free_positions(), &
+                                  constant_mass=.true., status=status)
+            call check(error, status%ok(), 'formulation: ' // status%text())
+            if (allocated(error)) return
+            n = dae%n
+            allocate (y(n), jac(n, n), fd(n, n), fp(n), fm(n), dq(nq))
+            call fill_random(dq, seed, -0.01_wp, 0.01_wp)
+            y(1:nq) = body%free_positions() + dq
+            call fill_random(y(nq + 1:), seed, -0.5_wp, 0.5_wp)
+            call dae%jacobian_dense(0.0_wp, y, jac, status)
+            call check(error, status%ok(), 'jacobian: ' // status%text())
+            if (allocated(error)) return
+            do j = 1, n
+                h = merge(1.0e-7_wp, 1.0e-4_wp, j <= nq)
+                yp = y
+                yp(j) = y(j) + h
+                call dae%rhs(0.0_wp, yp, fp, status)
+                yp(j) = y(j) - h
+                call dae%rhs(0.0_wp, yp, fm, status)
+                fd(:, j) = (fp - fm) / (2 * h)
+            end do
+            call check(error, maxval(abs(jac - fd)) <= 1.0e-6_wp * maxval(abs(jac)), &
+                       'formulation Jacobian differs from central differences')
+            deallocate (y, jac, fd, fp, fm, dq)
+            if (allocated(error)) return
+        end do
+    end subroutine test_formulation_jacobian
 end module test_fe_body

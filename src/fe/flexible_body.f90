@@ -47,6 +47,7 @@ module flexmbs_fe_flexible_body
         ! Workspace, allocated once: nodal positions and velocities, element
         ! gathers and element results (exact sizes, so no copies on calls).
         real(wp), allocatable :: x(:, :), v(:, :), me(:, :)
+        real(wp), allocatable :: force_work(:)            !! k for force_derivatives
         type(element_work_t), allocatable :: work(:)     !! one per thread
         !> Elements colour by colour: colour c is colour_elements(colour_start(c)
         !> : colour_start(c+1)-1), no two of them sharing a node.
@@ -65,6 +66,9 @@ module flexmbs_fe_flexible_body
         procedure :: momenta => body_momenta
         procedure :: add_nodal_load => body_add_nodal_load
         procedure :: admissible => body_admissible
+        procedure :: force_derivatives => body_force_derivatives
+        procedure :: kinematics_derivative => body_kinematics_derivative
+        procedure :: mass_derivative => body_mass_derivative
     end type flexible_body_t
 
     public :: new_flexible_body
@@ -153,7 +157,7 @@ contains
         if (present(gravity)) body%gravity = gravity
         body%x = mesh%x
         allocate (body%v(3, n), source=0.0_wp)
-        allocate (body%me(mesh%nnode_element, mesh%nnode_element))
+        allocate (body%me(mesh%nnode_element, mesh%nnode_element), body%force_work(nfree))
         nthreads = 1
         !$ nthreads = omp_get_max_threads()
         call allocate_workspace(body, nthreads)
@@ -613,6 +617,43 @@ contains
         end if
         f = self%applied_force - f
     end subroutine body_forces
+
+    !> ∂f/∂q = −∂k/∂q and ∂f/∂v = −∂k/∂v from the analytic tangents (the
+    !> applied force is constant), dense for the formulations.
+    subroutine body_force_derivatives(self, t, q, v, fq, fv, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: fq(:, :), fv(:, :)
+        type(status_t), intent(inout) :: status
+        type(status_t) :: local
+        call assemble(self, q, v, self%force_work, local, .true.)
+        if (.not. local%ok()) then
+            status = local
+            return
+        end if
+        call self%stiffness%to_dense(fq)
+        call self%damping%to_dense(fv)
+        fq = -fq
+        fv = -fv
+    end subroutine body_force_derivatives
+
+    !> T = I: ∂(T w)/∂q = 0.
+    subroutine body_kinematics_derivative(self, t, q, w, dq, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: dq(:, :)
+        type(status_t), intent(inout) :: status
+        dq = 0.0_wp
+    end subroutine body_kinematics_derivative
+
+    !> M constant: ∂(M w)/∂q = 0.
+    subroutine body_mass_derivative(self, t, q, w, dq, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: dq(:, :)
+        type(status_t), intent(inout) :: status
+        dq = 0.0_wp
+    end subroutine body_mass_derivative
 
     !> No constraints (nc = 0): fixed nodes are removed from q.
     subroutine body_constraint(self, t, q, g, status)
