@@ -30,6 +30,7 @@ program flexmbs_tests
     use test_formulation, only: collect_formulation
     use test_rigid_body, only: collect_rigid_body
     use test_mbs_system, only: collect_mbs_system
+    use test_mechanisms, only: collect_mechanisms
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -68,6 +69,7 @@ program flexmbs_tests
     call run_suite('formulation', collect_formulation(), filter, npassed, nfailed)
     call run_suite('rigid_body', collect_rigid_body(), filter, npassed, nfailed)
     call run_suite('mbs_system', collect_mbs_system(), filter, npassed, nfailed)
+    call run_suite('mechanisms', collect_mechanisms(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests

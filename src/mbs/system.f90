@@ -23,9 +23,12 @@
 !> Storage is dense for now (M, G and all their derivatives as full arrays;
 !> no `has_sparse`): the patterns are block-sparse (a joint touches the
 !> columns of at most two bodies) and a CSC assembly is future work.
-!> Drivers (∂c/∂t) are not yet declared by the system: every joint's driver
-!> values are zero, but the time derivatives are wired through (dual time
-!> direction), so that c_t and the time terms of γ appear once drivers do.
+!> Drivers: a joint of one primitive (kind joint_primitive) that is an angle
+!> driver, a translation driver or a distance follows s(t) of its driver_t,
+!> s = Σ c_k t^k (k ≤ 3) + a sin(ω t + φ), with s', s'' exact; c_t and the
+!> time terms of γ come from them (dual time direction). A driven revolute
+!> is the revolute plus an angle driver on the same markers, axes 1 and 1:
+!> the angle from x_i to x_j about z_i.
 !>
 !> Joint reactions (`joint_reaction`), our sign of λ (DESIGN.md: M v' =
 !> f − Gᵀλ): the generalised force of joint k on a body is −C_bᵀλ_k, C_b
@@ -42,7 +45,8 @@ module flexmbs_mbs_system
     use flexmbs_mbs_dual, only: dual_t, operator(+), assignment(=), dot_product
     use flexmbs_mbs_rigid_body, only: rigid_body_t, rigid_bodies_t, new_rigid_bodies, &
         rigid_body_nq, rigid_body_nv, rigid_body_energy, rigid_body_momenta
-    use flexmbs_mbs_joint, only: joint_t, new_joint, joint_part_time_derivative, &
+    use flexmbs_mbs_joint, only: joint_t, new_joint, new_primitive_joint, joint_primitive, &
+        joint_part_time_derivative, &
         joint_part_convective, joint_part_time_terms
     use flexmbs_mbs_constraint_primitives, only: marker_state_t, rigid_marker_state, &
         ground_marker_state, rigid_marker_jacobian, rigid_marker_jacobian_q, joint_value, &
@@ -80,15 +84,30 @@ module flexmbs_mbs_system
         real(wp) :: axes(3, 3) = identity3 !! orthonormal axes as columns, same frame
     end type marker_t
 
-    !> A joint of kind `kind` (joint_spherical ... joint_fixed) between two markers.
+    !> A prescribed function of time, s(t) = Σ_k poly(k) t^k + amplitude
+    !> sin(frequency t + phase): constant, constant rate, polynomial, harmonic.
+    type, public :: driver_t
+        real(wp) :: poly(0:3) = 0.0_wp
+        real(wp) :: amplitude = 0.0_wp
+        real(wp) :: frequency = 0.0_wp !! ω [rad/s]
+        real(wp) :: phase = 0.0_wp     !! φ [rad]
+    end type driver_t
+
+    !> A joint of kind `kind` (joint_spherical ... joint_fixed) between two
+    !> markers, or (kind joint_primitive) one constraint primitive on axes
+    !> axis_i, axis_j of the markers, driven by `driver` where it has s(t).
     type, public :: mbs_joint_t
         integer :: kind = 0
         integer :: marker_i = 0
         integer :: marker_j = 0
+        integer :: primitive = 0 !! joint_primitive: primitive_* kind
+        integer :: axis_i = 1, axis_j = 1
+        type(driver_t) :: driver
     end type mbs_joint_t
 
     type :: assembled_joint_t
         type(joint_t) :: joint
+        type(driver_t) :: driver
         integer :: marker_i = 0, marker_j = 0
         integer :: row0 = 0 !! rows row0+1 .. row0+joint%nrows of c
     end type assembled_joint_t
@@ -124,7 +143,7 @@ module flexmbs_mbs_system
         procedure :: momenta => system_momenta
     end type mbs_system_t
 
-    public :: new_mbs_system
+    public :: new_mbs_system, driver_values
 
 contains
 
@@ -190,7 +209,13 @@ contains
                                     &and the ground)')
                     return
                 end if
-                call new_joint(jt%joint, ji%kind, status)
+                if (ji%kind == joint_primitive) then
+                    call new_primitive_joint(jt%joint, ji%primitive, ji%axis_i, ji%axis_j, &
+                                             status)
+                else
+                    call new_joint(jt%joint, ji%kind, status)
+                end if
+                jt%driver = ji%driver
                 if (.not. status%ok()) then
                     call status%set(status_bad_input, where // ': ' // status%text())
                     return
@@ -442,14 +467,29 @@ contains
         call rigid_marker_jacobian_d(p, sb, ub, jx, ja)
     end subroutine marker_jacobian_dual
 
-    !> Driver values (s, s', s'') of joint k at t: none declared yet (module header).
+    !> Driver values (s, s', s'') of joint k at t (zero for joints without s).
     pure function joint_driver(self, k, t) result(drv)
         class(mbs_system_t), intent(in) :: self
         integer, intent(in) :: k
         real(wp), intent(in) :: t
         real(wp) :: drv(3)
-        drv = 0.0_wp
+        drv = driver_values(self%joints(k)%driver, t)
     end function joint_driver
+
+    !> (s, s', s'') of a driver at t.
+    pure function driver_values(driver, t) result(drv)
+        type(driver_t), intent(in) :: driver
+        real(wp), intent(in) :: t
+        real(wp) :: drv(3), arg
+        associate (c => driver%poly)
+            drv(1) = c(0) + t * (c(1) + t * (c(2) + t * c(3)))
+            drv(2) = c(1) + t * (2.0_wp * c(2) + 3.0_wp * t * c(3))
+            drv(3) = 2.0_wp * c(2) + 6.0_wp * t * c(3)
+        end associate
+        arg = driver%frequency * t + driver%phase
+        drv = drv + driver%amplitude * [sin(arg), driver%frequency * cos(arg), &
+                                        -driver%frequency**2 * sin(arg)]
+    end function driver_values
 
     !> Dual driver values, with the time tangent in direction td (none if td = 0).
     pure function driver_dual(drv, td) result(d)
