@@ -5,6 +5,7 @@
 !>   flexmbs-bench INTEGRATOR PROBLEM N SOLVER [MAX_STEPS] [RTOL] [REFERENCE]
 !>   flexmbs-bench reference PROBLEM N FILE [RTOL]
 !>   flexmbs-bench assembly hex8|hex27 NDOF
+!>   flexmbs-bench ad fourbar|slidercrank
 !>
 !> INTEGRATOR: radau5 | ddassl | ddassl-p2 (maximal BDF order 2) | ida |
 !> mexax (midpoint base) | mexax-euler (half-explicit Euler base).
@@ -24,6 +25,10 @@
 !> assembly (and of the force alone), per element, the nonzeros of the
 !> tangent pattern, the growth of the peak resident memory (VmHWM) over
 !> building the body and assembling once, per dof, and the thread count.
+!> The ad mode compares constraint_derivatives = 'analytic' and 'ad' on a
+!> driven closed-loop mechanism (flexmbs_problems_mechanisms): the time of
+!> one set of constraint derivatives (G, c_q, c_t, γ) and of a whole RADAU5
+!> run (GGL, rtol = atol = 1e-7, one crank revolution), and their ratios.
 !> bench/run.sh runs the grid of configurations; these are figures, not tests.
 program flexmbs_bench
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
@@ -54,6 +59,10 @@ program flexmbs_bench
     use flexmbs_fe_mesh, only: mesh_t
     use flexmbs_fe_box_mesh, only: box_mesh
     use flexmbs_fe_flexible_body, only: flexible_body_t, new_flexible_body
+    use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_ggl
+    use flexmbs_problems_mechanisms, only: new_mechanism, mechanism_slider_crank, &
+        mechanism_four_bar
     !$ use omp_lib, only: omp_get_max_threads
     implicit none
 
@@ -83,6 +92,13 @@ program flexmbs_bench
         call get_command_argument(1, integrator_name)
         if (integrator_name == 'assembly') then
             call run_assembly()
+            stop
+        end if
+    end if
+    if (command_argument_count() == 2) then
+        call get_command_argument(1, integrator_name)
+        if (integrator_name == 'ad') then
+            call run_ad()
             stop
         end if
     end if
@@ -381,6 +397,62 @@ contains
             (mem1 - mem0) * 1048576.0_wp / body%nv, threads
 
     end subroutine run_assembly
+
+    !> `ad MECHANISM`: derivative and whole-run cost, 'analytic' against 'ad'.
+    subroutine run_ad()
+        character(len=8), parameter :: modes(2) = ['analytic', 'ad      ']
+        type(mbs_system_t), target :: sys
+        type(formulation_t) :: dae
+        type(radau5_t) :: radau5
+        real(wp) :: q0(21), v0(18), t_deriv(2), t_run(2), tt
+        real(wp), allocatable :: c(:), g(:, :), cq(:, :), ct(:), gam(:), y(:), yp(:), y0(:)
+        integer :: mech, m, i, calls, runs
+        integer(8) :: c0, c1, rate
+        call get_command_argument(2, problem_name)
+        mech = merge(mechanism_four_bar, mechanism_slider_crank, problem_name == 'fourbar')
+        do m = 1, 2
+            call new_mechanism(mech, sys, q0, status, trim(modes(m)))
+            if (.not. status%ok()) then
+                write (*, '(a)') 'ad: ' // status%text()
+                error stop 1
+            end if
+            allocate (c(sys%nc), g(sys%nc, sys%nv), cq(sys%nc, sys%nq), ct(sys%nc), gam(sys%nc))
+            v0 = 0.1_wp
+            calls = 20000
+            call system_clock(c0, rate)
+            do i = 1, calls
+                call sys%constraint_jacobian(0.1_wp, q0, g, status)
+                call sys%constraint_position_jacobian(0.1_wp, q0, cq, status)
+                call sys%constraint_time_derivative(0.1_wp, q0, ct, status)
+                call sys%constraint_curvature(0.1_wp, q0, v0, gam, status)
+            end do
+            call system_clock(c1)
+            t_deriv(m) = real(c1 - c0, wp) / real(rate, wp) / calls
+            dae = new_formulation(sys, formulation_ggl, q0, status=status)
+            allocate (y0(dae%n), yp(dae%n), source=0.0_wp)
+            y0(1:21) = q0
+            call dae%consistent_initial(0.0_wp, y0, yp, status)
+            options%rtol = 1.0e-7_wp
+            options%atol = 1.0e-7_wp
+            runs = 5
+            call system_clock(c0)
+            do i = 1, runs
+                y = y0
+                tt = 0.0_wp
+                call radau5%integrate(dae, tt, y, 1.0_wp, options, stats, status)
+            end do
+            call system_clock(c1)
+            t_run(m) = real(c1 - c0, wp) / real(rate, wp) / runs
+            write (*, '(a,1x,a,1x,a,1x,a,es10.3,a,es10.3,a,3(1x,i0),1x,a)') 'ad', &
+                trim(problem_name), trim(modes(m)), 'derivatives[s]', t_deriv(m), &
+                ' run[s]', t_run(m), ' NST NFE NJE', stats%nst, stats%nfe, stats%nje, &
+                trim(merge('ok    ', 'failed', status%ok()))
+            deallocate (c, g, cq, ct, gam, y0, yp)
+        end do
+        write (*, '(a,1x,a,a,f6.2,a,f6.2)') 'ad', trim(problem_name), &
+            ' ratio ad/analytic: derivatives', t_deriv(2) / t_deriv(1), ', whole run', &
+            t_run(2) / t_run(1)
+    end subroutine run_ad
 
     !> Wall seconds per assembly of `body` (with tangents or the force alone).
     real(wp) function seconds_per_call(body, q, v, k, tangents, n)

@@ -68,6 +68,13 @@ for integ in mexax mexax-euler; do
     run $integ chain 1000 klu 300    # ~25 ms a step: capped at 300 steps
 done
 
+# The paper's AD comparison: constraint derivatives and whole runs, hand-coded
+# against dual-number AD, on the driven four-bar and slider-crank.
+echo
+for mech in fourbar slidercrank; do
+    "$BIN" ad $mech 2>>"$ERRORS" | tee -a "$RESULTS"
+done
+
 # Finite-element assembly: clamped cubes of 1e3..1e5 free dofs, both elements.
 echo
 echo "assembly element ndof elements nnz repeats t_tangent[s] us/element t_force[s] us/element bytes/dof threads"

@@ -1,13 +1,6 @@
-!> Driven mechanisms against closed-form kinematics, and the driver rows
-!> (angle, translation and distance drivers with s(t)) AD against hand-coded.
-!>
-!> Both mechanisms are planar (in the xy plane) but built in 3-D with a
-!> non-redundant constraint set of 17 rows on 3 bodies (18 velocities), the
-!> 18th row being the crank's angle driver: revolute (5) crank–ground,
-!> spherical (3) crank–coupler, universal (4) coupler–slider or –rocker
-!> (pins: the global z of the slider/rocker, and the coupler's in-plane
-!> normal), and a prismatic (5) or revolute (5) to the ground. All-revolute
-!> planar chains in 3-D would be redundant (20 rows for 18 velocities).
+!> Driven mechanisms (flexmbs_problems_mechanisms) against closed-form
+!> kinematics, and the driver rows (angle, translation and distance drivers
+!> with s(t)) AD against hand-coded.
 module test_mechanisms
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t
@@ -15,37 +8,23 @@ module test_mechanisms
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_sink, only: sink_t
     use flexmbs_dae_radau5, only: radau5_t
-    use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle
+    use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_mbs_rigid_body, only: rigid_body_t
-    use flexmbs_mbs_joint, only: joint_spherical, joint_revolute, joint_prismatic, &
-        joint_universal, joint_primitive
+    use flexmbs_mbs_joint, only: joint_primitive
     use flexmbs_mbs_primitive_kinds, only: primitive_angle_driver, &
         primitive_translation_driver, primitive_distance
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
         driver_t, driver_values
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_ggl
+    use flexmbs_problems_mechanisms, only: new_mechanism, slider_crank_exact, four_bar_exact, &
+        crank_angle, bar_b, bar_d
     use mbs_random, only: random_state_t, random_vector, random_quaternion
     use testing, only: test_case_t, new_test, error_t, check
     implicit none
     private
     public :: collect_mechanisms
 
-    real(wp), parameter :: pi = 3.14159265358979324_wp
-    real(wp), parameter :: omega = 2.0_wp * pi  !! crank rate: one revolution per second
-    real(wp), parameter :: theta0 = 0.3_wp      !! crank angle at t = 0
     real(wp), parameter :: rtol = 1.0e-7_wp
-    real(wp), parameter :: ez(3) = [0.0_wp, 0.0_wp, 1.0_wp]
-    !> Marker axes: identity; the coupler's universal pin (z = local y);
-    !> the prismatic guide (z = global x).
-    real(wp), parameter :: axes_id(3, 3) = reshape([1, 0, 0, 0, 1, 0, 0, 0, 1] * 1.0_wp, [3, 3])
-    real(wp), parameter :: axes_pin(3, 3) = reshape([0, 0, 1, 1, 0, 0, 0, 1, 0] * 1.0_wp, [3, 3])
-    real(wp), parameter :: axes_guide(3, 3) = reshape([0, 1, 0, 0, 0, 1, 1, 0, 0] * 1.0_wp, &
-                                                     [3, 3])
-    ! slider-crank: crank r, rod l
-    real(wp), parameter :: crank_r = 0.1_wp, rod_l = 0.3_wp
-    ! four-bar (Grashof crank-rocker: 0.1 + 0.4 < 0.3 + 0.35): crank a,
-    ! coupler b, rocker c, ground d
-    real(wp), parameter :: bar_a = 0.1_wp, bar_b = 0.4_wp, bar_c = 0.3_wp, bar_d = 0.35_wp
 
     !> Records the largest deviation from the closed form at output times.
     type, extends(sink_t) :: closed_form_sink_t
@@ -63,7 +42,8 @@ contains
         tests = [new_test('driver_values_exact', test_driver_values), &
                  new_test('driver_rows_ad_vs_analytic', test_driver_rows), &
                  new_test('slider_crank_closed_form', test_slider_crank), &
-                 new_test('four_bar_closed_form', test_four_bar)]
+                 new_test('four_bar_closed_form', test_four_bar), &
+                 new_test('four_bar_closed_form_ad', test_four_bar_ad)]
     end function collect_mechanisms
 
     !> s' and s'' of a polynomial + harmonic driver against central differences.
@@ -152,102 +132,14 @@ contains
         call check(error, all(abs(th) > 0.0_wp), 'driver rows: c_t vanishes')
     end subroutine test_driver_rows
 
-    !> Closed form, slider-crank: crank pin B, slider C = (s, 0), rod angle.
-    pure subroutine slider_crank_exact(theta, b, c, phi)
-        real(wp), intent(in) :: theta
-        real(wp), intent(out) :: b(3), c(3), phi
-        b = crank_r * [cos(theta), sin(theta), 0.0_wp]
-        c = [crank_r * cos(theta) + sqrt(rod_l**2 - (crank_r * sin(theta))**2), 0.0_wp, 0.0_wp]
-        phi = atan2(c(2) - b(2), c(1) - b(1))
-    end subroutine slider_crank_exact
-
-    !> Closed form, four-bar: B on the crank, C the intersection of the
-    !> circles |C − B| = b and |C − D| = c in the upper assembly mode.
-    pure subroutine four_bar_exact(theta, b, c)
-        real(wp), intent(in) :: theta
-        real(wp), intent(out) :: b(3), c(3)
-        real(wp) :: d(3), u(3), e, alpha
-        b = bar_a * [cos(theta), sin(theta), 0.0_wp]
-        d = [bar_d, 0.0_wp, 0.0_wp]
-        e = norm2(b - d)
-        u = (b - d) / e
-        alpha = acos((e**2 + bar_c**2 - bar_b**2) / (2.0_wp * e * bar_c))
-        ! rotate u by −α about z: the branch above the ground line here
-        c = d + bar_c * [cos(alpha) * u(1) + sin(alpha) * u(2), &
-                         -sin(alpha) * u(1) + cos(alpha) * u(2), 0.0_wp]
-    end subroutine four_bar_exact
-
-    !> A planar body state: centre, rotation about z.
-    subroutine set_body(q, k, centre, angle)
-        real(wp), intent(inout) :: q(:)
-        integer, intent(in) :: k
-        real(wp), intent(in) :: centre(3), angle
-        q(7 * k - 6:7 * k - 4) = centre
-        q(7 * k - 3:7 * k) = quat_from_axis_angle(ez, angle)
-    end subroutine set_body
-
-    !> The mechanism (1 slider-crank, 2 four-bar) and its state at t = 0.
-    subroutine build(mechanism, sys, q0, status)
-        integer, intent(in) :: mechanism
-        type(mbs_system_t), intent(out) :: sys
-        real(wp), intent(out) :: q0(21)
-        type(status_t), intent(out) :: status
-        type(marker_t) :: m(8)
-        type(mbs_joint_t) :: j(5)
-        type(driver_t) :: drive
-        type(rigid_body_t) :: bodies(3)
-        real(wp) :: b(3), c(3), phi, l1, l2, l3
-        integer :: k
-        drive%poly(0:1) = [theta0, omega]
-        do k = 1, 3
-            bodies(k)%mass = 1.0_wp / k
-            bodies(k)%inertia = 0.01_wp * axes_id
-        end do
-        if (mechanism == 1) then
-            l1 = crank_r
-            l2 = rod_l
-            call slider_crank_exact(theta0, b, c, phi)
-            call set_body(q0, 1, 0.5_wp * b, theta0)
-            call set_body(q0, 2, 0.5_wp * (b + c), phi)
-            call set_body(q0, 3, c, 0.0_wp)
-            m(6) = marker_t(3, [0.0_wp, 0.0_wp, 0.0_wp], axes_id)
-            m(7) = marker_t(0, [0.0_wp, 0.0_wp, 0.0_wp], axes_guide)
-            m(8) = marker_t(3, [0.0_wp, 0.0_wp, 0.0_wp], axes_guide)
-            j(5) = mbs_joint_t(joint_prismatic, 7, 8)
-        else
-            l1 = bar_a
-            l2 = bar_b
-            l3 = bar_c
-            call four_bar_exact(theta0, b, c)
-            call set_body(q0, 1, 0.5_wp * b, theta0)
-            call set_body(q0, 2, 0.5_wp * (b + c), atan2(c(2) - b(2), c(1) - b(1)))
-            call set_body(q0, 3, 0.5_wp * (c + [bar_d, 0.0_wp, 0.0_wp]), &
-                          atan2(c(2), c(1) - bar_d))
-            ! rocker local x from D to C
-            m(6) = marker_t(3, [0.5_wp * l3, 0.0_wp, 0.0_wp], axes_id)
-            m(7) = marker_t(3, [-0.5_wp * l3, 0.0_wp, 0.0_wp], axes_id)
-            m(8) = marker_t(0, [bar_d, 0.0_wp, 0.0_wp], axes_id)
-            j(5) = mbs_joint_t(joint_revolute, 8, 7)
-        end if
-        m(1) = marker_t(0, [0.0_wp, 0.0_wp, 0.0_wp], axes_id)
-        m(2) = marker_t(1, [-0.5_wp * l1, 0.0_wp, 0.0_wp], axes_id)
-        m(3) = marker_t(1, [0.5_wp * l1, 0.0_wp, 0.0_wp], axes_id)
-        m(4) = marker_t(2, [-0.5_wp * l2, 0.0_wp, 0.0_wp], axes_id)
-        m(5) = marker_t(2, [0.5_wp * l2, 0.0_wp, 0.0_wp], axes_pin)
-        j(1) = mbs_joint_t(joint_revolute, 1, 2)
-        j(2) = mbs_joint_t(joint_primitive, 1, 2, primitive_angle_driver, 1, 1, drive)
-        j(3) = mbs_joint_t(joint_spherical, 3, 4)
-        j(4) = mbs_joint_t(joint_universal, 5, 6)
-        sys = new_mbs_system(bodies, m, j, gravity=[0.0_wp, -9.81_wp, 0.0_wp], status=status)
-    end subroutine build
-
     !> Integrate one crank revolution with RADAU5 on the GGL form from the
     !> closed-form positions (velocities by the consistent-initial
     !> projection), comparing every output with the closed form.
-    subroutine run_mechanism(error, mechanism, name)
+    subroutine run_mechanism(error, mechanism, name, derivatives)
         type(error_t), allocatable, intent(inout) :: error
         integer, intent(in) :: mechanism
         character(len=*), intent(in) :: name
+        character(len=*), intent(in), optional :: derivatives
         type(mbs_system_t), target :: sys
         type(formulation_t) :: dae
         type(radau5_t) :: solver
@@ -258,7 +150,7 @@ contains
         real(wp) :: q0(21), t
         real(wp), allocatable :: y(:), yp(:)
         integer :: i
-        call build(mechanism, sys, q0, status)
+        call new_mechanism(mechanism, sys, q0, status, derivatives)
         call check(error, status%ok() .and. sys%nc == 18, name // ': build: ' // status%text())
         if (allocated(error)) return
         dae = new_formulation(sys, formulation_ggl, q0, status=status)
@@ -289,7 +181,7 @@ contains
         real(wp), intent(in) :: t, y(:)
         type(status_t), intent(inout) :: status
         real(wp) :: theta, b(3), c(3), phi, r2(3, 3), r3(3, 3), dev
-        theta = theta0 + omega * t
+        theta = crank_angle(t)
         r2 = rotation_matrix(y(11:14))
         r3 = rotation_matrix(y(18:21))
         if (self%mechanism == 1) then
@@ -319,4 +211,10 @@ contains
         type(error_t), allocatable, intent(out) :: error
         call run_mechanism(error, 2, 'four-bar')
     end subroutine test_four_bar
+
+    !> The same with constraint_derivatives = 'ad'.
+    subroutine test_four_bar_ad(error)
+        type(error_t), allocatable, intent(out) :: error
+        call run_mechanism(error, 2, 'four-bar (ad)', 'ad')
+    end subroutine test_four_bar_ad
 end module test_mechanisms
