@@ -35,7 +35,11 @@ module flexmbs
     use flexmbs_mbs_rigid_body, only: rigid_bodies_t, rigid_body_t, new_rigid_bodies, &
         rigid_body_energy, rigid_body_momenta
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
-        constraint_derivatives_analytic, constraint_derivatives_ad
+        constraint_derivatives_analytic, constraint_derivatives_ad, driver_t, driver_values
+    use flexmbs_mbs_rigid_chain, only: rigid_chain_t, new_rigid_chain, chain_body_t, &
+        chain_marker_t, chain_joint_revolute, chain_joint_prismatic
+    use flexmbs_problems_mechanisms, only: new_mechanism, mechanism_slider_crank, &
+        mechanism_four_bar
     use flexmbs_mbs_joint, only: joint_spherical, joint_revolute, joint_cylindrical, &
         joint_prismatic, joint_universal, joint_fixed
     use flexmbs_dae_mexax, only: mexax_t

@@ -31,6 +31,7 @@ program flexmbs_tests
     use test_rigid_body, only: collect_rigid_body
     use test_mbs_system, only: collect_mbs_system
     use test_mechanisms, only: collect_mechanisms
+    use test_rigid_chain, only: collect_rigid_chain
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -70,6 +71,7 @@ program flexmbs_tests
     call run_suite('rigid_body', collect_rigid_body(), filter, npassed, nfailed)
     call run_suite('mbs_system', collect_mbs_system(), filter, npassed, nfailed)
     call run_suite('mechanisms', collect_mechanisms(), filter, npassed, nfailed)
+    call run_suite('rigid_chain', collect_rigid_chain(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests

@@ -1,0 +1,380 @@
+!> Rigid chains: loop-free substructures in relative coordinates (DESIGN.md,
+!> the paper's rigid substructures). Body i hangs from its parent (0 = the
+!> ground) by a revolute or prismatic joint with coordinate q_i and rate
+!> v_i (q' = v, T = I), so M(q) v' = f(t, q, v) with f = −b(q, v) and no
+!> constraints (nc = 0).
+!>
+!> Geometry, for body i with parent p (frames: origin o, rotation R, world):
+!>   joint origin   o_i = o_p + R_p x_i (+ R_p R0_i a_i q_i, prismatic)
+!>   orientation    R_i = R_p R0_i Rot(a_i, q_i) (revolute), R_p R0_i (prismatic)
+!>   centre of mass c_i = o_i + R_i s_i
+!> with x_i the joint's position and R0_i its rotation in the parent's frame,
+!> a_i the unit joint axis (joint frame = child frame at q = 0), s_i the
+!> child's centre of mass in its frame, m_i, J_i (about the centre of mass,
+!> child frame).
+!>
+!> Dynamics in world-frame spatial vectors about the world origin
+!> (Featherstone, Rigid Body Dynamics Algorithms, 2008, chs. 2, 5, 6):
+!> motion [ω; v_O], force [n_O; f]. Joint i's motion subspace is
+!> S_i = [u; o_i × u] (revolute about the world axis u = R_p R0_i a_i
+!> through o_i) or [0; u] (prismatic); body i's spatial inertia about O is
+!>   I_i = [Ī + m [c]×[c]×ᵀ, m [c]×; m [c]×ᵀ, m 1],  Ī = R J Rᵀ.
+!> Composite-rigid-body algorithm: I^c_i = I_i + Σ_children I^c_c, then
+!> M_ii = S_iᵀ I^c_i S_i and M_ij = M_ji = S_jᵀ I^c_i S_i for the ancestors
+!> j of i (no transforms: every vector is about O). Recursive Newton–Euler:
+!> v_i = v_p + S_i q̇_i, a_i = a_p + S_i q̈_i + v_i ×m S_i q̇_i (a_0 = −[0; g]),
+!> f_i = I_i a_i + v_i ×* I_i v_i, τ_i = S_iᵀ (f_i + Σ_children f_c);
+!> b(q, v) = τ(q, v, q̈ = 0) holds the Coriolis, centrifugal and gravity terms.
+!>
+!> Markers on chain bodies: their pose and their Jacobians ∂(ẋ, ω)/∂v.
+module flexmbs_mbs_rigid_chain
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_text, only: int_text
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle, cross, skew
+    implicit none
+    private
+
+    integer, parameter, public :: chain_joint_revolute = 1
+    integer, parameter, public :: chain_joint_prismatic = 2
+
+    real(wp), parameter :: identity3(3, 3) = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
+        1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
+
+    !> One body of a chain and the joint to its parent.
+    type, public :: chain_body_t
+        integer :: parent = 0                     !! 0: the ground; else an earlier body
+        integer :: joint = chain_joint_revolute
+        real(wp) :: joint_position(3) = 0.0_wp    !! x_i, in the parent's frame
+        real(wp) :: joint_rotation(3, 3) = identity3 !! R0_i, in the parent's frame
+        real(wp) :: axis(3) = [0.0_wp, 0.0_wp, 1.0_wp] !! a_i, unit, joint frame
+        real(wp) :: centre(3) = 0.0_wp            !! s_i, centre of mass, own frame
+        real(wp) :: mass = 1.0_wp
+        real(wp) :: inertia(3, 3) = identity3     !! J_i about the centre of mass, own frame
+    end type chain_body_t
+
+    !> A marker on a chain body (body 0: the ground).
+    type, public :: chain_marker_t
+        integer :: body = 0
+        real(wp) :: position(3) = 0.0_wp          !! in the body's frame
+        real(wp) :: axes(3, 3) = identity3        !! columns, in the body's frame
+    end type chain_marker_t
+
+    type, extends(mechanical_problem_t), public :: rigid_chain_t
+        type(chain_body_t), allocatable :: bodies(:)
+        type(chain_marker_t), allocatable :: markers(:)
+        real(wp) :: gravity(3) = 0.0_wp
+        ! workspace, one column per body: frames, motion subspaces, velocities,
+        ! accelerations, spatial inertias and forces
+        real(wp), allocatable :: o(:, :), r(:, :, :), s(:, :), vel(:, :), acc(:, :), &
+            inert(:, :, :), comp(:, :, :), frc(:, :)
+    contains
+        procedure :: kinematics => chain_kinematics
+        procedure :: mass => chain_mass
+        procedure :: forces => chain_forces
+        procedure :: constraint => chain_constraint
+        procedure :: constraint_jacobian => chain_constraint_jacobian
+        procedure :: kinematics_derivative => chain_kinematics_derivative
+        procedure :: inverse_dynamics => chain_inverse_dynamics
+        procedure :: body_frame => chain_body_frame
+        procedure :: marker_pose => chain_marker_pose
+        procedure :: marker_jacobian => chain_marker_jacobian
+        procedure :: energy => chain_energy
+        procedure :: body_velocity => chain_body_velocity
+    end type rigid_chain_t
+
+    public :: new_rigid_chain
+
+contains
+
+    !> A chain of `bodies` (each body's parent listed before it) with
+    !> `markers`, under `gravity`.
+    function new_rigid_chain(bodies, status, markers, gravity) result(self)
+        type(chain_body_t), intent(in) :: bodies(:)
+        type(status_t), intent(out) :: status
+        type(chain_marker_t), intent(in), optional :: markers(:)
+        real(wp), intent(in), optional :: gravity(3)
+        type(rigid_chain_t) :: self
+        integer :: i, n
+        character(len=:), allocatable :: where
+        n = size(bodies)
+        do i = 1, n
+            where = 'rigid chain: body ' // int_text(i)
+            if (bodies(i)%parent < 0 .or. bodies(i)%parent >= i) then
+                call status%set(status_bad_input, where // ': parent ' // &
+                    int_text(bodies(i)%parent) // ' must be 0 (ground) or an earlier body')
+                return
+            end if
+            if (bodies(i)%joint /= chain_joint_revolute .and. &
+                bodies(i)%joint /= chain_joint_prismatic) then
+                call status%set(status_bad_input, where // ': joint must be revolute or ' // &
+                                'prismatic')
+                return
+            end if
+            if (abs(norm2(bodies(i)%axis) - 1.0_wp) > 1.0e-12_wp) then
+                call status%set(status_bad_input, where // ': joint axis is not a unit vector')
+                return
+            end if
+            if (.not. bodies(i)%mass > 0.0_wp) then
+                call status%set(status_bad_input, where // ': mass must be positive')
+                return
+            end if
+        end do
+        self%bodies = bodies
+        if (present(markers)) then
+            if (any(markers%body < 0 .or. markers%body > n)) then
+                call status%set(status_bad_input, 'rigid chain: a marker names a body ' // &
+                                'outside 0..' // int_text(n))
+                return
+            end if
+            self%markers = markers
+        else
+            allocate (self%markers(0))
+        end if
+        if (present(gravity)) self%gravity = gravity
+        self%nq = n
+        self%nv = n
+        self%nc = 0
+        allocate (self%o(3, 0:n), self%r(3, 3, 0:n), self%s(6, n), self%vel(6, 0:n), &
+                  self%acc(6, 0:n), self%inert(6, 6, n), self%comp(6, 6, n), self%frc(6, n))
+    end function new_rigid_chain
+
+    !> Forward kinematics: frames o, R, motion subspaces S and spatial
+    !> inertias about the world origin, for all bodies at q.
+    pure subroutine frames(self, q)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:)
+        integer :: i, p
+        real(wp) :: u(3), c(3), rj(3, 3), ibar(3, 3), cx(3, 3)
+        self%o(:, 0) = 0.0_wp
+        self%r(:, :, 0) = identity3
+        do i = 1, size(self%bodies)
+            associate (b => self%bodies(i))
+                p = b%parent
+                rj = matmul(self%r(:, :, p), b%joint_rotation)
+                u = matmul(rj, b%axis)
+                self%o(:, i) = self%o(:, p) + matmul(self%r(:, :, p), b%joint_position)
+                if (b%joint == chain_joint_revolute) then
+                    self%r(:, :, i) = matmul(rj, rotation_matrix(quat_from_axis_angle(b%axis, &
+                                                                                      q(i))))
+                    self%s(1:3, i) = u
+                    self%s(4:6, i) = cross(self%o(:, i), u)
+                else
+                    self%o(:, i) = self%o(:, i) + u * q(i)
+                    self%r(:, :, i) = rj
+                    self%s(1:3, i) = 0.0_wp
+                    self%s(4:6, i) = u
+                end if
+                c = self%o(:, i) + matmul(self%r(:, :, i), b%centre)
+                ibar = matmul(self%r(:, :, i), matmul(b%inertia, transpose(self%r(:, :, i))))
+                cx = skew(c)
+                self%inert(1:3, 1:3, i) = ibar + b%mass * matmul(cx, transpose(cx))
+                self%inert(1:3, 4:6, i) = b%mass * cx
+                self%inert(4:6, 1:3, i) = b%mass * transpose(cx)
+                self%inert(4:6, 4:6, i) = b%mass * identity3
+            end associate
+        end do
+    end subroutine frames
+
+    !> Spatial motion cross product v ×m u.
+    pure function cross_motion(v, u) result(w)
+        real(wp), intent(in) :: v(6), u(6)
+        real(wp) :: w(6)
+        w(1:3) = cross(v(1:3), u(1:3))
+        w(4:6) = cross(v(1:3), u(4:6)) + cross(v(4:6), u(1:3))
+    end function cross_motion
+
+    !> Spatial force cross product v ×* f.
+    pure function cross_force(v, f) result(w)
+        real(wp), intent(in) :: v(6), f(6)
+        real(wp) :: w(6)
+        w(1:3) = cross(v(1:3), f(1:3)) + cross(v(4:6), f(4:6))
+        w(4:6) = cross(v(1:3), f(4:6))
+    end function cross_force
+
+    !> Recursive Newton–Euler: tau = M(q) qdd + b(q, qd), gravity included
+    !> when `with_gravity` (default true).
+    subroutine chain_inverse_dynamics(self, q, qd, qdd, tau, with_gravity)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), qd(:), qdd(:)
+        real(wp), intent(out) :: tau(:)
+        logical, intent(in), optional :: with_gravity
+        integer :: i, p
+        call frames(self, q)
+        self%vel(:, 0) = 0.0_wp
+        self%acc(:, 0) = 0.0_wp
+        self%acc(4:6, 0) = -self%gravity
+        if (present(with_gravity)) then
+            if (.not. with_gravity) self%acc(4:6, 0) = 0.0_wp
+        end if
+        do i = 1, size(self%bodies)
+            p = self%bodies(i)%parent
+            self%vel(:, i) = self%vel(:, p) + self%s(:, i) * qd(i)
+            self%acc(:, i) = self%acc(:, p) + self%s(:, i) * qdd(i) &
+                             + cross_motion(self%vel(:, i), self%s(:, i)) * qd(i)
+            self%frc(:, i) = matmul(self%inert(:, :, i), self%acc(:, i)) &
+                             + cross_force(self%vel(:, i), matmul(self%inert(:, :, i), &
+                                                                  self%vel(:, i)))
+        end do
+        do i = size(self%bodies), 1, -1
+            tau(i) = dot_product(self%s(:, i), self%frc(:, i))
+            p = self%bodies(i)%parent
+            if (p > 0) self%frc(:, p) = self%frc(:, p) + self%frc(:, i)
+        end do
+    end subroutine chain_inverse_dynamics
+
+    !> M(q) by the composite-rigid-body algorithm.
+    subroutine chain_mass(self, t, q, m, status)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: m(:, :)
+        type(status_t), intent(inout) :: status
+        real(wp) :: f(6)
+        integer :: i, j, p
+        call frames(self, q)
+        self%comp = self%inert
+        do i = size(self%bodies), 1, -1
+            p = self%bodies(i)%parent
+            if (p > 0) self%comp(:, :, p) = self%comp(:, :, p) + self%comp(:, :, i)
+        end do
+        m = 0.0_wp
+        do i = 1, size(self%bodies)
+            f = matmul(self%comp(:, :, i), self%s(:, i))
+            m(i, i) = dot_product(self%s(:, i), f)
+            j = self%bodies(i)%parent
+            do while (j > 0)
+                m(i, j) = dot_product(self%s(:, j), f)
+                m(j, i) = m(i, j)
+                j = self%bodies(j)%parent
+            end do
+        end do
+    end subroutine chain_mass
+
+    !> f = −b(q, v): Coriolis, centrifugal and gravity terms (RNEA at q̈ = 0).
+    subroutine chain_forces(self, t, q, v, f, status)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: f(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: zero(size(q))
+        zero = 0.0_wp
+        call chain_inverse_dynamics(self, q, v, zero, f)
+        f = -f
+    end subroutine chain_forces
+
+    !> q' = v.
+    subroutine chain_kinematics(self, t, q, w, qdot, status)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: qdot(:)
+        type(status_t), intent(inout) :: status
+        qdot = w
+    end subroutine chain_kinematics
+
+    !> T = I: ∂(T w)/∂q = 0.
+    subroutine chain_kinematics_derivative(self, t, q, w, dq, status)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: dq(:, :)
+        type(status_t), intent(inout) :: status
+        dq = 0.0_wp
+    end subroutine chain_kinematics_derivative
+
+    !> No constraints on their own (a chain is loop-free).
+    subroutine chain_constraint(self, t, q, g, status)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: g(:)
+        type(status_t), intent(inout) :: status
+    end subroutine chain_constraint
+
+    subroutine chain_constraint_jacobian(self, t, q, gmat, status)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: gmat(:, :)
+        type(status_t), intent(inout) :: status
+    end subroutine chain_constraint_jacobian
+
+    !> Origin o and rotation R of body i's frame at q (body 0: the ground).
+    subroutine chain_body_frame(self, q, i, o, r)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:)
+        integer, intent(in) :: i
+        real(wp), intent(out) :: o(3), r(3, 3)
+        call frames(self, q)
+        o = self%o(:, i)
+        r = self%r(:, :, i)
+    end subroutine chain_body_frame
+
+    !> World position x and axes (columns) of marker k at q.
+    subroutine chain_marker_pose(self, q, k, x, axes)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:)
+        integer, intent(in) :: k
+        real(wp), intent(out) :: x(3), axes(3, 3)
+        integer :: b
+        call frames(self, q)
+        b = self%markers(k)%body
+        x = self%o(:, b) + matmul(self%r(:, :, b), self%markers(k)%position)
+        axes = matmul(self%r(:, :, b), self%markers(k)%axes)
+    end subroutine chain_marker_pose
+
+    !> Marker k's velocity ẋ = jx v and angular velocity ω = jr v (world):
+    !> the columns S_j of the body's ancestors, taken at the marker point.
+    subroutine chain_marker_jacobian(self, q, k, jx, jr)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:)
+        integer, intent(in) :: k
+        real(wp), intent(out) :: jx(:, :), jr(:, :)
+        real(wp) :: x(3), axes(3, 3)
+        integer :: j
+        call chain_marker_pose(self, q, k, x, axes)
+        jx = 0.0_wp
+        jr = 0.0_wp
+        j = self%markers(k)%body
+        do while (j > 0)
+            ! spatial [ω; v_O] → point velocity v_O + ω × x
+            jr(:, j) = self%s(1:3, j)
+            jx(:, j) = self%s(4:6, j) + cross(self%s(1:3, j), x)
+            j = self%bodies(j)%parent
+        end do
+    end subroutine chain_marker_jacobian
+
+    !> Body i's centre-of-mass velocity and angular velocity (world).
+    subroutine chain_body_velocity(self, q, v, i, vc, omega)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        integer, intent(in) :: i
+        real(wp), intent(out) :: vc(3), omega(3)
+        real(wp) :: twist(6), c(3)
+        integer :: j
+        call frames(self, q)
+        twist = 0.0_wp
+        j = i
+        do while (j > 0)
+            twist = twist + self%s(:, j) * v(j)
+            j = self%bodies(j)%parent
+        end do
+        c = self%o(:, i) + matmul(self%r(:, :, i), self%bodies(i)%centre)
+        omega = twist(1:3)
+        vc = twist(4:6) + cross(twist(1:3), c)
+    end subroutine chain_body_velocity
+
+    !> Kinetic energy ½ vᵀ M v and potential −Σ m_i g·c_i.
+    subroutine chain_energy(self, q, v, kinetic, potential)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(out) :: kinetic, potential
+        real(wp) :: m(size(q), size(q))
+        type(status_t) :: st
+        integer :: i
+        call chain_mass(self, 0.0_wp, q, m, st)
+        kinetic = 0.5_wp * dot_product(v, matmul(m, v))
+        potential = 0.0_wp
+        do i = 1, size(self%bodies)
+            potential = potential - self%bodies(i)%mass * dot_product(self%gravity, &
+                self%o(:, i) + matmul(self%r(:, :, i), self%bodies(i)%centre))
+        end do
+    end subroutine chain_energy
+end module flexmbs_mbs_rigid_chain
