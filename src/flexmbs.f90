@@ -40,6 +40,7 @@ module flexmbs
         chain_marker_t, chain_joint_revolute, chain_joint_prismatic
     use flexmbs_problems_mechanisms, only: new_mechanism, mechanism_slider_crank, &
         mechanism_four_bar
+    use flexmbs_mbs_flexible_marker, only: flexible_marker_t, new_flexible_marker
     use flexmbs_mbs_joint, only: joint_spherical, joint_revolute, joint_cylindrical, &
         joint_prismatic, joint_universal, joint_fixed
     use flexmbs_dae_mexax, only: mexax_t

@@ -3,7 +3,7 @@ module flexmbs_linalg_lapack
     use flexmbs_core_kinds, only: wp
     implicit none
     private
-    public :: dgetrf, dgetrs, zgetrf, zgetrs, dgbtrf, dgbtrs, zgbtrf, zgbtrs
+    public :: dgetrf, dgetrs, zgetrf, zgetrs, dgbtrf, dgbtrs, zgbtrf, zgbtrs, dgesvd
 
     interface
         subroutine dgetrf(m, n, a, lda, ipiv, info)
@@ -62,5 +62,13 @@ module flexmbs_linalg_lapack
             complex(wp), intent(inout) :: b(ldb, *)
             integer, intent(out) :: info
         end subroutine zgbtrs
+        subroutine dgesvd(jobu, jobvt, m, n, a, lda, s, u, ldu, vt, ldvt, work, lwork, info)
+            import :: wp
+            character, intent(in) :: jobu, jobvt
+            integer, intent(in) :: m, n, lda, ldu, ldvt, lwork
+            real(wp), intent(inout) :: a(lda, *)
+            real(wp), intent(out) :: s(*), u(ldu, *), vt(ldvt, *), work(*)
+            integer, intent(out) :: info
+        end subroutine dgesvd
     end interface
 end module flexmbs_linalg_lapack
