@@ -155,7 +155,8 @@ contains
             '  flexmbs --version                show the version', &
             '', &
             'FILE.nml holds the namelist groups &simulation, &solver and &output,', &
-            'and for a flexible body &flexible_body with one or more &material', &
+            'and for a flexible body &flexible_body with one or more &material;', &
+            'for rigid bodies and joints &multibody, &rigid_body, &marker, &joint, &driver', &
             '(see README.md for every variable, its type, unit and default).', &
             '--quiet turns the progress display on standard error off.', &
             '', &

@@ -157,5 +157,16 @@ bad material-not-covering "fb_cover.nml: &material: elements: element 1 has no m
 printf "%s\n&output file = 'no/such/dir/x.h5' /\n" "$sim" > io_error.nml
 expect io-error 4 "no/such/dir/x.h5: HDF5 cannot create the file" run io_error.nml --quiet
 
+# A driven four-bar (inputs/four_bar.nml) with every solver
+for s in radau5 ddassl ida mexax; do
+    sed -e "s/name = 'radau5'/name = '$s'/" -e "s/^&output/\&output file = 'out\/run.h5',/" \
+        "$root/inputs/four_bar.nml" > "fourbar_$s.nml"
+    kept "multibody-$s" 0 "$s: NST=" out/run.h5 run "fourbar_$s.nml" --quiet
+done
+sed -e "s/marker_i = 'B1', marker_j = 'B2'/marker_i = 'B1', marker_j = 'B9'/" \
+    "$root/inputs/four_bar.nml" > fourbar_bad.nml
+bad multibody-unknown-marker "fourbar_bad.nml: &joint: marker_j = 'B9': no &marker of that name" \
+    fourbar_bad.nml
+
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

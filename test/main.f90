@@ -33,6 +33,7 @@ program flexmbs_tests
     use test_mechanisms, only: collect_mechanisms
     use test_rigid_chain, only: collect_rigid_chain
     use test_flexible_marker, only: collect_flexible_marker
+    use test_multibody_scene, only: collect_multibody_scene
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -74,6 +75,7 @@ program flexmbs_tests
     call run_suite('mechanisms', collect_mechanisms(), filter, npassed, nfailed)
     call run_suite('rigid_chain', collect_rigid_chain(), filter, npassed, nfailed)
     call run_suite('flexible_marker', collect_flexible_marker(), filter, npassed, nfailed)
+    call run_suite('multibody_scene', collect_multibody_scene(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests

@@ -219,7 +219,8 @@ contains
         status = parse_status(vdp_sim() // '! the solver' // nl // '&solvers rtol = 1e-4 /')
         call check(error, status%code == status_bad_input, 'code')
         call expect(error, status, 'in.nml: &solvers: unknown group (expected &simulation, ' // &
-                    '&solver, &output, &flexible_body or &material) (line 3)')
+                    '&solver, &output, &flexible_body, &material, &multibody, &rigid_body, ' // &
+                    '&marker, &joint or &driver) (line 3)')
     end subroutine test_unknown_group
 
     subroutine test_other_bad_text(error)

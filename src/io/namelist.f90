@@ -99,17 +99,51 @@ module flexmbs_io_namelist
         var_spec_t('material', 'poisson_ratio', kind_real), &
         var_spec_t('material', 'density', kind_real), &
         var_spec_t('material', 'viscosity', kind_real), &
-        var_spec_t('material', 'elements', kind_string)]
+        var_spec_t('material', 'elements', kind_string), &
+        var_spec_t('multibody', 'formulation', kind_string), &
+        var_spec_t('multibody', 'gravity', kind_real, 3), &
+        var_spec_t('multibody', 'constraint_derivatives', kind_string), &
+        var_spec_t('multibody', 'projection', kind_logical), &
+        var_spec_t('rigid_body', 'name', kind_string), &
+        var_spec_t('rigid_body', 'mass', kind_real), &
+        var_spec_t('rigid_body', 'inertia', kind_real, 3), &
+        var_spec_t('rigid_body', 'inertia_products', kind_real, 3), &
+        var_spec_t('rigid_body', 'position', kind_real, 3), &
+        var_spec_t('rigid_body', 'rotation_axis', kind_real, 3), &
+        var_spec_t('rigid_body', 'rotation_angle', kind_real), &
+        var_spec_t('rigid_body', 'velocity', kind_real, 3), &
+        var_spec_t('rigid_body', 'angular_velocity', kind_real, 3), &
+        var_spec_t('marker', 'name', kind_string), &
+        var_spec_t('marker', 'body', kind_string), &
+        var_spec_t('marker', 'position', kind_real, 3), &
+        var_spec_t('marker', 'z_axis', kind_real, 3), &
+        var_spec_t('marker', 'x_axis', kind_real, 3), &
+        var_spec_t('joint', 'name', kind_string), &
+        var_spec_t('joint', 'type', kind_string), &
+        var_spec_t('joint', 'marker_i', kind_string), &
+        var_spec_t('joint', 'marker_j', kind_string), &
+        var_spec_t('driver', 'name', kind_string), &
+        var_spec_t('driver', 'type', kind_string), &
+        var_spec_t('driver', 'marker_i', kind_string), &
+        var_spec_t('driver', 'marker_j', kind_string), &
+        var_spec_t('driver', 'axis_i', kind_integer), &
+        var_spec_t('driver', 'axis_j', kind_integer), &
+        var_spec_t('driver', 'coefficients', kind_real, 4), &
+        var_spec_t('driver', 'amplitude', kind_real), &
+        var_spec_t('driver', 'frequency', kind_real), &
+        var_spec_t('driver', 'phase', kind_real)]
 
     character(len=16), parameter :: group_names(*) = [character(len=16) :: &
-        'simulation', 'solver', 'output', 'flexible_body', 'material']
-    !> The one group that may be given several times (one material each).
-    character(len=*), parameter :: repeatable_group = 'material'
+        'simulation', 'solver', 'output', 'flexible_body', 'material', 'multibody', &
+        'rigid_body', 'marker', 'joint', 'driver']
+    !> The groups that may be given several times (one item each).
+    character(len=16), parameter :: repeatable_groups(*) = [character(len=16) :: &
+        'material', 'rigid_body', 'marker', 'joint', 'driver']
 
     !> Problem names the schema accepts (the scene builder says which exist).
     character(len=16), parameter, public :: problem_names(*) = [character(len=16) :: &
         'van_der_pol', 'pendulum', 'robertson', 'brusselator_1d', 'brusselator_2d', &
-        'flexible_body']
+        'flexible_body', 'multibody']
     character(len=8), parameter, public :: formulation_names(*) = [character(len=8) :: &
         'index3', 'index2', 'index1', 'ggl']
 
@@ -146,6 +180,61 @@ module flexmbs_io_namelist
         character(len=len_name) :: formulation = 'index2'
         integer :: line = 0                               !! where the group starts
     end type body_input_t
+
+    !> The `&multibody` group: how rigid bodies and joints are integrated.
+    type, public :: multibody_input_t
+        character(len=len_name) :: formulation = 'ggl'
+        real(wp) :: gravity(3) = [0.0_wp, -9.81_wp, 0.0_wp]  !! [m/s²]
+        character(len=len_name) :: constraint_derivatives = 'analytic'
+        logical :: projection = .false.   !! coordinate projection after each step
+        integer :: line = 0
+    end type multibody_input_t
+
+    !> One `&rigid_body`: mass, inertia about the centre of mass (body
+    !> frame), initial pose and velocities (world).
+    type, public :: rigid_body_input_t
+        character(len=len_name) :: name = ''
+        real(wp) :: mass = 0.0_wp                   !! [kg], required
+        real(wp) :: inertia(3) = 0.0_wp             !! Jxx, Jyy, Jzz [kg m²], required
+        real(wp) :: inertia_products(3) = 0.0_wp    !! Jxy, Jyz, Jxz
+        real(wp) :: position(3) = 0.0_wp            !! centre of mass [m]
+        real(wp) :: rotation_axis(3) = [0.0_wp, 0.0_wp, 1.0_wp]
+        real(wp) :: rotation_angle = 0.0_wp         !! [rad]
+        real(wp) :: velocity(3) = 0.0_wp            !! [m/s]
+        real(wp) :: angular_velocity(3) = 0.0_wp    !! [rad/s], world frame
+        integer :: line = 0
+    end type rigid_body_input_t
+
+    !> One `&marker`: a frame on a rigid body or the ground.
+    type, public :: marker_input_t
+        character(len=len_name) :: name = ''
+        character(len=len_name) :: body = 'ground'
+        real(wp) :: position(3) = 0.0_wp            !! in the body's frame [m]
+        real(wp) :: z_axis(3) = [0.0_wp, 0.0_wp, 1.0_wp]
+        real(wp) :: x_axis(3) = 0.0_wp              !! 0: any normal to z
+        integer :: line = 0
+    end type marker_input_t
+
+    !> One `&joint` between two markers.
+    type, public :: joint_input_t
+        character(len=len_name) :: name = ''
+        character(len=len_name) :: type = ''
+        character(len=len_name) :: marker_i = '', marker_j = ''
+        integer :: line = 0
+    end type joint_input_t
+
+    !> One `&driver`: an angle, translation or distance following s(t).
+    type, public :: driver_input_t
+        character(len=len_name) :: name = ''
+        character(len=len_name) :: type = ''        !! 'angle' | 'translation' | 'distance'
+        character(len=len_name) :: marker_i = '', marker_j = ''
+        integer :: axis_i = 1, axis_j = 1
+        real(wp) :: coefficients(4) = 0.0_wp        !! s = c0 + c1 t + c2 t² + c3 t³
+        real(wp) :: amplitude = 0.0_wp              !! + a sin(ω t + φ)
+        real(wp) :: frequency = 0.0_wp              !! ω [rad/s]
+        real(wp) :: phase = 0.0_wp                  !! φ [rad]
+        integer :: line = 0
+    end type driver_input_t
 
     !> Everything a scene file says, with defaults for what it leaves out.
     type, public :: scene_input_t
@@ -203,6 +292,13 @@ module flexmbs_io_namelist
         logical :: has_body = .false.                 !! a &flexible_body group was given
         type(body_input_t) :: body
         type(material_input_t), allocatable :: materials(:) !! in the order given
+        ! &multibody, &rigid_body, &marker, &joint, &driver
+        logical :: has_multibody = .false.
+        type(multibody_input_t) :: multibody
+        type(rigid_body_input_t), allocatable :: rigid_bodies(:)
+        type(marker_input_t), allocatable :: markers(:)
+        type(joint_input_t), allocatable :: joints(:)
+        type(driver_input_t), allocatable :: drivers(:)
     end type scene_input_t
 
     !> One value of a variable's list.
@@ -263,7 +359,11 @@ contains
         if (.not. status%ok()) return
         call check_types(entries, path, status)
         if (.not. status%ok()) return
-        allocate (scene%materials(count(spans%group == find_group(repeatable_group))))
+        allocate (scene%materials(count(spans%group == find_group('material'))), &
+                  scene%rigid_bodies(count(spans%group == find_group('rigid_body'))), &
+                  scene%markers(count(spans%group == find_group('marker'))), &
+                  scene%joints(count(spans%group == find_group('joint'))), &
+                  scene%drivers(count(spans%group == find_group('driver'))))
         do i = 1, size(spans)
             g = spans(i)%group
             associate (group_text => clean(spans(i)%first:spans(i)%last))
@@ -276,6 +376,26 @@ contains
                     scene%materials(spans(i)%instance)%line = spans(i)%line
                     call read_material_group(group_text, path, &
                                              scene%materials(spans(i)%instance), status)
+                case ('multibody')
+                    scene%has_multibody = .true.
+                    scene%multibody%line = spans(i)%line
+                    call read_multibody_group(group_text, path, scene%multibody, status)
+                case ('rigid_body')
+                    scene%rigid_bodies(spans(i)%instance)%line = spans(i)%line
+                    call read_rigid_body_group(group_text, path, &
+                                               scene%rigid_bodies(spans(i)%instance), status)
+                case ('marker')
+                    scene%markers(spans(i)%instance)%line = spans(i)%line
+                    call read_marker_group(group_text, path, scene%markers(spans(i)%instance), &
+                                           status)
+                case ('joint')
+                    scene%joints(spans(i)%instance)%line = spans(i)%line
+                    call read_joint_group(group_text, path, scene%joints(spans(i)%instance), &
+                                          status)
+                case ('driver')
+                    scene%drivers(spans(i)%instance)%line = spans(i)%line
+                    call read_driver_group(group_text, path, scene%drivers(spans(i)%instance), &
+                                           status)
                 case default
                     call read_group(group_text, trim(group_names(g)), path, scene, status)
                 end select
@@ -286,6 +406,8 @@ contains
         call check_ranges(scene, entries, path, status)
         if (.not. status%ok()) return
         call check_body(scene, entries, path, status)
+        if (.not. status%ok()) return
+        call check_multibody(scene, entries, path, status)
         if (.not. status%ok()) return
         call resolve_output(scene, entries, path, status)
     end subroutine parse_scene
@@ -330,7 +452,8 @@ contains
             if (g == 0) then
                 call status%set(status_bad_input, path // ': &' // group // &
                     ': unknown group (expected &simulation, &solver, &output, &
-                    &&flexible_body or &material)' // at(line))
+                    &&flexible_body, &material, &multibody, &rigid_body, &marker, &joint or &
+                    &&driver)' // at(line))
                 return
             end if
             instance = count(spans%group == g) + 1
@@ -339,7 +462,7 @@ contains
                     ': group given more than once (one flexible body per scene for now)' &
                     // at(line))
                 return
-            else if (instance > 1 .and. group /= repeatable_group) then
+            else if (instance > 1 .and. all(repeatable_groups /= group)) then
                 call status%set(status_bad_input, path // ': &' // group // &
                     ': group given more than once' // at(line))
                 return
@@ -990,6 +1113,160 @@ contains
         if (ios /= 0) call status%set(status_bad_input, path // ': &material: ' // trim(msg))
     end subroutine read_material_group
 
+    !> `&multibody` through namelist I/O.
+    subroutine read_multibody_group(text, path, input, status)
+        character(len=*), intent(in) :: text, path
+        type(multibody_input_t), intent(inout) :: input
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: lines(:)
+        integer :: ios
+        character(len=256) :: msg
+        character(len=len_name) :: formulation, constraint_derivatives
+        real(wp) :: gravity(3)
+        logical :: projection
+        namelist /multibody/ formulation, gravity, constraint_derivatives, projection
+        formulation = input%formulation
+        gravity = input%gravity
+        constraint_derivatives = input%constraint_derivatives
+        projection = input%projection
+        msg = ''
+        lines = split_lines(text)
+        read (lines, nml=multibody, iostat=ios, iomsg=msg)
+        input%formulation = formulation
+        input%gravity = gravity
+        input%constraint_derivatives = constraint_derivatives
+        input%projection = projection
+        if (ios /= 0) call status%set(status_bad_input, path // ': &multibody: ' // trim(msg))
+    end subroutine read_multibody_group
+
+    !> One `&rigid_body` through namelist I/O.
+    subroutine read_rigid_body_group(text, path, input, status)
+        character(len=*), intent(in) :: text, path
+        type(rigid_body_input_t), intent(inout) :: input
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: lines(:)
+        integer :: ios
+        character(len=256) :: msg
+        character(len=len_name) :: name
+        real(wp) :: mass, rotation_angle
+        real(wp), dimension(3) :: inertia, inertia_products, position, rotation_axis, velocity, &
+            angular_velocity
+        namelist /rigid_body/ name, mass, inertia, inertia_products, position, rotation_axis, &
+            rotation_angle, velocity, angular_velocity
+        name = input%name
+        mass = input%mass
+        inertia = input%inertia
+        inertia_products = input%inertia_products
+        position = input%position
+        rotation_axis = input%rotation_axis
+        rotation_angle = input%rotation_angle
+        velocity = input%velocity
+        angular_velocity = input%angular_velocity
+        msg = ''
+        lines = split_lines(text)
+        read (lines, nml=rigid_body, iostat=ios, iomsg=msg)
+        input%name = name
+        input%mass = mass
+        input%inertia = inertia
+        input%inertia_products = inertia_products
+        input%position = position
+        input%rotation_axis = rotation_axis
+        input%rotation_angle = rotation_angle
+        input%velocity = velocity
+        input%angular_velocity = angular_velocity
+        if (ios /= 0) call status%set(status_bad_input, path // ': &rigid_body: ' // trim(msg))
+    end subroutine read_rigid_body_group
+
+    !> One `&marker` through namelist I/O.
+    subroutine read_marker_group(text, path, input, status)
+        character(len=*), intent(in) :: text, path
+        type(marker_input_t), intent(inout) :: input
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: lines(:)
+        integer :: ios
+        character(len=256) :: msg
+        character(len=len_name) :: name, body
+        real(wp), dimension(3) :: position, z_axis, x_axis
+        namelist /marker/ name, body, position, z_axis, x_axis
+        name = input%name
+        body = input%body
+        position = input%position
+        z_axis = input%z_axis
+        x_axis = input%x_axis
+        msg = ''
+        lines = split_lines(text)
+        read (lines, nml=marker, iostat=ios, iomsg=msg)
+        input%name = name
+        input%body = body
+        input%position = position
+        input%z_axis = z_axis
+        input%x_axis = x_axis
+        if (ios /= 0) call status%set(status_bad_input, path // ': &marker: ' // trim(msg))
+    end subroutine read_marker_group
+
+    !> One `&joint` through namelist I/O.
+    subroutine read_joint_group(text, path, input, status)
+        character(len=*), intent(in) :: text, path
+        type(joint_input_t), intent(inout) :: input
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: lines(:)
+        integer :: ios
+        character(len=256) :: msg
+        character(len=len_name) :: name, type, marker_i, marker_j
+        namelist /joint/ name, type, marker_i, marker_j
+        name = input%name
+        type = input%type
+        marker_i = input%marker_i
+        marker_j = input%marker_j
+        msg = ''
+        lines = split_lines(text)
+        read (lines, nml=joint, iostat=ios, iomsg=msg)
+        input%name = name
+        input%type = type
+        input%marker_i = marker_i
+        input%marker_j = marker_j
+        if (ios /= 0) call status%set(status_bad_input, path // ': &joint: ' // trim(msg))
+    end subroutine read_joint_group
+
+    !> One `&driver` through namelist I/O.
+    subroutine read_driver_group(text, path, input, status)
+        character(len=*), intent(in) :: text, path
+        type(driver_input_t), intent(inout) :: input
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: lines(:)
+        integer :: ios
+        character(len=256) :: msg
+        character(len=len_name) :: name, type, marker_i, marker_j
+        integer :: axis_i, axis_j
+        real(wp) :: coefficients(4), amplitude, frequency, phase
+        namelist /driver/ name, type, marker_i, marker_j, axis_i, axis_j, coefficients, &
+            amplitude, frequency, phase
+        name = input%name
+        type = input%type
+        marker_i = input%marker_i
+        marker_j = input%marker_j
+        axis_i = input%axis_i
+        axis_j = input%axis_j
+        coefficients = input%coefficients
+        amplitude = input%amplitude
+        frequency = input%frequency
+        phase = input%phase
+        msg = ''
+        lines = split_lines(text)
+        read (lines, nml=driver, iostat=ios, iomsg=msg)
+        input%name = name
+        input%type = type
+        input%marker_i = marker_i
+        input%marker_j = marker_j
+        input%axis_i = axis_i
+        input%axis_j = axis_j
+        input%coefficients = coefficients
+        input%amplitude = amplitude
+        input%frequency = frequency
+        input%phase = phase
+        if (ios /= 0) call status%set(status_bad_input, path // ': &driver: ' // trim(msg))
+    end subroutine read_driver_group
+
     !> Split text at newlines into records of equal length.
     pure function split_lines(text) result(lines)
         character(len=*), intent(in) :: text
@@ -1031,6 +1308,27 @@ contains
         integer :: i
         if (scene%has_body .and. .not. has_entry(entries, 'simulation', 'problem')) &
             scene%problem = 'flexible_body'
+        if (size(scene%rigid_bodies) > 0 .and. .not. scene%has_body .and. &
+            .not. has_entry(entries, 'simulation', 'problem')) scene%problem = 'multibody'
+        scene%multibody%formulation = lower(scene%multibody%formulation)
+        scene%multibody%constraint_derivatives = lower(scene%multibody%constraint_derivatives)
+        do i = 1, size(scene%rigid_bodies)
+            if (len_trim(scene%rigid_bodies(i)%name) == 0) &
+                scene%rigid_bodies(i)%name = 'body ' // itoa(i)
+        end do
+        do i = 1, size(scene%markers)
+            if (len_trim(scene%markers(i)%name) == 0) &
+                scene%markers(i)%name = 'marker ' // itoa(i)
+        end do
+        do i = 1, size(scene%joints)
+            if (len_trim(scene%joints(i)%name) == 0) scene%joints(i)%name = 'joint ' // itoa(i)
+            scene%joints(i)%type = lower(scene%joints(i)%type)
+        end do
+        do i = 1, size(scene%drivers)
+            if (len_trim(scene%drivers(i)%name) == 0) &
+                scene%drivers(i)%name = 'driver ' // itoa(i)
+            scene%drivers(i)%type = lower(scene%drivers(i)%type)
+        end do
         scene%body%element = lower(scene%body%element)
         scene%body%formulation = lower(scene%body%formulation)
         do i = 1, size(scene%materials)
@@ -1082,10 +1380,10 @@ contains
                      /= scene%solver_name)) then
             call bad(sol, 'name', 'must be ''radau5'', ''ddassl'', ''ida'' or ''mexax''')
         else if (scene%solver_name == 'mexax' .and. scene%problem /= 'pendulum' .and. &
-                 scene%problem /= 'flexible_body') then
+                 scene%problem /= 'flexible_body' .and. scene%problem /= 'multibody') then
             ! ALGORITHMS.md §6: MEXAX integrates the mechanical form only.
             call bad(sol, 'name', '''mexax'' integrates mechanical problems only: &
-                &problem must be ''pendulum'' or ''flexible_body''')
+                &problem must be ''pendulum'', ''flexible_body'' or ''multibody''')
         else if (.not. scene%rtol > 0.0_wp) then
             call bad(sol, 'rtol', 'must be positive')
         else if (.not. scene%rtol < 1.0_wp) then
@@ -1164,6 +1462,188 @@ contains
                 ': required (' // what // ')')
         end subroutine missing
     end subroutine check_ranges
+
+    !> &multibody, &rigid_body, &marker, &joint and &driver: present exactly
+    !> for problem = 'multibody'; values in range; names unique and known.
+    !> (Constraint rank and the initial assembly are checked by the builder.)
+    subroutine check_multibody(scene, entries, path, status)
+        type(scene_input_t), intent(in) :: scene
+        type(entry_t), intent(in) :: entries(:)
+        character(len=*), intent(in) :: path
+        type(status_t), intent(inout) :: status
+        character(len=16), parameter :: mb_groups(5) = [character(len=16) :: 'multibody', &
+            'rigid_body', 'marker', 'joint', 'driver']
+        character(len=12), parameter :: joint_types(6) = [character(len=12) :: 'spherical', &
+            'revolute', 'cylindrical', 'prismatic', 'universal', 'fixed']
+        character(len=12), parameter :: driver_types(3) = [character(len=12) :: 'angle', &
+            'translation', 'distance']
+        integer :: i, j, g
+        if (scene%problem /= 'multibody') then
+            do g = 1, size(mb_groups)
+                if (given(mb_groups(g)) .or. (g == 1 .and. scene%has_multibody)) then
+                    call status%set(status_bad_input, path // ': &' // trim(mb_groups(g)) // &
+                        ': given, but problem = ''' // trim(scene%problem) // ''' (a scene &
+                        &builds only what it declares)')
+                    return
+                end if
+            end do
+            return
+        end if
+        associate (mb => scene%multibody)
+            if (all(formulation_names /= mb%formulation)) then
+                call bad('multibody', 'formulation', 1, 'must be one of ' // &
+                         choices(formulation_names))
+            else if (all([character(len=8) :: 'analytic', 'ad'] /= &
+                          mb%constraint_derivatives)) then
+                call bad('multibody', 'constraint_derivatives', 1, 'must be ''analytic'' or ''ad''')
+            else if (size(scene%rigid_bodies) == 0) then
+                call status%set(status_bad_input, path // ': &simulation: problem = &
+                    &''multibody'': needs at least one &rigid_body group')
+            end if
+        end associate
+        if (.not. status%ok()) return
+        do i = 1, size(scene%rigid_bodies)
+            associate (b => scene%rigid_bodies(i))
+                if (.not. has_entry(entries, 'rigid_body', 'mass', i)) then
+                    call required('rigid_body', b%name, 'mass', 'in kg', b%line)
+                else if (.not. b%mass > 0.0_wp) then
+                    call bad('rigid_body', 'mass', i, 'must be positive')
+                else if (.not. has_entry(entries, 'rigid_body', 'inertia', i)) then
+                    call required('rigid_body', b%name, 'inertia', 'Jxx, Jyy, Jzz in kg m^2 &
+                        &about the centre of mass', b%line)
+                else if (any(.not. b%inertia > 0.0_wp)) then
+                    call bad('rigid_body', 'inertia', i, 'must be positive')
+                else if (.not. norm2(b%rotation_axis) > 0.0_wp) then
+                    call bad('rigid_body', 'rotation_axis', i, 'must not be zero')
+                end if
+                if (.not. status%ok()) return
+                do j = 1, i - 1
+                    if (scene%rigid_bodies(j)%name == b%name) then
+                        call bad('rigid_body', 'name', i, 'also the name of the &rigid_body' // &
+                                 at(scene%rigid_bodies(j)%line))
+                        return
+                    end if
+                end do
+                if (b%name == 'ground') then
+                    call bad('rigid_body', 'name', i, '''ground'' is reserved')
+                    return
+                end if
+            end associate
+        end do
+        do i = 1, size(scene%markers)
+            associate (m => scene%markers(i))
+                if (m%body /= 'ground' .and. .not. any([(scene%rigid_bodies(j)%name == m%body, &
+                                                         j = 1, size(scene%rigid_bodies))])) then
+                    call bad('marker', 'body', i, 'no &rigid_body of that name (nor ''ground'')')
+                else if (.not. norm2(m%z_axis) > 0.0_wp) then
+                    call bad('marker', 'z_axis', i, 'must not be zero')
+                else if (norm2(cross3(m%x_axis, m%z_axis)) <= 1.0e-12_wp * norm2(m%z_axis) * &
+                         norm2(m%x_axis)) then
+                    if (has_entry(entries, 'marker', 'x_axis', i)) &
+                        call bad('marker', 'x_axis', i, 'must not be parallel to z_axis')
+                end if
+                if (.not. status%ok()) return
+                do j = 1, i - 1
+                    if (scene%markers(j)%name == m%name) then
+                        call bad('marker', 'name', i, 'also the name of the &marker' // &
+                                 at(scene%markers(j)%line))
+                        return
+                    end if
+                end do
+            end associate
+        end do
+        do i = 1, size(scene%joints)
+            associate (jt => scene%joints(i))
+                if (all(joint_types /= jt%type)) then
+                    call bad('joint', 'type', i, 'must be one of ' // choices(joint_types))
+                else
+                    call check_markers('joint', i, jt%marker_i, jt%marker_j)
+                end if
+                if (.not. status%ok()) return
+            end associate
+        end do
+        do i = 1, size(scene%drivers)
+            associate (d => scene%drivers(i))
+                if (all(driver_types /= d%type)) then
+                    call bad('driver', 'type', i, 'must be one of ' // choices(driver_types))
+                else if (d%axis_i < 1 .or. d%axis_i > 3) then
+                    call bad('driver', 'axis_i', i, 'must be 1, 2 or 3 (x, y, z of marker_i)')
+                else if (d%axis_j < 1 .or. d%axis_j > 3) then
+                    call bad('driver', 'axis_j', i, 'must be 1, 2 or 3 (x, y, z of marker_j)')
+                else
+                    call check_markers('driver', i, d%marker_i, d%marker_j)
+                end if
+                if (.not. status%ok()) return
+            end associate
+        end do
+
+    contains
+
+        !> Some entry of the group was given (empty groups count via the scene).
+        logical function given(group)
+            character(len=*), intent(in) :: group
+            integer :: e
+            given = .false.
+            do e = 1, size(entries)
+                if (entries(e)%group == group) given = .true.
+            end do
+            select case (group)
+            case ('rigid_body'); given = given .or. size(scene%rigid_bodies) > 0
+            case ('marker'); given = given .or. size(scene%markers) > 0
+            case ('joint'); given = given .or. size(scene%joints) > 0
+            case ('driver'); given = given .or. size(scene%drivers) > 0
+            end select
+        end function given
+
+        !> Both markers exist and sit on different bodies.
+        subroutine check_markers(group, instance, mi, mj)
+            character(len=*), intent(in) :: group, mi, mj
+            integer, intent(in) :: instance
+            integer :: ki, kj, k
+            ki = 0
+            kj = 0
+            do k = size(scene%markers), 1, -1
+                if (scene%markers(k)%name == mi) ki = k
+                if (scene%markers(k)%name == mj) kj = k
+            end do
+            if (ki == 0) then
+                call bad(group, 'marker_i', instance, 'no &marker of that name')
+            else if (kj == 0) then
+                call bad(group, 'marker_j', instance, 'no &marker of that name')
+            else if (scene%markers(ki)%body == scene%markers(kj)%body) then
+                call bad(group, 'marker_j', instance, 'on the same body as marker_i (''' // &
+                         trim(scene%markers(ki)%body) // ''')')
+            end if
+        end subroutine check_markers
+
+        subroutine bad(group, name, instance, reason)
+            character(len=*), intent(in) :: group, name, reason
+            integer, intent(in) :: instance
+            integer :: e
+            do e = 1, size(entries)
+                if (entries(e)%group == group .and. entries(e)%name == name .and. &
+                    entries(e)%instance == instance) then
+                    call fail(status, path, entries(e), reason)
+                    return
+                end if
+            end do
+            call status%set(status_bad_input, path // ': &' // group // ' #' // itoa(instance) &
+                // ': ' // name // ' (default): ' // reason)
+        end subroutine bad
+
+        subroutine required(group, label, name, what, line)
+            character(len=*), intent(in) :: group, label, name, what
+            integer, intent(in) :: line
+            call status%set(status_bad_input, path // ': &' // group // ' ''' // trim(label) // &
+                ''': ' // name // ': required (' // what // ')' // at(line))
+        end subroutine required
+
+        pure function cross3(a, b) result(c)
+            real(wp), intent(in) :: a(3), b(3)
+            real(wp) :: c(3)
+            c = [a(2) * b(3) - a(3) * b(2), a(3) * b(1) - a(1) * b(3), a(1) * b(2) - a(2) * b(1)]
+        end function cross3
+    end subroutine check_multibody
 
     !> The `&flexible_body` and `&material` groups: presence, choices and
     !> ranges. Set names are checked against the mesh when the body is built.

@@ -28,6 +28,8 @@ module flexmbs_io_scene
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &
         formulation_index2, formulation_index3, formulation_ggl
     use flexmbs_io_namelist, only: scene_input_t, scene_dae_options, controller_code
+    use flexmbs_io_multibody_input, only: build_multibody
+    use flexmbs_mbs_system, only: mbs_system_t
     use flexmbs_io_body_input, only: build_flexible_body, body_energies
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_progress, only: progress_t, new_progress
@@ -77,7 +79,7 @@ contains
         type(pendulum_t) :: pendulum
         type(reaction_diffusion_t) :: bruss
         type(formulation_t) :: formulation
-        real(wp), allocatable :: q0(:), v0(:)
+        real(wp), allocatable :: q0(:), v0(:), yp0(:)
         integer :: nq
         logical :: klu
         klu = scene%linear_solver == 'klu'
@@ -141,6 +143,43 @@ contains
             y0(1:nq) = q0
             y0(nq + 1:2 * nq) = v0
             blocks = [block_spec_t('q', 1, nq), block_spec_t('v', nq + 1, 2 * nq)]
+            allocate (problem, source=formulation)
+        case ('multibody')
+            if (.not. present(mechanical)) then
+                call status%set(status_bad_input, scene%path // ': &simulation: problem = &
+                    &''multibody'': build_problem needs its `mechanical` argument')
+                return
+            end if
+            allocate (mbs_system_t :: mechanical)
+            select type (sys => mechanical)
+            type is (mbs_system_t)
+                call build_multibody(scene, sys, q0, v0, status)
+            end select
+            if (.not. status%ok()) return
+            ! Rigid bodies have a constant M (body-fixed ω'): y = (q, v, λ[, μ]);
+            ! MEXAX integrates y = (q, v, λ), the index-2 layout.
+            formulation = new_formulation(mechanical, merge(formulation_index2, &
+                mechanical_formulation(scene%multibody%formulation), &
+                scene%solver_name == 'mexax'), q0, constant_mass=.true., &
+                projection=scene%multibody%projection, status=status)
+            if (.not. status%ok()) then
+                status%message = scene%path // ': &multibody: ' // status%message
+                return
+            end if
+            allocate (y0(formulation%n), yp0(formulation%n), source=0.0_wp)
+            y0(formulation%oq + 1:formulation%oq + formulation%nq) = q0
+            y0(formulation%ov + 1:formulation%ov + formulation%nv) = v0
+            call formulation%consistent_initial(scene%t_start, y0, yp0, status)
+            if (.not. status%ok()) then
+                call status%set(status_bad_input, scene%path // ': no consistent initial &
+                    &state (the joints cannot be assembled from the given positions and &
+                    &velocities): ' // status%text())
+                return
+            end if
+            blocks = [block_spec_t('q', formulation%oq + 1, formulation%oq + formulation%nq), &
+                      block_spec_t('v', formulation%ov + 1, formulation%ov + formulation%nv)]
+            if (formulation%nc > 0) blocks = [blocks, block_spec_t('lambda', &
+                formulation%ol + 1, formulation%ol + formulation%nc)]
             allocate (problem, source=formulation)
         case ('brusselator_1d', 'brusselator_2d')
             bruss = new_reaction_diffusion(merge(1, 2, scene%problem == 'brusselator_1d'), &
@@ -230,6 +269,8 @@ contains
             stab = trim(scene%pendulum_formulation)
         else if (scene%problem == 'flexible_body') then
             stab = trim(scene%body%formulation)
+        else if (scene%problem == 'multibody') then
+            stab = trim(scene%multibody%formulation)
         else
             stab = '-'
         end if

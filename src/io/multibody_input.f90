@@ -1,0 +1,230 @@
+!> A multibody system from the `&multibody`, `&rigid_body`, `&marker`,
+!> `&joint` and `&driver` groups of a validated scene (names already
+!> checked): rigid bodies in absolute coordinates, markers (axes from z_axis
+!> and x_axis, made orthonormal), joints and drivers, as an mbs_system_t
+!> with its initial positions and velocities.
+!>
+!> The constraint set is checked before anything is written: the rows of G
+!> at the initial configuration must be independent (rank by SVD), so a
+!> redundant constraint set, or one singular at the start, is bad input that
+!> names the joints involved. Inconsistent initial positions are corrected
+!> by the formulation's consistent-initial projection (scene.f90), which
+!> fails with its own message when no assembly is found.
+module flexmbs_io_multibody_input
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_text, only: int_text, real_text
+    use flexmbs_linalg_lapack, only: dgesvd
+    use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle, cross
+    use flexmbs_mbs_rigid_body, only: rigid_body_t
+    use flexmbs_mbs_joint, only: joint_spherical, joint_revolute, joint_cylindrical, &
+        joint_prismatic, joint_universal, joint_fixed, joint_primitive
+    use flexmbs_mbs_primitive_kinds, only: primitive_angle_driver, &
+        primitive_translation_driver, primitive_distance
+    use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
+        driver_t
+    use flexmbs_io_namelist, only: scene_input_t
+    implicit none
+    private
+
+    !> Relative singular-value threshold for independent constraint rows.
+    real(wp), parameter :: rank_tolerance = 1.0e-10_wp
+
+    public :: build_multibody
+
+contains
+
+    !> The system of the scene, q0 = (r, p) per body and v0 = (ṙ, ω′) per body.
+    subroutine build_multibody(scene, sys, q0, v0, status)
+        type(scene_input_t), intent(in) :: scene
+        type(mbs_system_t), intent(out) :: sys
+        real(wp), allocatable, intent(out) :: q0(:), v0(:)
+        type(status_t), intent(out) :: status
+        type(rigid_body_t), allocatable :: bodies(:)
+        type(marker_t), allocatable :: markers(:)
+        type(mbs_joint_t), allocatable :: joints(:)
+        real(wp) :: p(4), r(3, 3)
+        integer :: i, nb, k
+        nb = size(scene%rigid_bodies)
+        allocate (bodies(nb), q0(7 * nb), v0(6 * nb))
+        do i = 1, nb
+            associate (b => scene%rigid_bodies(i))
+                bodies(i)%mass = b%mass
+                bodies(i)%inertia = reshape([b%inertia(1), b%inertia_products(1), &
+                    b%inertia_products(3), b%inertia_products(1), b%inertia(2), &
+                    b%inertia_products(2), b%inertia_products(3), b%inertia_products(2), &
+                    b%inertia(3)], [3, 3])
+                if (.not. positive_definite(bodies(i)%inertia)) then
+                    call status%set(status_bad_input, scene%path // ': &rigid_body ''' // &
+                        trim(b%name) // ''': inertia, inertia_products: the inertia tensor &
+                        &is not positive definite (line ' // int_text(b%line) // ')')
+                    return
+                end if
+                p = quat_from_axis_angle(b%rotation_axis / norm2(b%rotation_axis), &
+                                         b%rotation_angle)
+                r = rotation_matrix(p)
+                q0(7 * i - 6:7 * i) = [b%position, p]
+                v0(6 * i - 5:6 * i) = [b%velocity, matmul(transpose(r), b%angular_velocity)]
+            end associate
+        end do
+        allocate (markers(size(scene%markers)))
+        do i = 1, size(markers)
+            associate (m => scene%markers(i))
+                markers(i)%body = 0
+                if (m%body /= 'ground') markers(i)%body = body_index(scene, m%body)
+                markers(i)%position = m%position
+                markers(i)%axes = axes_from(m%z_axis, m%x_axis)
+            end associate
+        end do
+        allocate (joints(size(scene%joints) + size(scene%drivers)))
+        do i = 1, size(scene%joints)
+            associate (jt => scene%joints(i))
+                joints(i)%kind = joint_kind(jt%type)
+                joints(i)%marker_i = marker_index(scene, jt%marker_i)
+                joints(i)%marker_j = marker_index(scene, jt%marker_j)
+            end associate
+        end do
+        do i = 1, size(scene%drivers)
+            k = size(scene%joints) + i
+            associate (d => scene%drivers(i))
+                joints(k) = mbs_joint_t(joint_primitive, marker_index(scene, d%marker_i), &
+                    marker_index(scene, d%marker_j), &
+                    driver_kind(d%type), d%axis_i, d%axis_j, &
+                    driver_t(d%coefficients, d%amplitude, d%frequency, d%phase))
+            end associate
+        end do
+        sys = new_mbs_system(bodies, markers, joints, gravity=scene%multibody%gravity, &
+            constraint_derivatives=trim(scene%multibody%constraint_derivatives), status=status)
+        if (.not. status%ok()) then
+            call status%set(status_bad_input, scene%path // ': ' // status%text())
+            return
+        end if
+        call check_rank(scene, sys, q0, status)
+    end subroutine build_multibody
+
+    !> G(t0, q0) must have full row rank: otherwise the constraints are
+    !> redundant (or singular at the start); the message names the joints
+    !> whose rows are dependent (the least singular vector's support).
+    subroutine check_rank(scene, sys, q0, status)
+        type(scene_input_t), intent(in) :: scene
+        type(mbs_system_t), intent(inout) :: sys
+        real(wp), intent(in) :: q0(:)
+        type(status_t), intent(inout) :: status
+        real(wp), allocatable :: g(:, :), gt(:, :), sv(:), u(:, :), vt(:, :), work(:)
+        integer :: nc, nv, info, rank, k, row, first, last, nj
+        character(len=:), allocatable :: names
+        nc = sys%nc
+        nv = sys%nv
+        if (nc == 0) return
+        if (nc > nv) then
+            call status%set(status_bad_input, scene%path // ': the joints and drivers give ' &
+                // int_text(nc) // ' constraint rows for ' // int_text(nv) // ' velocities: &
+                &the constraint set is redundant')
+            return
+        end if
+        allocate (g(nc, nv), sv(nc), u(1, 1), vt(nc, nc), work(max(1, 5 * (nc + nv))))
+        call sys%constraint_jacobian(scene%t_start, q0, g, status)
+        if (.not. status%ok()) return
+        ! Gᵀ = U Σ Vᵀ: a dependence yᵀ G = 0 among the rows is the last row of Vᵀ.
+        gt = transpose(g)
+        call dgesvd('N', 'A', nv, nc, gt, nv, sv, u, 1, vt, nc, work, size(work), info)
+        if (info /= 0) return
+        rank = count(sv > rank_tolerance * sv(1))
+        if (rank == nc) return
+        ! rows taking part in the dependence: vt(nc, :) (last right singular vector of Gᵀ)
+        names = ''
+        nj = size(scene%joints) + size(scene%drivers)
+        do k = 1, nj
+            first = sys%joint_first_row(k)
+            last = nc
+            if (k < nj) last = sys%joint_first_row(k + 1) - 1
+            do row = first, last
+                if (abs(vt(nc, row)) > 1.0e-6_wp) then
+                    if (len(names) > 0) names = names // ', '
+                    names = names // joint_label(scene, k)
+                    exit
+                end if
+            end do
+        end do
+        call status%set(status_bad_input, scene%path // ': the constraint set is redundant &
+            &or singular at t_start: ' // int_text(nc) // ' rows of rank ' // int_text(rank) // &
+            ' (smallest singular value ' // real_text(sv(nc)) // '); involved: ' // names)
+    end subroutine check_rank
+
+    pure integer function marker_index(scene, name)
+        type(scene_input_t), intent(in) :: scene
+        character(len=*), intent(in) :: name
+        do marker_index = 1, size(scene%markers)
+            if (scene%markers(marker_index)%name == name) return
+        end do
+        marker_index = 0
+    end function marker_index
+
+    pure integer function body_index(scene, name)
+        type(scene_input_t), intent(in) :: scene
+        character(len=*), intent(in) :: name
+        do body_index = 1, size(scene%rigid_bodies)
+            if (scene%rigid_bodies(body_index)%name == name) return
+        end do
+        body_index = 0
+    end function body_index
+
+    !> 'joint ''name''' or 'driver ''name''' of system joint k.
+    function joint_label(scene, k) result(label)
+        type(scene_input_t), intent(in) :: scene
+        integer, intent(in) :: k
+        character(len=:), allocatable :: label
+        if (k <= size(scene%joints)) then
+            label = '&joint ''' // trim(scene%joints(k)%name) // ''''
+        else
+            label = '&driver ''' // trim(scene%drivers(k - size(scene%joints))%name) // ''''
+        end if
+    end function joint_label
+
+    !> Orthonormal axes (columns) with z along z_axis and x from x_axis made
+    !> normal to it (any normal when x_axis is zero).
+    pure function axes_from(z_axis, x_axis) result(a)
+        real(wp), intent(in) :: z_axis(3), x_axis(3)
+        real(wp) :: a(3, 3), h(3)
+        a(:, 3) = z_axis / norm2(z_axis)
+        h = x_axis
+        if (norm2(cross(h, a(:, 3))) <= 1.0e-12_wp * max(norm2(h), 1.0e-300_wp)) then
+            h = [1.0_wp, 0.0_wp, 0.0_wp]
+            if (abs(a(1, 3)) > 0.9_wp) h = [0.0_wp, 1.0_wp, 0.0_wp]
+        end if
+        a(:, 1) = h - dot_product(h, a(:, 3)) * a(:, 3)
+        a(:, 1) = a(:, 1) / norm2(a(:, 1))
+        a(:, 2) = cross(a(:, 3), a(:, 1))
+    end function axes_from
+
+    pure integer function joint_kind(name)
+        character(len=*), intent(in) :: name
+        select case (trim(name))
+        case ('spherical'); joint_kind = joint_spherical
+        case ('revolute'); joint_kind = joint_revolute
+        case ('cylindrical'); joint_kind = joint_cylindrical
+        case ('prismatic'); joint_kind = joint_prismatic
+        case ('universal'); joint_kind = joint_universal
+        case default; joint_kind = joint_fixed
+        end select
+    end function joint_kind
+
+    pure integer function driver_kind(name)
+        character(len=*), intent(in) :: name
+        select case (trim(name))
+        case ('angle'); driver_kind = primitive_angle_driver
+        case ('translation'); driver_kind = primitive_translation_driver
+        case default; driver_kind = primitive_distance
+        end select
+    end function driver_kind
+
+    !> Sylvester's criterion on a symmetric 3 × 3 matrix.
+    pure logical function positive_definite(j)
+        real(wp), intent(in) :: j(3, 3)
+        positive_definite = j(1, 1) > 0.0_wp .and. &
+            j(1, 1) * j(2, 2) - j(1, 2) * j(2, 1) > 0.0_wp .and. &
+            j(1, 1) * (j(2, 2) * j(3, 3) - j(2, 3) * j(3, 2)) &
+            - j(1, 2) * (j(2, 1) * j(3, 3) - j(2, 3) * j(3, 1)) &
+            + j(1, 3) * (j(2, 1) * j(3, 2) - j(2, 2) * j(3, 1)) > 0.0_wp
+    end function positive_definite
+end module flexmbs_io_multibody_input

@@ -1,0 +1,119 @@
+!> Multibody scenes (`&multibody`, `&rigid_body`, `&marker`, `&joint`,
+!> `&driver`): the four-bar of inputs/four_bar.nml against its closed form
+!> with every solver, and the messages for bad scenes (no output file).
+module test_multibody_scene
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_io_namelist, only: scene_input_t, read_scene, parse_scene
+    use flexmbs_io_scene, only: run_result_t, run_scene
+    use flexmbs_mbs_rotation, only: rotation_matrix
+    use flexmbs_problems_mechanisms, only: four_bar_exact, crank_angle, bar_b
+    use testing, only: test_case_t, new_test, error_t, check
+    implicit none
+    private
+    public :: collect_multibody_scene
+
+    character(len=*), parameter :: nl = new_line('a')
+
+contains
+
+    function collect_multibody_scene() result(tests)
+        type(test_case_t), allocatable :: tests(:)
+        tests = [new_test('four_bar_file_closed_form', test_four_bar), &
+                 new_test('bad_scenes', test_bad_scenes)]
+    end function collect_multibody_scene
+
+    !> inputs/four_bar.nml with each solver: the coupler end at t = 1
+    !> (rtol 1e-7) on the closed form (RADAU5, DDASSL, IDA within 1e-5;
+    !> MEXAX at its index-2 state within 1e-5).
+    subroutine test_four_bar(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=8), parameter :: solvers(4) = ['radau5', 'ddassl', 'ida   ', 'mexax ']
+        type(scene_input_t) :: scene
+        type(run_result_t) :: result
+        type(status_t) :: status
+        real(wp) :: b(3), c(3), r(3, 3), dev
+        integer :: k
+        do k = 1, size(solvers)
+            call read_scene('inputs/four_bar.nml', scene, status)
+            call check(error, status%ok(), 'read: ' // status%text())
+            if (allocated(error)) return
+            scene%output_file = ''
+            scene%progress = .false.
+            scene%solver_name = solvers(k)
+            call run_scene(scene, .true., result, status)
+            call check(error, status%ok(), trim(solvers(k)) // ': ' // status%text())
+            if (allocated(error)) return
+            call four_bar_exact(crank_angle(1.0_wp), b, c)
+            r = rotation_matrix(result%y(11:14))
+            dev = norm2(result%y(8:10) + 0.5_wp * bar_b * r(:, 1) - c)
+            print '(4x,a,a,es9.2)', solvers(k), ': coupler end off the closed form by ', dev
+            call check(error, dev <= 1.0e-5_wp, trim(solvers(k)) // ': four-bar off the closed form')
+        end do
+    end subroutine test_four_bar
+
+    !> A revolute pendulum scene, varied into each defect.
+    function pendulum(bar, markers, joints, extra) result(text)
+        character(len=*), intent(in) :: bar, markers, joints, extra
+        character(len=:), allocatable :: text
+        text = '&simulation problem = ''multibody'', t_end = 0.1 /' // nl // &
+               '&rigid_body name = ''bar'', mass = 1, inertia = 0.1, 0.1, 0.1, ' // bar // &
+               ' /' // nl // markers // nl // joints // nl // extra // nl // &
+               '&output file = ''none'' /'
+    end function pendulum
+
+    subroutine expect(error, text, part)
+        type(error_t), allocatable, intent(inout) :: error
+        character(len=*), intent(in) :: text, part
+        type(scene_input_t) :: scene
+        type(run_result_t) :: result
+        type(status_t) :: status
+        call parse_scene(text, 'mb.nml', scene, status)
+        if (status%ok()) then
+            scene%progress = .false.
+            call run_scene(scene, .true., result, status)
+        end if
+        call check(error, status%code == status_bad_input .and. index(status%text(), part) > 0, &
+                   'expected "' // part // '", got: ' // status%text())
+    end subroutine expect
+
+    subroutine test_bad_scenes(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), parameter :: bar = 'position = 0.25, 0.4330127018922193, 0, ' // &
+            'rotation_angle = 1.0471975511965976'
+        character(len=*), parameter :: markers = '&marker name = ''O'', body = ''ground'' /' &
+            // nl // '&marker name = ''P'', body = ''bar'', position = -0.5, 0, 0 /'
+        character(len=*), parameter :: hinge = '&joint type = ''revolute'', marker_i = ''O'', ' &
+            // 'marker_j = ''P'' /'
+        type(scene_input_t) :: scene
+        type(run_result_t) :: result
+        type(status_t) :: status
+        ! the valid scene runs
+        call parse_scene(pendulum(bar, markers, hinge, ''), 'mb.nml', scene, status)
+        if (status%ok()) call run_scene(scene, .true., result, status)
+        call check(error, status%ok(), 'valid pendulum: ' // status%text())
+        call expect(error, pendulum(bar, markers, '&joint type = ''revolute'', marker_i = ''O'', &
+            &marker_j = ''Q'' /', ''), "mb.nml: &joint: marker_j = 'Q': no &marker of that name")
+        call expect(error, pendulum(bar, markers // nl // '&marker name = ''R'', body = ''rod'' /', &
+            hinge, ''), "mb.nml: &marker: body = 'rod': no &rigid_body of that name")
+        call expect(error, pendulum(bar, markers, '&joint type = ''hinge'', marker_i = ''O'', &
+            &marker_j = ''P'' /', ''), "mb.nml: &joint: type = 'hinge': must be one of")
+        call expect(error, pendulum(bar, markers // nl // '&marker name = ''P2'', body = ''bar'' /', &
+            '&joint type = ''spherical'', marker_i = ''P'', marker_j = ''P2'' /', ''), &
+            "marker_j = 'P2': on the same body as marker_i ('bar')")
+        call expect(error, pendulum(bar, markers, '&joint name = ''a'', type = ''spherical'', &
+            &marker_i = ''O'', marker_j = ''P'' /' // nl // '&joint name = ''b'', type = &
+            &''spherical'', marker_i = ''O'', marker_j = ''P'' /', ''), &
+            "the constraint set is redundant or singular at t_start: 6 rows of rank 3")
+        call expect(error, pendulum(bar, markers // nl // '&marker name = ''E'', body = ''bar'', &
+            &position = 0.5, 0, 0 /' // nl // '&marker name = ''Q'', body = ''ground'', &
+            &position = 3, 0, 0 /', hinge // nl // '&driver type = ''distance'', marker_i = ''Q'', &
+            &marker_j = ''E'', coefficients = 5, 0, 0, 0 /', ''), 'no consistent initial state')
+        call expect(error, pendulum('inertia_products = 0.2, 0, 0', markers, hinge, ''), &
+            'the inertia tensor is not positive definite')
+        call expect(error, '&simulation problem = ''pendulum'', t_end = 1 /' // nl // &
+            '&rigid_body mass = 1 /', "&rigid_body: given, but problem = 'pendulum'")
+        call expect(error, pendulum(bar, markers, hinge, '&multibody formulation = ''idx2'' /'), &
+            "&multibody: formulation = 'idx2': must be one of")
+    end subroutine test_bad_scenes
+end module test_multibody_scene
