@@ -156,7 +156,8 @@ contains
             '', &
             'FILE.nml holds the namelist groups &simulation, &solver and &output,', &
             'and for a flexible body &flexible_body with one or more &material;', &
-            'for rigid bodies and joints &multibody, &rigid_body, &marker, &joint, &driver', &
+            'for rigid bodies and joints &multibody, &rigid_body, &marker, &joint, &driver;', &
+            'for a chain in relative coordinates &rigid_chain', &
             '(see README.md for every variable, its type, unit and default).', &
             '--quiet turns the progress display on standard error off.', &
             '', &

@@ -168,5 +168,12 @@ sed -e "s/marker_i = 'B1', marker_j = 'B2'/marker_i = 'B1', marker_j = 'B9'/" \
 bad multibody-unknown-marker "fourbar_bad.nml: &joint: marker_j = 'B9': no &marker of that name" \
     fourbar_bad.nml
 
+# A rigid chain in relative coordinates (inputs/double_pendulum_chain.nml)
+for s in radau5 ddassl ida mexax; do
+    sed -e "s/name = 'radau5'/name = '$s'/" -e "s/^&output/\&output file = 'out\/run.h5',/" \
+        "$root/inputs/double_pendulum_chain.nml" > "chain_$s.nml"
+    kept "rigid-chain-$s" 0 "$s: NST=" out/run.h5 run "chain_$s.nml" --quiet
+done
+
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

@@ -220,7 +220,7 @@ contains
         call check(error, status%code == status_bad_input, 'code')
         call expect(error, status, 'in.nml: &solvers: unknown group (expected &simulation, ' // &
                     '&solver, &output, &flexible_body, &material, &multibody, &rigid_body, ' // &
-                    '&marker, &joint or &driver) (line 3)')
+                    '&marker, &joint, &driver or &rigid_chain) (line 3)')
     end subroutine test_unknown_group
 
     subroutine test_other_bad_text(error)

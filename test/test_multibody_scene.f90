@@ -8,6 +8,8 @@ module test_multibody_scene
     use flexmbs_io_scene, only: run_result_t, run_scene
     use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_problems_mechanisms, only: four_bar_exact, crank_angle, bar_b
+    use flexmbs_io_chain_input, only: build_rigid_chain
+    use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     use testing, only: test_case_t, new_test, error_t, check
     implicit none
     private
@@ -20,7 +22,9 @@ contains
     function collect_multibody_scene() result(tests)
         type(test_case_t), allocatable :: tests(:)
         tests = [new_test('four_bar_file_closed_form', test_four_bar), &
-                 new_test('bad_scenes', test_bad_scenes)]
+                 new_test('bad_scenes', test_bad_scenes), &
+                 new_test('rigid_chain_file', test_chain_file), &
+                 new_test('rigid_chain_bad_scenes', test_chain_bad)]
     end function collect_multibody_scene
 
     !> inputs/four_bar.nml with each solver: the coupler end at t = 1
@@ -116,4 +120,57 @@ contains
         call expect(error, pendulum(bar, markers, hinge, '&multibody formulation = ''idx2'' /'), &
             "&multibody: formulation = 'idx2': must be one of")
     end subroutine test_bad_scenes
+    !> inputs/double_pendulum_chain.nml: every solver reaches the same state
+    !> (1e-6), and RADAU5 keeps the energy (undamped) to 1e-6 relative.
+    subroutine test_chain_file(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=8), parameter :: solvers(4) = ['radau5', 'ddassl', 'ida   ', 'mexax ']
+        type(scene_input_t) :: scene
+        type(run_result_t) :: result
+        type(status_t) :: status
+        type(rigid_chain_t) :: chain
+        real(wp), allocatable :: q0(:), v0(:)
+        real(wp) :: y_ref(4), ek0, ep0, ek, ep
+        integer :: k
+        do k = 1, size(solvers)
+            call read_scene('inputs/double_pendulum_chain.nml', scene, status)
+            call check(error, status%ok(), 'read: ' // status%text())
+            if (allocated(error)) return
+            scene%output_file = ''
+            scene%progress = .false.
+            scene%solver_name = solvers(k)
+            call run_scene(scene, .true., result, status)
+            call check(error, status%ok(), trim(solvers(k)) // ': ' // status%text())
+            if (allocated(error)) return
+            if (k == 1) then
+                y_ref = result%y(1:4)
+                call build_rigid_chain(scene, chain, q0, v0, status)
+                call chain%energy(q0, v0, ek0, ep0)
+                call chain%energy(result%y(1:2), result%y(3:4), ek, ep)
+                print '(4x,a,es9.2)', 'chain scene, RADAU5: relative energy drift ', &
+                    abs(ek + ep - ek0 - ep0) / ek0
+                call check(error, abs(ek + ep - ek0 - ep0) <= 1.0e-6_wp * ek0, 'energy drift')
+            else
+                call check(error, maxval(abs(result%y(1:4) - y_ref)) <= 1.0e-6_wp, &
+                           trim(solvers(k)) // ': differs from RADAU5')
+            end if
+        end do
+    end subroutine test_chain_file
+
+    subroutine test_chain_bad(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), parameter :: sim = '&simulation problem = ''rigid_chain'', ' // &
+            't_end = 0.1 /' // nl
+        character(len=*), parameter :: link = '&rigid_chain name = ''a'', mass = 1, ' // &
+            'inertia = 1, 1, 1 /' // nl
+        call expect(error, sim // link // '&rigid_chain name = ''b'', parent = ''c'', mass = 1, &
+            &inertia = 1, 1, 1 /', "mb.nml: &rigid_chain: parent = 'c': must be 'ground' or a &
+            &body of an earlier &rigid_chain group")
+        call expect(error, sim // '&rigid_chain joint = ''ball'', mass = 1, inertia = 1, 1, 1 /', &
+            "mb.nml: &rigid_chain: joint = 'ball': must be 'revolute' or 'prismatic'")
+        call expect(error, sim // '&rigid_chain inertia = 1, 1, 1 /', &
+            "&rigid_chain 'link 1': mass (default): must be positive (required)")
+        call expect(error, '&simulation problem = ''pendulum'', t_end = 1 /' // nl // link, &
+            "&rigid_chain: given, but problem = 'pendulum'")
+    end subroutine test_chain_bad
 end module test_multibody_scene

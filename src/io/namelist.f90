@@ -131,19 +131,30 @@ module flexmbs_io_namelist
         var_spec_t('driver', 'coefficients', kind_real, 4), &
         var_spec_t('driver', 'amplitude', kind_real), &
         var_spec_t('driver', 'frequency', kind_real), &
-        var_spec_t('driver', 'phase', kind_real)]
+        var_spec_t('driver', 'phase', kind_real), &
+        var_spec_t('rigid_chain', 'name', kind_string), &
+        var_spec_t('rigid_chain', 'parent', kind_string), &
+        var_spec_t('rigid_chain', 'joint', kind_string), &
+        var_spec_t('rigid_chain', 'joint_position', kind_real, 3), &
+        var_spec_t('rigid_chain', 'joint_axis', kind_real, 3), &
+        var_spec_t('rigid_chain', 'centre', kind_real, 3), &
+        var_spec_t('rigid_chain', 'mass', kind_real), &
+        var_spec_t('rigid_chain', 'inertia', kind_real, 3), &
+        var_spec_t('rigid_chain', 'inertia_products', kind_real, 3), &
+        var_spec_t('rigid_chain', 'coordinate', kind_real), &
+        var_spec_t('rigid_chain', 'rate', kind_real)]
 
     character(len=16), parameter :: group_names(*) = [character(len=16) :: &
         'simulation', 'solver', 'output', 'flexible_body', 'material', 'multibody', &
-        'rigid_body', 'marker', 'joint', 'driver']
+        'rigid_body', 'marker', 'joint', 'driver', 'rigid_chain']
     !> The groups that may be given several times (one item each).
     character(len=16), parameter :: repeatable_groups(*) = [character(len=16) :: &
-        'material', 'rigid_body', 'marker', 'joint', 'driver']
+        'material', 'rigid_body', 'marker', 'joint', 'driver', 'rigid_chain']
 
     !> Problem names the schema accepts (the scene builder says which exist).
     character(len=16), parameter, public :: problem_names(*) = [character(len=16) :: &
         'van_der_pol', 'pendulum', 'robertson', 'brusselator_1d', 'brusselator_2d', &
-        'flexible_body', 'multibody']
+        'flexible_body', 'multibody', 'rigid_chain']
     character(len=8), parameter, public :: formulation_names(*) = [character(len=8) :: &
         'index3', 'index2', 'index1', 'ggl']
 
@@ -236,6 +247,23 @@ module flexmbs_io_namelist
         integer :: line = 0
     end type driver_input_t
 
+    !> One `&rigid_chain` group: a body of a loop-free chain in relative
+    !> coordinates and the joint to its parent (flexmbs_mbs_rigid_chain).
+    type, public :: chain_body_input_t
+        character(len=len_name) :: name = ''
+        character(len=len_name) :: parent = 'ground'  !! 'ground' or an earlier body
+        character(len=len_name) :: joint = 'revolute' !! 'revolute' | 'prismatic'
+        real(wp) :: joint_position(3) = 0.0_wp        !! in the parent's frame [m]
+        real(wp) :: joint_axis(3) = [0.0_wp, 0.0_wp, 1.0_wp] !! parent's frame
+        real(wp) :: centre(3) = 0.0_wp                !! centre of mass, own frame [m]
+        real(wp) :: mass = 0.0_wp                     !! [kg], required
+        real(wp) :: inertia(3) = 0.0_wp               !! about the centre of mass, required
+        real(wp) :: inertia_products(3) = 0.0_wp
+        real(wp) :: coordinate = 0.0_wp               !! initial q [rad or m]
+        real(wp) :: rate = 0.0_wp                     !! initial q' [rad/s or m/s]
+        integer :: line = 0
+    end type chain_body_input_t
+
     !> Everything a scene file says, with defaults for what it leaves out.
     type, public :: scene_input_t
         character(len=:), allocatable :: path !! the file read
@@ -299,6 +327,8 @@ module flexmbs_io_namelist
         type(marker_input_t), allocatable :: markers(:)
         type(joint_input_t), allocatable :: joints(:)
         type(driver_input_t), allocatable :: drivers(:)
+        ! &rigid_chain
+        type(chain_body_input_t), allocatable :: chain(:)
     end type scene_input_t
 
     !> One value of a variable's list.
@@ -363,7 +393,8 @@ contains
                   scene%rigid_bodies(count(spans%group == find_group('rigid_body'))), &
                   scene%markers(count(spans%group == find_group('marker'))), &
                   scene%joints(count(spans%group == find_group('joint'))), &
-                  scene%drivers(count(spans%group == find_group('driver'))))
+                  scene%drivers(count(spans%group == find_group('driver'))), &
+                  scene%chain(count(spans%group == find_group('rigid_chain'))))
         do i = 1, size(spans)
             g = spans(i)%group
             associate (group_text => clean(spans(i)%first:spans(i)%last))
@@ -392,6 +423,10 @@ contains
                     scene%joints(spans(i)%instance)%line = spans(i)%line
                     call read_joint_group(group_text, path, scene%joints(spans(i)%instance), &
                                           status)
+                case ('rigid_chain')
+                    scene%chain(spans(i)%instance)%line = spans(i)%line
+                    call read_chain_group(group_text, path, scene%chain(spans(i)%instance), &
+                                          status)
                 case ('driver')
                     scene%drivers(spans(i)%instance)%line = spans(i)%line
                     call read_driver_group(group_text, path, scene%drivers(spans(i)%instance), &
@@ -408,6 +443,8 @@ contains
         call check_body(scene, entries, path, status)
         if (.not. status%ok()) return
         call check_multibody(scene, entries, path, status)
+        if (.not. status%ok()) return
+        call check_chain(scene, entries, path, status)
         if (.not. status%ok()) return
         call resolve_output(scene, entries, path, status)
     end subroutine parse_scene
@@ -452,8 +489,8 @@ contains
             if (g == 0) then
                 call status%set(status_bad_input, path // ': &' // group // &
                     ': unknown group (expected &simulation, &solver, &output, &
-                    &&flexible_body, &material, &multibody, &rigid_body, &marker, &joint or &
-                    &&driver)' // at(line))
+                    &&flexible_body, &material, &multibody, &rigid_body, &marker, &joint, &
+                    &&driver or &rigid_chain)' // at(line))
                 return
             end if
             instance = count(spans%group == g) + 1
@@ -1267,6 +1304,47 @@ contains
         if (ios /= 0) call status%set(status_bad_input, path // ': &driver: ' // trim(msg))
     end subroutine read_driver_group
 
+    !> One `&rigid_chain` through namelist I/O.
+    subroutine read_chain_group(text, path, input, status)
+        character(len=*), intent(in) :: text, path
+        type(chain_body_input_t), intent(inout) :: input
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: lines(:)
+        integer :: ios
+        character(len=256) :: msg
+        character(len=len_name) :: name, parent, joint
+        real(wp), dimension(3) :: joint_position, joint_axis, centre, inertia, inertia_products
+        real(wp) :: mass, coordinate, rate
+        namelist /rigid_chain/ name, parent, joint, joint_position, joint_axis, centre, mass, &
+            inertia, inertia_products, coordinate, rate
+        name = input%name
+        parent = input%parent
+        joint = input%joint
+        joint_position = input%joint_position
+        joint_axis = input%joint_axis
+        centre = input%centre
+        mass = input%mass
+        inertia = input%inertia
+        inertia_products = input%inertia_products
+        coordinate = input%coordinate
+        rate = input%rate
+        msg = ''
+        lines = split_lines(text)
+        read (lines, nml=rigid_chain, iostat=ios, iomsg=msg)
+        input%name = name
+        input%parent = parent
+        input%joint = joint
+        input%joint_position = joint_position
+        input%joint_axis = joint_axis
+        input%centre = centre
+        input%mass = mass
+        input%inertia = inertia
+        input%inertia_products = inertia_products
+        input%coordinate = coordinate
+        input%rate = rate
+        if (ios /= 0) call status%set(status_bad_input, path // ': &rigid_chain: ' // trim(msg))
+    end subroutine read_chain_group
+
     !> Split text at newlines into records of equal length.
     pure function split_lines(text) result(lines)
         character(len=*), intent(in) :: text
@@ -1329,6 +1407,10 @@ contains
                 scene%drivers(i)%name = 'driver ' // itoa(i)
             scene%drivers(i)%type = lower(scene%drivers(i)%type)
         end do
+        do i = 1, size(scene%chain)
+            if (len_trim(scene%chain(i)%name) == 0) scene%chain(i)%name = 'link ' // itoa(i)
+            scene%chain(i)%joint = lower(scene%chain(i)%joint)
+        end do
         scene%body%element = lower(scene%body%element)
         scene%body%formulation = lower(scene%body%formulation)
         do i = 1, size(scene%materials)
@@ -1380,10 +1462,12 @@ contains
                      /= scene%solver_name)) then
             call bad(sol, 'name', 'must be ''radau5'', ''ddassl'', ''ida'' or ''mexax''')
         else if (scene%solver_name == 'mexax' .and. scene%problem /= 'pendulum' .and. &
-                 scene%problem /= 'flexible_body' .and. scene%problem /= 'multibody') then
+                 scene%problem /= 'flexible_body' .and. scene%problem /= 'multibody' .and. &
+                 scene%problem /= 'rigid_chain') then
             ! ALGORITHMS.md §6: MEXAX integrates the mechanical form only.
             call bad(sol, 'name', '''mexax'' integrates mechanical problems only: &
-                &problem must be ''pendulum'', ''flexible_body'' or ''multibody''')
+                &problem must be ''pendulum'', ''flexible_body'', ''multibody'' or &
+                &''rigid_chain''')
         else if (.not. scene%rtol > 0.0_wp) then
             call bad(sol, 'rtol', 'must be positive')
         else if (.not. scene%rtol < 1.0_wp) then
@@ -1463,6 +1547,78 @@ contains
         end subroutine missing
     end subroutine check_ranges
 
+    !> &rigid_chain groups: present exactly for problem = 'rigid_chain', each
+    !> body's parent the ground or an earlier body, values in range.
+    subroutine check_chain(scene, entries, path, status)
+        type(scene_input_t), intent(in) :: scene
+        type(entry_t), intent(in) :: entries(:)
+        character(len=*), intent(in) :: path
+        type(status_t), intent(inout) :: status
+        integer :: i, j
+        logical :: found
+        if (scene%problem /= 'rigid_chain') then
+            if (size(scene%chain) > 0) call status%set(status_bad_input, path // &
+                ': &rigid_chain: given, but problem = ''' // trim(scene%problem) // &
+                ''' (a scene builds only what it declares)' // at(scene%chain(1)%line))
+            return
+        end if
+        if (size(scene%chain) == 0) then
+            call status%set(status_bad_input, path // ': &simulation: problem = &
+                &''rigid_chain'': needs at least one &rigid_chain group (one per body)')
+            return
+        end if
+        if (all(formulation_names /= scene%multibody%formulation)) then
+            call status%set(status_bad_input, path // ': &multibody: formulation = ''' // &
+                trim(scene%multibody%formulation) // ''': must be one of ' // &
+                choices(formulation_names))
+            return
+        end if
+        do i = 1, size(scene%chain)
+            associate (b => scene%chain(i))
+                found = b%parent == 'ground'
+                do j = 1, i - 1
+                    if (scene%chain(j)%name == b%parent) found = .true.
+                    if (scene%chain(j)%name == b%name) then
+                        call bad('name', i, 'also the name of the &rigid_chain' // &
+                                 at(scene%chain(j)%line))
+                        return
+                    end if
+                end do
+                if (.not. found) then
+                    call bad('parent', i, 'must be ''ground'' or a body of an earlier &
+                        &&rigid_chain group')
+                else if (all([character(len=12) :: 'revolute', 'prismatic'] /= b%joint)) then
+                    call bad('joint', i, 'must be ''revolute'' or ''prismatic''')
+                else if (.not. norm2(b%joint_axis) > 0.0_wp) then
+                    call bad('joint_axis', i, 'must not be zero')
+                else if (.not. b%mass > 0.0_wp) then
+                    call bad('mass', i, 'must be positive (required)')
+                else if (any(.not. b%inertia > 0.0_wp)) then
+                    call bad('inertia', i, 'must be positive (required: Jxx, Jyy, Jzz)')
+                end if
+                if (.not. status%ok()) return
+            end associate
+        end do
+
+    contains
+
+        subroutine bad(name, instance, reason)
+            character(len=*), intent(in) :: name, reason
+            integer, intent(in) :: instance
+            integer :: e
+            do e = 1, size(entries)
+                if (entries(e)%group == 'rigid_chain' .and. entries(e)%name == name .and. &
+                    entries(e)%instance == instance) then
+                    call fail(status, path, entries(e), reason)
+                    return
+                end if
+            end do
+            call status%set(status_bad_input, path // ': &rigid_chain ''' // &
+                trim(scene%chain(instance)%name) // ''': ' // name // ' (default): ' // reason &
+                // at(scene%chain(instance)%line))
+        end subroutine bad
+    end subroutine check_chain
+
     !> &multibody, &rigid_body, &marker, &joint and &driver: present exactly
     !> for problem = 'multibody'; values in range; names unique and known.
     !> (Constraint rank and the initial assembly are checked by the builder.)
@@ -1480,6 +1636,8 @@ contains
         integer :: i, j, g
         if (scene%problem /= 'multibody') then
             do g = 1, size(mb_groups)
+                ! a chain takes gravity and formulation from &multibody
+                if (g == 1 .and. scene%problem == 'rigid_chain') cycle
                 if (given(mb_groups(g)) .or. (g == 1 .and. scene%has_multibody)) then
                     call status%set(status_bad_input, path // ': &' // trim(mb_groups(g)) // &
                         ': given, but problem = ''' // trim(scene%problem) // ''' (a scene &

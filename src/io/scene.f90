@@ -29,6 +29,8 @@ module flexmbs_io_scene
         formulation_index2, formulation_index3, formulation_ggl
     use flexmbs_io_namelist, only: scene_input_t, scene_dae_options, controller_code
     use flexmbs_io_multibody_input, only: build_multibody
+    use flexmbs_io_chain_input, only: build_rigid_chain
+    use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     use flexmbs_mbs_system, only: mbs_system_t
     use flexmbs_io_body_input, only: build_flexible_body, body_energies
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
@@ -181,6 +183,38 @@ contains
             if (formulation%nc > 0) blocks = [blocks, block_spec_t('lambda', &
                 formulation%ol + 1, formulation%ol + formulation%nc)]
             allocate (problem, source=formulation)
+        case ('rigid_chain')
+            if (.not. present(mechanical)) then
+                call status%set(status_bad_input, scene%path // ': &simulation: problem = &
+                    &''rigid_chain'': build_problem needs its `mechanical` argument')
+                return
+            end if
+            allocate (rigid_chain_t :: mechanical)
+            select type (chain => mechanical)
+            type is (rigid_chain_t)
+                call build_rigid_chain(scene, chain, q0, v0, status)
+            end select
+            if (.not. status%ok()) return
+            ! M(q) varies: the acceleration layout y = (q, v, a) (nc = 0). MEXAX
+            ! integrates y = (q, v); its formulation only gives that layout.
+            formulation = new_formulation(mechanical, merge(formulation_index2, &
+                mechanical_formulation(scene%multibody%formulation), &
+                scene%solver_name == 'mexax'), q0, &
+                constant_mass=scene%solver_name == 'mexax', status=status)
+            if (.not. status%ok()) then
+                status%message = scene%path // ': &rigid_chain: ' // status%message
+                return
+            end if
+            allocate (y0(formulation%n), yp0(formulation%n), source=0.0_wp)
+            y0(formulation%oq + 1:formulation%oq + formulation%nq) = q0
+            y0(formulation%ov + 1:formulation%ov + formulation%nv) = v0
+            if (scene%solver_name /= 'mexax') then
+                call formulation%consistent_initial(scene%t_start, y0, yp0, status)
+                if (.not. status%ok()) return
+            end if
+            blocks = [block_spec_t('q', formulation%oq + 1, formulation%oq + formulation%nq), &
+                      block_spec_t('v', formulation%ov + 1, formulation%ov + formulation%nv)]
+            allocate (problem, source=formulation)
         case ('brusselator_1d', 'brusselator_2d')
             bruss = new_reaction_diffusion(merge(1, 2, scene%problem == 'brusselator_1d'), &
                 scene%npoints, sparse=scene%linear_solver /= 'dense', status=status)
@@ -269,7 +303,7 @@ contains
             stab = trim(scene%pendulum_formulation)
         else if (scene%problem == 'flexible_body') then
             stab = trim(scene%body%formulation)
-        else if (scene%problem == 'multibody') then
+        else if (scene%problem == 'multibody' .or. scene%problem == 'rigid_chain') then
             stab = trim(scene%multibody%formulation)
         else
             stab = '-'

@@ -1,0 +1,51 @@
+!> A rigid chain (flexmbs_mbs_rigid_chain) from the `&rigid_chain` groups of
+!> a validated scene (one group per body, parents by name) and the gravity
+!> of `&multibody`; joint frames are aligned with the parent's frame
+!> (R0 = I), so joint_axis is given in the parent's frame.
+module flexmbs_io_chain_input
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_mbs_rigid_chain, only: rigid_chain_t, new_rigid_chain, chain_body_t, &
+        chain_joint_revolute, chain_joint_prismatic
+    use flexmbs_io_namelist, only: scene_input_t
+    implicit none
+    private
+
+    public :: build_rigid_chain
+
+contains
+
+    !> The chain of the scene and its initial coordinates q0 and rates v0.
+    subroutine build_rigid_chain(scene, chain, q0, v0, status)
+        type(scene_input_t), intent(in) :: scene
+        type(rigid_chain_t), intent(out) :: chain
+        real(wp), allocatable, intent(out) :: q0(:), v0(:)
+        type(status_t), intent(out) :: status
+        type(chain_body_t), allocatable :: bodies(:)
+        integer :: i, j
+        allocate (bodies(size(scene%chain)), q0(size(scene%chain)), v0(size(scene%chain)))
+        do i = 1, size(bodies)
+            associate (c => scene%chain(i))
+                bodies(i)%parent = 0
+                do j = 1, i - 1
+                    if (scene%chain(j)%name == c%parent) bodies(i)%parent = j
+                end do
+                bodies(i)%joint = merge(chain_joint_prismatic, chain_joint_revolute, &
+                                        c%joint == 'prismatic')
+                bodies(i)%joint_position = c%joint_position
+                bodies(i)%axis = c%joint_axis / norm2(c%joint_axis)
+                bodies(i)%centre = c%centre
+                bodies(i)%mass = c%mass
+                bodies(i)%inertia = reshape([c%inertia(1), c%inertia_products(1), &
+                    c%inertia_products(3), c%inertia_products(1), c%inertia(2), &
+                    c%inertia_products(2), c%inertia_products(3), c%inertia_products(2), &
+                    c%inertia(3)], [3, 3])
+                q0(i) = c%coordinate
+                v0(i) = c%rate
+            end associate
+        end do
+        chain = new_rigid_chain(bodies, status, gravity=scene%multibody%gravity)
+        if (.not. status%ok()) call status%set(status_bad_input, scene%path // ': ' // &
+                                               status%text())
+    end subroutine build_rigid_chain
+end module flexmbs_io_chain_input
