@@ -90,6 +90,14 @@ contains
             if (allocated(mechanical)) deallocate (mechanical)
         end if
         select case (trim(scene%problem))
+        case ('flexible_body', 'multibody', 'rigid_chain')
+            if (.not. present(mechanical)) then
+                call status%set(status_bad_input, scene%path // ': &simulation: problem = ''' &
+                    // trim(scene%problem) // ''': build_problem needs its `mechanical` argument')
+                return
+            end if
+        end select
+        select case (trim(scene%problem))
         case ('van_der_pol')
             allocate (problem, source=new_van_der_pol(scene%vdp_eps, sparse=klu))
             y0 = [scene%vdp_y1, scene%vdp_y2]
@@ -121,11 +129,6 @@ contains
                     length=scene%pendulum_length, gravity=scene%gravity, status=status))
             end if
         case ('flexible_body')
-            if (.not. present(mechanical)) then
-                call status%set(status_bad_input, scene%path // ': &simulation: problem = &
-                    &''flexible_body'': build_problem needs its `mechanical` argument')
-                return
-            end if
             allocate (flexible_body_t :: mechanical)
             select type (body => mechanical)
             type is (flexible_body_t)
@@ -147,11 +150,6 @@ contains
             blocks = [block_spec_t('q', 1, nq), block_spec_t('v', nq + 1, 2 * nq)]
             allocate (problem, source=formulation)
         case ('multibody')
-            if (.not. present(mechanical)) then
-                call status%set(status_bad_input, scene%path // ': &simulation: problem = &
-                    &''multibody'': build_problem needs its `mechanical` argument')
-                return
-            end if
             allocate (mbs_system_t :: mechanical)
             select type (sys => mechanical)
             type is (mbs_system_t)
@@ -184,11 +182,6 @@ contains
                 formulation%ol + 1, formulation%ol + formulation%nc)]
             allocate (problem, source=formulation)
         case ('rigid_chain')
-            if (.not. present(mechanical)) then
-                call status%set(status_bad_input, scene%path // ': &simulation: problem = &
-                    &''rigid_chain'': build_problem needs its `mechanical` argument')
-                return
-            end if
             allocate (rigid_chain_t :: mechanical)
             select type (chain => mechanical)
             type is (rigid_chain_t)
