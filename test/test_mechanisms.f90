@@ -8,6 +8,8 @@ module test_mechanisms
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_sink, only: sink_t
     use flexmbs_dae_radau5, only: radau5_t
+    use flexmbs_dae_mexax, only: mexax_t
+    use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_mbs_rigid_body, only: rigid_body_t
     use flexmbs_mbs_joint, only: joint_primitive
@@ -43,7 +45,8 @@ contains
                  new_test('driver_rows_ad_vs_analytic', test_driver_rows), &
                  new_test('slider_crank_closed_form', test_slider_crank), &
                  new_test('four_bar_closed_form', test_four_bar), &
-                 new_test('four_bar_closed_form_ad', test_four_bar_ad)]
+                 new_test('four_bar_closed_form_ad', test_four_bar_ad), &
+                 new_test('sparse_forms_and_mexax_klu', test_sparse)]
     end function collect_mechanisms
 
     !> s' and s'' of a polynomial + harmonic driver against central differences.
@@ -217,4 +220,71 @@ contains
         type(error_t), allocatable, intent(out) :: error
         call run_mechanism(error, 2, 'four-bar (ad)', 'ad')
     end subroutine test_four_bar_ad
+    !> The system's CSC M and G equal the dense ones; MEXAX with KLU on
+    !> [M Gᵀ; G 0] follows MEXAX dense on the slider-crank.
+    subroutine test_sparse(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(mbs_system_t), target :: sys
+        type(csc_matrix_t) :: mp, gp
+        type(status_t) :: status
+        type(mexax_t) :: mexax
+        type(dae_options_t) :: options
+        type(dae_stats_t) :: stats
+        real(wp) :: q0(21), md(18, 18), ms(18, 18), gd(18, 18), gs(18, 18), t, dev
+        real(wp) :: q(21, 2), v(18, 2), lam(18, 2)
+        real(wp), allocatable :: values(:)
+        integer :: k
+        call new_mechanism(1, sys, q0, status)
+        call sys%mass_pattern(mp, status)
+        allocate (values(mp%nnz))
+        call sys%mass_sparse(0.0_wp, q0, values, status)
+        mp%values = values
+        call mp%to_dense(ms)
+        call sys%mass(0.0_wp, q0, md, status)
+        call sys%constraint_jacobian_pattern(gp, status)
+        deallocate (values)
+        allocate (values(gp%nnz))
+        call sys%constraint_jacobian_sparse(0.1_wp, q0, values, status)
+        gp%values = values
+        call gp%to_dense(gs)
+        call sys%constraint_jacobian(0.1_wp, q0, gd, status)
+        call check(error, status%ok(), 'sparse forms: ' // status%text())
+        call check(error, all(ms == md), 'sparse M differs from dense M')
+        call check(error, all(gs == gd), 'sparse G differs from dense G')
+        if (allocated(error)) return
+        options%rtol = 1.0e-8_wp
+        options%atol = 1.0e-8_wp
+        do k = 1, 2
+            options%linear_solver = trim(merge('dense', 'klu  ', k == 1))
+            q(:, k) = q0
+            v(:, k) = 0.0_wp
+            lam(:, k) = 0.0_wp
+            call consistent_velocity(sys, q(:, k), v(:, k))
+            t = 0.0_wp
+            call mexax%integrate_mechanical(sys, t, q(:, k), v(:, k), 0.5_wp, options, stats, &
+                                            status, lambda=lam(:, k))
+            call check(error, status%ok(), 'mexax ' // trim(options%linear_solver) // ': ' // &
+                       status%text())
+            if (allocated(error)) return
+        end do
+        dev = maxval(abs(q(:, 1) - q(:, 2)))
+        print '(4x,a,es9.2)', 'MEXAX dense vs KLU on the slider-crank: ', dev
+        call check(error, dev <= 1.0e-8_wp, 'MEXAX KLU differs from dense')
+    end subroutine test_sparse
+
+    !> Velocities of the driven mechanism at t = 0 by the formulation's
+    !> consistent-initial projection.
+    subroutine consistent_velocity(sys, q, v)
+        type(mbs_system_t), target, intent(inout) :: sys
+        real(wp), intent(inout) :: q(:), v(:)
+        type(formulation_t) :: dae
+        type(status_t) :: status
+        real(wp), allocatable :: y(:), yp(:)
+        dae = new_formulation(sys, formulation_ggl, q, status=status)
+        allocate (y(dae%n), yp(dae%n), source=0.0_wp)
+        y(1:21) = q
+        call dae%consistent_initial(0.0_wp, y, yp, status)
+        q = y(1:21)
+        v = y(22:39)
+    end subroutine consistent_velocity
 end module test_mechanisms

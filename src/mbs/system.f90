@@ -20,9 +20,10 @@
 !> hand-coded first derivatives (exact, one dual pass per joint and block),
 !> in place of the forward-difference defaults of mechanical_problem_t.
 !>
-!> Storage is dense for now (M, G and all their derivatives as full arrays;
-!> no `has_sparse`): the patterns are block-sparse (a joint touches the
-!> columns of at most two bodies) and a CSC assembly is future work.
+!> Storage: M and G also in CSC (`has_sparse`, patterns fixed once: per body
+!> the m I₃ diagonal and the 3 × 3 inertia block; per joint its rows times
+!> the 6 velocity columns of each marker's body), which MEXAX's KLU path
+!> uses; the derivatives the formulations need are dense arrays.
 !> Drivers: a joint of one primitive (kind joint_primitive) that is an angle
 !> driver, a translation driver or a distance follows s(t) of its driver_t,
 !> s = Σ c_k t^k (k ≤ 3) + a sin(ω t + φ), with s', s'' exact; c_t and the
@@ -41,6 +42,7 @@ module flexmbs_mbs_system
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_text, only: int_text
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_mbs_rotation, only: rotation_matrix, quat_rate_matrix, cross
     use flexmbs_mbs_dual, only: dual_t, operator(+), assignment(=), dot_product
     use flexmbs_mbs_rigid_body, only: rigid_body_t, rigid_bodies_t, new_rigid_bodies, &
@@ -120,8 +122,15 @@ module flexmbs_mbs_system
         integer :: derivatives = constraint_derivatives_analytic
         integer :: nq_rigid = 0, nv_rigid = 0
         real(wp), allocatable :: zero_v(:) !! v = 0 for position-only evaluations
+        !> copies of the CSC patterns handed out (their triplet maps place values)
+        type(csc_matrix_t) :: mass_csc, jacobian_csc
     contains
         procedure :: kinematics => system_kinematics
+        procedure :: has_sparse => system_has_sparse
+        procedure :: mass_pattern => system_mass_pattern
+        procedure :: mass_sparse => system_mass_sparse
+        procedure :: constraint_jacobian_pattern => system_constraint_jacobian_pattern
+        procedure :: constraint_jacobian_sparse => system_constraint_jacobian_sparse
         procedure :: mass => system_mass
         procedure :: forces => system_forces
         procedure :: normalize => system_normalize
@@ -242,6 +251,125 @@ contains
         integer, intent(in) :: k
         row = self%joints(k)%row0 + 1
     end function system_joint_first_row
+
+    ! ------------------------------------------------ sparse (CSC) forms
+
+    logical function system_has_sparse(self)
+        class(mbs_system_t), intent(in) :: self
+        system_has_sparse = .true.
+    end function system_has_sparse
+
+    !> M: per body m I₃ (3 slots) and the full 3 × 3 inertia block, in the
+    !> triplet order mass_sparse fills.
+    subroutine system_mass_pattern(self, pattern, status)
+        class(mbs_system_t), intent(inout) :: self
+        type(csc_matrix_t), intent(inout) :: pattern
+        type(status_t), intent(inout) :: status
+        integer, allocatable :: rows(:), cols(:)
+        integer :: b, i, j, n, iv
+        allocate (rows(12 * size(self%rigid%bodies)), cols(12 * size(self%rigid%bodies)))
+        n = 0
+        do b = 1, size(self%rigid%bodies)
+            iv = rigid_body_nv * (b - 1)
+            do i = 1, 3
+                n = n + 1
+                rows(n) = iv + i
+                cols(n) = iv + i
+            end do
+            do j = 4, 6
+                do i = 4, 6
+                    n = n + 1
+                    rows(n) = iv + i
+                    cols(n) = iv + j
+                end do
+            end do
+        end do
+        call pattern%build(self%nv, self%nv, rows, cols, status)
+        if (status%ok()) self%mass_csc = pattern
+    end subroutine system_mass_pattern
+
+    subroutine system_mass_sparse(self, t, q, values, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        integer :: b, i, j, n
+        n = 0
+        values = 0.0_wp
+        do b = 1, size(self%rigid%bodies)
+            do i = 1, 3
+                n = n + 1
+                values(self%mass_csc%triplet_map(n)) = self%rigid%bodies(b)%mass
+            end do
+            do j = 1, 3
+                do i = 1, 3
+                    n = n + 1
+                    values(self%mass_csc%triplet_map(n)) = self%rigid%bodies(b)%inertia(i, j)
+                end do
+            end do
+        end do
+    end subroutine system_mass_sparse
+
+    !> G: joint k's rows times the 6 velocity columns of each of its
+    !> markers' bodies (none for the ground), joint by joint.
+    subroutine system_constraint_jacobian_pattern(self, pattern, status)
+        class(mbs_system_t), intent(inout) :: self
+        type(csc_matrix_t), intent(inout) :: pattern
+        type(status_t), intent(inout) :: status
+        integer, allocatable :: rows(:), cols(:)
+        integer :: k, n, r, c, side, mk, b, iq, iv, nt
+        nt = 0
+        do k = 1, size(self%joints)
+            do side = 1, 2
+                mk = merge(self%joints(k)%marker_i, self%joints(k)%marker_j, side == 1)
+                nt = nt + self%joints(k)%joint%nrows * marker_columns(self, mk, .false.)
+            end do
+        end do
+        allocate (rows(nt), cols(nt))
+        n = 0
+        do k = 1, size(self%joints)
+            do side = 1, 2
+                mk = merge(self%joints(k)%marker_i, self%joints(k)%marker_j, side == 1)
+                call marker_offsets(self, mk, b, iq, iv)
+                do c = 1, marker_columns(self, mk, .false.)
+                    do r = 1, self%joints(k)%joint%nrows
+                        n = n + 1
+                        rows(n) = self%joints(k)%row0 + r
+                        cols(n) = iv + c
+                    end do
+                end do
+            end do
+        end do
+        call pattern%build(self%nc, self%nv, rows, cols, status)
+        if (status%ok()) self%jacobian_csc = pattern
+    end subroutine system_constraint_jacobian_pattern
+
+    subroutine system_constraint_jacobian_sparse(self, t, q, values, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq), ct(max_rows)
+        integer :: k, n, r, c, ni, nj, nr
+        n = 0
+        values = 0.0_wp
+        do k = 1, size(self%joints)
+            nr = self%joints(k)%joint%nrows
+            call joint_first_derivatives(self, k, t, q, .false., ci, cj, ni, nj, ct)
+            do c = 1, ni
+                do r = 1, nr
+                    n = n + 1
+                    values(self%jacobian_csc%triplet_map(n)) = ci(r, c)
+                end do
+            end do
+            do c = 1, nj
+                do r = 1, nr
+                    n = n + 1
+                    values(self%jacobian_csc%triplet_map(n)) = cj(r, c)
+                end do
+            end do
+        end do
+    end subroutine system_constraint_jacobian_sparse
 
     ! ------------------------------------------------ bodies (delegated)
 
