@@ -167,7 +167,7 @@ contains
             &inertia = 1, 1, 1 /', "mb.nml: &rigid_chain: parent = 'c': must be 'ground' or a &
             &body of an earlier &rigid_chain group")
         call expect(error, sim // '&rigid_chain joint = ''ball'', mass = 1, inertia = 1, 1, 1 /', &
-            "mb.nml: &rigid_chain: joint = 'ball': must be 'revolute' or 'prismatic'")
+            "mb.nml: &rigid_chain: joint = 'ball': must be 'revolute', 'prismatic' or 'spherical'")
         call expect(error, sim // '&rigid_chain inertia = 1, 1, 1 /', &
             "&rigid_chain 'link 1': mass (default): must be positive (required)")
         call expect(error, '&simulation problem = ''pendulum'', t_end = 1 /' // nl // link, &

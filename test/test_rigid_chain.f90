@@ -11,9 +11,9 @@ module test_rigid_chain
     use flexmbs_dae_mexax, only: mexax_t
     use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle, quat_product, cross
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, new_rigid_chain, chain_body_t, &
-        chain_marker_t, chain_joint_revolute, chain_joint_prismatic
+        chain_marker_t, chain_joint_revolute, chain_joint_prismatic, chain_joint_spherical
     use flexmbs_mbs_rigid_body, only: rigid_body_t
-    use flexmbs_mbs_joint, only: joint_revolute
+    use flexmbs_mbs_joint, only: joint_revolute, joint_spherical
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index2, &
         formulation_ggl
@@ -32,7 +32,9 @@ contains
                  new_test('newton_euler_vs_lagrange', test_lagrange), &
                  new_test('energy_conserved', test_energy), &
                  new_test('same_motion_as_absolute_coordinates', test_absolute), &
-                 new_test('mexax_runs_the_chain', test_mexax)]
+                 new_test('mexax_runs_the_chain', test_mexax), &
+                 new_test('spherical_joint_mass_and_energy', test_spherical), &
+                 new_test('spherical_joint_same_motion_as_absolute', test_spherical_absolute)]
     end function collect_rigid_chain
 
     !> A tree of four bodies: 1 on the ground (revolute z), 2 on 1 (revolute
@@ -317,4 +319,147 @@ contains
         call check(error, max(maxval(abs(q - y(1:4))), maxval(abs(v - y(5:8)))) <= 1.0e-5_wp, &
                    'MEXAX and RADAU5 disagree on the chain')
     end subroutine test_mexax
+    !> A spherical root (quaternion coordinates, body-fixed rates) under a
+    !> revolute link: two bodies, nq = 5, nv = 4.
+    function spherical_pair(status) result(chain)
+        type(status_t), intent(out) :: status
+        type(rigid_chain_t) :: chain
+        type(chain_body_t) :: b(2)
+        type(chain_marker_t) :: m(2)
+        b(1) = chain_body_t(0, chain_joint_spherical, [0.0_wp, 0.0_wp, 0.0_wp], &
+                            body_rotation(0.0_wp), [0.0_wp, 0.0_wp, 1.0_wp], &
+                            [0.3_wp, 0.05_wp, -0.1_wp], 1.2_wp, inertia(1))
+        b(2) = chain_body_t(1, chain_joint_revolute, [0.6_wp, 0.0_wp, -0.2_wp], &
+                            body_rotation(0.0_wp), [0.6_wp, 0.0_wp, 0.8_wp], &
+                            [0.0_wp, 0.25_wp, -0.1_wp], 0.7_wp, inertia(2))
+        m(1) = chain_marker_t(1, b(1)%centre)
+        m(2) = chain_marker_t(2, b(2)%centre)
+        chain = new_rigid_chain(b, status, m, g_earth)
+    end function spherical_pair
+
+    !> With a spherical joint: M against the kinetic energy (1e-12), and
+    !> RADAU5 keeps the energy (rtol 1e-8, 1e-6 relative over 2 s).
+    subroutine test_spherical(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(rigid_chain_t), target :: chain
+        type(formulation_t) :: dae
+        type(radau5_t) :: solver
+        type(dae_options_t) :: options
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        real(wp) :: q0(5), v0(4), m(4, 4), mk(4, 4), jx(3, 4), jr(3, 4), o(3), r(3, 3), &
+            t, ek0, ep0, ek, ep
+        real(wp), allocatable :: y(:)
+        integer :: i
+        chain = spherical_pair(status)
+        call check(error, status%ok() .and. chain%nq == 5 .and. chain%nv == 4, &
+                   'spherical chain: ' // status%text())
+        if (allocated(error)) return
+        q0(1:4) = quat_from_axis_angle([0.48_wp, 0.6_wp, 0.64_wp], 0.7_wp)
+        q0(5) = -0.4_wp
+        v0 = [0.5_wp, -1.0_wp, 0.8_wp, 1.5_wp]
+        call chain%mass(0.0_wp, q0, m, status)
+        mk = 0.0_wp
+        do i = 1, 2
+            call chain%marker_jacobian(q0, i, jx, jr)
+            call chain%body_frame(q0, i, o, r)
+            mk = mk + chain%bodies(i)%mass * matmul(transpose(jx), jx) &
+                 + matmul(transpose(jr), matmul(matmul(r, matmul(chain%bodies(i)%inertia, &
+                                                                 transpose(r))), jr))
+        end do
+        call check(error, maxval(abs(m - mk)) <= 1.0e-12_wp * maxval(abs(m)), &
+                   'spherical: CRBA M differs from the kinetic energy')
+        call chain%energy(q0, v0, ek0, ep0)
+        dae = new_formulation(chain, formulation_index2, q0, status=status)
+        allocate (y(dae%n), source=0.0_wp)
+        y(1:5) = q0
+        y(6:9) = v0
+        options%rtol = 1.0e-8_wp
+        options%atol = 1.0e-8_wp
+        t = 0.0_wp
+        call solver%integrate(dae, t, y, 2.0_wp, options, stats, status)
+        call check(error, status%ok(), 'spherical run: ' // status%text())
+        if (allocated(error)) return
+        call chain%energy(y(1:5), y(6:9), ek, ep)
+        print '(4x,a,es9.2,a,es9.2)', 'spherical chain: energy drift ', &
+            abs(ek + ep - ek0 - ep0) / ek0, ', |p| - 1 = ', norm2(y(1:4)) - 1.0_wp
+        call check(error, abs(ek + ep - ek0 - ep0) <= 1.0e-6_wp * ek0, 'spherical: energy drift')
+    end subroutine test_spherical
+
+    !> The spherical–revolute pair as a chain and as two free bodies with a
+    !> spherical and a revolute joint (GGL): centres of mass and rotations
+    !> agree at t = 1 (rtol 1e-8).
+    subroutine test_spherical_absolute(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(rigid_chain_t), target :: chain
+        type(mbs_system_t), target :: sys
+        type(formulation_t) :: dae_chain, dae_abs
+        type(radau5_t) :: solver
+        type(dae_options_t) :: options
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        type(marker_t) :: m(4)
+        type(rigid_body_t) :: bodies(2)
+        real(wp) :: q0(5), v0(4), qa(14), o(3), r(3, 3), p(4, 2), vc(3), w(3), t, worst
+        real(wp), allocatable :: y(:), ya(:), yp(:)
+        integer :: i
+        chain = spherical_pair(status)
+        q0(1:4) = quat_from_axis_angle([0.48_wp, 0.6_wp, 0.64_wp], 0.7_wp)
+        q0(5) = -0.4_wp
+        v0 = [0.5_wp, -1.0_wp, 0.8_wp, 1.5_wp]
+        p(:, 1) = q0(1:4)
+        p(:, 2) = quat_product(p(:, 1), quat_from_axis_angle(chain%bodies(2)%axis, q0(5)))
+        do i = 1, 2
+            call chain%body_frame(q0, i, o, r)
+            call check(error, maxval(abs(rotation_matrix(p(:, i)) - r)) < 1.0e-14_wp, &
+                       'quaternion of the chain frame')
+            qa(7 * i - 6:7 * i - 4) = o + matmul(r, chain%bodies(i)%centre)
+            qa(7 * i - 3:7 * i) = p(:, i)
+            bodies(i) = rigid_body_t(chain%bodies(i)%mass, chain%bodies(i)%inertia)
+        end do
+        if (allocated(error)) return
+        m(1) = marker_t(0, [0.0_wp, 0.0_wp, 0.0_wp])
+        m(2) = marker_t(1, -chain%bodies(1)%centre)
+        m(3) = marker_t(1, chain%bodies(2)%joint_position - chain%bodies(1)%centre, &
+                        axes_with_z(chain%bodies(2)%axis))
+        m(4) = marker_t(2, -chain%bodies(2)%centre, axes_with_z(chain%bodies(2)%axis))
+        sys = new_mbs_system(bodies, m, [mbs_joint_t(joint_spherical, 1, 2), &
+                             mbs_joint_t(joint_revolute, 3, 4)], gravity=g_earth, status=status)
+        call check(error, status%ok(), 'absolute system: ' // status%text())
+        if (allocated(error)) return
+        dae_abs = new_formulation(sys, formulation_ggl, qa, status=status)
+        allocate (ya(dae_abs%n), yp(dae_abs%n), source=0.0_wp)
+        ya(1:14) = qa
+        do i = 1, 2
+            call chain%body_velocity(q0, v0, i, vc, w)
+            call chain%body_frame(q0, i, o, r)
+            ya(14 + 6 * i - 5:14 + 6 * i - 3) = vc
+            ya(14 + 6 * i - 2:14 + 6 * i) = matmul(transpose(r), w)
+        end do
+        call dae_abs%consistent_initial(0.0_wp, ya, yp, status)
+        options%rtol = 1.0e-8_wp
+        options%atol = 1.0e-8_wp
+        t = 0.0_wp
+        call solver%integrate(dae_abs, t, ya, 1.0_wp, options, stats, status)
+        call check(error, status%ok(), 'absolute run: ' // status%text())
+        dae_chain = new_formulation(chain, formulation_index2, q0, status=status)
+        allocate (y(dae_chain%n), source=0.0_wp)
+        y(1:5) = q0
+        y(6:9) = v0
+        t = 0.0_wp
+        call solver%integrate(dae_chain, t, y, 1.0_wp, options, stats, status)
+        call check(error, status%ok(), 'chain run: ' // status%text())
+        if (allocated(error)) return
+        worst = 0.0_wp
+        do i = 1, 2
+            call chain%body_frame(y(1:5) / [norm2(y(1:4)), norm2(y(1:4)), norm2(y(1:4)), &
+                                            norm2(y(1:4)), 1.0_wp], i, o, r)
+            worst = max(worst, norm2(o + matmul(r, chain%bodies(i)%centre) - &
+                                     ya(7 * i - 6:7 * i - 4)), &
+                        maxval(abs(rotation_matrix(ya(7 * i - 3:7 * i) / &
+                                                   norm2(ya(7 * i - 3:7 * i))) - r)))
+        end do
+        print '(4x,a,es9.2)', 'spherical chain vs absolute coordinates at t = 1: ', worst
+        call check(error, worst <= 1.0e-6_wp, 'spherical chain and absolute coordinates differ')
+    end subroutine test_spherical_absolute
 end module test_rigid_chain

@@ -142,7 +142,10 @@ module flexmbs_io_namelist
         var_spec_t('rigid_chain', 'inertia', kind_real, 3), &
         var_spec_t('rigid_chain', 'inertia_products', kind_real, 3), &
         var_spec_t('rigid_chain', 'coordinate', kind_real), &
-        var_spec_t('rigid_chain', 'rate', kind_real)]
+        var_spec_t('rigid_chain', 'rate', kind_real), &
+        var_spec_t('rigid_chain', 'rotation_axis', kind_real, 3), &
+        var_spec_t('rigid_chain', 'rotation_angle', kind_real), &
+        var_spec_t('rigid_chain', 'angular_rate', kind_real, 3)]
 
     character(len=16), parameter :: group_names(*) = [character(len=16) :: &
         'simulation', 'solver', 'output', 'flexible_body', 'material', 'multibody', &
@@ -261,6 +264,10 @@ module flexmbs_io_namelist
         real(wp) :: inertia_products(3) = 0.0_wp
         real(wp) :: coordinate = 0.0_wp               !! initial q [rad or m]
         real(wp) :: rate = 0.0_wp                     !! initial q' [rad/s or m/s]
+        !> spherical: initial relative rotation and angular velocity (own frame)
+        real(wp) :: rotation_axis(3) = [0.0_wp, 0.0_wp, 1.0_wp]
+        real(wp) :: rotation_angle = 0.0_wp
+        real(wp) :: angular_rate(3) = 0.0_wp
         integer :: line = 0
     end type chain_body_input_t
 
@@ -1314,9 +1321,11 @@ contains
         character(len=256) :: msg
         character(len=len_name) :: name, parent, joint
         real(wp), dimension(3) :: joint_position, joint_axis, centre, inertia, inertia_products
-        real(wp) :: mass, coordinate, rate
+        real(wp) :: mass, coordinate, rate, rotation_angle
+        real(wp), dimension(3) :: rotation_axis, angular_rate
         namelist /rigid_chain/ name, parent, joint, joint_position, joint_axis, centre, mass, &
-            inertia, inertia_products, coordinate, rate
+            inertia, inertia_products, coordinate, rate, rotation_axis, rotation_angle, &
+            angular_rate
         name = input%name
         parent = input%parent
         joint = input%joint
@@ -1328,6 +1337,9 @@ contains
         inertia_products = input%inertia_products
         coordinate = input%coordinate
         rate = input%rate
+        rotation_axis = input%rotation_axis
+        rotation_angle = input%rotation_angle
+        angular_rate = input%angular_rate
         msg = ''
         lines = split_lines(text)
         read (lines, nml=rigid_chain, iostat=ios, iomsg=msg)
@@ -1342,6 +1354,9 @@ contains
         input%inertia_products = inertia_products
         input%coordinate = coordinate
         input%rate = rate
+        input%rotation_axis = rotation_axis
+        input%rotation_angle = rotation_angle
+        input%angular_rate = angular_rate
         if (ios /= 0) call status%set(status_bad_input, path // ': &rigid_chain: ' // trim(msg))
     end subroutine read_chain_group
 
@@ -1587,8 +1602,11 @@ contains
                 if (.not. found) then
                     call bad('parent', i, 'must be ''ground'' or a body of an earlier &
                         &&rigid_chain group')
-                else if (all([character(len=12) :: 'revolute', 'prismatic'] /= b%joint)) then
-                    call bad('joint', i, 'must be ''revolute'' or ''prismatic''')
+                else if (all([character(len=12) :: 'revolute', 'prismatic', 'spherical'] /= &
+                              b%joint)) then
+                    call bad('joint', i, 'must be ''revolute'', ''prismatic'' or ''spherical''')
+                else if (b%joint == 'spherical' .and. .not. norm2(b%rotation_axis) > 0.0_wp) then
+                    call bad('rotation_axis', i, 'must not be zero')
                 else if (.not. norm2(b%joint_axis) > 0.0_wp) then
                     call bad('joint_axis', i, 'must not be zero')
                 else if (.not. b%mass > 0.0_wp) then

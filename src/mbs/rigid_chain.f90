@@ -1,12 +1,15 @@
 !> Rigid chains: loop-free substructures in relative coordinates (DESIGN.md,
 !> the paper's rigid substructures). Body i hangs from its parent (0 = the
-!> ground) by a revolute or prismatic joint with coordinate q_i and rate
-!> v_i (q' = v, T = I), so M(q) v' = f(t, q, v) with f = −b(q, v) and no
-!> constraints (nc = 0).
+!> ground) by a revolute or prismatic joint (one coordinate q_i, rate v_i,
+!> q_i' = v_i) or a spherical joint (a unit quaternion p_i of the relative
+!> rotation, 4 coordinates, and the relative angular velocity w_i in the
+!> child's frame, 3 rates, p_i' = T(p_i) w_i), so q' = T(q) v,
+!> M(q) v' = f(t, q, v) with f = −b(q, v), and no constraints (nc = 0).
 !>
 !> Geometry, for body i with parent p (frames: origin o, rotation R, world):
 !>   joint origin   o_i = o_p + R_p x_i (+ R_p R0_i a_i q_i, prismatic)
-!>   orientation    R_i = R_p R0_i Rot(a_i, q_i) (revolute), R_p R0_i (prismatic)
+!>   orientation    R_i = R_p R0_i Rot(a_i, q_i) (revolute), R_p R0_i (prismatic),
+!>                  R_p R0_i R(p_i) (spherical)
 !>   centre of mass c_i = o_i + R_i s_i
 !> with x_i the joint's position and R0_i its rotation in the parent's frame,
 !> a_i the unit joint axis (joint frame = child frame at q = 0), s_i the
@@ -17,12 +20,14 @@
 !> (Featherstone, Rigid Body Dynamics Algorithms, 2008, chs. 2, 5, 6):
 !> motion [ω; v_O], force [n_O; f]. Joint i's motion subspace is
 !> S_i = [u; o_i × u] (revolute about the world axis u = R_p R0_i a_i
-!> through o_i) or [0; u] (prismatic); body i's spatial inertia about O is
+!> through o_i), [0; u] (prismatic), or the three columns [u_k; o_i × u_k],
+!> u_k = R_i e_k (spherical); body i's spatial inertia about O is
 !>   I_i = [Ī + m [c]×[c]×ᵀ, m [c]×; m [c]×ᵀ, m 1],  Ī = R J Rᵀ.
 !> Composite-rigid-body algorithm: I^c_i = I_i + Σ_children I^c_c, then
 !> M_ii = S_iᵀ I^c_i S_i and M_ij = M_ji = S_jᵀ I^c_i S_i for the ancestors
 !> j of i (no transforms: every vector is about O). Recursive Newton–Euler:
-!> v_i = v_p + S_i q̇_i, a_i = a_p + S_i q̈_i + v_i ×m S_i q̇_i (a_0 = −[0; g]),
+!> v_i = v_p + S_i v_i, a_i = a_p + S_i v̇_i + v_i ×m S_i v_i (a_0 = −[0; g];
+!> S_i is fixed in the child, so Ṡ_i = v_i ×m S_i),
 !> f_i = I_i a_i + v_i ×* I_i v_i, τ_i = S_iᵀ (f_i + Σ_children f_c);
 !> b(q, v) = τ(q, v, q̈ = 0) holds the Coriolis, centrifugal and gravity terms.
 !>
@@ -32,12 +37,14 @@ module flexmbs_mbs_rigid_chain
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_text, only: int_text
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
-    use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle, cross, skew
+    use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle, cross, skew, &
+        quat_rate_matrix, quat_normalize
     implicit none
     private
 
     integer, parameter, public :: chain_joint_revolute = 1
     integer, parameter, public :: chain_joint_prismatic = 2
+    integer, parameter, public :: chain_joint_spherical = 3
 
     real(wp), parameter :: identity3(3, 3) = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
         1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
@@ -69,6 +76,9 @@ module flexmbs_mbs_rigid_chain
         ! accelerations, spatial inertias and forces
         real(wp), allocatable :: o(:, :), r(:, :, :), s(:, :), vel(:, :), acc(:, :), &
             inert(:, :, :), comp(:, :, :), frc(:, :)
+        !> coordinates iq(i)+1 .. iq(i+1) and rates iv(i)+1 .. iv(i+1) of body i;
+        !> s holds the motion subspace columns by rate index
+        integer, allocatable :: iq(:), iv(:)
     contains
         procedure :: kinematics => chain_kinematics
         procedure :: mass => chain_mass
@@ -76,6 +86,7 @@ module flexmbs_mbs_rigid_chain
         procedure :: constraint => chain_constraint
         procedure :: constraint_jacobian => chain_constraint_jacobian
         procedure :: kinematics_derivative => chain_kinematics_derivative
+        procedure :: normalize => chain_normalize
         procedure :: inverse_dynamics => chain_inverse_dynamics
         procedure :: body_frame => chain_body_frame
         procedure :: marker_pose => chain_marker_pose
@@ -106,10 +117,10 @@ contains
                     int_text(bodies(i)%parent) // ' must be 0 (ground) or an earlier body')
                 return
             end if
-            if (bodies(i)%joint /= chain_joint_revolute .and. &
-                bodies(i)%joint /= chain_joint_prismatic) then
-                call status%set(status_bad_input, where // ': joint must be revolute or ' // &
-                                'prismatic')
+            if (bodies(i)%joint < chain_joint_revolute .or. &
+                bodies(i)%joint > chain_joint_spherical) then
+                call status%set(status_bad_input, where // ': joint must be revolute, ' // &
+                                'prismatic or spherical')
                 return
             end if
             if (abs(norm2(bodies(i)%axis) - 1.0_wp) > 1.0e-12_wp) then
@@ -133,10 +144,17 @@ contains
             allocate (self%markers(0))
         end if
         if (present(gravity)) self%gravity = gravity
-        self%nq = n
-        self%nv = n
+        allocate (self%iq(n + 1), self%iv(n + 1))
+        self%iq(1) = 0
+        self%iv(1) = 0
+        do i = 1, n
+            self%iq(i + 1) = self%iq(i) + merge(4, 1, bodies(i)%joint == chain_joint_spherical)
+            self%iv(i + 1) = self%iv(i) + merge(3, 1, bodies(i)%joint == chain_joint_spherical)
+        end do
+        self%nq = self%iq(n + 1)
+        self%nv = self%iv(n + 1)
         self%nc = 0
-        allocate (self%o(3, 0:n), self%r(3, 3, 0:n), self%s(6, n), self%vel(6, 0:n), &
+        allocate (self%o(3, 0:n), self%r(3, 3, 0:n), self%s(6, self%nv), self%vel(6, 0:n), &
                   self%acc(6, 0:n), self%inert(6, 6, n), self%comp(6, 6, n), self%frc(6, n))
     end function new_rigid_chain
 
@@ -145,27 +163,36 @@ contains
     pure subroutine frames(self, q)
         class(rigid_chain_t), intent(inout) :: self
         real(wp), intent(in) :: q(:)
-        integer :: i, p
+        integer :: i, p, k, jq, jv
         real(wp) :: u(3), c(3), rj(3, 3), ibar(3, 3), cx(3, 3)
         self%o(:, 0) = 0.0_wp
         self%r(:, :, 0) = identity3
         do i = 1, size(self%bodies)
             associate (b => self%bodies(i))
                 p = b%parent
+                jq = self%iq(i) + 1
+                jv = self%iv(i) + 1
                 rj = matmul(self%r(:, :, p), b%joint_rotation)
                 u = matmul(rj, b%axis)
                 self%o(:, i) = self%o(:, p) + matmul(self%r(:, :, p), b%joint_position)
-                if (b%joint == chain_joint_revolute) then
+                select case (b%joint)
+                case (chain_joint_revolute)
                     self%r(:, :, i) = matmul(rj, rotation_matrix(quat_from_axis_angle(b%axis, &
-                                                                                      q(i))))
-                    self%s(1:3, i) = u
-                    self%s(4:6, i) = cross(self%o(:, i), u)
-                else
-                    self%o(:, i) = self%o(:, i) + u * q(i)
+                                                                                      q(jq))))
+                    self%s(1:3, jv) = u
+                    self%s(4:6, jv) = cross(self%o(:, i), u)
+                case (chain_joint_prismatic)
+                    self%o(:, i) = self%o(:, i) + u * q(jq)
                     self%r(:, :, i) = rj
-                    self%s(1:3, i) = 0.0_wp
-                    self%s(4:6, i) = u
-                end if
+                    self%s(1:3, jv) = 0.0_wp
+                    self%s(4:6, jv) = u
+                case default
+                    self%r(:, :, i) = matmul(rj, rotation_matrix(q(jq:jq + 3)))
+                    do k = 0, 2
+                        self%s(1:3, jv + k) = self%r(:, k + 1, i)
+                        self%s(4:6, jv + k) = cross(self%o(:, i), self%r(:, k + 1, i))
+                    end do
+                end select
                 c = self%o(:, i) + matmul(self%r(:, :, i), b%centre)
                 ibar = matmul(self%r(:, :, i), matmul(b%inertia, transpose(self%r(:, :, i))))
                 cx = skew(c)
@@ -200,7 +227,8 @@ contains
         real(wp), intent(in) :: q(:), qd(:), qdd(:)
         real(wp), intent(out) :: tau(:)
         logical, intent(in), optional :: with_gravity
-        integer :: i, p
+        integer :: i, p, c
+        real(wp) :: sv(6)
         call frames(self, q)
         self%vel(:, 0) = 0.0_wp
         self%acc(:, 0) = 0.0_wp
@@ -210,15 +238,20 @@ contains
         end if
         do i = 1, size(self%bodies)
             p = self%bodies(i)%parent
-            self%vel(:, i) = self%vel(:, p) + self%s(:, i) * qd(i)
-            self%acc(:, i) = self%acc(:, p) + self%s(:, i) * qdd(i) &
-                             + cross_motion(self%vel(:, i), self%s(:, i)) * qd(i)
+            associate (cols => [(c, c = self%iv(i) + 1, self%iv(i + 1))])
+                sv = matmul(self%s(:, cols), qd(cols))
+                self%vel(:, i) = self%vel(:, p) + sv
+                self%acc(:, i) = self%acc(:, p) + matmul(self%s(:, cols), qdd(cols)) &
+                                 + cross_motion(self%vel(:, i), sv)
+            end associate
             self%frc(:, i) = matmul(self%inert(:, :, i), self%acc(:, i)) &
                              + cross_force(self%vel(:, i), matmul(self%inert(:, :, i), &
                                                                   self%vel(:, i)))
         end do
         do i = size(self%bodies), 1, -1
-            tau(i) = dot_product(self%s(:, i), self%frc(:, i))
+            do c = self%iv(i) + 1, self%iv(i + 1)
+                tau(c) = dot_product(self%s(:, c), self%frc(:, i))
+            end do
             p = self%bodies(i)%parent
             if (p > 0) self%frc(:, p) = self%frc(:, p) + self%frc(:, i)
         end do
@@ -231,7 +264,7 @@ contains
         real(wp), intent(out) :: m(:, :)
         type(status_t), intent(inout) :: status
         real(wp) :: f(6)
-        integer :: i, j, p
+        integer :: i, j, p, a, b
         call frames(self, q)
         self%comp = self%inert
         do i = size(self%bodies), 1, -1
@@ -240,46 +273,86 @@ contains
         end do
         m = 0.0_wp
         do i = 1, size(self%bodies)
-            f = matmul(self%comp(:, :, i), self%s(:, i))
-            m(i, i) = dot_product(self%s(:, i), f)
-            j = self%bodies(i)%parent
-            do while (j > 0)
-                m(i, j) = dot_product(self%s(:, j), f)
-                m(j, i) = m(i, j)
-                j = self%bodies(j)%parent
+            do a = self%iv(i) + 1, self%iv(i + 1)
+                f = matmul(self%comp(:, :, i), self%s(:, a))
+                do b = self%iv(i) + 1, self%iv(i + 1)
+                    m(b, a) = dot_product(self%s(:, b), f)
+                end do
+                j = self%bodies(i)%parent
+                do while (j > 0)
+                    do b = self%iv(j) + 1, self%iv(j + 1)
+                        m(b, a) = dot_product(self%s(:, b), f)
+                        m(a, b) = m(b, a)
+                    end do
+                    j = self%bodies(j)%parent
+                end do
             end do
         end do
     end subroutine chain_mass
 
-    !> f = −b(q, v): Coriolis, centrifugal and gravity terms (RNEA at q̈ = 0).
+    !> f = −b(q, v): Coriolis, centrifugal and gravity terms (RNEA at v' = 0).
     subroutine chain_forces(self, t, q, v, f, status)
         class(rigid_chain_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: f(:)
         type(status_t), intent(inout) :: status
-        real(wp) :: zero(size(q))
+        real(wp) :: zero(size(v))
         zero = 0.0_wp
         call chain_inverse_dynamics(self, q, v, zero, f)
         f = -f
     end subroutine chain_forces
 
-    !> q' = v.
+    !> q' = T(q) v: the rate itself, or T(p) w for a spherical joint.
     subroutine chain_kinematics(self, t, q, w, qdot, status)
         class(rigid_chain_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:), w(:)
         real(wp), intent(out) :: qdot(:)
         type(status_t), intent(inout) :: status
-        qdot = w
+        integer :: i, jq, jv
+        do i = 1, size(self%bodies)
+            jq = self%iq(i) + 1
+            jv = self%iv(i) + 1
+            if (self%bodies(i)%joint == chain_joint_spherical) then
+                qdot(jq:jq + 3) = matmul(quat_rate_matrix(q(jq:jq + 3)), w(jv:jv + 2))
+            else
+                qdot(jq) = w(jv)
+            end if
+        end do
     end subroutine chain_kinematics
 
-    !> T = I: ∂(T w)/∂q = 0.
+    !> ∂(T w)/∂q: zero but for spherical joints, where T(p) w is linear in p,
+    !> so column k is T(e_k) w.
     subroutine chain_kinematics_derivative(self, t, q, w, dq, status)
         class(rigid_chain_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:), w(:)
         real(wp), intent(out) :: dq(:, :)
         type(status_t), intent(inout) :: status
+        real(wp) :: e(4)
+        integer :: i, k, jq, jv
         dq = 0.0_wp
+        do i = 1, size(self%bodies)
+            if (self%bodies(i)%joint /= chain_joint_spherical) cycle
+            jq = self%iq(i) + 1
+            jv = self%iv(i) + 1
+            do k = 1, 4
+                e = 0.0_wp
+                e(k) = 1.0_wp
+                dq(jq:jq + 3, jq + k - 1) = matmul(quat_rate_matrix(e), w(jv:jv + 2))
+            end do
+        end do
     end subroutine chain_kinematics_derivative
+
+    !> Unit quaternions of the spherical joints.
+    subroutine chain_normalize(self, q)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(inout) :: q(:)
+        integer :: i, jq
+        do i = 1, size(self%bodies)
+            if (self%bodies(i)%joint /= chain_joint_spherical) cycle
+            jq = self%iq(i) + 1
+            q(jq:jq + 3) = quat_normalize(q(jq:jq + 3))
+        end do
+    end subroutine chain_normalize
 
     !> No constraints on their own (a chain is loop-free).
     subroutine chain_constraint(self, t, q, g, status)
@@ -328,15 +401,17 @@ contains
         integer, intent(in) :: k
         real(wp), intent(out) :: jx(:, :), jr(:, :)
         real(wp) :: x(3), axes(3, 3)
-        integer :: j
+        integer :: j, c
         call chain_marker_pose(self, q, k, x, axes)
         jx = 0.0_wp
         jr = 0.0_wp
         j = self%markers(k)%body
         do while (j > 0)
             ! spatial [ω; v_O] → point velocity v_O + ω × x
-            jr(:, j) = self%s(1:3, j)
-            jx(:, j) = self%s(4:6, j) + cross(self%s(1:3, j), x)
+            do c = self%iv(j) + 1, self%iv(j + 1)
+                jr(:, c) = self%s(1:3, c)
+                jx(:, c) = self%s(4:6, c) + cross(self%s(1:3, c), x)
+            end do
             j = self%bodies(j)%parent
         end do
     end subroutine chain_marker_jacobian
@@ -348,12 +423,14 @@ contains
         integer, intent(in) :: i
         real(wp), intent(out) :: vc(3), omega(3)
         real(wp) :: twist(6), c(3)
-        integer :: j
+        integer :: j, a
         call frames(self, q)
         twist = 0.0_wp
         j = i
         do while (j > 0)
-            twist = twist + self%s(:, j) * v(j)
+            do a = self%iv(j) + 1, self%iv(j + 1)
+                twist = twist + self%s(:, a) * v(a)
+            end do
             j = self%bodies(j)%parent
         end do
         c = self%o(:, i) + matmul(self%r(:, :, i), self%bodies(i)%centre)
@@ -366,7 +443,7 @@ contains
         class(rigid_chain_t), intent(inout) :: self
         real(wp), intent(in) :: q(:), v(:)
         real(wp), intent(out) :: kinetic, potential
-        real(wp) :: m(size(q), size(q))
+        real(wp) :: m(size(v), size(v))
         type(status_t) :: st
         integer :: i
         call chain_mass(self, 0.0_wp, q, m, st)
