@@ -207,23 +207,14 @@ contains
     end function axes_with_z
 
     !> A double pendulum with non-parallel revolute axes as a chain and as
-    !> two free bodies with revolute joints (GGL): the centres of mass agree
-    !> at t = 1 (rtol 1e-8).
+    !> two free bodies with revolute joints.
     subroutine test_absolute(error)
         type(error_t), allocatable, intent(out) :: error
         type(rigid_chain_t), target :: chain
-        type(mbs_system_t), target :: sys
-        type(formulation_t) :: dae_chain, dae_abs
-        type(radau5_t) :: solver
-        type(dae_options_t) :: options
-        type(dae_stats_t) :: stats
         type(status_t) :: status
         type(chain_body_t) :: b(2)
         type(marker_t) :: m(4)
-        type(rigid_body_t) :: bodies(2)
-        real(wp) :: q0(2), v0(2), qa(14), o(3), r(3, 3), p(4, 0:2), vc(3), w(3), t, worst
-        real(wp), allocatable :: y(:), ya(:), yp(:)
-        integer :: i
+        real(wp) :: q0(2), v0(2), p(4, 2)
         b(1) = chain_body_t(0, chain_joint_revolute, [0.0_wp, 0.0_wp, 0.0_wp], &
                             body_rotation(0.0_wp), [0.0_wp, 1.0_wp, 0.0_wp], &
                             [0.3_wp, 0.0_wp, -0.1_wp], 1.0_wp, inertia(1))
@@ -233,25 +224,49 @@ contains
         chain = new_rigid_chain(b, status, gravity=g_earth)
         q0 = [0.5_wp, -0.4_wp]
         v0 = [0.8_wp, 1.5_wp]
-        ! the same bodies in absolute coordinates (frames at the centres of mass)
-        p(:, 0) = [1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
-        do i = 1, 2
-            p(:, i) = quat_product(p(:, b(i)%parent), quat_from_axis_angle(b(i)%axis, q0(i)))
-            call chain%body_frame(q0, i, o, r)
-            call check(error, maxval(abs(rotation_matrix(p(:, i)) - r)) < 1.0e-14_wp, &
-                       'quaternion of the chain frame')
-            qa(7 * i - 6:7 * i - 4) = o + matmul(r, b(i)%centre)
-            qa(7 * i - 3:7 * i) = p(:, i)
-            bodies(i) = rigid_body_t(b(i)%mass, b(i)%inertia)
-        end do
-        if (allocated(error)) return
+        p(:, 1) = quat_from_axis_angle(b(1)%axis, q0(1))
+        p(:, 2) = quat_product(p(:, 1), quat_from_axis_angle(b(2)%axis, q0(2)))
         m(1) = marker_t(0, b(1)%joint_position, axes_with_z(b(1)%axis))
         m(2) = marker_t(1, -b(1)%centre, axes_with_z(b(1)%axis))
         m(3) = marker_t(1, b(2)%joint_position - b(1)%centre, axes_with_z(b(2)%axis))
         m(4) = marker_t(2, -b(2)%centre, axes_with_z(b(2)%axis))
-        sys = new_mbs_system(bodies, m, [mbs_joint_t(joint_revolute, 1, 2), &
-                             mbs_joint_t(joint_revolute, 3, 4)], gravity=g_earth, status=status)
-        call check(error, status%ok(), 'absolute system: ' // status%text())
+        call compare_absolute(error, chain, q0, v0, p, m, [mbs_joint_t(joint_revolute, 1, 2), &
+                              mbs_joint_t(joint_revolute, 3, 4)], 'revolute chain')
+    end subroutine test_absolute
+
+    !> Two bodies of `chain` (frames' quaternions p at q0) also as free bodies
+    !> joined by `joints` between `markers` (GGL); both integrated to t = 1 at
+    !> rtol 1e-8; the centres of mass and rotations must agree to 1e-6.
+    subroutine compare_absolute(error, chain, q0, v0, p, markers, joints, label)
+        type(error_t), allocatable, intent(inout) :: error
+        type(rigid_chain_t), target, intent(inout) :: chain
+        real(wp), intent(in) :: q0(:), v0(:), p(4, 2)
+        type(marker_t), intent(in) :: markers(:)
+        type(mbs_joint_t), intent(in) :: joints(:)
+        character(len=*), intent(in) :: label
+        type(mbs_system_t), target :: sys
+        type(formulation_t) :: dae_chain, dae_abs
+        type(radau5_t) :: solver
+        type(dae_options_t) :: options
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        type(rigid_body_t) :: bodies(2)
+        real(wp) :: qa(14), o(3), r(3, 3), vc(3), w(3), t, worst
+        real(wp), allocatable :: y(:), ya(:), yp(:), qn(:)
+        integer :: i, nq, nv
+        nq = chain%nq
+        nv = chain%nv
+        do i = 1, 2
+            call chain%body_frame(q0, i, o, r)
+            call check(error, maxval(abs(rotation_matrix(p(:, i)) - r)) < 1.0e-14_wp, &
+                       label // ': quaternion of the chain frame')
+            qa(7 * i - 6:7 * i - 4) = o + matmul(r, chain%bodies(i)%centre)
+            qa(7 * i - 3:7 * i) = p(:, i)
+            bodies(i) = rigid_body_t(chain%bodies(i)%mass, chain%bodies(i)%inertia)
+        end do
+        if (allocated(error)) return
+        sys = new_mbs_system(bodies, markers, joints, gravity=g_earth, status=status)
+        call check(error, status%ok(), label // ': absolute system: ' // status%text())
         if (allocated(error)) return
         dae_abs = new_formulation(sys, formulation_ggl, qa, status=status)
         allocate (ya(dae_abs%n), yp(dae_abs%n), source=0.0_wp)
@@ -267,24 +282,29 @@ contains
         options%atol = 1.0e-8_wp
         t = 0.0_wp
         call solver%integrate(dae_abs, t, ya, 1.0_wp, options, stats, status)
-        call check(error, status%ok(), 'absolute run: ' // status%text())
+        call check(error, status%ok(), label // ': absolute run: ' // status%text())
         dae_chain = new_formulation(chain, formulation_index2, q0, status=status)
         allocate (y(dae_chain%n), source=0.0_wp)
-        y(1:2) = q0
-        y(3:4) = v0
+        y(1:nq) = q0
+        y(nq + 1:nq + nv) = v0
         t = 0.0_wp
         call solver%integrate(dae_chain, t, y, 1.0_wp, options, stats, status)
-        call check(error, status%ok(), 'chain run: ' // status%text())
+        call check(error, status%ok(), label // ': chain run: ' // status%text())
         if (allocated(error)) return
+        qn = y(1:nq)
+        call chain%normalize(qn)
         worst = 0.0_wp
         do i = 1, 2
-            call chain%body_frame(y(1:2), i, o, r)
-            worst = max(worst, norm2(o + matmul(r, b(i)%centre) - ya(7 * i - 6:7 * i - 4)), &
-                        maxval(abs(rotation_matrix(ya(7 * i - 3:7 * i)) - r)))
+            call chain%body_frame(qn, i, o, r)
+            worst = max(worst, norm2(o + matmul(r, chain%bodies(i)%centre) - &
+                                     ya(7 * i - 6:7 * i - 4)), &
+                        maxval(abs(rotation_matrix(ya(7 * i - 3:7 * i) / &
+                                                   norm2(ya(7 * i - 3:7 * i))) - r)))
         end do
-        print '(4x,a,es9.2)', 'chain vs absolute coordinates at t = 1: ', worst
-        call check(error, worst <= 1.0e-6_wp, 'chain and absolute coordinates differ')
-    end subroutine test_absolute
+        print '(4x,a,a,es9.2)', label, ' vs absolute coordinates at t = 1: ', worst
+        call check(error, worst <= 1.0e-6_wp, label // ': chain and absolute coordinates differ')
+    end subroutine compare_absolute
+
 
     !> MEXAX integrates the chain's mechanical form (nc = 0) to the RADAU5
     !> state within the tolerance.
@@ -387,79 +407,25 @@ contains
     end subroutine test_spherical
 
     !> The spherical–revolute pair as a chain and as two free bodies with a
-    !> spherical and a revolute joint (GGL): centres of mass and rotations
-    !> agree at t = 1 (rtol 1e-8).
+    !> spherical and a revolute joint.
     subroutine test_spherical_absolute(error)
         type(error_t), allocatable, intent(out) :: error
         type(rigid_chain_t), target :: chain
-        type(mbs_system_t), target :: sys
-        type(formulation_t) :: dae_chain, dae_abs
-        type(radau5_t) :: solver
-        type(dae_options_t) :: options
-        type(dae_stats_t) :: stats
         type(status_t) :: status
         type(marker_t) :: m(4)
-        type(rigid_body_t) :: bodies(2)
-        real(wp) :: q0(5), v0(4), qa(14), o(3), r(3, 3), p(4, 2), vc(3), w(3), t, worst
-        real(wp), allocatable :: y(:), ya(:), yp(:)
-        integer :: i
+        real(wp) :: q0(5), v0(4), p(4, 2)
         chain = spherical_pair(status)
         q0(1:4) = quat_from_axis_angle([0.48_wp, 0.6_wp, 0.64_wp], 0.7_wp)
         q0(5) = -0.4_wp
         v0 = [0.5_wp, -1.0_wp, 0.8_wp, 1.5_wp]
         p(:, 1) = q0(1:4)
         p(:, 2) = quat_product(p(:, 1), quat_from_axis_angle(chain%bodies(2)%axis, q0(5)))
-        do i = 1, 2
-            call chain%body_frame(q0, i, o, r)
-            call check(error, maxval(abs(rotation_matrix(p(:, i)) - r)) < 1.0e-14_wp, &
-                       'quaternion of the chain frame')
-            qa(7 * i - 6:7 * i - 4) = o + matmul(r, chain%bodies(i)%centre)
-            qa(7 * i - 3:7 * i) = p(:, i)
-            bodies(i) = rigid_body_t(chain%bodies(i)%mass, chain%bodies(i)%inertia)
-        end do
-        if (allocated(error)) return
         m(1) = marker_t(0, [0.0_wp, 0.0_wp, 0.0_wp])
         m(2) = marker_t(1, -chain%bodies(1)%centre)
         m(3) = marker_t(1, chain%bodies(2)%joint_position - chain%bodies(1)%centre, &
                         axes_with_z(chain%bodies(2)%axis))
         m(4) = marker_t(2, -chain%bodies(2)%centre, axes_with_z(chain%bodies(2)%axis))
-        sys = new_mbs_system(bodies, m, [mbs_joint_t(joint_spherical, 1, 2), &
-                             mbs_joint_t(joint_revolute, 3, 4)], gravity=g_earth, status=status)
-        call check(error, status%ok(), 'absolute system: ' // status%text())
-        if (allocated(error)) return
-        dae_abs = new_formulation(sys, formulation_ggl, qa, status=status)
-        allocate (ya(dae_abs%n), yp(dae_abs%n), source=0.0_wp)
-        ya(1:14) = qa
-        do i = 1, 2
-            call chain%body_velocity(q0, v0, i, vc, w)
-            call chain%body_frame(q0, i, o, r)
-            ya(14 + 6 * i - 5:14 + 6 * i - 3) = vc
-            ya(14 + 6 * i - 2:14 + 6 * i) = matmul(transpose(r), w)
-        end do
-        call dae_abs%consistent_initial(0.0_wp, ya, yp, status)
-        options%rtol = 1.0e-8_wp
-        options%atol = 1.0e-8_wp
-        t = 0.0_wp
-        call solver%integrate(dae_abs, t, ya, 1.0_wp, options, stats, status)
-        call check(error, status%ok(), 'absolute run: ' // status%text())
-        dae_chain = new_formulation(chain, formulation_index2, q0, status=status)
-        allocate (y(dae_chain%n), source=0.0_wp)
-        y(1:5) = q0
-        y(6:9) = v0
-        t = 0.0_wp
-        call solver%integrate(dae_chain, t, y, 1.0_wp, options, stats, status)
-        call check(error, status%ok(), 'chain run: ' // status%text())
-        if (allocated(error)) return
-        worst = 0.0_wp
-        do i = 1, 2
-            call chain%body_frame(y(1:5) / [norm2(y(1:4)), norm2(y(1:4)), norm2(y(1:4)), &
-                                            norm2(y(1:4)), 1.0_wp], i, o, r)
-            worst = max(worst, norm2(o + matmul(r, chain%bodies(i)%centre) - &
-                                     ya(7 * i - 6:7 * i - 4)), &
-                        maxval(abs(rotation_matrix(ya(7 * i - 3:7 * i) / &
-                                                   norm2(ya(7 * i - 3:7 * i))) - r)))
-        end do
-        print '(4x,a,es9.2)', 'spherical chain vs absolute coordinates at t = 1: ', worst
-        call check(error, worst <= 1.0e-6_wp, 'spherical chain and absolute coordinates differ')
+        call compare_absolute(error, chain, q0, v0, p, m, [mbs_joint_t(joint_spherical, 1, 2), &
+                              mbs_joint_t(joint_revolute, 3, 4)], 'spherical chain')
     end subroutine test_spherical_absolute
 end module test_rigid_chain
