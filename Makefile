@@ -5,6 +5,7 @@
 #   make bench   install what is missing, build (release), run the benchmarks
 #   make install PREFIX=...   install library, modules and the classic faces
 #   OPENMP=1     (with any of them) thread the finite-element assembly
+#   LTO=1        (with any of them) link-time optimisation
 
 SHELL := /bin/bash
 .DEFAULT_GOAL := run
@@ -16,10 +17,16 @@ VENV         := $(BUILD)/venv
 # One set of flags for every fpm call: changing them makes fpm rebuild everything.
 export FPM_FFLAGS := -I/usr/include/hdf5/serial -I/usr/include/sundials/fortran
 export FPM_CFLAGS := -I/usr/include/suitesparse
+# LTO=1 adds link-time optimisation (inlines the dual-number operators of
+# the AD mode across modules; fat objects keep the library linkable without it).
+ifeq ($(LTO),1)
+export FPM_FFLAGS := $(FPM_FFLAGS) -flto -ffat-lto-objects
+export FPM_LDFLAGS := $(FPM_LDFLAGS) -flto
+endif
 # OPENMP=1 threads the finite-element assembly (results bitwise identical).
 ifeq ($(OPENMP),1)
 export FPM_FFLAGS := $(FPM_FFLAGS) -fopenmp
-export FPM_LDFLAGS := -fopenmp
+export FPM_LDFLAGS := $(FPM_LDFLAGS) -fopenmp
 OMP_LINK := -fopenmp
 endif
 FPM          = $(shell command -v fpm 2>/dev/null || echo $(VENV)/bin/fpm)
