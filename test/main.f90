@@ -34,6 +34,7 @@ program flexmbs_tests
     use test_rigid_chain, only: collect_rigid_chain
     use test_flexible_marker, only: collect_flexible_marker
     use test_multibody_scene, only: collect_multibody_scene
+    use test_flexible_coupling, only: collect_flexible_coupling
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -76,6 +77,8 @@ program flexmbs_tests
     call run_suite('rigid_chain', collect_rigid_chain(), filter, npassed, nfailed)
     call run_suite('flexible_marker', collect_flexible_marker(), filter, npassed, nfailed)
     call run_suite('multibody_scene', collect_multibody_scene(), filter, npassed, nfailed)
+    call run_suite('flexible_coupling', collect_flexible_coupling(), filter, npassed, &
+                   nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests

@@ -38,16 +38,19 @@
 !> joint exerts on the body. A body hanging at rest from a spherical joint
 !> is held up: F = −m g (upwards, for gravity g).
 module flexmbs_mbs_system
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_text, only: int_text
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_linalg_csc, only: csc_matrix_t
+    use flexmbs_fe_flexible_body, only: flexible_body_t
+    use flexmbs_mbs_primitive_kinds, only: primitive_distance
     use flexmbs_mbs_rotation, only: rotation_matrix, quat_rate_matrix, cross
     use flexmbs_mbs_dual, only: dual_t, operator(+), assignment(=), dot_product
     use flexmbs_mbs_rigid_body, only: rigid_body_t, rigid_bodies_t, new_rigid_bodies, &
         rigid_body_nq, rigid_body_nv, rigid_body_energy, rigid_body_momenta
     use flexmbs_mbs_joint, only: joint_t, new_joint, new_primitive_joint, joint_primitive, &
+        joint_spherical, &
         joint_part_time_derivative, &
         joint_part_convective, joint_part_time_terms
     use flexmbs_mbs_constraint_primitives, only: marker_state_t, rigid_marker_state, &
@@ -79,11 +82,16 @@ module flexmbs_mbs_system
     real(wp), parameter :: identity3(3, 3) = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
         1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
 
-    !> A frame fixed in a body (body >= 1) or in the ground (body = 0).
+    !> A frame fixed in a body (body >= 1) or in the ground (body = 0), or a
+    !> node of a flexible body (flexible >= 1, node >= 1; body and position
+    !> unused): the node's position with constant axes, for joints that use
+    !> no marker rotation (spherical, distance).
     type, public :: marker_t
         integer :: body = 0 !! body number, 0 for the ground
         real(wp) :: position(3) = 0.0_wp !! origin: body coordinates (ground: global)
         real(wp) :: axes(3, 3) = identity3 !! orthonormal axes as columns, same frame
+        integer :: flexible = 0 !! flexible body number (node markers)
+        integer :: node = 0     !! its mesh node
     end type marker_t
 
     !> A prescribed function of time, s(t) = Σ_k poly(k) t^k + amplitude
@@ -121,6 +129,11 @@ module flexmbs_mbs_system
         type(assembled_joint_t), allocatable :: joints(:)
         integer :: derivatives = constraint_derivatives_analytic
         integer :: nq_rigid = 0, nv_rigid = 0
+        !> flexible bodies after the rigid ones in q and v; flexible body f's
+        !> free coordinates are q(flex_q(f)+1 : flex_q(f)+nq_f), its velocities
+        !> v(flex_v(f)+1 : flex_v(f)+nv_f)
+        type(flexible_body_t), allocatable :: flex(:)
+        integer, allocatable :: flex_q(:), flex_v(:)
         real(wp), allocatable :: zero_v(:) !! v = 0 for position-only evaluations
         !> copies of the CSC patterns handed out (their triplet maps place values)
         type(csc_matrix_t) :: mass_csc, jacobian_csc
@@ -134,6 +147,7 @@ module flexmbs_mbs_system
         procedure :: mass => system_mass
         procedure :: forces => system_forces
         procedure :: normalize => system_normalize
+        procedure :: admissible => system_admissible
         procedure :: kinematics_derivative => system_kinematics_derivative
         procedure :: mass_derivative => system_mass_derivative
         procedure :: force_derivatives => system_force_derivatives
@@ -160,15 +174,17 @@ contains
     !> `constraint_derivatives` is 'analytic' (default) or 'ad'. On bad input
     !> `status` says which item is wrong and why.
     function new_mbs_system(bodies, markers, joints, gravity, constraint_derivatives, &
-                            status) result(self)
+                            status, flexible) result(self)
         type(rigid_body_t), intent(in) :: bodies(:)
         type(marker_t), intent(in) :: markers(:)
         type(mbs_joint_t), intent(in) :: joints(:)
         real(wp), intent(in), optional :: gravity(3)
         character(len=*), intent(in), optional :: constraint_derivatives !! 'analytic' | 'ad'
         type(status_t), intent(out) :: status
+        !> flexible bodies (their own gravity and loads), after the rigid ones
+        type(flexible_body_t), intent(in), optional :: flexible(:)
         type(mbs_system_t) :: self
-        integer :: k, row0
+        integer :: k, row0, f
         character(len=:), allocatable :: where
 
         self%rigid = new_rigid_bodies(bodies, gravity, status)
@@ -185,8 +201,36 @@ contains
                 return
             end select
         end if
+        if (present(flexible)) then
+            self%flex = flexible
+        else
+            allocate (self%flex(0))
+        end if
         do k = 1, size(markers)
             where = 'mbs system: marker ' // int_text(k)
+            if (markers(k)%flexible /= 0) then
+                if (markers(k)%flexible < 1 .or. markers(k)%flexible > size(self%flex)) then
+                    call status%set(status_bad_input, where // ': flexible = ' // &
+                        int_text(markers(k)%flexible) // ': must name a flexible body 1 .. ' &
+                        // int_text(size(self%flex)))
+                    return
+                end if
+                associate (fb => self%flex(markers(k)%flexible))
+                    if (markers(k)%node < 1 .or. markers(k)%node > fb%mesh%node_count()) then
+                        call status%set(status_bad_input, where // ': node ' // &
+                            int_text(markers(k)%node) // ' outside the mesh')
+                        return
+                    end if
+                    if (any(fb%dof(:, markers(k)%node) == 0) .or. &
+                        fb%dof(2, markers(k)%node) /= fb%dof(1, markers(k)%node) + 1 .or. &
+                        fb%dof(3, markers(k)%node) /= fb%dof(1, markers(k)%node) + 2) then
+                        call status%set(status_bad_input, where // ': node ' // &
+                            int_text(markers(k)%node) // ' is fixed (a node marker needs &
+                            &a free node)')
+                        return
+                    end if
+                end associate
+            end if
             if (markers(k)%body < 0 .or. markers(k)%body > size(bodies)) then
                 call status%set(status_bad_input, where // ': body = ' // &
                                 int_text(markers(k)%body) // ': must be 0 (ground) .. ' // &
@@ -211,7 +255,14 @@ contains
                                     ': must name markers 1 .. ' // int_text(size(markers)))
                     return
                 end if
-                if (markers(ji%marker_i)%body == markers(ji%marker_j)%body) then
+                if (markers(ji%marker_i)%flexible + markers(ji%marker_j)%flexible > 0) then
+                    if (ji%kind /= joint_spherical .and. .not. (ji%kind == joint_primitive &
+                        .and. ji%primitive == primitive_distance)) then
+                        call status%set(status_bad_input, where // ': a node marker (no &
+                            &rotation) takes spherical joints and distances only')
+                        return
+                    end if
+                else if (markers(ji%marker_i)%body == markers(ji%marker_j)%body) then
                     call status%set(status_bad_input, where // ': both markers are on body ' &
                                     // int_text(markers(ji%marker_i)%body) // &
                                     ': a joint connects two different bodies (or a body &
@@ -238,8 +289,15 @@ contains
         self%markers = markers
         self%nq_rigid = self%rigid%nq
         self%nv_rigid = self%rigid%nv
+        allocate (self%flex_q(size(self%flex)), self%flex_v(size(self%flex)))
         self%nq = self%nq_rigid
         self%nv = self%nv_rigid
+        do f = 1, size(self%flex)
+            self%flex_q(f) = self%nq
+            self%flex_v(f) = self%nv
+            self%nq = self%nq + self%flex(f)%nq
+            self%nv = self%nv + self%flex(f)%nv
+        end do
         self%nc = row0
         allocate (self%zero_v(self%nv))
         self%zero_v = 0.0_wp
@@ -266,8 +324,13 @@ contains
         type(csc_matrix_t), intent(inout) :: pattern
         type(status_t), intent(inout) :: status
         integer, allocatable :: rows(:), cols(:)
-        integer :: b, i, j, n, iv
-        allocate (rows(12 * size(self%rigid%bodies)), cols(12 * size(self%rigid%bodies)))
+        integer :: b, i, j, n, iv, f
+        integer(i8) :: p
+        n = 12 * size(self%rigid%bodies)
+        do f = 1, size(self%flex)
+            n = n + int(self%flex(f)%mass_matrix%nnz)
+        end do
+        allocate (rows(n), cols(n))
         n = 0
         do b = 1, size(self%rigid%bodies)
             iv = rigid_body_nv * (b - 1)
@@ -284,6 +347,18 @@ contains
                 end do
             end do
         end do
+        ! flexible bodies: their own mass patterns, column by column
+        do f = 1, size(self%flex)
+            associate (mm => self%flex(f)%mass_matrix)
+                do j = 1, mm%ncol
+                    do p = mm%colptr(j) + 1, mm%colptr(j + 1)
+                        n = n + 1
+                        rows(n) = self%flex_v(f) + int(mm%rowind(p)) + 1
+                        cols(n) = self%flex_v(f) + j
+                    end do
+                end do
+            end associate
+        end do
         call pattern%build(self%nv, self%nv, rows, cols, status)
         if (status%ok()) self%mass_csc = pattern
     end subroutine system_mass_pattern
@@ -293,7 +368,8 @@ contains
         real(wp), intent(in) :: t, q(:)
         real(wp), intent(out) :: values(:)
         type(status_t), intent(inout) :: status
-        integer :: b, i, j, n
+        integer :: b, i, j, n, f
+        integer(i8) :: p
         n = 0
         values = 0.0_wp
         do b = 1, size(self%rigid%bodies)
@@ -307,6 +383,14 @@ contains
                     values(self%mass_csc%triplet_map(n)) = self%rigid%bodies(b)%inertia(i, j)
                 end do
             end do
+        end do
+        do f = 1, size(self%flex)
+            associate (mm => self%flex(f)%mass_matrix)
+                do p = 1, mm%nnz
+                    n = n + 1
+                    values(self%mass_csc%triplet_map(n)) = mm%values(p)
+                end do
+            end associate
         end do
     end subroutine system_mass_sparse
 
@@ -380,6 +464,7 @@ contains
         type(status_t), intent(inout) :: status
         call self%rigid%kinematics(t, q(1:self%nq_rigid), w(1:self%nv_rigid), &
                                    qdot(1:self%nq_rigid), status)
+        if (size(self%flex) > 0) qdot(self%nq_rigid + 1:) = w(self%nv_rigid + 1:)
     end subroutine system_kinematics
 
     subroutine system_kinematics_derivative(self, t, q, w, dq, status)
@@ -397,8 +482,14 @@ contains
         real(wp), intent(in) :: t, q(:)
         real(wp), intent(out) :: m(:, :)
         type(status_t), intent(inout) :: status
+        integer :: f
         m = 0.0_wp
         call self%rigid%mass(t, q(1:self%nq_rigid), m(1:self%nv_rigid, 1:self%nv_rigid), status)
+        do f = 1, size(self%flex)
+            associate (i0 => self%flex_v(f), n => self%flex(f)%nv)
+                call self%flex(f)%mass_matrix%to_dense(m(i0 + 1:i0 + n, i0 + 1:i0 + n))
+            end associate
+        end do
     end subroutine system_mass
 
     subroutine system_mass_derivative(self, t, q, w, dq, status)
@@ -414,8 +505,16 @@ contains
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: f(:)
         type(status_t), intent(inout) :: status
+        integer :: b
         call self%rigid%forces(t, q(1:self%nq_rigid), v(1:self%nv_rigid), &
                                f(1:self%nv_rigid), status)
+        do b = 1, size(self%flex)
+            if (.not. status%ok()) return
+            associate (iq => self%flex_q(b), iv => self%flex_v(b), n => self%flex(b)%nv)
+                call self%flex(b)%forces(t, q(iq + 1:iq + n), v(iv + 1:iv + n), &
+                                         f(iv + 1:iv + n), status)
+            end associate
+        end do
     end subroutine system_forces
 
     subroutine system_force_derivatives(self, t, q, v, fq, fv, status)
@@ -423,12 +522,35 @@ contains
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: fq(:, :), fv(:, :)
         type(status_t), intent(inout) :: status
+        integer :: b
         fq = 0.0_wp
         fv = 0.0_wp
         call self%rigid%force_derivatives(t, q(1:self%nq_rigid), v(1:self%nv_rigid), &
                                           fq(1:self%nv_rigid, 1:self%nq_rigid), &
                                           fv(1:self%nv_rigid, 1:self%nv_rigid), status)
+        do b = 1, size(self%flex)
+            if (.not. status%ok()) return
+            associate (iq => self%flex_q(b), iv => self%flex_v(b), n => self%flex(b)%nv)
+                call self%flex(b)%force_derivatives(t, q(iq + 1:iq + n), v(iv + 1:iv + n), &
+                    fq(iv + 1:iv + n, iq + 1:iq + n), fv(iv + 1:iv + n, iv + 1:iv + n), status)
+            end associate
+        end do
     end subroutine system_force_derivatives
+
+    !> det F > 0 in every flexible body (see dae_problem_t%admissible).
+    subroutine system_admissible(self, q, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:)
+        type(status_t), intent(out) :: status
+        integer :: b
+        call status%clear()
+        do b = 1, size(self%flex)
+            associate (iq => self%flex_q(b), n => self%flex(b)%nq)
+                call self%flex(b)%admissible(q(iq + 1:iq + n), status)
+            end associate
+            if (.not. status%ok()) return
+        end do
+    end subroutine system_admissible
 
     subroutine system_normalize(self, q)
         class(mbs_system_t), intent(inout) :: self
@@ -436,29 +558,60 @@ contains
         call self%rigid%normalize(q(1:self%nq_rigid))
     end subroutine system_normalize
 
-    !> Kinetic plus potential energy.
+    !> Kinetic plus potential energy; flexible bodies add kinetic and strain
+    !> energy and the potential −g·(q − X) of their constant applied forces.
     real(wp) function system_energy(self, q, v) result(e)
-        class(mbs_system_t), intent(in) :: self
+        class(mbs_system_t), intent(inout) :: self
         real(wp), intent(in) :: q(:), v(:)
+        type(status_t) :: st
+        integer :: b
         e = rigid_body_energy(self%rigid, q(1:self%nq_rigid), v(1:self%nv_rigid))
+        do b = 1, size(self%flex)
+            associate (iq => self%flex_q(b), iv => self%flex_v(b), n => self%flex(b)%nv)
+                e = e + self%flex(b)%kinetic_energy(v(iv + 1:iv + n)) &
+                    + self%flex(b)%strain_energy(q(iq + 1:iq + n), st) &
+                    - dot_product(self%flex(b)%applied_force, &
+                                  q(iq + 1:iq + n) - self%flex(b)%free_positions())
+            end associate
+        end do
     end function system_energy
 
     !> Total linear momentum and angular momentum about the global origin.
     subroutine system_momenta(self, q, v, linear, angular)
-        class(mbs_system_t), intent(in) :: self
+        class(mbs_system_t), intent(inout) :: self
         real(wp), intent(in) :: q(:), v(:)
         real(wp), intent(out) :: linear(3), angular(3)
+        real(wp) :: lf(3), af(3)
+        integer :: b
         call rigid_body_momenta(self%rigid, q(1:self%nq_rigid), v(1:self%nv_rigid), linear, &
                                 angular)
+        do b = 1, size(self%flex)
+            associate (iq => self%flex_q(b), iv => self%flex_v(b), n => self%flex(b)%nv)
+                call self%flex(b)%momenta(q(iq + 1:iq + n), v(iv + 1:iv + n), lf, af)
+            end associate
+            linear = linear + lf
+            angular = angular + af
+        end do
     end subroutine system_momenta
 
     ! ------------------------------------------------ markers, real and dual
 
     !> Offsets of marker k's body in q and v; ground: body = 0.
+    !> A node marker reports body = −(its flexible body) and the offsets of
+    !> the node's x coordinate.
     pure subroutine marker_offsets(self, k, body, iq, iv)
         class(mbs_system_t), intent(in) :: self
         integer, intent(in) :: k
         integer, intent(out) :: body, iq, iv
+        integer :: f, d
+        f = self%markers(k)%flexible
+        if (f > 0) then
+            body = -f
+            d = self%flex(f)%dof(1, self%markers(k)%node) - 1
+            iq = self%flex_q(f) + d
+            iv = self%flex_v(f) + d
+            return
+        end if
         body = self%markers(k)%body
         iq = rigid_body_nq * (body - 1)
         iv = rigid_body_nv * (body - 1)
@@ -471,6 +624,7 @@ contains
         logical, intent(in) :: position_space
         n = 0
         if (self%markers(k)%body > 0) n = merge(rigid_body_nq, rigid_body_nv, position_space)
+        if (self%markers(k)%flexible > 0) n = 3
     end function marker_columns
 
     !> Real frame and motion of marker k at (q, v).
@@ -482,7 +636,11 @@ contains
         integer :: b, iq, iv
         call marker_offsets(self, k, b, iq, iv)
         associate (mk => self%markers(k))
-            if (b == 0) then
+            if (b < 0) then
+                ! a node: its position and velocity, constant axes
+                call ground_marker_state(q(iq + 1:iq + 3), mk%axes, m)
+                m%xd = v(iv + 1:iv + 3)
+            else if (b == 0) then
                 call ground_marker_state(mk%position, mk%axes, m)
             else
                 call rigid_marker_state(q(iq + 1:iq + 3), q(iq + 4:iq + 7), v(iv + 1:iv + 3), &
@@ -507,6 +665,13 @@ contains
         jx = 0.0_wp
         ja = 0.0_wp
         if (b == 0) return
+        if (b < 0) then
+            ! a node: x = q_node in both spaces (T = I), axes constant
+            jx(1, 1) = 1.0_wp
+            jx(2, 2) = 1.0_wp
+            jx(3, 3) = 1.0_wp
+            return
+        end if
         associate (mk => self%markers(k))
             if (position_space) then
                 call rigid_marker_jacobian_q(q(iq + 4:iq + 7), mk%position, mk%axes, jx, ja)
@@ -539,6 +704,31 @@ contains
                 a = mk%axes
                 p = 0.0_wp
                 call ground_marker_state_d(x, a, m)
+                return
+            end if
+            if (b < 0) then
+                ! a node: x = q_node, ẋ = v_node; every seed space is (x, y, z)
+                x = q(iq + 1:iq + 3)
+                rd = v(iv + 1:iv + 3)
+                a = mk%axes
+                p = 0.0_wp
+                select case (seed)
+                case (seed_velocity_space, seed_position)
+                    n = 3
+                    do l = 1, 3
+                        x(l)%der(first + l - 1) = 1.0_wp
+                    end do
+                case (seed_velocity)
+                    n = 3
+                    do l = 1, 3
+                        rd(l)%der(first + l - 1) = 1.0_wp
+                    end do
+                case (seed_rate)
+                    n = 1
+                    x%der(first) = v(iv + 1:iv + 3)
+                end select
+                call ground_marker_state_d(x, a, m)
+                m%xd = rd
                 return
             end if
             r = q(iq + 1:iq + 3)
@@ -585,9 +775,14 @@ contains
         type(dual_t), intent(in) :: p(4)
         type(dual_t), intent(out) :: jx(3, 6), ja(3, 6, 3)
         type(dual_t) :: sb(3), ub(3, 3)
-        if (self%markers(k)%body == 0) then
+        if (self%markers(k)%body == 0 .or. self%markers(k)%flexible > 0) then
             jx = 0.0_wp
             ja = 0.0_wp
+            if (self%markers(k)%flexible > 0) then
+                jx(1, 1) = 1.0_wp
+                jx(2, 2) = 1.0_wp
+                jx(3, 3) = 1.0_wp
+            end if
             return
         end if
         sb = self%markers(k)%position
@@ -973,6 +1168,12 @@ contains
                 mk = merge(jt%marker_i, jt%marker_j, side == 1)
                 call marker_offsets(self, mk, b, iq, iv)
                 if (b == 0) cycle
+                if (b < 0) then
+                    ! a node takes the force only
+                    if (side == 1) force(:, side) = -matmul(lambda(r0 + 1:r0 + nr), ci(1:nr, 1:3))
+                    if (side == 2) force(:, side) = -matmul(lambda(r0 + 1:r0 + nr), cj(1:nr, 1:3))
+                    cycle
+                end if
                 if (side == 1) then
                     gen = -matmul(lambda(r0 + 1:r0 + nr), ci(1:nr, 1:6))
                 else
