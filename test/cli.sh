@@ -175,5 +175,16 @@ for s in radau5 ddassl ida mexax; do
     kept "rigid-chain-$s" 0 "$s: NST=" out/run.h5 run "chain_$s.nml" --quiet
 done
 
+# A rigid link with a soft bar attached (inputs/rigid_flexible_pendulum.nml)
+for s in radau5 ddassl; do
+    sed -e "s/name = 'radau5'/name = '$s'/" -e "s/^&output/\&output file = 'out\/run.h5',/" \
+        "$root/inputs/rigid_flexible_pendulum.nml" > "rigidflex_$s.nml"
+    kept "rigid-flexible-$s" 0 "$s: NST=" out/run.h5 run "rigidflex_$s.nml" --quiet
+done
+sed -e "s/node_set = 'xmin'/node_set = 'xmn'/" "$root/inputs/rigid_flexible_pendulum.nml" \
+    > rigidflex_bad.nml
+bad rigid-flexible-unknown-set "rigidflex_bad.nml: &joint 'root': marker_j 'root': mesh: no node set named 'xmn'" \
+    rigidflex_bad.nml
+
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

@@ -24,7 +24,9 @@ contains
         tests = [new_test('four_bar_file_closed_form', test_four_bar), &
                  new_test('bad_scenes', test_bad_scenes), &
                  new_test('rigid_chain_file', test_chain_file), &
-                 new_test('rigid_chain_bad_scenes', test_chain_bad)]
+                 new_test('rigid_chain_bad_scenes', test_chain_bad), &
+                 new_test('rigid_flexible_file', test_rigid_flexible), &
+                 new_test('rigid_flexible_bad_scenes', test_rigid_flexible_bad)]
     end function collect_multibody_scene
 
     !> inputs/four_bar.nml with each solver: the coupler end at t = 1
@@ -173,4 +175,64 @@ contains
         call expect(error, '&simulation problem = ''pendulum'', t_end = 1 /' // nl // link, &
             "&rigid_chain: given, but problem = 'pendulum'")
     end subroutine test_chain_bad
+    !> inputs/rigid_flexible_pendulum.nml: RADAU5 and DDASSL agree (1e-5);
+    !> the attached face stays on the link (GGL: to the tolerance).
+    subroutine test_rigid_flexible(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=8), parameter :: solvers(2) = ['radau5', 'ddassl']
+        type(scene_input_t) :: scene
+        type(run_result_t) :: result
+        type(status_t) :: status
+        real(wp), allocatable :: y_ref(:)
+        real(wp) :: r(3, 3), pin(3), worst
+        integer :: k, j
+        do k = 1, size(solvers)
+            call read_scene('inputs/rigid_flexible_pendulum.nml', scene, status)
+            call check(error, status%ok(), 'read: ' // status%text())
+            if (allocated(error)) return
+            scene%output_file = ''
+            scene%progress = .false.
+            scene%solver_name = solvers(k)
+            call run_scene(scene, .true., result, status)
+            call check(error, status%ok(), trim(solvers(k)) // ': ' // status%text())
+            if (allocated(error)) return
+            if (k == 1) then
+                y_ref = result%y
+                ! bar nodes 1, 6, 11, 16 (the xmin face of the 5 x 2 x 2 grid)
+                ! sit at the link's tip corners (0.15, ±0.025, ±0.025)
+                r = rotation_matrix(result%y(4:7))
+                worst = 0.0_wp
+                do j = 1, 4
+                    pin = result%y(1:3) + matmul(r, [0.15_wp, merge(-0.025_wp, 0.025_wp, &
+                        mod(j - 1, 2) == 0), merge(-0.025_wp, 0.025_wp, j <= 2)])
+                    worst = max(worst, norm2(result%y(7 + 15 * (j - 1) + 1:7 + 15 * (j - 1) &
+                                                      + 3) - pin))
+                end do
+                print '(4x,a,es9.2)', 'attached face off the link tip by ', worst
+                call check(error, worst <= 1.0e-5_wp, 'the attached face left the link')
+            else
+                call check(error, maxval(abs(result%y(1:7) - y_ref(1:7))) <= 1.0e-5_wp, &
+                           trim(solvers(k)) // ': link differs from RADAU5')
+            end if
+        end do
+    end subroutine test_rigid_flexible
+
+    subroutine test_rigid_flexible_bad(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), parameter :: base = '&simulation problem = ''multibody'', ' // &
+            't_end = 0.1 /' // nl // '&rigid_body name = ''link'', mass = 1, inertia = 1, 1, 1 /' &
+            // nl // '&flexible_body name = ''bar'', lengths = 0.4, 0.05, 0.05 /' // nl // &
+            '&material youngs_modulus = 7e5, density = 920 /' // nl // &
+            '&marker name = ''tip'', body = ''link'' /' // nl // '&output file = ''none'' /' // nl
+        call expect(error, base // '&marker name = ''root'', body = ''bar'' /', &
+            "&marker: body = 'bar': a marker on the flexible body needs node_set")
+        call expect(error, base // '&marker name = ''root'', body = ''bar'', node_set = &
+            &''xmn'' /' // nl // '&joint type = ''attach'', marker_i = ''tip'', marker_j = &
+            &''root'' /', "marker_j 'root': mesh: no node set named 'xmn'")
+        call expect(error, base // '&marker name = ''root'', body = ''bar'', node_set = &
+            &''xmin'' /' // nl // '&joint type = ''spherical'', marker_i = ''tip'', marker_j = &
+            &''root'' /', "'attach' joins a marker of a rigid body or the ground")
+        call expect(error, base // '&marker name = ''m2'', body = ''link'', node_set = &
+            &''xmin'' /', "&marker: node_set = 'xmin': only for markers on the &flexible_body")
+    end subroutine test_rigid_flexible_bad
 end module test_multibody_scene

@@ -24,6 +24,8 @@ module flexmbs_io_multibody_input
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
         driver_t
     use flexmbs_io_namelist, only: scene_input_t
+    use flexmbs_io_body_input, only: build_flexible_body
+    use flexmbs_fe_flexible_body, only: flexible_body_t
     implicit none
     private
 
@@ -43,8 +45,12 @@ contains
         type(rigid_body_t), allocatable :: bodies(:)
         type(marker_t), allocatable :: markers(:)
         type(mbs_joint_t), allocatable :: joints(:)
-        real(wp) :: p(4), r(3, 3)
-        integer :: i, nb, k
+        type(flexible_body_t), allocatable :: flex(:)
+        real(wp), allocatable :: qf(:), vf(:)
+        integer, allocatable :: nodes(:)
+        character(len=:), allocatable :: labels(:)
+        real(wp) :: p(4), r(3, 3), anchor(3)
+        integer :: i, nb, k, n, b, mi
         nb = size(scene%rigid_bodies)
         allocate (bodies(nb), q0(7 * nb), v0(6 * nb))
         do i = 1, nb
@@ -67,48 +73,90 @@ contains
                 v0(6 * i - 5:6 * i) = [b%velocity, matmul(transpose(r), b%angular_velocity)]
             end associate
         end do
+        ! the flexible body, after the rigid ones in q and v
+        allocate (flex(merge(1, 0, scene%has_body)))
+        if (scene%has_body) then
+            call build_flexible_body(scene, flex(1), qf, vf, status)
+            if (.not. status%ok()) return
+            q0 = [q0, qf]
+            v0 = [v0, vf]
+        end if
+        ! scene markers first (those on the flexible body are placeholders:
+        ! an 'attach' joint expands into node markers, appended below)
         allocate (markers(size(scene%markers)))
         do i = 1, size(markers)
             associate (m => scene%markers(i))
                 markers(i)%body = 0
-                if (m%body /= 'ground') markers(i)%body = body_index(scene, m%body)
+                if (m%body /= 'ground' .and. len_trim(m%node_set) == 0) &
+                    markers(i)%body = body_index(scene, m%body)
                 markers(i)%position = m%position
                 markers(i)%axes = axes_from(m%z_axis, m%x_axis)
             end associate
         end do
-        allocate (joints(size(scene%joints) + size(scene%drivers)))
+        allocate (joints(0))
+        allocate (character(len=80) :: labels(0))
         do i = 1, size(scene%joints)
             associate (jt => scene%joints(i))
-                joints(i)%kind = joint_kind(jt%type)
-                joints(i)%marker_i = marker_index(scene, jt%marker_i)
-                joints(i)%marker_j = marker_index(scene, jt%marker_j)
+                if (jt%type /= 'attach') then
+                    joints = [joints, mbs_joint_t(joint_kind(jt%type), &
+                        marker_index(scene, jt%marker_i), marker_index(scene, jt%marker_j))]
+                    labels = [character(len=80) :: labels, '&joint ''' // trim(jt%name) // '''']
+                    cycle
+                end if
+                ! 'attach': a spherical joint per node of the set, the rigid side's
+                ! marker at the node's reference position in that body's frame
+                mi = marker_index(scene, jt%marker_i)
+                call flex(1)%mesh%node_set(trim(scene%markers(marker_index(scene, &
+                    jt%marker_j))%node_set), nodes, status)
+                if (.not. status%ok()) then
+                    call status%set(status_bad_input, scene%path // ': &joint ''' // &
+                        trim(jt%name) // ''': marker_j ''' // trim(jt%marker_j) // ''': ' // &
+                        status%text())
+                    return
+                end if
+                b = markers(mi)%body
+                do n = 1, size(nodes)
+                    anchor = flex(1)%mesh%x(:, nodes(n))
+                    if (b > 0) then
+                        r = rotation_matrix(q0(7 * b - 3:7 * b))
+                        anchor = matmul(transpose(r), anchor - q0(7 * b - 6:7 * b - 4))
+                    end if
+                    markers = [markers, marker_t(b, anchor), &
+                               marker_t(0, flexible=1, node=nodes(n))]
+                    joints = [joints, mbs_joint_t(joint_spherical, size(markers) - 1, &
+                                                  size(markers))]
+                    labels = [character(len=80) :: labels, '&joint ''' // trim(jt%name) // &
+                              ''' (node ' // int_text(nodes(n)) // ')']
+                end do
             end associate
         end do
         do i = 1, size(scene%drivers)
-            k = size(scene%joints) + i
             associate (d => scene%drivers(i))
-                joints(k) = mbs_joint_t(joint_primitive, marker_index(scene, d%marker_i), &
+                joints = [joints, mbs_joint_t(joint_primitive, marker_index(scene, d%marker_i), &
                     marker_index(scene, d%marker_j), &
                     driver_kind(d%type), d%axis_i, d%axis_j, &
-                    driver_t(d%coefficients, d%amplitude, d%frequency, d%phase))
+                    driver_t(d%coefficients, d%amplitude, d%frequency, d%phase))]
+                labels = [character(len=80) :: labels, '&driver ''' // trim(d%name) // '''']
             end associate
         end do
         sys = new_mbs_system(bodies, markers, joints, gravity=scene%multibody%gravity, &
-            constraint_derivatives=trim(scene%multibody%constraint_derivatives), status=status)
+            constraint_derivatives=trim(scene%multibody%constraint_derivatives), status=status, &
+            flexible=flex)
         if (.not. status%ok()) then
             call status%set(status_bad_input, scene%path // ': ' // status%text())
             return
         end if
-        call check_rank(scene, sys, q0, status)
+        call check_rank(scene, sys, q0, labels, status)
     end subroutine build_multibody
 
     !> G(t0, q0) must have full row rank: otherwise the constraints are
     !> redundant (or singular at the start); the message names the joints
     !> whose rows are dependent (the least singular vector's support).
-    subroutine check_rank(scene, sys, q0, status)
+    subroutine check_rank(scene, sys, q0, labels, status)
         type(scene_input_t), intent(in) :: scene
         type(mbs_system_t), intent(inout) :: sys
         real(wp), intent(in) :: q0(:)
+        character(len=*), intent(in) :: labels(:) !! per system joint
         type(status_t), intent(inout) :: status
         real(wp), allocatable :: g(:, :), gt(:, :), sv(:), u(:, :), vt(:, :), work(:)
         integer :: nc, nv, info, rank, k, row, first, last, nj
@@ -133,7 +181,7 @@ contains
         if (rank == nc) return
         ! rows taking part in the dependence: vt(nc, :) (last right singular vector of Gᵀ)
         names = ''
-        nj = size(scene%joints) + size(scene%drivers)
+        nj = size(labels)
         do k = 1, nj
             first = sys%joint_first_row(k)
             last = nc
@@ -141,7 +189,7 @@ contains
             do row = first, last
                 if (abs(vt(nc, row)) > 1.0e-6_wp) then
                     if (len(names) > 0) names = names // ', '
-                    names = names // joint_label(scene, k)
+                    names = names // trim(labels(k))
                     exit
                 end if
             end do
@@ -169,17 +217,6 @@ contains
         body_index = 0
     end function body_index
 
-    !> 'joint ''name''' or 'driver ''name''' of system joint k.
-    function joint_label(scene, k) result(label)
-        type(scene_input_t), intent(in) :: scene
-        integer, intent(in) :: k
-        character(len=:), allocatable :: label
-        if (k <= size(scene%joints)) then
-            label = '&joint ''' // trim(scene%joints(k)%name) // ''''
-        else
-            label = '&driver ''' // trim(scene%drivers(k - size(scene%joints))%name) // ''''
-        end if
-    end function joint_label
 
     !> Orthonormal axes (columns) with z along z_axis and x from x_axis made
     !> normal to it (any normal when x_axis is zero).

@@ -118,6 +118,7 @@ module flexmbs_io_namelist
         var_spec_t('marker', 'position', kind_real, 3), &
         var_spec_t('marker', 'z_axis', kind_real, 3), &
         var_spec_t('marker', 'x_axis', kind_real, 3), &
+        var_spec_t('marker', 'node_set', kind_string), &
         var_spec_t('joint', 'name', kind_string), &
         var_spec_t('joint', 'type', kind_string), &
         var_spec_t('joint', 'marker_i', kind_string), &
@@ -226,6 +227,7 @@ module flexmbs_io_namelist
         real(wp) :: position(3) = 0.0_wp            !! in the body's frame [m]
         real(wp) :: z_axis(3) = [0.0_wp, 0.0_wp, 1.0_wp]
         real(wp) :: x_axis(3) = 0.0_wp              !! 0: any normal to z
+        character(len=len_name) :: node_set = ''    !! on the flexible body: its nodes
         integer :: line = 0
     end type marker_input_t
 
@@ -1229,14 +1231,15 @@ contains
         character(len=:), allocatable :: lines(:)
         integer :: ios
         character(len=256) :: msg
-        character(len=len_name) :: name, body
+        character(len=len_name) :: name, body, node_set
         real(wp), dimension(3) :: position, z_axis, x_axis
-        namelist /marker/ name, body, position, z_axis, x_axis
+        namelist /marker/ name, body, position, z_axis, x_axis, node_set
         name = input%name
         body = input%body
         position = input%position
         z_axis = input%z_axis
         x_axis = input%x_axis
+        node_set = input%node_set
         msg = ''
         lines = split_lines(text)
         read (lines, nml=marker, iostat=ios, iomsg=msg)
@@ -1245,6 +1248,7 @@ contains
         input%position = position
         input%z_axis = z_axis
         input%x_axis = x_axis
+        input%node_set = node_set
         if (ios /= 0) call status%set(status_bad_input, path // ': &marker: ' // trim(msg))
     end subroutine read_marker_group
 
@@ -1401,7 +1405,7 @@ contains
         integer :: i
         if (scene%has_body .and. .not. has_entry(entries, 'simulation', 'problem')) &
             scene%problem = 'flexible_body'
-        if (size(scene%rigid_bodies) > 0 .and. .not. scene%has_body .and. &
+        if (size(scene%rigid_bodies) > 0 .and. &
             .not. has_entry(entries, 'simulation', 'problem')) scene%problem = 'multibody'
         scene%multibody%formulation = lower(scene%multibody%formulation)
         scene%multibody%constraint_derivatives = lower(scene%multibody%constraint_derivatives)
@@ -1647,8 +1651,8 @@ contains
         type(status_t), intent(inout) :: status
         character(len=16), parameter :: mb_groups(5) = [character(len=16) :: 'multibody', &
             'rigid_body', 'marker', 'joint', 'driver']
-        character(len=12), parameter :: joint_types(6) = [character(len=12) :: 'spherical', &
-            'revolute', 'cylindrical', 'prismatic', 'universal', 'fixed']
+        character(len=12), parameter :: joint_types(7) = [character(len=12) :: 'spherical', &
+            'revolute', 'cylindrical', 'prismatic', 'universal', 'fixed', 'attach']
         character(len=12), parameter :: driver_types(3) = [character(len=12) :: 'angle', &
             'translation', 'distance']
         integer :: i, j, g
@@ -1708,8 +1712,13 @@ contains
         end do
         do i = 1, size(scene%markers)
             associate (m => scene%markers(i))
-                if (m%body /= 'ground' .and. .not. any([(scene%rigid_bodies(j)%name == m%body, &
-                                                         j = 1, size(scene%rigid_bodies))])) then
+                if (scene%has_body .and. m%body == scene%body%name) then
+                    if (len_trim(m%node_set) == 0) call bad('marker', 'body', i, 'a marker &
+                        &on the flexible body needs node_set (the nodes a joint attaches)')
+                else if (len_trim(m%node_set) > 0) then
+                    call bad('marker', 'node_set', i, 'only for markers on the &flexible_body')
+                else if (m%body /= 'ground' .and. .not. any([(scene%rigid_bodies(j)%name == &
+                         m%body, j = 1, size(scene%rigid_bodies))])) then
                     call bad('marker', 'body', i, 'no &rigid_body of that name (nor ''ground'')')
                 else if (.not. norm2(m%z_axis) > 0.0_wp) then
                     call bad('marker', 'z_axis', i, 'must not be zero')
@@ -1735,6 +1744,12 @@ contains
                 else
                     call check_markers('joint', i, jt%marker_i, jt%marker_j)
                 end if
+                if (status%ok()) then
+                    if ((jt%type == 'attach') .neqv. (on_flexible(jt%marker_j) .and. &
+                        .not. on_flexible(jt%marker_i))) call bad('joint', 'type', i, &
+                        '''attach'' joins a marker of a rigid body or the ground (marker_i) to &
+                        &a node-set marker of the flexible body (marker_j), and only it does')
+                end if
                 if (.not. status%ok()) return
             end associate
         end do
@@ -1749,6 +1764,8 @@ contains
                 else
                     call check_markers('driver', i, d%marker_i, d%marker_j)
                 end if
+                if (status%ok() .and. (on_flexible(d%marker_i) .or. on_flexible(d%marker_j))) &
+                    call bad('driver', 'marker_j', i, 'drivers act between rigid markers only')
                 if (.not. status%ok()) return
             end associate
         end do
@@ -1770,6 +1787,18 @@ contains
             case ('driver'); given = given .or. size(scene%drivers) > 0
             end select
         end function given
+
+        !> The marker of that name sits on the flexible body.
+        logical function on_flexible(name)
+            character(len=*), intent(in) :: name
+            integer :: k
+            on_flexible = .false.
+            if (.not. scene%has_body) return
+            do k = 1, size(scene%markers)
+                if (scene%markers(k)%name == name) on_flexible = scene%markers(k)%body == &
+                                                                 scene%body%name
+            end do
+        end function on_flexible
 
         !> Both markers exist and sit on different bodies.
         subroutine check_markers(group, instance, mi, mj)
@@ -1831,7 +1860,8 @@ contains
         character(len=*), parameter :: fb = 'flexible_body', mat = 'material'
         integer :: i, j
 
-        if (scene%problem /= 'flexible_body') then
+        if (scene%problem /= 'flexible_body' .and. &
+            .not. (scene%problem == 'multibody' .and. scene%has_body)) then
             if (scene%has_body) then
                 call status%set(status_bad_input, path // ': &flexible_body: given, but &
                     &problem = ''' // trim(scene%problem) // ''' (a scene builds only what &
