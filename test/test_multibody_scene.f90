@@ -41,14 +41,7 @@ contains
         real(wp) :: b(3), c(3), r(3, 3), dev
         integer :: k
         do k = 1, size(solvers)
-            call read_scene('inputs/four_bar.nml', scene, status)
-            call check(error, status%ok(), 'read: ' // status%text())
-            if (allocated(error)) return
-            scene%output_file = ''
-            scene%progress = .false.
-            scene%solver_name = solvers(k)
-            call run_scene(scene, .true., result, status)
-            call check(error, status%ok(), trim(solvers(k)) // ': ' // status%text())
+            call run_file(error, 'inputs/four_bar.nml', solvers(k), scene, result)
             if (allocated(error)) return
             call four_bar_exact(crank_angle(1.0_wp), b, c)
             r = rotation_matrix(result%y(11:14))
@@ -135,14 +128,7 @@ contains
         real(wp) :: y_ref(4), ek0, ep0, ek, ep
         integer :: k
         do k = 1, size(solvers)
-            call read_scene('inputs/double_pendulum_chain.nml', scene, status)
-            call check(error, status%ok(), 'read: ' // status%text())
-            if (allocated(error)) return
-            scene%output_file = ''
-            scene%progress = .false.
-            scene%solver_name = solvers(k)
-            call run_scene(scene, .true., result, status)
-            call check(error, status%ok(), trim(solvers(k)) // ': ' // status%text())
+            call run_file(error, 'inputs/double_pendulum_chain.nml', solvers(k), scene, result)
             if (allocated(error)) return
             if (k == 1) then
                 y_ref = result%y(1:4)
@@ -187,14 +173,7 @@ contains
         real(wp) :: r(3, 3), pin(3), worst
         integer :: k, j
         do k = 1, size(solvers)
-            call read_scene('inputs/rigid_flexible_pendulum.nml', scene, status)
-            call check(error, status%ok(), 'read: ' // status%text())
-            if (allocated(error)) return
-            scene%output_file = ''
-            scene%progress = .false.
-            scene%solver_name = solvers(k)
-            call run_scene(scene, .true., result, status)
-            call check(error, status%ok(), trim(solvers(k)) // ': ' // status%text())
+            call run_file(error, 'inputs/rigid_flexible_pendulum.nml', solvers(k), scene, result)
             if (allocated(error)) return
             if (k == 1) then
                 y_ref = result%y
@@ -235,4 +214,20 @@ contains
         call expect(error, base // '&marker name = ''m2'', body = ''link'', node_set = &
             &''xmin'' /', "&marker: node_set = 'xmin': only for markers on the &flexible_body")
     end subroutine test_rigid_flexible_bad
+    !> Read the scene file, run it with `solver` (no output file).
+    subroutine run_file(error, path, solver, scene, result)
+        type(error_t), allocatable, intent(inout) :: error
+        character(len=*), intent(in) :: path, solver
+        type(scene_input_t), intent(out) :: scene
+        type(run_result_t), intent(out) :: result
+        type(status_t) :: status
+        call read_scene(path, scene, status)
+        call check(error, status%ok(), 'read: ' // status%text())
+        if (allocated(error)) return
+        scene%output_file = ''
+        scene%progress = .false.
+        scene%solver_name = solver
+        call run_scene(scene, .true., result, status)
+        call check(error, status%ok(), trim(solver) // ': ' // status%text())
+    end subroutine run_file
 end module test_multibody_scene
