@@ -37,7 +37,8 @@ contains
         type(test_case_t), allocatable :: tests(:)
         tests = [new_test('node_joints_ad_vs_analytic', test_ad), &
                  new_test('formulation_jacobian_fd', test_jacobian), &
-                 new_test('closed_loop_energy', test_energy)]
+                 new_test('closed_loop_energy', test_energy), &
+                 new_test('free_system_momentum', test_momentum)]
     end function collect_flexible_coupling
 
     !> The loop (and, with `second`, a small cube whose corner node is
@@ -228,4 +229,59 @@ contains
         call check(error, drift(2) < drift(1), 'energy drift does not shrink with the tolerance')
         call check(error, drift(2) <= 1.0e-4_wp * max(abs(e0), scale), 'energy drift too large')
     end subroutine test_energy
+    !> A free rigid link with the soft bar pinned to it (no ground, no
+    !> gravity), spinning and flying: linear and angular momentum conserved
+    !> (RADAU5, GGL, rtol 1e-8).
+    subroutine test_momentum(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(mesh_t) :: mesh
+        type(neo_hooke_t) :: mat
+        type(flexible_body_t) :: bar(1)
+        type(mbs_system_t), target :: sys
+        type(formulation_t) :: gen
+        type(radau5_t) :: solver
+        type(dae_options_t) :: options
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        type(marker_t) :: m(8)
+        type(mbs_joint_t) :: j(4)
+        integer, allocatable :: face(:)
+        real(wp), allocatable :: y(:), yp(:)
+        real(wp) :: l0(3), a0(3), l1(3), a1(3), t
+        integer :: i
+        call new_neo_hooke(mat, 7.0e5_wp, 0.3_wp, 920.0_wp, 0.0_wp, status)
+        call box_mesh(mesh, hex8, [2, 1, 1], [0.4_wp, 0.05_wp, 0.05_wp], status, &
+                      origin=[0.3_wp, -0.025_wp, -0.025_wp])
+        call mesh%node_set('xmin', face, status)
+        call new_flexible_body(bar(1), mesh, [mat], [integer ::], status)
+        do i = 1, 4
+            m(i) = marker_t(1, mesh%x(:, face(i)) - [0.15_wp, 0.0_wp, 0.0_wp])
+            m(4 + i) = marker_t(0, flexible=1, node=face(i))
+            j(i) = mbs_joint_t(joint_spherical, i, 4 + i)
+        end do
+        sys = new_mbs_system([rigid_body_t(0.5_wp, 0.01_wp * reshape([1.0_wp, 0.0_wp, 0.0_wp, &
+            0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3]))], m, j, status=status, &
+            flexible=bar)
+        call check(error, status%ok(), 'system: ' // status%text())
+        if (allocated(error)) return
+        gen = new_formulation(sys, formulation_ggl, [0.15_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, &
+            0.0_wp, 0.0_wp, bar(1)%free_positions()], constant_mass=.true., status=status)
+        allocate (y(gen%n), yp(gen%n), source=0.0_wp)
+        y(1:7) = [0.15_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+        y(8:sys%nq) = bar(1)%free_positions()
+        y(gen%ov + 1:gen%ov + 6) = [0.3_wp, -0.2_wp, 0.1_wp, 0.5_wp, 1.0_wp, 3.0_wp]
+        call gen%consistent_initial(0.0_wp, y, yp, status)
+        call sys%momenta(y(1:sys%nq), y(gen%ov + 1:gen%ov + sys%nv), l0, a0)
+        options%rtol = 1.0e-8_wp
+        options%atol = 1.0e-8_wp
+        t = 0.0_wp
+        call solver%integrate(gen, t, y, 0.2_wp, options, stats, status)
+        call check(error, status%ok(), 'run: ' // status%text())
+        if (allocated(error)) return
+        call sys%momenta(y(1:sys%nq), y(gen%ov + 1:gen%ov + sys%nv), l1, a1)
+        print '(4x,a,2es9.2)', 'free system: momentum change (linear, angular) ', &
+            norm2(l1 - l0) / norm2(l0), norm2(a1 - a0) / norm2(a0)
+        call check(error, norm2(l1 - l0) <= 1.0e-6_wp * norm2(l0), 'linear momentum')
+        call check(error, norm2(a1 - a0) <= 1.0e-6_wp * norm2(a0), 'angular momentum')
+    end subroutine test_momentum
 end module test_flexible_coupling
