@@ -92,8 +92,7 @@ contains
             m(12) = marker_t(0, flexible=2, node=1)
             j(6) = mbs_joint_t(joint_spherical, 11, 12)
         end if
-        sys = new_mbs_system([rigid_body_t(0.5_wp, 0.01_wp * reshape([1.0_wp, 0.0_wp, 0.0_wp, &
-            0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3]))], m, j, &
+        sys = new_mbs_system([link()], m, j, &
             gravity=g_earth, constraint_derivatives=derivatives, status=status, flexible=flex)
         if (.not. status%ok()) return
         allocate (q0(sys%nq))
@@ -259,8 +258,7 @@ contains
             m(4 + i) = marker_t(0, flexible=1, node=face(i))
             j(i) = mbs_joint_t(joint_spherical, i, 4 + i)
         end do
-        sys = new_mbs_system([rigid_body_t(0.5_wp, 0.01_wp * reshape([1.0_wp, 0.0_wp, 0.0_wp, &
-            0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3]))], m, j, status=status, &
+        sys = new_mbs_system([link()], m, j, status=status, &
             flexible=bar)
         call check(error, status%ok(), 'system: ' // status%text())
         if (allocated(error)) return
@@ -284,4 +282,10 @@ contains
         call check(error, norm2(l1 - l0) <= 1.0e-6_wp * norm2(l0), 'linear momentum')
         call check(error, norm2(a1 - a0) <= 1.0e-6_wp * norm2(a0), 'angular momentum')
     end subroutine test_momentum
+    !> The rigid link: 0.5 kg, isotropic inertia 0.01 kg m².
+    pure function link() result(body)
+        type(rigid_body_t) :: body
+        body = rigid_body_t(0.5_wp, 0.01_wp * reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
+                            1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3]))
+    end function link
 end module test_flexible_coupling
