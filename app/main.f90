@@ -104,6 +104,10 @@ contains
         end do
         if (n > max_printed) write (output_unit, '(a,i0,a)') '... (', n, &
             ' components; all of them are in the HDF5 file)'
+        if (result%has_drift .and. result%constraints > 0) then
+            write (output_unit, '(a,2es11.3)') 'constraint drift at t_end: |g|, |G v + g_I|', &
+                result%drift_end
+        end if
         if (result%has_energy) then
             write (output_unit, '(a,3es14.6)') 'energy at t_start [J]: strain, kinetic, total', &
                 result%energy_start

@@ -2,6 +2,7 @@
 !> `&driver`): the four-bar of inputs/four_bar.nml against its closed form
 !> with every solver, and the messages for bad scenes (no output file).
 module test_multibody_scene
+    use hdf5
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_io_namelist, only: scene_input_t, read_scene, parse_scene
@@ -26,7 +27,8 @@ contains
                  new_test('rigid_chain_file', test_chain_file), &
                  new_test('rigid_chain_bad_scenes', test_chain_bad), &
                  new_test('rigid_flexible_file', test_rigid_flexible), &
-                 new_test('rigid_flexible_bad_scenes', test_rigid_flexible_bad)]
+                 new_test('rigid_flexible_bad_scenes', test_rigid_flexible_bad), &
+                 new_test('monitor_drift_energy', test_monitor)]
     end function collect_multibody_scene
 
     !> inputs/four_bar.nml with each solver: the coupler end at t = 1
@@ -230,4 +232,51 @@ contains
         call run_scene(scene, .true., result, status)
         call check(error, status%ok(), trim(solver) // ': ' // status%text())
     end subroutine run_file
+    !> The four-bar with an HDF5 file: /monitor holds (t, ‖g‖, ‖Gv + g_I‖,
+    !> energy) at the 101 output times (dense output between steps: GGL keeps
+    !> the drifts at the tolerance level there, rtol 1e-7); the summary
+    !> reports the last; after one crank revolution the energy returns.
+    subroutine test_monitor(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), parameter :: h5 = 'build/test-monitor.h5'
+        type(scene_input_t) :: scene
+        type(run_result_t) :: result
+        type(status_t) :: status
+        integer(hid_t) :: file, dset, space
+        integer(hsize_t) :: dims(2), maxdims(2)
+        real(wp), allocatable :: table(:, :)
+        integer :: err, unit
+        call read_scene('inputs/four_bar.nml', scene, status)
+        scene%output_file = h5
+        scene%progress = .false.
+        call run_scene(scene, .true., result, status)
+        call check(error, status%ok(), 'run: ' // status%text())
+        if (allocated(error)) return
+        call check(error, result%has_drift .and. result%constraints == 18 .and. &
+                   maxval(result%drift_end) <= 1.0e-8_wp, 'summary drift')
+        call h5open_f(err)
+        call h5fopen_f(h5, H5F_ACC_RDONLY_F, file, err)
+        call h5dopen_f(file, 'monitor', dset, err)
+        call check(error, err >= 0, '/monitor missing')
+        if (allocated(error)) return
+        call h5dget_space_f(dset, space, err)
+        call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
+        allocate (table(dims(1), dims(2)))
+        call h5dread_f(dset, H5T_NATIVE_DOUBLE, table, dims, err)
+        call h5sclose_f(space, err)
+        call h5dclose_f(dset, err)
+        call h5fclose_f(file, err)
+        call check(error, all(dims == [4_hsize_t, 101_hsize_t]), '/monitor shape')
+        if (allocated(error)) return
+        print '(4x,a,2es9.2,a,2es10.2)', 'four-bar monitor: max drift ', &
+            maxval(table(2, :)), maxval(table(3, :)), ', energy from/to ', table(4, 1), &
+            table(4, 101)
+        call check(error, table(1, 101) == 1.0_wp .and. maxval(table(2:3, :)) <= 1.0e-6_wp, &
+                   '/monitor values')
+        call check(error, abs(table(4, 101) - table(4, 1)) <= 1.0e-5_wp * abs(table(4, 1)), &
+                   'energy after one revolution')
+        call check(error, all(table(4, :) == table(4, :)), 'energy not finite')
+        open (newunit=unit, file=h5)
+        close (unit, status='delete')
+    end subroutine test_monitor
 end module test_multibody_scene

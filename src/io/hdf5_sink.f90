@@ -51,6 +51,7 @@ module flexmbs_io_hdf5_sink
         procedure :: finish => sink_finish
         procedure :: write_text => sink_write_text
         procedure :: write_statistics => sink_write_statistics
+        procedure :: write_matrix => sink_write_matrix
         procedure :: close => sink_close
     end type hdf5_sink_t
 
@@ -211,6 +212,28 @@ contains
         end if
         if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
     end subroutine sink_write_text
+
+    !> A 2-D real dataset /name (rows, columns), e.g. the monitor table.
+    subroutine sink_write_matrix(self, name, values, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        real(wp), intent(in) :: values(:, :)
+        type(status_t), intent(out) :: status
+        integer(hid_t) :: space, dset
+        integer(hsize_t) :: dims(2)
+        integer :: err
+        if (.not. self%is_open) then
+            call status%set(status_bad_input, 'HDF5 sink: write_matrix before create')
+            return
+        end if
+        dims = shape(values, kind=hsize_t)
+        call h5screate_simple_f(2, dims, space, err)
+        if (err >= 0) call h5dcreate_f(self%file, name, H5T_NATIVE_DOUBLE, space, dset, err)
+        if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, err)
+        if (err >= 0) call h5dclose_f(dset, err)
+        if (err >= 0) call h5sclose_f(space, err)
+        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
+    end subroutine sink_write_matrix
 
     !> Store the statistics (and optionally solver name and outcome) as
     !> attributes of '/'; call after the integration, before `close`.

@@ -29,6 +29,7 @@ module flexmbs_io_scene
         formulation_index2, formulation_index3, formulation_ggl
     use flexmbs_io_namelist, only: scene_input_t, scene_dae_options, controller_code
     use flexmbs_io_multibody_input, only: build_multibody
+    use flexmbs_io_monitor_sink, only: monitor_sink_t
     use flexmbs_io_chain_input, only: build_rigid_chain
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     use flexmbs_mbs_system, only: mbs_system_t
@@ -57,6 +58,11 @@ module flexmbs_io_scene
         !> potential of gravity and loads) at the start and at the end [J].
         logical :: has_energy = .false.
         real(wp) :: energy_start(3) = 0.0_wp, energy_end(3) = 0.0_wp
+        !> A formulated mechanical scene: ‖g‖∞ and ‖G v + g_I‖∞ at the end
+        !> (the whole history is /monitor in the HDF5 file), constraint rows.
+        logical :: has_drift = .false.
+        real(wp) :: drift_end(2) = 0.0_wp
+        integer :: constraints = 0
     end type run_result_t
 
     public :: build_problem, build_solver, scene_stab, run_scene
@@ -312,7 +318,8 @@ contains
         logical, intent(in) :: quiet             !! no progress display
         type(run_result_t), intent(out) :: result
         type(status_t), intent(out) :: status
-        class(dae_problem_t), allocatable :: problem
+        class(dae_problem_t), allocatable, target :: problem
+        type(monitor_sink_t), target :: monitor
         class(mechanical_problem_t), allocatable, target :: mechanical
         class(dae_solver_t), allocatable, target :: solver
         type(block_spec_t), allocatable :: blocks(:)
@@ -374,6 +381,18 @@ contains
             call progress%watch(solver%native%nstep, solver%native%naccpt)
         end select
         call sinks%attach(progress)
+        ! drift and energy of formulated mechanical scenes, at the output times
+        select type (p => problem)
+        type is (formulation_t)
+            if (allocated(mechanical)) then
+                monitor%formulation => p
+                monitor%mechanical => mechanical
+                monitor%every_step = scene%every_step
+                monitor%q_start = result%y(p%oq + 1:p%oq + p%nq)
+                call sinks%attach(monitor)
+                result%constraints = p%nc
+            end if
+        end select
 
         y_start = result%y
         call record_energy(y_start, result%energy_start)
@@ -387,7 +406,17 @@ contains
         if (status%ok()) call record_energy(result%y, result%energy_end)
         result%has_energy = result%has_energy .and. status%ok()
 
+        if (monitor%records > 0) then
+            result%has_drift = .true.
+            result%drift_end = monitor%table(2:3, monitor%records)
+        end if
         if (h5%is_open) then
+            if (monitor%records > 0) then
+                call h5%write_matrix('monitor', monitor%table(:, 1:monitor%records), io_status)
+                if (io_status%ok()) call h5%write_text('monitor_columns', &
+                    't, |g|_inf, |G v + g_I|_inf, energy [J]', io_status)
+                if (status%ok() .and. .not. io_status%ok()) status = io_status
+            end if
             outcome = 'ok'
             if (.not. status%ok()) outcome = status%text()
             call h5%write_statistics(result%stats, io_status, result%solver_name, outcome)

@@ -1,0 +1,98 @@
+!> A sink that records, at the same times as the trajectory, the drift of
+!> the constraints (‖g‖∞ and ‖G v + g_I‖∞) and the mechanical energy of a
+!> formulated mechanical problem, for the HDF5 file (/monitor) and the run
+!> summary.
+!>
+!> Energy: a multibody system's kinetic plus potential energy (flexible
+!> bodies: kinetic, strain and the potential of their constant applied
+!> forces); a rigid chain's kinetic plus potential; a flexible body's strain
+!> plus kinetic energy minus the work of its applied forces from the start.
+module flexmbs_io_monitor_sink
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t
+    use flexmbs_dae_sink, only: sink_t, dense_output_t
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    use flexmbs_mbs_formulation, only: formulation_t
+    use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_mbs_rigid_chain, only: rigid_chain_t
+    use flexmbs_fe_flexible_body, only: flexible_body_t
+    implicit none
+    private
+
+    type, extends(sink_t), public :: monitor_sink_t
+        type(formulation_t), pointer :: formulation => null()
+        class(mechanical_problem_t), pointer :: mechanical => null()
+        logical :: every_step = .false.      !! as the trajectory sink
+        real(wp), allocatable :: q_start(:)  !! flexible body: the work's origin
+        integer :: records = 0
+        !> (4, records): t, ‖g‖∞, ‖G v + g_I‖∞, energy
+        real(wp), allocatable :: table(:, :)
+    contains
+        procedure :: output => monitor_output
+        procedure :: wants_steps => monitor_wants_steps
+        procedure :: step => monitor_step
+    end type monitor_sink_t
+
+contains
+
+    subroutine monitor_output(self, t, y, status)
+        class(monitor_sink_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        type(status_t), intent(inout) :: status
+        if (.not. self%every_step) call record(self, t, y)
+    end subroutine monitor_output
+
+    logical function monitor_wants_steps(self)
+        class(monitor_sink_t), intent(in) :: self
+        monitor_wants_steps = self%every_step
+    end function monitor_wants_steps
+
+    subroutine monitor_step(self, nr, t_old, t, y, dense, stop, status)
+        class(monitor_sink_t), intent(inout) :: self
+        integer, intent(in) :: nr
+        real(wp), intent(in) :: t_old, t, y(:)
+        class(dense_output_t), intent(in) :: dense
+        logical, intent(inout) :: stop
+        type(status_t), intent(inout) :: status
+        if (self%every_step) call record(self, t, y)
+    end subroutine monitor_step
+
+    !> Append one row (the table doubles when full).
+    subroutine record(self, t, y)
+        class(monitor_sink_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), allocatable :: grown(:, :)
+        real(wp) :: position, velocity
+        type(status_t) :: st
+        if (.not. allocated(self%table)) allocate (self%table(4, 64))
+        if (self%records == size(self%table, 2)) then
+            allocate (grown(4, 2 * size(self%table, 2)))
+            grown(:, 1:self%records) = self%table
+            call move_alloc(grown, self%table)
+        end if
+        call self%formulation%drift(t, y, position, velocity, st)
+        self%records = self%records + 1
+        self%table(:, self%records) = [t, position, velocity, &
+            energy(self, y(self%formulation%oq + 1:self%formulation%oq + self%formulation%nq), &
+                   y(self%formulation%ov + 1:self%formulation%ov + self%formulation%nv))]
+    end subroutine record
+
+    real(wp) function energy(self, q, v) result(e)
+        class(monitor_sink_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp) :: ek, ep
+        type(status_t) :: st
+        e = ieee_value(1.0_wp, ieee_quiet_nan)
+        select type (m => self%mechanical)
+        type is (mbs_system_t)
+            e = m%energy(q, v)
+        type is (rigid_chain_t)
+            call m%energy(q, v, ek, ep)
+            e = ek + ep
+        type is (flexible_body_t)
+            e = m%strain_energy(q, st) + m%kinetic_energy(v)
+            if (allocated(self%q_start)) e = e - dot_product(m%applied_force, q - self%q_start)
+        end select
+    end function energy
+end module flexmbs_io_monitor_sink
