@@ -276,6 +276,23 @@ contains
         call check(error, abs(table(4, 101) - table(4, 1)) <= 1.0e-5_wp * abs(table(4, 1)), &
                    'energy after one revolution')
         call check(error, all(table(4, :) == table(4, :)), 'energy not finite')
+        ! /reactions: 12 numbers per system joint (4 joints and the driver)
+        call h5fopen_f(h5, H5F_ACC_RDONLY_F, file, err)
+        call h5dopen_f(file, 'reactions', dset, err)
+        call check(error, err >= 0, '/reactions missing')
+        if (allocated(error)) return
+        call h5dget_space_f(dset, space, err)
+        call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
+        deallocate (table)
+        allocate (table(dims(1), dims(2)))
+        call h5dread_f(dset, H5T_NATIVE_DOUBLE, table, dims, err)
+        call h5sclose_f(space, err)
+        call h5dclose_f(dset, err)
+        call h5fclose_f(file, err)
+        call check(error, all(dims == [60_hsize_t, 101_hsize_t]), '/reactions shape')
+        ! the motor drives the crank: its torque on the crank is not zero
+        call check(error, maxval(abs(table(58:60, :))) > 0.0_wp .and. &
+                   all(table == table), '/reactions values')
         open (newunit=unit, file=h5)
         close (unit, status='delete')
     end subroutine test_monitor

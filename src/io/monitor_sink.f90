@@ -7,6 +7,10 @@
 !> bodies: kinetic, strain and the potential of their constant applied
 !> forces); a rigid chain's kinetic plus potential; a flexible body's strain
 !> plus kinetic energy minus the work of its applied forces from the start.
+!>
+!> Reactions (multibody systems): for joint k, the force and torque it
+!> exerts on the body of marker i and of marker j (mbs_system_t%joint_reaction,
+!> our sign of λ), 12 numbers per joint and record: F_i, n_i, F_j, n_j.
 module flexmbs_io_monitor_sink
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use flexmbs_core_kinds, only: wp
@@ -28,6 +32,8 @@ module flexmbs_io_monitor_sink
         integer :: records = 0
         !> (4, records): t, ‖g‖∞, ‖G v + g_I‖∞, energy
         real(wp), allocatable :: table(:, :)
+        !> (12 joints, records): joint reactions of a multibody system
+        real(wp), allocatable :: reactions(:, :)
     contains
         procedure :: output => monitor_output
         procedure :: wants_steps => monitor_wants_steps
@@ -63,19 +69,40 @@ contains
         class(monitor_sink_t), intent(inout) :: self
         real(wp), intent(in) :: t, y(:)
         real(wp), allocatable :: grown(:, :)
-        real(wp) :: position, velocity
+        real(wp) :: position, velocity, force(3, 2), torque(3, 2)
         type(status_t) :: st
-        if (.not. allocated(self%table)) allocate (self%table(4, 64))
+        integer :: k, nj
+        nj = 0
+        select type (m => self%mechanical)
+        type is (mbs_system_t)
+            nj = size(m%joints)
+        end select
+        if (.not. allocated(self%table)) allocate (self%table(4, 64), &
+                                                   self%reactions(12 * nj, 64))
         if (self%records == size(self%table, 2)) then
             allocate (grown(4, 2 * size(self%table, 2)))
             grown(:, 1:self%records) = self%table
             call move_alloc(grown, self%table)
+            allocate (grown(12 * nj, size(self%table, 2)))
+            grown(:, 1:self%records) = self%reactions
+            call move_alloc(grown, self%reactions)
         end if
         call self%formulation%drift(t, y, position, velocity, st)
         self%records = self%records + 1
         self%table(:, self%records) = [t, position, velocity, &
             energy(self, y(self%formulation%oq + 1:self%formulation%oq + self%formulation%nq), &
                    y(self%formulation%ov + 1:self%formulation%ov + self%formulation%nv))]
+        select type (m => self%mechanical)
+        type is (mbs_system_t)
+            associate (f => self%formulation)
+                do k = 1, nj
+                    call m%joint_reaction(k, t, y(f%oq + 1:f%oq + f%nq), &
+                                          y(f%ol + 1:f%ol + f%nc), force, torque)
+                    self%reactions(12 * k - 11:12 * k, self%records) = [force(:, 1), &
+                        torque(:, 1), force(:, 2), torque(:, 2)]
+                end do
+            end associate
+        end select
     end subroutine record
 
     real(wp) function energy(self, q, v) result(e)

@@ -415,6 +415,13 @@ contains
                 call h5%write_matrix('monitor', monitor%table(:, 1:monitor%records), io_status)
                 if (io_status%ok()) call h5%write_text('monitor_columns', &
                     't, |g|_inf, |G v + g_I|_inf, energy [J]', io_status)
+                if (io_status%ok() .and. size(monitor%reactions, 1) > 0) then
+                    call h5%write_matrix('reactions', &
+                        monitor%reactions(:, 1:monitor%records), io_status)
+                    if (io_status%ok()) call h5%write_text('reactions_columns', 'per joint &
+                        &of the system: force and torque on the body of marker i, then of &
+                        &marker j (N, N m; global; torque about the marker)', io_status)
+                end if
                 if (status%ok() .and. .not. io_status%ok()) status = io_status
             end if
             outcome = 'ok'
