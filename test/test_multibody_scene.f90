@@ -242,8 +242,7 @@ contains
         type(scene_input_t) :: scene
         type(run_result_t) :: result
         type(status_t) :: status
-        integer(hid_t) :: file, dset, space
-        integer(hsize_t) :: dims(2), maxdims(2)
+        integer(hsize_t) :: dims(2)
         real(wp), allocatable :: table(:, :)
         integer :: err, unit
         call read_scene('inputs/four_bar.nml', scene, status)
@@ -255,17 +254,9 @@ contains
         call check(error, result%has_drift .and. result%constraints == 18 .and. &
                    maxval(result%drift_end) <= 1.0e-8_wp, 'summary drift')
         call h5open_f(err)
-        call h5fopen_f(h5, H5F_ACC_RDONLY_F, file, err)
-        call h5dopen_f(file, 'monitor', dset, err)
-        call check(error, err >= 0, '/monitor missing')
+        call read_matrix(h5, 'monitor', table, error)
         if (allocated(error)) return
-        call h5dget_space_f(dset, space, err)
-        call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
-        allocate (table(dims(1), dims(2)))
-        call h5dread_f(dset, H5T_NATIVE_DOUBLE, table, dims, err)
-        call h5sclose_f(space, err)
-        call h5dclose_f(dset, err)
-        call h5fclose_f(file, err)
+        dims = shape(table, kind=hsize_t)
         call check(error, all(dims == [4_hsize_t, 101_hsize_t]), '/monitor shape')
         if (allocated(error)) return
         print '(4x,a,2es9.2,a,2es10.2)', 'four-bar monitor: max drift ', &
@@ -277,18 +268,9 @@ contains
                    'energy after one revolution')
         call check(error, all(table(4, :) == table(4, :)), 'energy not finite')
         ! /reactions: 12 numbers per system joint (4 joints and the driver)
-        call h5fopen_f(h5, H5F_ACC_RDONLY_F, file, err)
-        call h5dopen_f(file, 'reactions', dset, err)
-        call check(error, err >= 0, '/reactions missing')
+        call read_matrix(h5, 'reactions', table, error)
         if (allocated(error)) return
-        call h5dget_space_f(dset, space, err)
-        call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
-        deallocate (table)
-        allocate (table(dims(1), dims(2)))
-        call h5dread_f(dset, H5T_NATIVE_DOUBLE, table, dims, err)
-        call h5sclose_f(space, err)
-        call h5dclose_f(dset, err)
-        call h5fclose_f(file, err)
+        dims = shape(table, kind=hsize_t)
         call check(error, all(dims == [60_hsize_t, 101_hsize_t]), '/reactions shape')
         ! the motor drives the crank: its torque on the crank is not zero
         call check(error, maxval(abs(table(58:60, :))) > 0.0_wp .and. &
@@ -296,4 +278,24 @@ contains
         open (newunit=unit, file=h5)
         close (unit, status='delete')
     end subroutine test_monitor
+    !> A 2-D real dataset of an HDF5 file.
+    subroutine read_matrix(path, name, table, error)
+        character(len=*), intent(in) :: path, name
+        real(wp), allocatable, intent(out) :: table(:, :)
+        type(error_t), allocatable, intent(inout) :: error
+        integer(hid_t) :: file, dset, space
+        integer(hsize_t) :: dims(2), maxdims(2)
+        integer :: err
+        call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
+        call h5dopen_f(file, name, dset, err)
+        call check(error, err >= 0, '/' // name // ' missing')
+        if (allocated(error)) return
+        call h5dget_space_f(dset, space, err)
+        call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
+        allocate (table(dims(1), dims(2)))
+        call h5dread_f(dset, H5T_NATIVE_DOUBLE, table, dims, err)
+        call h5sclose_f(space, err)
+        call h5dclose_f(dset, err)
+        call h5fclose_f(file, err)
+    end subroutine read_matrix
 end module test_multibody_scene
