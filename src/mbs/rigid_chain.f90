@@ -228,7 +228,7 @@ contains
         real(wp), intent(out) :: tau(:)
         logical, intent(in), optional :: with_gravity
         integer :: i, p, c
-        real(wp) :: sv(6)
+        real(wp) :: sv(6), sa(6)
         call frames(self, q)
         self%vel(:, 0) = 0.0_wp
         self%acc(:, 0) = 0.0_wp
@@ -238,12 +238,15 @@ contains
         end if
         do i = 1, size(self%bodies)
             p = self%bodies(i)%parent
-            associate (cols => [(c, c = self%iv(i) + 1, self%iv(i + 1))])
-                sv = matmul(self%s(:, cols), qd(cols))
-                self%vel(:, i) = self%vel(:, p) + sv
-                self%acc(:, i) = self%acc(:, p) + matmul(self%s(:, cols), qdd(cols)) &
-                                 + cross_motion(self%vel(:, i), sv)
-            end associate
+            ! S v and S v' over the joint's rate columns (no temporaries)
+            sv = 0.0_wp
+            sa = 0.0_wp
+            do c = self%iv(i) + 1, self%iv(i + 1)
+                sv = sv + self%s(:, c) * qd(c)
+                sa = sa + self%s(:, c) * qdd(c)
+            end do
+            self%vel(:, i) = self%vel(:, p) + sv
+            self%acc(:, i) = self%acc(:, p) + sa + cross_motion(self%vel(:, i), sv)
             self%frc(:, i) = matmul(self%inert(:, :, i), self%acc(:, i)) &
                              + cross_force(self%vel(:, i), matmul(self%inert(:, :, i), &
                                                                   self%vel(:, i)))
