@@ -3,9 +3,11 @@
 module mbs_random
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_mbs_rotation, only: quat_normalize
+    use flexmbs_core_status, only: status_t
+    use flexmbs_mbs_system, only: mbs_system_t
     implicit none
     private
-    public :: random_state_t, uniform, random_vector, random_quaternion
+    public :: random_state_t, uniform, random_vector, random_quaternion, ad_deviation
 
     type :: random_state_t
         integer(i8) :: s = 88172645463325252_i8
@@ -46,4 +48,29 @@ contains
         end do
         p = quat_normalize(p)
     end function random_quaternion
+
+    !> The largest deviation of the 'ad' system from the 'analytic' one at
+    !> (t, q, v): c absolute; G, c_q, γ relative to their largest entry; c_t
+    !> absolute.
+    real(wp) function ad_deviation(hand, ad, t, q, v, status) result(worst)
+        type(mbs_system_t), intent(inout) :: hand, ad
+        real(wp), intent(in) :: t, q(:), v(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: ch(hand%nc), cd(hand%nc), gh(hand%nc, hand%nv), gd(hand%nc, hand%nv), &
+            qh(hand%nc, hand%nq), qd(hand%nc, hand%nq), th(hand%nc), td(hand%nc), &
+            yh(hand%nc), yd(hand%nc)
+        call hand%constraint(t, q, ch, status)
+        call ad%constraint(t, q, cd, status)
+        call hand%constraint_jacobian(t, q, gh, status)
+        call ad%constraint_jacobian(t, q, gd, status)
+        call hand%constraint_position_jacobian(t, q, qh, status)
+        call ad%constraint_position_jacobian(t, q, qd, status)
+        call hand%constraint_time_derivative(t, q, th, status)
+        call ad%constraint_time_derivative(t, q, td, status)
+        call hand%constraint_curvature(t, q, v, yh, status)
+        call ad%constraint_curvature(t, q, v, yd, status)
+        worst = max(maxval(abs(ch - cd)), maxval(abs(gh - gd)) / maxval(abs(gh)), &
+                    maxval(abs(qh - qd)) / maxval(abs(qh)), maxval(abs(th - td)), &
+                    maxval(abs(yh - yd)) / max(maxval(abs(yh)), 1.0_wp))
+    end function ad_deviation
 end module mbs_random

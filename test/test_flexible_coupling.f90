@@ -23,6 +23,7 @@ module test_flexible_coupling
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_ggl, &
         formulation_index2
     use test_problems, only: fill_random
+    use mbs_random, only: ad_deviation
     use test_formulation, only: difference_jacobian
     use testing, only: test_case_t, new_test, error_t, check
     implicit none
@@ -107,8 +108,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         type(mbs_system_t) :: hand, ad
         type(status_t) :: status
-        real(wp), allocatable :: q0(:), q(:), v(:), ch(:), cd(:), gh(:, :), gd(:, :), &
-            qh(:, :), qd(:, :), th(:), td(:), yh(:), yd(:)
+        real(wp), allocatable :: q0(:), q(:), v(:)
         real(wp) :: worst
         integer(i8) :: seed
         integer :: trial
@@ -118,8 +118,7 @@ contains
         if (allocated(error)) return
         associate (nc => hand%nc, nq => hand%nq, nv => hand%nv)
             call check(error, nc == 5 + 12 + 3, 'rows')
-            allocate (q(nq), v(nv), ch(nc), cd(nc), gh(nc, nv), gd(nc, nv), qh(nc, nq), &
-                      qd(nc, nq), th(nc), td(nc), yh(nc), yd(nc))
+            allocate (q(nq), v(nv))
         end associate
         seed = 3_i8
         worst = 0.0_wp
@@ -128,19 +127,7 @@ contains
             q = q0 + q
             q(4:7) = q(4:7) / norm2(q(4:7))
             call fill_random(v, seed, -1.0_wp, 1.0_wp)
-            call hand%constraint(0.2_wp, q, ch, status)
-            call ad%constraint(0.2_wp, q, cd, status)
-            call hand%constraint_jacobian(0.2_wp, q, gh, status)
-            call ad%constraint_jacobian(0.2_wp, q, gd, status)
-            call hand%constraint_position_jacobian(0.2_wp, q, qh, status)
-            call ad%constraint_position_jacobian(0.2_wp, q, qd, status)
-            call hand%constraint_time_derivative(0.2_wp, q, th, status)
-            call ad%constraint_time_derivative(0.2_wp, q, td, status)
-            call hand%constraint_curvature(0.2_wp, q, v, yh, status)
-            call ad%constraint_curvature(0.2_wp, q, v, yd, status)
-            worst = max(worst, maxval(abs(ch - cd)), maxval(abs(gh - gd)) / maxval(abs(gh)), &
-                        maxval(abs(qh - qd)) / maxval(abs(qh)), maxval(abs(th - td)), &
-                        maxval(abs(yh - yd)) / max(maxval(abs(yh)), 1.0_wp))
+            worst = max(worst, ad_deviation(hand, ad, 0.2_wp, q, v, status))
         end do
         print '(4x,a,es9.2)', 'node joints: AD vs analytic ', worst
         call check(error, status%ok(), 'evaluations: ' // status%text())

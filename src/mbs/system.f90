@@ -41,7 +41,7 @@ module flexmbs_mbs_system
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_text, only: int_text
-    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t, difference_step
     use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_mbs_primitive_kinds, only: primitive_distance
@@ -55,12 +55,15 @@ module flexmbs_mbs_system
         joint_part_convective, joint_part_time_terms
     use flexmbs_mbs_constraint_primitives, only: marker_state_t, rigid_marker_state, &
         ground_marker_state, rigid_marker_jacobian, rigid_marker_jacobian_q, joint_value, &
-        joint_jacobian, joint_rows
+        joint_jacobian, joint_rows, chain_marker_state, chain_marker_jacobian
     use flexmbs_mbs_constraint_primitives_dual, only: marker_state_d => marker_state_t, &
         rigid_marker_state_d => rigid_marker_state, &
         ground_marker_state_d => ground_marker_state, &
         rigid_marker_jacobian_d => rigid_marker_jacobian, joint_value_d => joint_value, &
-        joint_jacobian_d => joint_jacobian, joint_rows_d => joint_rows
+        joint_jacobian_d => joint_jacobian, joint_rows_d => joint_rows, &
+        chain_marker_state_d => chain_marker_state, &
+        chain_marker_jacobian_d => chain_marker_jacobian
+    use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     implicit none
     private
 
@@ -92,7 +95,15 @@ module flexmbs_mbs_system
         real(wp) :: axes(3, 3) = identity3 !! orthonormal axes as columns, same frame
         integer :: flexible = 0 !! flexible body number (node markers)
         integer :: node = 0     !! its mesh node
+        integer :: chain = 0    !! rigid chain number (chain markers; position, axes
+        integer :: link = 0     !! in the frame of this body of the chain)
     end type marker_t
+
+    !> A chain's joint geometry as plain arrays (for the marker formulas).
+    type :: chain_geometry_t
+        integer, allocatable :: parent(:), kinds(:)
+        real(wp), allocatable :: jpos(:, :), jrot(:, :, :), axis(:, :)
+    end type chain_geometry_t
 
     !> A prescribed function of time, s(t) = Σ_k poly(k) t^k + amplitude
     !> sin(frequency t + phase): constant, constant rate, polynomial, harmonic.
@@ -134,6 +145,11 @@ module flexmbs_mbs_system
         !> v(flex_v(f)+1 : flex_v(f)+nv_f)
         type(flexible_body_t), allocatable :: flex(:)
         integer, allocatable :: flex_q(:), flex_v(:)
+        !> rigid chains in relative coordinates (revolute and prismatic joints,
+        !> at most 7 coordinates each), between the rigid and the flexible bodies
+        type(rigid_chain_t), allocatable :: chains(:)
+        type(chain_geometry_t), allocatable :: chain_geom(:)
+        integer, allocatable :: chain_q(:), chain_v(:)
         real(wp), allocatable :: zero_v(:) !! v = 0 for position-only evaluations
         !> copies of the CSC patterns handed out (their triplet maps place values)
         type(csc_matrix_t) :: mass_csc, jacobian_csc
@@ -174,7 +190,7 @@ contains
     !> `constraint_derivatives` is 'analytic' (default) or 'ad'. On bad input
     !> `status` says which item is wrong and why.
     function new_mbs_system(bodies, markers, joints, gravity, constraint_derivatives, &
-                            status, flexible) result(self)
+                            status, flexible, chains) result(self)
         type(rigid_body_t), intent(in) :: bodies(:)
         type(marker_t), intent(in) :: markers(:)
         type(mbs_joint_t), intent(in) :: joints(:)
@@ -183,6 +199,8 @@ contains
         type(status_t), intent(out) :: status
         !> flexible bodies (their own gravity and loads), after the rigid ones
         type(flexible_body_t), intent(in), optional :: flexible(:)
+        !> rigid chains (their own gravity), after the rigid bodies
+        type(rigid_chain_t), intent(in), optional :: chains(:)
         type(mbs_system_t) :: self
         integer :: k, row0, f
         character(len=:), allocatable :: where
@@ -206,8 +224,47 @@ contains
         else
             allocate (self%flex(0))
         end if
+        if (present(chains)) then
+            self%chains = chains
+        else
+            allocate (self%chains(0))
+        end if
+        allocate (self%chain_geom(size(self%chains)))
+        do f = 1, size(self%chains)
+            associate (ch => self%chains(f), g => self%chain_geom(f))
+                if (ch%nq /= ch%nv .or. ch%nv > rigid_body_nq) then
+                    call status%set(status_bad_input, 'mbs system: chain ' // int_text(f) // &
+                        ': only revolute and prismatic joints, at most ' // &
+                        int_text(rigid_body_nq) // ' coordinates, inside a system')
+                    return
+                end if
+                g%parent = ch%bodies%parent
+                g%kinds = ch%bodies%joint
+                allocate (g%jpos(3, size(ch%bodies)), g%jrot(3, 3, size(ch%bodies)), &
+                          g%axis(3, size(ch%bodies)))
+                do k = 1, size(ch%bodies)
+                    g%jpos(:, k) = ch%bodies(k)%joint_position
+                    g%jrot(:, :, k) = ch%bodies(k)%joint_rotation
+                    g%axis(:, k) = ch%bodies(k)%axis
+                end do
+            end associate
+        end do
         do k = 1, size(markers)
             where = 'mbs system: marker ' // int_text(k)
+            if (markers(k)%chain /= 0) then
+                if (markers(k)%chain < 1 .or. markers(k)%chain > size(self%chains)) then
+                    call status%set(status_bad_input, where // ': chain = ' // &
+                        int_text(markers(k)%chain) // ': must name a chain 1 .. ' // &
+                        int_text(size(self%chains)))
+                    return
+                end if
+                if (markers(k)%link < 1 .or. &
+                    markers(k)%link > size(self%chains(markers(k)%chain)%bodies)) then
+                    call status%set(status_bad_input, where // ': link ' // &
+                        int_text(markers(k)%link) // ' is not a body of its chain')
+                    return
+                end if
+            end if
             if (markers(k)%flexible /= 0) then
                 if (markers(k)%flexible < 1 .or. markers(k)%flexible > size(self%flex)) then
                     call status%set(status_bad_input, where // ': flexible = ' // &
@@ -262,7 +319,9 @@ contains
                             &rotation) takes spherical joints and distances only')
                         return
                     end if
-                else if (markers(ji%marker_i)%body == markers(ji%marker_j)%body) then
+                else if (markers(ji%marker_i)%body == markers(ji%marker_j)%body .and. &
+                         markers(ji%marker_i)%chain == 0 .and. &
+                         markers(ji%marker_j)%chain == 0) then
                     call status%set(status_bad_input, where // ': both markers are on body ' &
                                     // int_text(markers(ji%marker_i)%body) // &
                                     ': a joint connects two different bodies (or a body &
@@ -289,9 +348,16 @@ contains
         self%markers = markers
         self%nq_rigid = self%rigid%nq
         self%nv_rigid = self%rigid%nv
-        allocate (self%flex_q(size(self%flex)), self%flex_v(size(self%flex)))
+        allocate (self%flex_q(size(self%flex)), self%flex_v(size(self%flex)), &
+                  self%chain_q(size(self%chains)), self%chain_v(size(self%chains)))
         self%nq = self%nq_rigid
         self%nv = self%nv_rigid
+        do f = 1, size(self%chains)
+            self%chain_q(f) = self%nq
+            self%chain_v(f) = self%nv
+            self%nq = self%nq + self%chains(f)%nq
+            self%nv = self%nv + self%chains(f)%nv
+        end do
         do f = 1, size(self%flex)
             self%flex_q(f) = self%nq
             self%flex_v(f) = self%nv
@@ -330,6 +396,9 @@ contains
         do f = 1, size(self%flex)
             n = n + int(self%flex(f)%mass_matrix%nnz)
         end do
+        do f = 1, size(self%chains)
+            n = n + self%chains(f)%nv**2
+        end do
         allocate (rows(n), cols(n))
         n = 0
         do b = 1, size(self%rigid%bodies)
@@ -344,6 +413,16 @@ contains
                     n = n + 1
                     rows(n) = iv + i
                     cols(n) = iv + j
+                end do
+            end do
+        end do
+        ! chains: dense blocks M(q), column by column
+        do f = 1, size(self%chains)
+            do j = 1, self%chains(f)%nv
+                do i = 1, self%chains(f)%nv
+                    n = n + 1
+                    rows(n) = self%chain_v(f) + i
+                    cols(n) = self%chain_v(f) + j
                 end do
             end do
         end do
@@ -370,6 +449,7 @@ contains
         type(status_t), intent(inout) :: status
         integer :: b, i, j, n, f
         integer(i8) :: p
+        real(wp) :: mc(rigid_body_nq, rigid_body_nq)
         n = 0
         values = 0.0_wp
         do b = 1, size(self%rigid%bodies)
@@ -383,6 +463,17 @@ contains
                     values(self%mass_csc%triplet_map(n)) = self%rigid%bodies(b)%inertia(i, j)
                 end do
             end do
+        end do
+        do f = 1, size(self%chains)
+            associate (iq => self%chain_q(f), nc => self%chains(f)%nv)
+                call self%chains(f)%mass(t, q(iq + 1:iq + nc), mc(1:nc, 1:nc), status)
+                do j = 1, nc
+                    do i = 1, nc
+                        n = n + 1
+                        values(self%mass_csc%triplet_map(n)) = mc(i, j)
+                    end do
+                end do
+            end associate
         end do
         do f = 1, size(self%flex)
             associate (mm => self%flex(f)%mass_matrix)
@@ -464,7 +555,8 @@ contains
         type(status_t), intent(inout) :: status
         call self%rigid%kinematics(t, q(1:self%nq_rigid), w(1:self%nv_rigid), &
                                    qdot(1:self%nq_rigid), status)
-        if (size(self%flex) > 0) qdot(self%nq_rigid + 1:) = w(self%nv_rigid + 1:)
+        ! chains (revolute, prismatic) and flexible bodies: q' = v
+        if (self%nq > self%nq_rigid) qdot(self%nq_rigid + 1:) = w(self%nv_rigid + 1:)
     end subroutine system_kinematics
 
     subroutine system_kinematics_derivative(self, t, q, w, dq, status)
@@ -485,6 +577,12 @@ contains
         integer :: f
         m = 0.0_wp
         call self%rigid%mass(t, q(1:self%nq_rigid), m(1:self%nv_rigid, 1:self%nv_rigid), status)
+        do f = 1, size(self%chains)
+            associate (iq => self%chain_q(f), iv => self%chain_v(f), n => self%chains(f)%nv)
+                call self%chains(f)%mass(t, q(iq + 1:iq + n), m(iv + 1:iv + n, iv + 1:iv + n), &
+                                         status)
+            end associate
+        end do
         do f = 1, size(self%flex)
             associate (i0 => self%flex_v(f), n => self%flex(f)%nv)
                 call self%flex(f)%mass_matrix%to_dense(m(i0 + 1:i0 + n, i0 + 1:i0 + n))
@@ -492,12 +590,31 @@ contains
         end do
     end subroutine system_mass
 
+    !> ∂(M w)/∂q: zero for rigid and flexible bodies (constant M), central
+    !> differences of the chains' M(q) w (at most 7 coordinates each).
     subroutine system_mass_derivative(self, t, q, w, dq, status)
         class(mbs_system_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:), w(:)
         real(wp), intent(out) :: dq(:, :)
         type(status_t), intent(inout) :: status
+        real(wp) :: mp(rigid_body_nq, rigid_body_nq), mm(rigid_body_nq, rigid_body_nq), &
+            qc(rigid_body_nq), h
+        integer :: f, j
         dq = 0.0_wp
+        do f = 1, size(self%chains)
+            associate (iq => self%chain_q(f), iv => self%chain_v(f), n => self%chains(f)%nv)
+                do j = 1, n
+                    qc(1:n) = q(iq + 1:iq + n)
+                    h = difference_step(qc(j))
+                    qc(j) = q(iq + j) + h
+                    call self%chains(f)%mass(t, qc(1:n), mp(1:n, 1:n), status)
+                    qc(j) = q(iq + j) - h
+                    call self%chains(f)%mass(t, qc(1:n), mm(1:n, 1:n), status)
+                    dq(iv + 1:iv + n, iq + j) = matmul(mp(1:n, 1:n) - mm(1:n, 1:n), &
+                                                       w(iv + 1:iv + n)) / (2 * h)
+                end do
+            end associate
+        end do
     end subroutine system_mass_derivative
 
     subroutine system_forces(self, t, q, v, f, status)
@@ -508,6 +625,12 @@ contains
         integer :: b
         call self%rigid%forces(t, q(1:self%nq_rigid), v(1:self%nv_rigid), &
                                f(1:self%nv_rigid), status)
+        do b = 1, size(self%chains)
+            associate (iq => self%chain_q(b), iv => self%chain_v(b), n => self%chains(b)%nv)
+                call self%chains(b)%forces(t, q(iq + 1:iq + n), v(iv + 1:iv + n), &
+                                           f(iv + 1:iv + n), status)
+            end associate
+        end do
         do b = 1, size(self%flex)
             if (.not. status%ok()) return
             associate (iq => self%flex_q(b), iv => self%flex_v(b), n => self%flex(b)%nv)
@@ -528,6 +651,13 @@ contains
         call self%rigid%force_derivatives(t, q(1:self%nq_rigid), v(1:self%nv_rigid), &
                                           fq(1:self%nv_rigid, 1:self%nq_rigid), &
                                           fv(1:self%nv_rigid, 1:self%nv_rigid), status)
+        do b = 1, size(self%chains)
+            ! the chains' defaults: differences of their RNEA forces
+            associate (iq => self%chain_q(b), iv => self%chain_v(b), n => self%chains(b)%nv)
+                call self%chains(b)%force_derivatives(t, q(iq + 1:iq + n), v(iv + 1:iv + n), &
+                    fq(iv + 1:iv + n, iq + 1:iq + n), fv(iv + 1:iv + n, iv + 1:iv + n), status)
+            end associate
+        end do
         do b = 1, size(self%flex)
             if (.not. status%ok()) return
             associate (iq => self%flex_q(b), iv => self%flex_v(b), n => self%flex(b)%nv)
@@ -565,7 +695,14 @@ contains
         real(wp), intent(in) :: q(:), v(:)
         type(status_t) :: st
         integer :: b
+        real(wp) :: ek, ep
         e = rigid_body_energy(self%rigid, q(1:self%nq_rigid), v(1:self%nv_rigid))
+        do b = 1, size(self%chains)
+            associate (iq => self%chain_q(b), iv => self%chain_v(b), n => self%chains(b)%nv)
+                call self%chains(b)%energy(q(iq + 1:iq + n), v(iv + 1:iv + n), ek, ep)
+            end associate
+            e = e + ek + ep
+        end do
         do b = 1, size(self%flex)
             associate (iq => self%flex_q(b), iv => self%flex_v(b), n => self%flex(b)%nv)
                 e = e + self%flex(b)%kinetic_energy(v(iv + 1:iv + n)) &
@@ -604,6 +741,12 @@ contains
         integer, intent(in) :: k
         integer, intent(out) :: body, iq, iv
         integer :: f, d
+        if (self%markers(k)%chain > 0) then
+            body = -1000 - self%markers(k)%chain
+            iq = self%chain_q(self%markers(k)%chain)
+            iv = self%chain_v(self%markers(k)%chain)
+            return
+        end if
         f = self%markers(k)%flexible
         if (f > 0) then
             body = -f
@@ -625,6 +768,7 @@ contains
         n = 0
         if (self%markers(k)%body > 0) n = merge(rigid_body_nq, rigid_body_nv, position_space)
         if (self%markers(k)%flexible > 0) n = 3
+        if (self%markers(k)%chain > 0) n = self%chains(self%markers(k)%chain)%nv
     end function marker_columns
 
     !> Real frame and motion of marker k at (q, v).
@@ -636,7 +780,12 @@ contains
         integer :: b, iq, iv
         call marker_offsets(self, k, b, iq, iv)
         associate (mk => self%markers(k))
-            if (b < 0) then
+            if (mk%chain > 0) then
+                associate (g => self%chain_geom(mk%chain), nc => self%chains(mk%chain)%nv)
+                    call chain_marker_state(g%parent, g%kinds, g%jpos, g%jrot, g%axis, &
+                        mk%link, mk%position, mk%axes, q(iq + 1:iq + nc), v(iv + 1:iv + nc), m)
+                end associate
+            else if (b < 0) then
                 ! a node: its position and velocity, constant axes
                 call ground_marker_state(q(iq + 1:iq + 3), mk%axes, m)
                 m%xd = v(iv + 1:iv + 3)
@@ -665,6 +814,14 @@ contains
         jx = 0.0_wp
         ja = 0.0_wp
         if (b == 0) return
+        if (self%markers(k)%chain > 0) then
+            ! T = I: the same columns in both spaces
+            associate (mk => self%markers(k), g => self%chain_geom(self%markers(k)%chain))
+                call chain_marker_jacobian(g%parent, g%kinds, g%jpos, g%jrot, g%axis, &
+                    mk%link, mk%position, mk%axes, q(iq + 1:iq + n), jx(:, 1:n), ja(:, 1:n, :))
+            end associate
+            return
+        end if
         if (b < 0) then
             ! a node: x = q_node in both spaces (T = I), axes constant
             jx(1, 1) = 1.0_wp
@@ -691,14 +848,21 @@ contains
         integer, intent(in) :: k, seed, first
         real(wp), intent(in) :: q(:), v(:)
         type(marker_state_d), intent(out) :: m
-        type(dual_t), intent(out) :: p(4)
+        !> the pose coordinates the dual Jacobians need: the quaternion of a
+        !> rigid body (1:4), the coordinates of a chain (1:n)
+        type(dual_t), intent(out) :: p(rigid_body_nq)
         integer, intent(out) :: n
         type(dual_t) :: r(3), rd(3), wb(3), sb(3), ub(3, 3), x(3), a(3, 3)
         real(wp) :: tp(4, 3)
         integer :: b, iq, iv, l
         call marker_offsets(self, k, b, iq, iv)
         n = 0
+        p = 0.0_wp
         associate (mk => self%markers(k))
+            if (mk%chain > 0) then
+                call chain_state_dual(self, k, q, v, seed, first, iq, iv, m, p, n)
+                return
+            end if
             if (b == 0) then
                 x = mk%position
                 a = mk%axes
@@ -732,7 +896,7 @@ contains
                 return
             end if
             r = q(iq + 1:iq + 3)
-            p = q(iq + 4:iq + 7)
+            p(1:4) = q(iq + 4:iq + 7)
             rd = v(iv + 1:iv + 3)
             wb = v(iv + 4:iv + 6)
             sb = mk%position
@@ -743,7 +907,7 @@ contains
                 n = rigid_body_nv
                 do l = 1, 3
                     r(l)%der(first + l - 1) = 1.0_wp
-                    p%der(first + 2 + l) = tp(:, l)
+                    p(1:4)%der(first + 2 + l) = tp(:, l)
                 end do
             case (seed_position)
                 n = rigid_body_nq
@@ -762,9 +926,9 @@ contains
             case (seed_rate)
                 n = 1
                 r%der(first) = v(iv + 1:iv + 3)
-                p%der(first) = matmul(tp, v(iv + 4:iv + 6))
+                p(1:4)%der(first) = matmul(tp, v(iv + 4:iv + 6))
             end select
-            call rigid_marker_state_d(r, p, rd, wb, sb, ub, m)
+            call rigid_marker_state_d(r, p(1:4), rd, wb, sb, ub, m)
         end associate
     end subroutine marker_state_dual
 
@@ -772,9 +936,21 @@ contains
     pure subroutine marker_jacobian_dual(self, k, p, jx, ja)
         class(mbs_system_t), intent(in) :: self
         integer, intent(in) :: k
-        type(dual_t), intent(in) :: p(4)
-        type(dual_t), intent(out) :: jx(3, 6), ja(3, 6, 3)
-        type(dual_t) :: sb(3), ub(3, 3)
+        type(dual_t), intent(in) :: p(rigid_body_nq)
+        type(dual_t), intent(out) :: jx(3, rigid_body_nq), ja(3, rigid_body_nq, 3)
+        type(dual_t) :: sb(3), ub(3, 3), jx6(3, 6), ja6(3, 6, 3)
+        integer :: c
+        if (self%markers(k)%chain > 0) then
+            c = self%markers(k)%chain
+            associate (ch => self%chains(c), g => self%chain_geom(c))
+                jx = 0.0_wp
+                ja = 0.0_wp
+                call chain_marker_jacobian_d(g%parent, g%kinds, g%jpos, g%jrot, g%axis, &
+                    self%markers(k)%link, self%markers(k)%position, self%markers(k)%axes, &
+                    p(1:ch%nq), jx(:, 1:ch%nv), ja(:, 1:ch%nv, :))
+            end associate
+            return
+        end if
         if (self%markers(k)%body == 0 .or. self%markers(k)%flexible > 0) then
             jx = 0.0_wp
             ja = 0.0_wp
@@ -787,8 +963,48 @@ contains
         end if
         sb = self%markers(k)%position
         ub = self%markers(k)%axes
-        call rigid_marker_jacobian_d(p, sb, ub, jx, ja)
+        call rigid_marker_jacobian_d(p(1:4), sb, ub, jx6, ja6)
+        jx(:, 1:6) = jx6
+        ja(:, 1:6, :) = ja6
+        jx(:, 7) = 0.0_wp
+        ja(:, 7, :) = 0.0_wp
     end subroutine marker_jacobian_dual
+
+    !> Dual state of chain marker k: the chain's coordinates (and rates)
+    !> seeded as for a body (T = I: velocity space = position space).
+    pure subroutine chain_state_dual(self, k, q, v, seed, first, iq, iv, m, p, n)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k, seed, first, iq, iv
+        real(wp), intent(in) :: q(:), v(:)
+        type(marker_state_d), intent(out) :: m
+        type(dual_t), intent(inout) :: p(rigid_body_nq)
+        integer, intent(out) :: n
+        type(dual_t) :: vc(rigid_body_nq)
+        integer :: c, l, nc
+        c = self%markers(k)%chain
+        nc = self%chains(c)%nv
+        p(1:nc) = q(iq + 1:iq + nc)
+        vc(1:nc) = v(iv + 1:iv + nc)
+        n = nc
+        select case (seed)
+        case (seed_velocity_space, seed_position)
+            do l = 1, nc
+                p(l)%der(first + l - 1) = 1.0_wp
+            end do
+        case (seed_velocity)
+            do l = 1, nc
+                vc(l)%der(first + l - 1) = 1.0_wp
+            end do
+        case (seed_rate)
+            n = 1
+            p(1:nc)%der(first) = v(iv + 1:iv + nc)
+        end select
+        associate (g => self%chain_geom(c))
+            call chain_marker_state_d(g%parent, g%kinds, g%jpos, g%jrot, g%axis, &
+                self%markers(k)%link, self%markers(k)%position, self%markers(k)%axes, &
+                p(1:nc), vc(1:nc), m)
+        end associate
+    end subroutine chain_state_dual
 
     !> Driver values (s, s', s'') of joint k at t (zero for joints without s).
     pure function joint_driver(self, k, t) result(drv)
@@ -856,7 +1072,7 @@ contains
         type(marker_state_d) :: mid, mjd
         real(wp) :: jxi(3, rigid_body_nq), jai(3, rigid_body_nq, 3), jxj(3, rigid_body_nq), &
             jaj(3, rigid_body_nq, 3), drv(3)
-        type(dual_t) :: pd(4), cd(max_rows)
+        type(dual_t) :: pd(rigid_body_nq), cd(max_rows)
         integer :: seed, nr, r, td
         ci = 0.0_wp
         cj = 0.0_wp
@@ -971,8 +1187,9 @@ contains
         type(status_t), intent(inout) :: status
         type(marker_state_t) :: mi, mj
         type(marker_state_d) :: mid, mjd
-        type(dual_t) :: pi(4), pj(4), jxi(3, 6), jai(3, 6, 3), jxj(3, 6), jaj(3, 6, 3), &
-            cid(max_rows, 6), cjd(max_rows, 6), ctd(max_rows), drvd(3), cv
+        type(dual_t) :: pi(rigid_body_nq), pj(rigid_body_nq), jxi(3, rigid_body_nq), &
+            jai(3, rigid_body_nq, 3), jxj(3, rigid_body_nq), jaj(3, rigid_body_nq, 3), &
+            cid(max_rows, rigid_body_nq), cjd(max_rows, rigid_body_nq), ctd(max_rows), drvd(3), cv
         real(wp) :: drv(3), tt(max_rows)
         integer :: k, r0, nr, ni, nj, r, bi, bj, iqi, iqj, ivi, ivj
         do k = 1, size(self%joints)
@@ -1022,8 +1239,9 @@ contains
         real(wp), intent(out) :: gwq(:, :), gtlq(:, :)
         type(status_t), intent(inout) :: status
         type(marker_state_d) :: mid, mjd
-        type(dual_t) :: pi(4), pj(4), jxi(3, 6), jai(3, 6, 3), jxj(3, 6), jaj(3, 6, 3), &
-            cid(max_rows, 6), cjd(max_rows, 6), s
+        type(dual_t) :: pi(rigid_body_nq), pj(rigid_body_nq), jxi(3, rigid_body_nq), &
+            jai(3, rigid_body_nq, 3), jxj(3, rigid_body_nq), jaj(3, rigid_body_nq, 3), &
+            cid(max_rows, rigid_body_nq), cjd(max_rows, rigid_body_nq), s
         integer :: k, r0, nr, qi, qj, ni, nj, r, l, bi, bj, iqi, iqj, ivi, ivj
         gwq = 0.0_wp
         gtlq = 0.0_wp
@@ -1081,7 +1299,7 @@ contains
         real(wp), intent(out) :: dq(:, :)
         type(status_t), intent(inout) :: status
         type(marker_state_d) :: mid, mjd
-        type(dual_t) :: pd(4), ctd(max_rows)
+        type(dual_t) :: pd(rigid_body_nq), ctd(max_rows)
         integer :: k, nr, qi, qj, r, bi, bj, iqi, iqj, ivi, ivj
         dq = 0.0_wp
         do k = 1, size(self%joints)
@@ -1110,7 +1328,7 @@ contains
         real(wp), intent(out) :: gq(:, :), gv(:, :)
         type(status_t), intent(inout) :: status
         type(marker_state_d) :: mid, mjd
-        type(dual_t) :: pd(4), conv(max_rows), tt(max_rows), drvd(3)
+        type(dual_t) :: pd(rigid_body_nq), conv(max_rows), tt(max_rows), drvd(3)
         integer :: k, nr, ni, nj, r, bi, bj, iqi, iqj, ivi, ivj, pass, seed
         gq = 0.0_wp
         gv = 0.0_wp

@@ -1,0 +1,175 @@
+!> Rigid chains inside the multibody system: the Grashof four-bar with the
+!> crank and coupler as a two-link chain in relative coordinates and the
+!> rocker as a free rigid body, closed by two dot-2 rows (in-plane
+!> coincidence of the coupler end and the rocker end) and driven by an angle
+!> driver on the chain's first link: 2 + 6 velocities, 5 + 2 + 1 rows.
+module test_chain_coupling
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_status, only: status_t
+    use flexmbs_dae_options, only: dae_options_t
+    use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_radau5, only: radau5_t
+    use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle
+    use flexmbs_mbs_rigid_body, only: rigid_body_t
+    use flexmbs_mbs_rigid_chain, only: rigid_chain_t, new_rigid_chain, chain_body_t, &
+        chain_joint_revolute
+    use flexmbs_mbs_joint, only: joint_revolute, joint_primitive
+    use flexmbs_mbs_primitive_kinds, only: primitive_dot2, primitive_angle_driver
+    use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, driver_t
+    use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_ggl
+    use flexmbs_problems_mechanisms, only: four_bar_exact, crank_angle, mechanism_theta0, &
+        mechanism_omega, bar_a, bar_b, bar_c, bar_d
+    use test_problems, only: fill_random
+    use mbs_random, only: ad_deviation
+    use test_formulation, only: difference_jacobian
+    use testing, only: test_case_t, new_test, error_t, check
+    implicit none
+    private
+    public :: collect_chain_coupling
+
+    real(wp), parameter :: g_earth(3) = [0.0_wp, -9.81_wp, 0.0_wp]
+    real(wp), parameter :: identity(3, 3) = reshape([1, 0, 0, 0, 1, 0, 0, 0, 1] * 1.0_wp, [3, 3])
+
+contains
+
+    function collect_chain_coupling() result(tests)
+        type(test_case_t), allocatable :: tests(:)
+        tests = [new_test('chain_markers_ad_vs_analytic', test_ad), &
+                 new_test('formulation_jacobian_fd', test_jacobian), &
+                 new_test('four_bar_with_chain_closed_form', test_closed_form)]
+    end function collect_chain_coupling
+
+    subroutine make(derivatives, sys, q0, status)
+        character(len=*), intent(in) :: derivatives
+        type(mbs_system_t), intent(out) :: sys
+        real(wp), intent(out) :: q0(9)
+        type(status_t), intent(out) :: status
+        type(rigid_chain_t) :: chain
+        type(chain_body_t) :: b(2)
+        type(marker_t) :: m(6)
+        type(driver_t) :: drive
+        real(wp) :: pb(3), pc(3), phi, psi
+        call four_bar_exact(mechanism_theta0, pb, pc)
+        phi = atan2(pc(2) - pb(2), pc(1) - pb(1))
+        psi = atan2(pc(2), pc(1) - bar_d)
+        b(1) = chain_body_t(0, chain_joint_revolute, [0.0_wp, 0.0_wp, 0.0_wp], identity, &
+                            [0.0_wp, 0.0_wp, 1.0_wp], [0.5_wp * bar_a, 0.0_wp, 0.0_wp], 1.0_wp, &
+                            0.01_wp * identity)
+        b(2) = chain_body_t(1, chain_joint_revolute, [bar_a, 0.0_wp, 0.0_wp], identity, &
+                            [0.0_wp, 0.0_wp, 1.0_wp], [0.5_wp * bar_b, 0.0_wp, 0.0_wp], 0.5_wp, &
+                            0.01_wp * identity)
+        chain = new_rigid_chain(b, status, gravity=g_earth)
+        if (.not. status%ok()) return
+        m(1) = marker_t(0, [0.0_wp, 0.0_wp, 0.0_wp])
+        m(2) = marker_t(0, chain=1, link=1)
+        m(3) = marker_t(0, [bar_b, 0.0_wp, 0.0_wp], chain=1, link=2)
+        m(4) = marker_t(1, [0.5_wp * bar_c, 0.0_wp, 0.0_wp])
+        m(5) = marker_t(1, [-0.5_wp * bar_c, 0.0_wp, 0.0_wp])
+        m(6) = marker_t(0, [bar_d, 0.0_wp, 0.0_wp])
+        drive%poly(0:1) = [mechanism_theta0, mechanism_omega]
+        sys = new_mbs_system([rigid_body_t(0.333_wp, 0.01_wp * identity)], m, &
+            [mbs_joint_t(joint_revolute, 6, 5), &
+             mbs_joint_t(joint_primitive, 3, 4, primitive_dot2, 1, 1), &
+             mbs_joint_t(joint_primitive, 3, 4, primitive_dot2, 2, 1), &
+             mbs_joint_t(joint_primitive, 1, 2, primitive_angle_driver, 1, 1, drive)], &
+            gravity=g_earth, constraint_derivatives=derivatives, status=status, chains=[chain])
+        if (.not. status%ok()) return
+        ! q = (rocker r, p; chain θ1, θ2)
+        q0(1:3) = 0.5_wp * (pc + [bar_d, 0.0_wp, 0.0_wp])
+        q0(4:7) = quat_from_axis_angle([0.0_wp, 0.0_wp, 1.0_wp], psi)
+        q0(8:9) = [mechanism_theta0, phi - mechanism_theta0]
+    end subroutine make
+
+    !> G, c_q, c_t and γ with chain markers: 'ad' equals 'analytic' (1e-12).
+    subroutine test_ad(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(mbs_system_t) :: hand, ad
+        type(status_t) :: status
+        real(wp) :: q0(9), q(9), v(8), worst
+        integer(i8) :: seed
+        integer :: trial
+        call make('analytic', hand, q0, status)
+        if (status%ok()) call make('ad', ad, q0, status)
+        call check(error, status%ok() .and. hand%nc == 8 .and. hand%nv == 8, &
+                   'systems: ' // status%text())
+        if (allocated(error)) return
+        seed = 12_i8
+        worst = 0.0_wp
+        do trial = 1, 5
+            call fill_random(q, seed, -0.1_wp, 0.1_wp)
+            q = q0 + q
+            q(4:7) = q(4:7) / norm2(q(4:7))
+            call fill_random(v, seed, -1.0_wp, 1.0_wp)
+            worst = max(worst, ad_deviation(hand, ad, 0.2_wp, q, v, status))
+        end do
+        print '(4x,a,es9.2)', 'chain markers: AD vs analytic ', worst
+        call check(error, status%ok(), 'evaluations: ' // status%text())
+        call check(error, worst <= 1.0e-12_wp, 'AD differs from analytic')
+    end subroutine test_ad
+
+    !> The GGL Jacobian (acceleration layout: M depends on the chain's q)
+    !> against central differences of F (1e-6 relative).
+    subroutine test_jacobian(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(mbs_system_t), target :: sys
+        type(formulation_t) :: gen
+        type(status_t) :: status
+        real(wp) :: q0(9)
+        real(wp), allocatable :: y(:), jac(:, :), jfd(:, :)
+        integer(i8) :: seed
+        call make('analytic', sys, q0, status)
+        gen = new_formulation(sys, formulation_ggl, q0, status=status)
+        allocate (y(gen%n), jac(gen%n, gen%n), jfd(gen%n, gen%n))
+        seed = 4_i8
+        call fill_random(y, seed, -0.1_wp, 0.1_wp)
+        y(1:9) = y(1:9) + q0
+        y(4:7) = y(4:7) / norm2(y(4:7))
+        call gen%jacobian_dense(0.0_wp, y, jac, status)
+        call difference_jacobian(gen, y, jfd, status)
+        call check(error, status%ok(), 'jacobian: ' // status%text())
+        print '(4x,a,es9.2)', 'chain coupling: Jacobian vs differences ', &
+            maxval(abs(jac - jfd)) / maxval(abs(jac))
+        call check(error, maxval(abs(jac - jfd)) <= 1.0e-6_wp * maxval(abs(jac)), &
+                   'Jacobian differs from differences')
+    end subroutine test_jacobian
+
+    !> One crank revolution (RADAU5, GGL, rtol 1e-7): the rocker angle and
+    !> the chain's coupler angle follow the closed form.
+    subroutine test_closed_form(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(mbs_system_t), target :: sys
+        type(formulation_t) :: gen
+        type(radau5_t) :: solver
+        type(dae_options_t) :: options
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        real(wp) :: q0(9), t, pb(3), pc(3), r(3, 3), dev
+        real(wp), allocatable :: y(:), yp(:)
+        call make('analytic', sys, q0, status)
+        gen = new_formulation(sys, formulation_ggl, q0, status=status)
+        allocate (y(gen%n), yp(gen%n), source=0.0_wp)
+        y(1:9) = q0
+        call gen%consistent_initial(0.0_wp, y, yp, status)
+        call check(error, status%ok(), 'initial: ' // status%text())
+        if (allocated(error)) return
+        options%rtol = 1.0e-7_wp
+        options%atol = 1.0e-7_wp
+        t = 0.0_wp
+        call solver%integrate(gen, t, y, 1.0_wp, options, stats, status)
+        call check(error, status%ok(), 'run: ' // status%text())
+        if (allocated(error)) return
+        call four_bar_exact(crank_angle(t), pb, pc)
+        r = rotation_matrix(y(4:7) / norm2(y(4:7)))
+        dev = max(abs(angle_difference(atan2(r(2, 1), r(1, 1)), atan2(pc(2), pc(1) - bar_d))), &
+                  abs(angle_difference(y(8) + y(9), atan2(pc(2) - pb(2), pc(1) - pb(1)))), &
+                  abs(angle_difference(y(8), crank_angle(t))))
+        print '(4x,a,i0,a,es9.2)', 'four-bar with a chain: NST=', stats%nst, &
+            ', closed-form deviation ', dev
+        call check(error, dev <= 1.0e-5_wp, 'off the closed form')
+    end subroutine test_closed_form
+
+    pure real(wp) function angle_difference(a, b)
+        real(wp), intent(in) :: a, b
+        angle_difference = atan2(sin(a - b), cos(a - b))
+    end function angle_difference
+end module test_chain_coupling
