@@ -86,8 +86,6 @@ contains
         type(mbs_joint_t) :: joints(3)
         type(driver_t) :: drv
         real(wp) :: q(14), v(12), cp(3), cm(3), th(3), t, worst, fd
-
-
         integer :: trial, k
         drv%poly = [0.5_wp, 0.8_wp, -0.3_wp, 0.1_wp]
         drv%amplitude = 0.2_wp
