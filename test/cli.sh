@@ -168,6 +168,11 @@ sed -e "s/marker_i = 'B1', marker_j = 'B2'/marker_i = 'B1', marker_j = 'B9'/" \
 bad multibody-unknown-marker "fourbar_bad.nml: &joint: marker_j = 'B9': no &marker of that name" \
     fourbar_bad.nml
 
+# The four-bar with its crank as a chain inside the system
+sed -e "s/^&output/\&output file = 'out\/run.h5',/" "$root/inputs/four_bar_chain.nml" \
+    > fourbar_chain.nml
+kept "multibody-with-chain" 0 "radau5: NST=" out/run.h5 run fourbar_chain.nml --quiet
+
 # A rigid chain in relative coordinates (inputs/double_pendulum_chain.nml)
 for s in radau5 ddassl ida mexax; do
     sed -e "s/name = 'radau5'/name = '$s'/" -e "s/^&output/\&output file = 'out\/run.h5',/" \

@@ -28,7 +28,8 @@ contains
                  new_test('rigid_chain_bad_scenes', test_chain_bad), &
                  new_test('rigid_flexible_file', test_rigid_flexible), &
                  new_test('rigid_flexible_bad_scenes', test_rigid_flexible_bad), &
-                 new_test('monitor_drift_energy', test_monitor)]
+                 new_test('monitor_drift_energy', test_monitor), &
+                 new_test('four_bar_chain_file', test_four_bar_chain)]
     end function collect_multibody_scene
 
     !> inputs/four_bar.nml with each solver: the coupler end at t = 1
@@ -96,7 +97,7 @@ contains
         call expect(error, pendulum(bar, markers, '&joint type = ''revolute'', marker_i = ''O'', &
             &marker_j = ''Q'' /', ''), "mb.nml: &joint: marker_j = 'Q': no &marker of that name")
         call expect(error, pendulum(bar, markers // nl // '&marker name = ''R'', body = ''rod'' /', &
-            hinge, ''), "mb.nml: &marker: body = 'rod': no &rigid_body of that name")
+            hinge, ''), "mb.nml: &marker: body = 'rod': no &rigid_body or &rigid_chain body of that name")
         call expect(error, pendulum(bar, markers, '&joint type = ''hinge'', marker_i = ''O'', &
             &marker_j = ''P'' /', ''), "mb.nml: &joint: type = 'hinge': must be one of")
         call expect(error, pendulum(bar, markers // nl // '&marker name = ''P2'', body = ''bar'' /', &
@@ -298,4 +299,26 @@ contains
         call h5dclose_f(dset, err)
         call h5fclose_f(file, err)
     end subroutine read_matrix
+    !> inputs/four_bar_chain.nml (the crank as a one-link chain inside the
+    !> multibody system) with each solver: the coupler end on the closed form.
+    subroutine test_four_bar_chain(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=8), parameter :: solvers(4) = ['radau5', 'ddassl', 'ida   ', 'mexax ']
+        type(scene_input_t) :: scene
+        type(run_result_t) :: result
+        real(wp) :: b(3), c(3), r(3, 3), dev
+        integer :: k
+        do k = 1, size(solvers)
+            call run_file(error, 'inputs/four_bar_chain.nml', solvers(k), scene, result)
+            if (allocated(error)) return
+            call four_bar_exact(crank_angle(1.0_wp), b, c)
+            ! q = (coupler r, p; rocker r, p; crank angle)
+            r = rotation_matrix(result%y(4:7))
+            dev = max(norm2(result%y(1:3) + 0.5_wp * bar_b * r(:, 1) - c), &
+                      abs(atan2(sin(result%y(15) - crank_angle(1.0_wp)), &
+                                cos(result%y(15) - crank_angle(1.0_wp)))))
+            print '(4x,a,a,es9.2)', solvers(k), ': four-bar with a chain crank off by ', dev
+            call check(error, dev <= 1.0e-5_wp, trim(solvers(k)) // ': off the closed form')
+        end do
+    end subroutine test_four_bar_chain
 end module test_multibody_scene

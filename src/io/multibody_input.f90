@@ -25,6 +25,8 @@ module flexmbs_io_multibody_input
         driver_t
     use flexmbs_io_namelist, only: scene_input_t
     use flexmbs_io_body_input, only: build_flexible_body
+    use flexmbs_io_chain_input, only: build_rigid_chain
+    use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
     implicit none
     private
@@ -46,7 +48,8 @@ contains
         type(marker_t), allocatable :: markers(:)
         type(mbs_joint_t), allocatable :: joints(:)
         type(flexible_body_t), allocatable :: flex(:)
-        real(wp), allocatable :: qf(:), vf(:)
+        type(rigid_chain_t), allocatable :: chains(:)
+        real(wp), allocatable :: qf(:), vf(:), qc(:), vc(:)
         integer, allocatable :: nodes(:)
         character(len=:), allocatable :: labels(:)
         real(wp) :: p(4), r(3, 3), anchor(3)
@@ -73,7 +76,15 @@ contains
                 v0(6 * i - 5:6 * i) = [b%velocity, matmul(transpose(r), b%angular_velocity)]
             end associate
         end do
-        ! the flexible body, after the rigid ones in q and v
+        ! a rigid chain (&rigid_chain groups), after the rigid bodies
+        allocate (chains(merge(1, 0, size(scene%chain) > 0)))
+        if (size(scene%chain) > 0) then
+            call build_rigid_chain(scene, chains(1), qc, vc, status)
+            if (.not. status%ok()) return
+            q0 = [q0, qc]
+            v0 = [v0, vc]
+        end if
+        ! the flexible body, after them
         allocate (flex(merge(1, 0, scene%has_body)))
         if (scene%has_body) then
             call build_flexible_body(scene, flex(1), qf, vf, status)
@@ -89,6 +100,14 @@ contains
                 markers(i)%body = 0
                 if (m%body /= 'ground' .and. len_trim(m%node_set) == 0) &
                     markers(i)%body = body_index(scene, m%body)
+                if (markers(i)%body == 0 .and. m%body /= 'ground') then
+                    do k = 1, size(scene%chain)
+                        if (scene%chain(k)%name == m%body) then
+                            markers(i)%chain = 1
+                            markers(i)%link = k
+                        end if
+                    end do
+                end if
                 markers(i)%position = m%position
                 markers(i)%axes = axes_from(m%z_axis, m%x_axis)
             end associate
@@ -106,6 +125,12 @@ contains
                 ! 'attach': a spherical joint per node of the set, the rigid side's
                 ! marker at the node's reference position in that body's frame
                 mi = marker_index(scene, jt%marker_i)
+                if (markers(mi)%chain > 0) then
+                    call status%set(status_bad_input, scene%path // ': &joint ''' // &
+                        trim(jt%name) // ''': ''attach'' pins nodes to a rigid body or the &
+                        &ground, not to a chain body')
+                    return
+                end if
                 call flex(1)%mesh%node_set(trim(scene%markers(marker_index(scene, &
                     jt%marker_j))%node_set), nodes, status)
                 if (.not. status%ok()) then
@@ -141,7 +166,7 @@ contains
         end do
         sys = new_mbs_system(bodies, markers, joints, gravity=scene%multibody%gravity, &
             constraint_derivatives=trim(scene%multibody%constraint_derivatives), status=status, &
-            flexible=flex)
+            flexible=flex, chains=chains)
         if (.not. status%ok()) then
             call status%set(status_bad_input, scene%path // ': ' // status%text())
             return

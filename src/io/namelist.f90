@@ -1575,7 +1575,8 @@ contains
         type(status_t), intent(inout) :: status
         integer :: i, j
         logical :: found
-        if (scene%problem /= 'rigid_chain') then
+        if (scene%problem /= 'rigid_chain' .and. &
+            .not. (scene%problem == 'multibody' .and. size(scene%chain) > 0)) then
             if (size(scene%chain) > 0) call status%set(status_bad_input, path // &
                 ': &rigid_chain: given, but problem = ''' // trim(scene%problem) // &
                 ''' (a scene builds only what it declares)' // at(scene%chain(1)%line))
@@ -1676,9 +1677,9 @@ contains
             else if (all([character(len=8) :: 'analytic', 'ad'] /= &
                           mb%constraint_derivatives)) then
                 call bad('multibody', 'constraint_derivatives', 1, 'must be ''analytic'' or ''ad''')
-            else if (size(scene%rigid_bodies) == 0) then
+            else if (size(scene%rigid_bodies) + size(scene%chain) == 0) then
                 call status%set(status_bad_input, path // ': &simulation: problem = &
-                    &''multibody'': needs at least one &rigid_body group')
+                    &''multibody'': needs at least one &rigid_body or &rigid_chain group')
             end if
         end associate
         if (.not. status%ok()) return
@@ -1718,8 +1719,11 @@ contains
                 else if (len_trim(m%node_set) > 0) then
                     call bad('marker', 'node_set', i, 'only for markers on the &flexible_body')
                 else if (m%body /= 'ground' .and. .not. any([(scene%rigid_bodies(j)%name == &
-                         m%body, j = 1, size(scene%rigid_bodies))])) then
-                    call bad('marker', 'body', i, 'no &rigid_body of that name (nor ''ground'')')
+                         m%body, j = 1, size(scene%rigid_bodies))]) .and. &
+                         .not. any([(scene%chain(j)%name == m%body, &
+                                     j = 1, size(scene%chain))])) then
+                    call bad('marker', 'body', i, 'no &rigid_body or &rigid_chain body of &
+                        &that name (nor ''ground'')')
                 else if (.not. norm2(m%z_axis) > 0.0_wp) then
                     call bad('marker', 'z_axis', i, 'must not be zero')
                 else if (norm2(cross3(m%x_axis, m%z_axis)) <= 1.0e-12_wp * norm2(m%z_axis) * &

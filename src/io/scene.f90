@@ -162,12 +162,14 @@ contains
                 call build_multibody(scene, sys, q0, v0, status)
             end select
             if (.not. status%ok()) return
-            ! Rigid bodies have a constant M (body-fixed ω'): y = (q, v, λ[, μ]);
-            ! MEXAX integrates y = (q, v, λ), the index-2 layout.
+            ! Rigid and flexible bodies have a constant M (body-fixed ω'):
+            ! y = (q, v, λ[, μ]); a chain's M(q) needs the acceleration layout
+            ! y = (q, v, a, λ[, μ]). MEXAX integrates y = (q, v, λ) (index 2).
             formulation = new_formulation(mechanical, merge(formulation_index2, &
                 mechanical_formulation(scene%multibody%formulation), &
-                scene%solver_name == 'mexax'), q0, constant_mass=.true., &
-                projection=scene%multibody%projection, status=status)
+                scene%solver_name == 'mexax'), q0, constant_mass=size(scene%chain) == 0 &
+                .or. scene%solver_name == 'mexax', projection=scene%multibody%projection, &
+                status=status)
             if (.not. status%ok()) then
                 status%message = scene%path // ': &multibody: ' // status%message
                 return
