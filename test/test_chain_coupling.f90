@@ -12,8 +12,8 @@ module test_chain_coupling
     use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle
     use flexmbs_mbs_rigid_body, only: rigid_body_t
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, new_rigid_chain, chain_body_t, &
-        chain_joint_revolute
-    use flexmbs_mbs_joint, only: joint_revolute, joint_primitive
+        chain_joint_revolute, chain_joint_spherical
+    use flexmbs_mbs_joint, only: joint_revolute, joint_primitive, joint_spherical
     use flexmbs_mbs_primitive_kinds, only: primitive_dot2, primitive_angle_driver
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, driver_t
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_ggl
@@ -36,7 +36,8 @@ contains
         type(test_case_t), allocatable :: tests(:)
         tests = [new_test('chain_markers_ad_vs_analytic', test_ad), &
                  new_test('formulation_jacobian_fd', test_jacobian), &
-                 new_test('four_bar_with_chain_closed_form', test_closed_form)]
+                 new_test('four_bar_with_chain_closed_form', test_closed_form), &
+                 new_test('spherical_chain_in_system', test_spherical)]
     end function collect_chain_coupling
 
     subroutine make(derivatives, sys, q0, status)
@@ -172,4 +173,93 @@ contains
         real(wp), intent(in) :: a, b
         angle_difference = atan2(sin(a - b), cos(a - b))
     end function angle_difference
+    !> A chain with a spherical root (quaternion coordinates) and a revolute
+    !> link, and a rigid body hanging from the link's end by a spherical
+    !> joint: AD against hand-coded (1e-12), the GGL Jacobian against
+    !> differences (1e-6), and the energy over 0.5 s (RADAU5, rtol 1e-8).
+    subroutine test_spherical(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(mbs_system_t), target :: hand, ad
+        type(formulation_t) :: gen
+        type(radau5_t) :: solver
+        type(dae_options_t) :: options
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        real(wp) :: q0(12), q(12), v(10), worst, t, e0, e1
+        real(wp), allocatable :: y(:), yp(:), jac(:, :), jfd(:, :)
+        integer(i8) :: seed
+        integer :: trial
+        call make_pair('analytic', hand, q0, status)
+        if (status%ok()) call make_pair('ad', ad, q0, status)
+        call check(error, status%ok() .and. hand%nq == 12 .and. hand%nv == 10 .and. &
+                   hand%nc == 3, 'systems: ' // status%text())
+        if (allocated(error)) return
+        seed = 21_i8
+        worst = 0.0_wp
+        do trial = 1, 5
+            call fill_random(q, seed, -0.05_wp, 0.05_wp)
+            q = q0 + q
+            q(4:7) = q(4:7) / norm2(q(4:7))
+            q(8:11) = q(8:11) / norm2(q(8:11))
+            call fill_random(v, seed, -1.0_wp, 1.0_wp)
+            worst = max(worst, ad_deviation(hand, ad, 0.2_wp, q, v, status))
+        end do
+        print '(4x,a,es9.2)', 'spherical chain markers: AD vs analytic ', worst
+        call check(error, worst <= 1.0e-12_wp, 'AD differs from analytic')
+        gen = new_formulation(hand, formulation_ggl, q0, status=status)
+        allocate (y(gen%n), yp(gen%n), jac(gen%n, gen%n), jfd(gen%n, gen%n))
+        call fill_random(y, seed, -0.05_wp, 0.05_wp)
+        y(1:12) = q0 + y(1:12)
+        y(4:7) = y(4:7) / norm2(y(4:7))
+        y(8:11) = y(8:11) / norm2(y(8:11))
+        call gen%jacobian_dense(0.0_wp, y, jac, status)
+        call difference_jacobian(gen, y, jfd, status)
+        print '(4x,a,es9.2)', 'spherical chain coupling: Jacobian vs differences ', &
+            maxval(abs(jac - jfd)) / maxval(abs(jac))
+        call check(error, maxval(abs(jac - jfd)) <= 1.0e-6_wp * maxval(abs(jac)), &
+                   'Jacobian differs from differences')
+        y = 0.0_wp
+        y(1:12) = q0
+        y(gen%ov + 8:gen%ov + 10) = [1.0_wp, -0.5_wp, 0.8_wp]   ! the ball joint's spin
+        call gen%consistent_initial(0.0_wp, y, yp, status)
+        e0 = hand%energy(y(1:12), y(gen%ov + 1:gen%ov + 10))
+        options%rtol = 1.0e-8_wp
+        options%atol = 1.0e-8_wp
+        t = 0.0_wp
+        call solver%integrate(gen, t, y, 0.5_wp, options, stats, status)
+        call check(error, status%ok(), 'run: ' // status%text())
+        if (allocated(error)) return
+        e1 = hand%energy(y(1:12), y(gen%ov + 1:gen%ov + 10))
+        print '(4x,a,es9.2)', 'spherical chain coupling: relative energy drift ', &
+            abs(e1 - e0) / abs(e0)
+        call check(error, abs(e1 - e0) <= 1.0e-5_wp * abs(e0), 'energy drift')
+    end subroutine test_spherical
+
+    !> The pair: rigid body (q 1:7), chain (ball quaternion 8:11, hinge 12).
+    subroutine make_pair(derivatives, sys, q0, status)
+        character(len=*), intent(in) :: derivatives
+        type(mbs_system_t), intent(out) :: sys
+        real(wp), intent(out) :: q0(12)
+        type(status_t), intent(out) :: status
+        type(rigid_chain_t) :: chain
+        type(chain_body_t) :: b(2)
+        type(marker_t) :: m(2)
+        b(1) = chain_body_t(0, chain_joint_spherical, [0.0_wp, 0.0_wp, 0.0_wp], identity, &
+                            [0.0_wp, 0.0_wp, 1.0_wp], [0.3_wp, 0.0_wp, 0.0_wp], 1.0_wp, &
+                            0.02_wp * identity)
+        b(2) = chain_body_t(1, chain_joint_revolute, [0.6_wp, 0.0_wp, 0.0_wp], identity, &
+                            [0.6_wp, 0.0_wp, 0.8_wp], [0.2_wp, 0.0_wp, 0.0_wp], 0.5_wp, &
+                            0.01_wp * identity)
+        chain = new_rigid_chain(b, status, gravity=g_earth)
+        if (.not. status%ok()) return
+        m(1) = marker_t(0, [0.4_wp, 0.0_wp, 0.0_wp], chain=1, link=2)
+        m(2) = marker_t(1, [-0.1_wp, 0.0_wp, 0.0_wp])
+        sys = new_mbs_system([rigid_body_t(0.4_wp, 0.005_wp * identity)], m, &
+            [mbs_joint_t(joint_spherical, 1, 2)], gravity=g_earth, &
+            constraint_derivatives=derivatives, status=status, chains=[chain])
+        if (.not. status%ok()) return
+        ! link 2's end at (1.0, 0, 0) with the chain at rest (q = identity, 0)
+        q0(1:7) = [1.1_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+        q0(8:12) = [1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+    end subroutine make_pair
 end module test_chain_coupling

@@ -101,7 +101,7 @@ module flexmbs_mbs_system
 
     !> A chain's joint geometry as plain arrays (for the marker formulas).
     type :: chain_geometry_t
-        integer, allocatable :: parent(:), kinds(:)
+        integer, allocatable :: parent(:), kinds(:), iq(:), iv(:)
         real(wp), allocatable :: jpos(:, :), jrot(:, :, :), axis(:, :)
     end type chain_geometry_t
 
@@ -232,14 +232,15 @@ contains
         allocate (self%chain_geom(size(self%chains)))
         do f = 1, size(self%chains)
             associate (ch => self%chains(f), g => self%chain_geom(f))
-                if (ch%nq /= ch%nv .or. ch%nv > rigid_body_nq) then
+                if (ch%nq > rigid_body_nq) then
                     call status%set(status_bad_input, 'mbs system: chain ' // int_text(f) // &
-                        ': only revolute and prismatic joints, at most ' // &
-                        int_text(rigid_body_nq) // ' coordinates, inside a system')
+                        ': at most ' // int_text(rigid_body_nq) // ' coordinates inside a system')
                     return
                 end if
                 g%parent = ch%bodies%parent
                 g%kinds = ch%bodies%joint
+                g%iq = ch%iq(1:size(ch%bodies))
+                g%iv = ch%iv(1:size(ch%bodies))
                 allocate (g%jpos(3, size(ch%bodies)), g%jrot(3, 3, size(ch%bodies)), &
                           g%axis(3, size(ch%bodies)))
                 do k = 1, size(ch%bodies)
@@ -465,8 +466,8 @@ contains
             end do
         end do
         do f = 1, size(self%chains)
-            associate (iq => self%chain_q(f), nc => self%chains(f)%nv)
-                call self%chains(f)%mass(t, q(iq + 1:iq + nc), mc(1:nc, 1:nc), status)
+            associate (iq => self%chain_q(f), nc => self%chains(f)%nv, nq => self%chains(f)%nq)
+                call self%chains(f)%mass(t, q(iq + 1:iq + nq), mc(1:nc, 1:nc), status)
                 do j = 1, nc
                     do i = 1, nc
                         n = n + 1
@@ -553,10 +554,19 @@ contains
         real(wp), intent(in) :: t, q(:), w(:)
         real(wp), intent(out) :: qdot(:)
         type(status_t), intent(inout) :: status
+        integer :: f
         call self%rigid%kinematics(t, q(1:self%nq_rigid), w(1:self%nv_rigid), &
                                    qdot(1:self%nq_rigid), status)
-        ! chains (revolute, prismatic) and flexible bodies: q' = v
-        if (self%nq > self%nq_rigid) qdot(self%nq_rigid + 1:) = w(self%nv_rigid + 1:)
+        do f = 1, size(self%chains)
+            call chain_rates(self, f, q(self%chain_q(f) + 1:self%chain_q(f) + self%chains(f)%nq), &
+                             w(self%chain_v(f) + 1:self%chain_v(f) + self%chains(f)%nv), &
+                             qdot(self%chain_q(f) + 1:self%chain_q(f) + self%chains(f)%nq))
+        end do
+        ! flexible bodies: q' = v
+        do f = 1, size(self%flex)
+            qdot(self%flex_q(f) + 1:self%flex_q(f) + self%flex(f)%nq) = &
+                w(self%flex_v(f) + 1:self%flex_v(f) + self%flex(f)%nv)
+        end do
     end subroutine system_kinematics
 
     subroutine system_kinematics_derivative(self, t, q, w, dq, status)
@@ -564,9 +574,17 @@ contains
         real(wp), intent(in) :: t, q(:), w(:)
         real(wp), intent(out) :: dq(:, :)
         type(status_t), intent(inout) :: status
+        integer :: f
         dq = 0.0_wp
         call self%rigid%kinematics_derivative(t, q(1:self%nq_rigid), w(1:self%nv_rigid), &
                                               dq(1:self%nq_rigid, 1:self%nq_rigid), status)
+        do f = 1, size(self%chains)
+            associate (iq => self%chain_q(f), iv => self%chain_v(f), nq => self%chains(f)%nq, &
+                       nv => self%chains(f)%nv)
+                call self%chains(f)%kinematics_derivative(t, q(iq + 1:iq + nq), &
+                    w(iv + 1:iv + nv), dq(iq + 1:iq + nq, iq + 1:iq + nq), status)
+            end associate
+        end do
     end subroutine system_kinematics_derivative
 
     subroutine system_mass(self, t, q, m, status)
@@ -578,8 +596,9 @@ contains
         m = 0.0_wp
         call self%rigid%mass(t, q(1:self%nq_rigid), m(1:self%nv_rigid, 1:self%nv_rigid), status)
         do f = 1, size(self%chains)
-            associate (iq => self%chain_q(f), iv => self%chain_v(f), n => self%chains(f)%nv)
-                call self%chains(f)%mass(t, q(iq + 1:iq + n), m(iv + 1:iv + n, iv + 1:iv + n), &
+            associate (iq => self%chain_q(f), iv => self%chain_v(f), n => self%chains(f)%nv, &
+                       nq => self%chains(f)%nq)
+                call self%chains(f)%mass(t, q(iq + 1:iq + nq), m(iv + 1:iv + n, iv + 1:iv + n), &
                                          status)
             end associate
         end do
@@ -602,14 +621,15 @@ contains
         integer :: f, j
         dq = 0.0_wp
         do f = 1, size(self%chains)
-            associate (iq => self%chain_q(f), iv => self%chain_v(f), n => self%chains(f)%nv)
-                do j = 1, n
-                    qc(1:n) = q(iq + 1:iq + n)
+            associate (iq => self%chain_q(f), iv => self%chain_v(f), n => self%chains(f)%nv, &
+                       nq => self%chains(f)%nq)
+                do j = 1, nq
+                    qc(1:nq) = q(iq + 1:iq + nq)
                     h = difference_step(qc(j))
                     qc(j) = q(iq + j) + h
-                    call self%chains(f)%mass(t, qc(1:n), mp(1:n, 1:n), status)
+                    call self%chains(f)%mass(t, qc(1:nq), mp(1:n, 1:n), status)
                     qc(j) = q(iq + j) - h
-                    call self%chains(f)%mass(t, qc(1:n), mm(1:n, 1:n), status)
+                    call self%chains(f)%mass(t, qc(1:nq), mm(1:n, 1:n), status)
                     dq(iv + 1:iv + n, iq + j) = matmul(mp(1:n, 1:n) - mm(1:n, 1:n), &
                                                        w(iv + 1:iv + n)) / (2 * h)
                 end do
@@ -626,8 +646,9 @@ contains
         call self%rigid%forces(t, q(1:self%nq_rigid), v(1:self%nv_rigid), &
                                f(1:self%nv_rigid), status)
         do b = 1, size(self%chains)
-            associate (iq => self%chain_q(b), iv => self%chain_v(b), n => self%chains(b)%nv)
-                call self%chains(b)%forces(t, q(iq + 1:iq + n), v(iv + 1:iv + n), &
+            associate (iq => self%chain_q(b), iv => self%chain_v(b), n => self%chains(b)%nv, &
+                       nq => self%chains(b)%nq)
+                call self%chains(b)%forces(t, q(iq + 1:iq + nq), v(iv + 1:iv + n), &
                                            f(iv + 1:iv + n), status)
             end associate
         end do
@@ -653,9 +674,10 @@ contains
                                           fv(1:self%nv_rigid, 1:self%nv_rigid), status)
         do b = 1, size(self%chains)
             ! the chains' defaults: differences of their RNEA forces
-            associate (iq => self%chain_q(b), iv => self%chain_v(b), n => self%chains(b)%nv)
-                call self%chains(b)%force_derivatives(t, q(iq + 1:iq + n), v(iv + 1:iv + n), &
-                    fq(iv + 1:iv + n, iq + 1:iq + n), fv(iv + 1:iv + n, iv + 1:iv + n), status)
+            associate (iq => self%chain_q(b), iv => self%chain_v(b), n => self%chains(b)%nv, &
+                       nq => self%chains(b)%nq)
+                call self%chains(b)%force_derivatives(t, q(iq + 1:iq + nq), v(iv + 1:iv + n), &
+                    fq(iv + 1:iv + n, iq + 1:iq + nq), fv(iv + 1:iv + n, iv + 1:iv + n), status)
             end associate
         end do
         do b = 1, size(self%flex)
@@ -685,7 +707,12 @@ contains
     subroutine system_normalize(self, q)
         class(mbs_system_t), intent(inout) :: self
         real(wp), intent(inout) :: q(:)
+        integer :: f
         call self%rigid%normalize(q(1:self%nq_rigid))
+        do f = 1, size(self%chains)
+            call self%chains(f)%normalize(q(self%chain_q(f) + 1:self%chain_q(f) + &
+                                            self%chains(f)%nq))
+        end do
     end subroutine system_normalize
 
     !> Kinetic plus potential energy; flexible bodies add kinetic and strain
@@ -698,8 +725,9 @@ contains
         real(wp) :: ek, ep
         e = rigid_body_energy(self%rigid, q(1:self%nq_rigid), v(1:self%nv_rigid))
         do b = 1, size(self%chains)
-            associate (iq => self%chain_q(b), iv => self%chain_v(b), n => self%chains(b)%nv)
-                call self%chains(b)%energy(q(iq + 1:iq + n), v(iv + 1:iv + n), ek, ep)
+            associate (iq => self%chain_q(b), iv => self%chain_v(b), n => self%chains(b)%nv, &
+                       nq => self%chains(b)%nq)
+                call self%chains(b)%energy(q(iq + 1:iq + nq), v(iv + 1:iv + n), ek, ep)
             end associate
             e = e + ek + ep
         end do
@@ -768,7 +796,8 @@ contains
         n = 0
         if (self%markers(k)%body > 0) n = merge(rigid_body_nq, rigid_body_nv, position_space)
         if (self%markers(k)%flexible > 0) n = 3
-        if (self%markers(k)%chain > 0) n = self%chains(self%markers(k)%chain)%nv
+        if (self%markers(k)%chain > 0) n = merge(self%chains(self%markers(k)%chain)%nq, &
+            self%chains(self%markers(k)%chain)%nv, position_space)
     end function marker_columns
 
     !> Real frame and motion of marker k at (q, v).
@@ -781,9 +810,11 @@ contains
         call marker_offsets(self, k, b, iq, iv)
         associate (mk => self%markers(k))
             if (mk%chain > 0) then
-                associate (g => self%chain_geom(mk%chain), nc => self%chains(mk%chain)%nv)
-                    call chain_marker_state(g%parent, g%kinds, g%jpos, g%jrot, g%axis, &
-                        mk%link, mk%position, mk%axes, q(iq + 1:iq + nc), v(iv + 1:iv + nc), m)
+                associate (g => self%chain_geom(mk%chain), nq => self%chains(mk%chain)%nq, &
+                           nv => self%chains(mk%chain)%nv)
+                    call chain_marker_state(g%parent, g%kinds, g%iq, g%iv, g%jpos, g%jrot, &
+                        g%axis, mk%link, mk%position, mk%axes, q(iq + 1:iq + nq), &
+                        v(iv + 1:iv + nv), m)
                 end associate
             else if (b < 0) then
                 ! a node: its position and velocity, constant axes
@@ -815,11 +846,7 @@ contains
         ja = 0.0_wp
         if (b == 0) return
         if (self%markers(k)%chain > 0) then
-            ! T = I: the same columns in both spaces
-            associate (mk => self%markers(k), g => self%chain_geom(self%markers(k)%chain))
-                call chain_marker_jacobian(g%parent, g%kinds, g%jpos, g%jrot, g%axis, &
-                    mk%link, mk%position, mk%axes, q(iq + 1:iq + n), jx(:, 1:n), ja(:, 1:n, :))
-            end associate
+            call chain_jacobian_real(self, k, q, iq, position_space, jx, ja)
             return
         end if
         if (b < 0) then
@@ -945,7 +972,8 @@ contains
             associate (ch => self%chains(c), g => self%chain_geom(c))
                 jx = 0.0_wp
                 ja = 0.0_wp
-                call chain_marker_jacobian_d(g%parent, g%kinds, g%jpos, g%jrot, g%axis, &
+                call chain_marker_jacobian_d(g%parent, g%kinds, g%iq, g%iv, g%jpos, g%jrot, &
+                    g%axis, &
                     self%markers(k)%link, self%markers(k)%position, self%markers(k)%axes, &
                     p(1:ch%nq), jx(:, 1:ch%nv), ja(:, 1:ch%nv, :))
             end associate
@@ -980,31 +1008,109 @@ contains
         type(dual_t), intent(inout) :: p(rigid_body_nq)
         integer, intent(out) :: n
         type(dual_t) :: vc(rigid_body_nq)
-        integer :: c, l, nc
+        real(wp) :: tp(4, 3), rate(rigid_body_nq)
+        integer :: c, l, nq, nv, b, jq, jv
         c = self%markers(k)%chain
-        nc = self%chains(c)%nv
-        p(1:nc) = q(iq + 1:iq + nc)
-        vc(1:nc) = v(iv + 1:iv + nc)
-        n = nc
+        nq = self%chains(c)%nq
+        nv = self%chains(c)%nv
+        p(1:nq) = q(iq + 1:iq + nq)
+        vc(1:nv) = v(iv + 1:iv + nv)
         select case (seed)
-        case (seed_velocity_space, seed_position)
-            do l = 1, nc
+        case (seed_velocity_space)
+            ! the tangents T e_l: unit for single-coordinate joints, T(p) e_k
+            ! for a spherical joint's quaternion
+            n = nv
+            associate (g => self%chain_geom(c))
+                do b = 1, size(g%parent)
+                    jq = g%iq(b)
+                    jv = g%iv(b)
+                    if (g%kinds(b) == 3) then
+                        tp = quat_rate_matrix(q(iq + jq + 1:iq + jq + 4))
+                        do l = 1, 3
+                            p(jq + 1:jq + 4)%der(first + jv + l - 1) = tp(:, l)
+                        end do
+                    else
+                        p(jq + 1)%der(first + jv) = 1.0_wp
+                    end if
+                end do
+            end associate
+        case (seed_position)
+            n = nq
+            do l = 1, nq
                 p(l)%der(first + l - 1) = 1.0_wp
             end do
         case (seed_velocity)
-            do l = 1, nc
+            n = nv
+            do l = 1, nv
                 vc(l)%der(first + l - 1) = 1.0_wp
             end do
         case (seed_rate)
             n = 1
-            p(1:nc)%der(first) = v(iv + 1:iv + nc)
+            call chain_rates(self, c, q(iq + 1:iq + nq), v(iv + 1:iv + nv), rate(1:nq))
+            p(1:nq)%der(first) = rate(1:nq)
         end select
         associate (g => self%chain_geom(c))
-            call chain_marker_state_d(g%parent, g%kinds, g%jpos, g%jrot, g%axis, &
+            call chain_marker_state_d(g%parent, g%kinds, g%iq, g%iv, g%jpos, g%jrot, &
+                    g%axis, &
                 self%markers(k)%link, self%markers(k)%position, self%markers(k)%axes, &
-                p(1:nc), vc(1:nc), m)
+                p(1:nq), vc(1:nv), m)
         end associate
     end subroutine chain_state_dual
+
+    !> q' = T(q) v of chain c (pure: the chain's own kinematics, inlined).
+    pure subroutine chain_rates(self, c, qc, vc, rate)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: c
+        real(wp), intent(in) :: qc(:), vc(:)
+        real(wp), intent(out) :: rate(:)
+        integer :: b, jq, jv
+        associate (g => self%chain_geom(c))
+            do b = 1, size(g%parent)
+                jq = g%iq(b)
+                jv = g%iv(b)
+                if (g%kinds(b) == 3) then
+                    rate(jq + 1:jq + 4) = matmul(quat_rate_matrix(qc(jq + 1:jq + 4)), &
+                                                 vc(jv + 1:jv + 3))
+                else
+                    rate(jq + 1) = vc(jv + 1)
+                end if
+            end do
+        end associate
+    end subroutine chain_rates
+
+    !> Real Jacobians of chain marker k: velocity space by the formulas,
+    !> position space (quaternion coordinates) by one dual pass.
+    pure subroutine chain_jacobian_real(self, k, q, iq, position_space, jx, ja)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k, iq
+        real(wp), intent(in) :: q(:)
+        logical, intent(in) :: position_space
+        real(wp), intent(out) :: jx(3, rigid_body_nq), ja(3, rigid_body_nq, 3)
+        type(marker_state_d) :: m
+        type(dual_t) :: p(rigid_body_nq)
+        integer :: c, nq, nv, n, l
+        c = self%markers(k)%chain
+        nq = self%chains(c)%nq
+        nv = self%chains(c)%nv
+        jx = 0.0_wp
+        ja = 0.0_wp
+        if (.not. position_space .or. nq == nv) then
+            associate (mk => self%markers(k), g => self%chain_geom(c))
+                call chain_marker_jacobian(g%parent, g%kinds, g%iq, g%iv, g%jpos, g%jrot, &
+                    g%axis, mk%link, mk%position, mk%axes, q(iq + 1:iq + nq), jx(:, 1:nv), &
+                    ja(:, 1:nv, :))
+            end associate
+            return
+        end if
+        p = 0.0_wp
+        call chain_state_dual(self, k, q, self%zero_v, seed_position, 1, iq, 0, m, p, n)
+        do l = 1, 3
+            jx(l, 1:nq) = m%x(l)%der(1:nq)
+            ja(l, 1:nq, 1) = m%a(l, 1)%der(1:nq)
+            ja(l, 1:nq, 2) = m%a(l, 2)%der(1:nq)
+            ja(l, 1:nq, 3) = m%a(l, 3)%der(1:nq)
+        end do
+    end subroutine chain_jacobian_real
 
     !> Driver values (s, s', s'') of joint k at t (zero for joints without s).
     pure function joint_driver(self, k, t) result(drv)
