@@ -133,6 +133,28 @@ contains
         call solve_static(body, q, status, options, report)
     end subroutine uniaxial_case
 
+    !> Quadratic convergence of a relative error measure e: every pair with
+    !> e_i < upper and e_{i+1} > lower (above round-off) has
+    !> log e_{i+1} / log e_i ≥ 1.7, and there is at least one such pair.
+    subroutine check_quadratic(error, e, upper, lower, what)
+        type(error_t), allocatable, intent(inout) :: error
+        real(wp), intent(in) :: e(:), upper, lower
+        character(len=*), intent(in) :: what
+        real(wp) :: order
+        integer :: i, npairs
+        npairs = 0
+        do i = 1, size(e) - 1
+            if (e(i) < upper .and. e(i + 1) > lower) then
+                order = log(e(i + 1)) / log(e(i))
+                print '(4x,a,es9.2,a,es9.2,a,f5.2)', what // ' ', e(i), ' -> ', e(i + 1), &
+                    ', log ratio ', order
+                call check(error, order >= 1.7_wp, what // ': Newton not quadratic')
+                npairs = npairs + 1
+            end if
+        end do
+        call check(error, npairs >= 1, what // ': no iteration pair in the asymptotic range')
+    end subroutine check_quadratic
+
     !> Both element types reach the exact homogeneous state to 1e-8 relative
     !> at a large stretch (1.5).
     subroutine test_uniaxial(error)
@@ -175,27 +197,16 @@ contains
         type(status_t) :: status
         type(static_report_t) :: report
         type(static_options_t) :: options
-        real(wp), allocatable :: q(:), r(:)
-        real(wp) :: lambda2, gnorm, order
-        integer :: i, npairs
+        real(wp), allocatable :: q(:)
+        real(wp) :: lambda2, gnorm
         options%residual_tolerance = 1.0e-14_wp
         options%increment_tolerance = 1.0e-14_wp
         call uniaxial_case(hex8, 1.3_wp, body, q, status, report, lambda2, options)
         call check(error, status%ok(), 'quadratic: ' // status%text())
         if (allocated(error)) return
         gnorm = maxval(abs(body%applied_force))
-        r = report%residual_history / gnorm
-        npairs = 0
-        do i = 1, size(r) - 1
-            if (r(i) < 1.0e-2_wp .and. r(i + 1) > 1.0e-13_wp) then
-                order = log(r(i + 1)) / log(r(i))
-                print '(4x,a,es9.2,a,es9.2,a,f5.2)', 'Newton: |r| ', r(i), ' -> ', r(i + 1), &
-                    ', log ratio ', order
-                call check(error, order >= 1.7_wp, 'quadratic: Newton not quadratic')
-                npairs = npairs + 1
-            end if
-        end do
-        call check(error, npairs >= 1, 'quadratic: no iteration pair in the asymptotic range')
+        call check_quadratic(error, report%residual_history / gnorm, 1.0e-2_wp, 1.0e-13_wp, &
+                             'quadratic: |r|')
     end subroutine test_quadratic
 
     !> With at most 3 Newton iterations per step the full load fails; the
@@ -330,9 +341,8 @@ contains
         type(status_t) :: status
         type(static_report_t) :: report
         type(static_options_t) :: options
-        real(wp) :: load, deflection, order
+        real(wp) :: load, deflection
         real(wp), allocatable :: r(:)
-        integer :: i, npairs
         call paper_material(mat)
         load = 0.3_wp * beam(1) / timoshenko(mat, 1.0_wp)
         options%residual_tolerance = 1.0e-14_wp
@@ -350,17 +360,8 @@ contains
         ! (= sqrt(P δ_linear)), is the affine-invariant error measure. Pairs
         ! ending within a factor 10 of the round-off floor are left out.
         r = report%decrement_history / report%decrement_history(1)
-        npairs = 0
-        do i = 1, size(r) - 1
-            if (r(i) < 1.0e-3_wp .and. r(i + 1) > 10.0_wp * r(size(r))) then
-                order = log(r(i + 1)) / log(r(i))
-                print '(4x,a,es9.2,a,es9.2,a,f5.2)', 'Newton decrement ', r(i), ' -> ', &
-                    r(i + 1), ', log ratio ', order
-                call check(error, order >= 1.7_wp, 'large deflection: Newton not quadratic')
-                npairs = npairs + 1
-            end if
-        end do
-        call check(error, npairs >= 1, 'large deflection: no iteration pair in the asymptotic range')
+        call check_quadratic(error, r, 1.0e-3_wp, 10.0_wp * r(size(r)), &
+                             'large deflection: decrement')
     end subroutine test_large_deflection
 
     !> A tip load a thousand times what bends the beam by its length in
