@@ -3,6 +3,7 @@
 !> cantilever against Timoshenko beam theory under refinement, linearity,
 !> and the failure paths.
 module test_fe_statics
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_solver_failure, status_bad_input
     use flexmbs_fe_hexahedron, only: hex8, hex27
@@ -29,6 +30,8 @@ contains
                  new_test('load_stepping_recovers', test_stepping), &
                  new_test('cantilever_timoshenko', test_cantilever), &
                  new_test('small_load_linear', test_linear), &
+                 new_test('large_deflection_quadratic', test_large_deflection), &
+                 new_test('extreme_load', test_extreme_load), &
                  new_test('failures_reported', test_failures)]
     end function collect_fe_statics
 
@@ -130,8 +133,30 @@ contains
         call solve_static(body, q, status, options, report)
     end subroutine uniaxial_case
 
-    !> Both element types reach the exact homogeneous state to 1e-8 relative,
-    !> at a stretch (1.5) that needs several load steps.
+    !> Quadratic convergence of a relative error measure e: every pair with
+    !> e_i < upper and e_{i+1} > lower (above round-off) has
+    !> log e_{i+1} / log e_i ≥ 1.7, and there is at least one such pair.
+    subroutine check_quadratic(error, e, upper, lower, what)
+        type(error_t), allocatable, intent(inout) :: error
+        real(wp), intent(in) :: e(:), upper, lower
+        character(len=*), intent(in) :: what
+        real(wp) :: order
+        integer :: i, npairs
+        npairs = 0
+        do i = 1, size(e) - 1
+            if (e(i) < upper .and. e(i + 1) > lower) then
+                order = log(e(i + 1)) / log(e(i))
+                print '(4x,a,es9.2,a,es9.2,a,f5.2)', what // ' ', e(i), ' -> ', e(i + 1), &
+                    ', log ratio ', order
+                call check(error, order >= 1.7_wp, what // ': Newton not quadratic')
+                npairs = npairs + 1
+            end if
+        end do
+        call check(error, npairs >= 1, what // ': no iteration pair in the asymptotic range')
+    end subroutine check_quadratic
+
+    !> Both element types reach the exact homogeneous state to 1e-8 relative
+    !> at a large stretch (1.5).
     subroutine test_uniaxial(error)
         type(error_t), allocatable, intent(out) :: error
         integer, parameter :: kinds(2) = [hex8, hex27]
@@ -172,27 +197,16 @@ contains
         type(status_t) :: status
         type(static_report_t) :: report
         type(static_options_t) :: options
-        real(wp), allocatable :: q(:), r(:)
-        real(wp) :: lambda2, gnorm, order
-        integer :: i, npairs
+        real(wp), allocatable :: q(:)
+        real(wp) :: lambda2, gnorm
         options%residual_tolerance = 1.0e-14_wp
         options%increment_tolerance = 1.0e-14_wp
         call uniaxial_case(hex8, 1.3_wp, body, q, status, report, lambda2, options)
         call check(error, status%ok(), 'quadratic: ' // status%text())
         if (allocated(error)) return
         gnorm = maxval(abs(body%applied_force))
-        r = report%residual_history / gnorm
-        npairs = 0
-        do i = 1, size(r) - 1
-            if (r(i) < 1.0e-2_wp .and. r(i + 1) > 1.0e-13_wp) then
-                order = log(r(i + 1)) / log(r(i))
-                print '(4x,a,es9.2,a,es9.2,a,f5.2)', 'Newton: |r| ', r(i), ' -> ', r(i + 1), &
-                    ', log ratio ', order
-                call check(error, order >= 1.7_wp, 'quadratic: Newton not quadratic')
-                npairs = npairs + 1
-            end if
-        end do
-        call check(error, npairs >= 1, 'quadratic: no iteration pair in the asymptotic range')
+        call check_quadratic(error, report%residual_history / gnorm, 1.0e-2_wp, 1.0e-13_wp, &
+                             'quadratic: |r|')
     end subroutine test_quadratic
 
     !> With at most 3 Newton iterations per step the full load fails; the
@@ -222,11 +236,13 @@ contains
 
     !> Clamped box beam (27-node, n × 1 × 1), tip load P in z spread
     !> consistently over the xmax face; the face-averaged deflection.
-    subroutine cantilever(n, load, deflection, status)
+    subroutine cantilever(n, load, deflection, status, report, options)
         integer, intent(in) :: n
         real(wp), intent(in) :: load
         real(wp), intent(out) :: deflection
         type(status_t), intent(out) :: status
+        type(static_report_t), intent(out), optional :: report
+        type(static_options_t), intent(in), optional :: options
         type(mesh_t) :: mesh
         type(neo_hooke_t) :: mat
         type(flexible_body_t) :: body
@@ -249,8 +265,7 @@ contains
             if (.not. status%ok()) return
         end do
         q = body%free_positions()
-        call solve_static(body, q, status)
-        if (.not. status%ok()) return
+        call solve_static(body, q, status, options, report)
         deflection = 0.0_wp
         do i = 1, size(tip)
             deflection = deflection + weights(i) * (q(body%dof(3, tip(i))) - mesh%x(3, tip(i)))
@@ -278,6 +293,7 @@ contains
         integer, parameter :: ns(3) = [2, 4, 8]
         type(neo_hooke_t) :: mat
         type(status_t) :: status
+        type(static_report_t) :: report
         real(wp) :: load, reference, deflection, rel(3)
         integer :: i
         call paper_material(mat)
@@ -285,13 +301,14 @@ contains
         load = 1.0e-4_wp * beam(1) / timoshenko(mat, 1.0_wp)
         reference = timoshenko(mat, load)
         do i = 1, size(ns)
-            call cantilever(ns(i), load, deflection, status)
+            call cantilever(ns(i), load, deflection, status, report)
             call check(error, status%ok(), 'cantilever: ' // status%text())
             if (allocated(error)) return
             rel(i) = abs(deflection - reference) / reference
-            print '(4x,a,i0,a,es12.5,a,es12.5,a,f6.2,a)', 'cantilever ', ns(i), &
+            print '(4x,a,i0,a,es12.5,a,es12.5,a,f6.2,a,i0,a,i0,a)', 'cantilever ', ns(i), &
                 'x1x1 hex27: tip ', deflection, ', Timoshenko ', reference, ', error ', &
-                100 * rel(i), ' %'
+                100 * rel(i), ' % (', report%load_steps, ' load steps, ', &
+                report%newton_iterations, ' Newton iterations)'
         end do
         call check(error, rel(2) < rel(1) .and. rel(3) < rel(2), &
                    'cantilever: error does not decrease under refinement')
@@ -312,6 +329,61 @@ contains
         if (allocated(error)) return
         call check_close(error, d2 / d1, 2.0_wp, 2.0e-6_wp, 'linear: deflection ratio')
     end subroutine test_linear
+
+    !> A cantilever bent far into the nonlinear range (linear theory: δ/L =
+    !> 0.3), an inhomogeneous state with large rotations: Newton's decrement
+    !> in the last load step shrinks quadratically (log ratio ≥ 1.7 once
+    !> below 1e-3 of the first), and the deflection stays below the linear
+    !> prediction (the tip moves inwards as the beam rotates).
+    subroutine test_large_deflection(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(neo_hooke_t) :: mat
+        type(status_t) :: status
+        type(static_report_t) :: report
+        type(static_options_t) :: options
+        real(wp) :: load, deflection
+        real(wp), allocatable :: r(:)
+        call paper_material(mat)
+        load = 0.3_wp * beam(1) / timoshenko(mat, 1.0_wp)
+        options%residual_tolerance = 1.0e-14_wp
+        options%increment_tolerance = 1.0e-14_wp
+        call cantilever(4, load, deflection, status, report, options)
+        call check(error, status%ok(), 'large deflection: ' // status%text())
+        if (allocated(error)) return
+        print '(4x,a,f7.4,a,i0,a,i0,a,i0,a)', 'large deflection: δ/L ', deflection / beam(1), &
+            ' (linear 0.3), ', report%load_steps, ' load steps, ', report%failed_steps, &
+            ' halvings, ', report%newton_iterations, ' Newton iterations'
+        call check(error, deflection > 0.1_wp * beam(1) .and. deflection < 0.3_wp * beam(1), &
+                   'large deflection: tip deflection outside (0.1, 0.3) L')
+        ! ‖r‖ is dominated by the stiff axial terms and need not fall
+        ! monotonically; the Newton decrement, normalised by the first one
+        ! (= sqrt(P δ_linear)), is the affine-invariant error measure. Pairs
+        ! ending within a factor 10 of the round-off floor are left out.
+        r = report%decrement_history / report%decrement_history(1)
+        call check_quadratic(error, r, 1.0e-3_wp, 10.0_wp * r(size(r)), &
+                             'large deflection: decrement')
+    end subroutine test_large_deflection
+
+    !> A tip load a thousand times what bends the beam by its length in
+    !> linear theory (nominal stress 2.5 E): the beam swings round and
+    !> stretches several times over (tip deflection > L), and the load
+    !> stepping still reaches it.
+    subroutine test_extreme_load(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(neo_hooke_t) :: mat
+        type(status_t) :: status
+        type(static_report_t) :: report
+        real(wp) :: load, deflection
+        call paper_material(mat)
+        load = 1.0e3_wp * beam(1) / timoshenko(mat, 1.0_wp)
+        call cantilever(2, load, deflection, status, report)
+        call check(error, status%ok(), 'extreme load: ' // status%text())
+        if (allocated(error)) return
+        print '(4x,a,f6.3,a,i0,a,i0,a,i0,a)', 'extreme load: δ/L ', deflection / beam(1), ', ', &
+            report%load_steps, ' load steps, ', report%failed_steps, ' halvings, ', &
+            report%newton_iterations, ' Newton iterations'
+        call check(error, deflection > beam(1), 'extreme load: tip did not swing round')
+    end subroutine test_extreme_load
 
     !> A load step that cannot converge in one iteration with a large minimum
     !> increment fails with the load factor reached; a wrong q size is bad
@@ -340,5 +412,14 @@ contains
         call solve_static(body, q, status)
         call check(error, status%code == status_bad_input .and. &
                    index(status%text(), 'entries') > 0, 'failures: wrong size: ' // status%text())
+        if (allocated(error)) return
+        ! A NaN load is bad input, reported before any iteration.
+        call body%add_nodal_load(body%mesh%node_count(), [ieee_value(1.0_wp, ieee_quiet_nan), &
+                                 0.0_wp, 0.0_wp], status)
+        q = q0
+        call solve_static(body, q, status, report=report)
+        call check(error, status%code == status_bad_input .and. &
+                   index(status%text(), 'not finite') > 0 .and. report%newton_iterations == 0, &
+                   'failures: NaN load: ' // status%text())
     end subroutine test_failures
 end module test_fe_statics
