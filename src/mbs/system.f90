@@ -63,7 +63,7 @@ module flexmbs_mbs_system
         joint_jacobian_d => joint_jacobian, joint_rows_d => joint_rows, &
         chain_marker_state_d => chain_marker_state, &
         chain_marker_jacobian_d => chain_marker_jacobian
-    use flexmbs_mbs_rigid_chain, only: rigid_chain_t
+    use flexmbs_mbs_rigid_chain, only: rigid_chain_t, chain_joint_spherical
     implicit none
     private
 
@@ -72,6 +72,8 @@ module flexmbs_mbs_system
     !> constraint_derivatives: the same formulas' values on dual numbers.
     integer, parameter, public :: constraint_derivatives_ad = 2
 
+    ! marker_offsets reports a chain marker's body as -(chain_body_flag + chain).
+    integer, parameter :: chain_body_flag = 1000
     ! The most rows of a joint (fixed: spherical + 3 dot-1).
     integer, parameter :: max_rows = 6
     ! Marker axes must be orthonormal to this (max |UᵀU - I|).
@@ -770,7 +772,8 @@ contains
         integer, intent(out) :: body, iq, iv
         integer :: f, d
         if (self%markers(k)%chain > 0) then
-            body = -1000 - self%markers(k)%chain
+            ! negative like a node marker (not the ground, not a rigid body)
+            body = -chain_body_flag - self%markers(k)%chain
             iq = self%chain_q(self%markers(k)%chain)
             iv = self%chain_v(self%markers(k)%chain)
             return
@@ -1024,7 +1027,7 @@ contains
                 do b = 1, size(g%parent)
                     jq = g%iq(b)
                     jv = g%iv(b)
-                    if (g%kinds(b) == 3) then
+                    if (g%kinds(b) == chain_joint_spherical) then
                         tp = quat_rate_matrix(q(iq + jq + 1:iq + jq + 4))
                         do l = 1, 3
                             p(jq + 1:jq + 4)%der(first + jv + l - 1) = tp(:, l)
@@ -1068,7 +1071,7 @@ contains
             do b = 1, size(g%parent)
                 jq = g%iq(b)
                 jv = g%iv(b)
-                if (g%kinds(b) == 3) then
+                if (g%kinds(b) == chain_joint_spherical) then
                     rate(jq + 1:jq + 4) = matmul(quat_rate_matrix(qc(jq + 1:jq + 4)), &
                                                  vc(jv + 1:jv + 3))
                 else
