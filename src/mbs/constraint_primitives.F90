@@ -12,7 +12,7 @@ module flexmbs_mbs_constraint_primitives
     use flexmbs_mbs_joint, only: joint_t, joint_part_time_derivative, joint_part_convective
     implicit none
     private
-    public :: rigid_marker_state, ground_marker_state, rigid_marker_jacobian, &
+    public :: rigid_marker_state, rigid_marker_pose, ground_marker_state, rigid_marker_jacobian, &
         rigid_marker_jacobian_q, primitive_value, primitive_jacobian, &
         primitive_time_derivative, primitive_convective, primitive_time_terms, &
         joint_value, joint_jacobian, joint_rows, chain_marker_state, chain_marker_jacobian

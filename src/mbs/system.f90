@@ -57,7 +57,7 @@ module flexmbs_mbs_system
         ground_marker_state, rigid_marker_jacobian, rigid_marker_jacobian_q, joint_value, &
         joint_jacobian, joint_rows, chain_marker_state, chain_marker_jacobian
     use flexmbs_mbs_constraint_primitives_dual, only: marker_state_d => marker_state_t, &
-        rigid_marker_state_d => rigid_marker_state, &
+        rigid_marker_state_d => rigid_marker_state, rigid_marker_pose_d => rigid_marker_pose, &
         ground_marker_state_d => ground_marker_state, &
         rigid_marker_jacobian_d => rigid_marker_jacobian, joint_value_d => joint_value, &
         joint_jacobian_d => joint_jacobian, joint_rows_d => joint_rows, &
@@ -873,9 +873,11 @@ contains
     !> Dual frame and motion of marker k at (q, v) with its body's tangents
     !> `seed` in directions first, first+1, ...; p the dual quaternion (for the
     !> dual marker Jacobians); n the directions used (0 on the ground).
-    pure subroutine marker_state_dual(self, k, q, v, seed, first, m, p, n)
+    pure subroutine marker_state_dual(self, k, q, v, seed, first, m, p, n, pose_only)
         class(mbs_system_t), intent(in) :: self
         integer, intent(in) :: k, seed, first
+        !> the frame only (rigid markers): values and first derivatives of c
+        logical, intent(in), optional :: pose_only
         real(wp), intent(in) :: q(:), v(:)
         type(marker_state_d), intent(out) :: m
         !> the pose coordinates the dual Jacobians need: the quaternion of a
@@ -958,6 +960,12 @@ contains
                 r%der(first) = v(iv + 1:iv + 3)
                 p(1:4)%der(first) = matmul(tp, v(iv + 4:iv + 6))
             end select
+            if (present(pose_only)) then
+                if (pose_only) then
+                    call rigid_marker_pose_d(r, p(1:4), sb, ub, m)
+                    return
+                end if
+            end if
             call rigid_marker_state_d(r, p(1:4), rd, wb, sb, ub, m)
         end associate
     end subroutine marker_state_dual
@@ -1200,9 +1208,10 @@ contains
                 call joint_rows(joint_part_time_derivative, jt%joint, mi, mj, drv, ct(1:nr))
             else
                 seed = merge(seed_position, seed_velocity_space, position_space)
-                call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed, 1, mid, pd, ni)
+                call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed, 1, mid, pd, ni, &
+                                       pose_only=.true.)
                 call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed, 1 + ni, mjd, &
-                                       pd, nj)
+                                       pd, nj, pose_only=.true.)
                 td = ni + nj + 1
                 call joint_value_d(jt%joint, mid, mjd, driver_dual(drv, td), cd(1:nr))
                 do r = 1, nr
@@ -1359,9 +1368,9 @@ contains
                 r0 = jt%row0
                 nr = jt%joint%nrows
                 call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed_position, 1, &
-                                       mid, pi, qi)
+                                       mid, pi, qi, pose_only=.true.)
                 call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed_position, &
-                                       1 + qi, mjd, pj, qj)
+                                       1 + qi, mjd, pj, qj, pose_only=.true.)
                 call marker_jacobian_dual(self, jt%marker_i, pi, jxi, jai)
                 call marker_jacobian_dual(self, jt%marker_j, pj, jxj, jaj)
                 ni = marker_columns(self, jt%marker_i, .false.)
@@ -1415,9 +1424,9 @@ contains
             associate (jt => self%joints(k))
                 nr = jt%joint%nrows
                 call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed_position, 1, &
-                                       mid, pd, qi)
+                                       mid, pd, qi, pose_only=.true.)
                 call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed_position, &
-                                       1 + qi, mjd, pd, qj)
+                                       1 + qi, mjd, pd, qj, pose_only=.true.)
                 call joint_rows_d(joint_part_time_derivative, jt%joint, mid, mjd, &
                                   driver_dual(joint_driver(self, k, t), 0), ctd(1:nr))
                 call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
