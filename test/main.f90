@@ -35,6 +35,7 @@ program flexmbs_tests
     use test_flexible_marker, only: collect_flexible_marker
     use test_multibody_scene, only: collect_multibody_scene
     use test_flexible_coupling, only: collect_flexible_coupling
+    use test_node_frame, only: collect_node_frame
     use test_chain_coupling, only: collect_chain_coupling
     implicit none
     integer :: npassed, nfailed, nargs
@@ -81,6 +82,7 @@ program flexmbs_tests
     call run_suite('flexible_coupling', collect_flexible_coupling(), filter, npassed, &
                    nfailed)
     call run_suite('chain_coupling', collect_chain_coupling(), filter, npassed, nfailed)
+    call run_suite('node_frame', collect_node_frame(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests

@@ -32,6 +32,9 @@ module flexmbs_mbs_rigid_body
             0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3]) !! body-fixed, about the centre of mass
         real(wp) :: force(3) = 0.0_wp  !! applied global force at the centre of mass
         real(wp) :: torque(3) = 0.0_wp !! applied body-fixed torque
+        !> a massless frame that constraints carry (flexmbs_mbs_node_frame):
+        !> mass, inertia, force and torque are taken as zero
+        logical :: frame = .false.
     end type rigid_body_t
 
     !> Free rigid bodies under gravity as a mechanical problem (nc = 0).
@@ -56,7 +59,8 @@ module flexmbs_mbs_rigid_body
 contains
 
     !> The bodies `bodies` under `gravity`; masses must be positive and the
-    !> inertias symmetric positive definite (checked by Cholesky).
+    !> inertias symmetric positive definite (checked by Cholesky), except for
+    !> frames (massless; only constraints can hold them).
     function new_rigid_bodies(bodies, gravity, status) result(self)
         type(rigid_body_t), intent(in) :: bodies(:)
         real(wp), intent(in), optional :: gravity(3)
@@ -65,6 +69,7 @@ contains
         integer :: i
         character(len=120) :: msg
         do i = 1, size(bodies)
+            if (bodies(i)%frame) cycle
             if (.not. (bodies(i)%mass > 0.0_wp) .or. .not. spd(bodies(i)%inertia)) then
                 write (msg, '(a,i0,a,es10.3,a)') 'rigid body ', i, ': mass = ', &
                     bodies(i)%mass, ': need mass > 0 and a symmetric positive definite inertia'
@@ -73,6 +78,13 @@ contains
             end if
         end do
         self%bodies = bodies
+        do i = 1, size(bodies)
+            if (.not. bodies(i)%frame) cycle
+            self%bodies(i)%mass = 0.0_wp
+            self%bodies(i)%inertia = 0.0_wp
+            self%bodies(i)%force = 0.0_wp
+            self%bodies(i)%torque = 0.0_wp
+        end do
         if (present(gravity)) self%gravity = gravity
         self%nq = rigid_body_nq * size(bodies)
         self%nv = rigid_body_nv * size(bodies)

@@ -64,6 +64,10 @@ module flexmbs_mbs_system
         chain_marker_state_d => chain_marker_state, &
         chain_marker_jacobian_d => chain_marker_jacobian
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, chain_joint_spherical
+    use flexmbs_mbs_flexible_marker, only: flexible_marker_t, new_flexible_marker
+    use flexmbs_mbs_node_frame, only: node_frame_t, node_frame_rows, frame_columns, &
+        frame_value, frame_jacobian, frame_curvature, frame_jacobian_ad, frame_curvature_ad, &
+        frame_rate_q, frame_gtl_q, frame_curvature_qv
     implicit none
     private
 
@@ -152,6 +156,9 @@ module flexmbs_mbs_system
         type(rigid_chain_t), allocatable :: chains(:)
         type(chain_geometry_t), allocatable :: chain_geom(:)
         integer, allocatable :: chain_q(:), chain_v(:)
+        !> node frames (flexmbs_mbs_node_frame): massless rigid bodies held on
+        !> node sets of the flexible bodies, rows after the joints' rows
+        type(node_frame_t), allocatable :: frames(:)
         real(wp), allocatable :: zero_v(:) !! v = 0 for position-only evaluations
         !> copies of the CSC patterns handed out (their triplet maps place values)
         type(csc_matrix_t) :: mass_csc, jacobian_csc
@@ -184,7 +191,7 @@ module flexmbs_mbs_system
         procedure :: momenta => system_momenta
     end type mbs_system_t
 
-    public :: new_mbs_system, driver_values
+    public :: new_mbs_system, driver_values, node_frame_t
 
 contains
 
@@ -192,7 +199,7 @@ contains
     !> `constraint_derivatives` is 'analytic' (default) or 'ad'. On bad input
     !> `status` says which item is wrong and why.
     function new_mbs_system(bodies, markers, joints, gravity, constraint_derivatives, &
-                            status, flexible, chains) result(self)
+                            status, flexible, chains, frames) result(self)
         type(rigid_body_t), intent(in) :: bodies(:)
         type(marker_t), intent(in) :: markers(:)
         type(mbs_joint_t), intent(in) :: joints(:)
@@ -203,6 +210,9 @@ contains
         type(flexible_body_t), intent(in), optional :: flexible(:)
         !> rigid chains (their own gravity), after the rigid bodies
         type(rigid_chain_t), intent(in), optional :: chains(:)
+        !> node frames: flexible, body (a frame body of `bodies`) and nodes
+        !> given; the rest is filled in here
+        type(node_frame_t), intent(in), optional :: frames(:)
         type(mbs_system_t) :: self
         integer :: k, row0, f
         character(len=:), allocatable :: where
@@ -367,17 +377,145 @@ contains
             self%nq = self%nq + self%flex(f)%nq
             self%nv = self%nv + self%flex(f)%nv
         end do
+        if (present(frames)) then
+            self%frames = frames
+        else
+            allocate (self%frames(0))
+        end if
+        call place_frames(self, bodies, row0, status)
+        if (.not. status%ok()) return
         self%nc = row0
         allocate (self%zero_v(self%nv))
         self%zero_v = 0.0_wp
     end function new_mbs_system
 
-    !> First row of joint k in c (rows joint_first_row(k) + 0 .. nrows - 1).
+    !> Check the node frames and place them: reference offsets, their bodies'
+    !> and nodes' offsets in q and v, six rows each after row0 (updated).
+    subroutine place_frames(self, bodies, row0, status)
+        type(mbs_system_t), intent(inout) :: self
+        type(rigid_body_t), intent(in) :: bodies(:)
+        integer, intent(inout) :: row0
+        type(status_t), intent(inout) :: status
+        type(flexible_marker_t) :: fit
+        character(len=:), allocatable :: where
+        integer :: i, a, b, f, node
+        do b = 1, size(bodies)
+            if (bodies(b)%frame .and. count(self%frames%body == b) /= 1) then
+                call status%set(status_bad_input, 'mbs system: rigid body ' // int_text(b) // &
+                    ' is a frame: exactly one node frame must hold it')
+                return
+            end if
+        end do
+        do i = 1, size(self%frames)
+            where = 'mbs system: node frame ' // int_text(i)
+            associate (fr => self%frames(i))
+                f = fr%flexible
+                b = fr%body
+                if (f < 1 .or. f > size(self%flex)) then
+                    call status%set(status_bad_input, where // ': flexible = ' // int_text(f) &
+                        // ': must name a flexible body 1 .. ' // int_text(size(self%flex)))
+                    return
+                end if
+                if (b < 1 .or. b > size(bodies)) then
+                    call status%set(status_bad_input, where // ': body = ' // int_text(b) // &
+                        ': must name a rigid body 1 .. ' // int_text(size(bodies)))
+                    return
+                end if
+                if (.not. bodies(b)%frame) then
+                    call status%set(status_bad_input, where // ': rigid body ' // int_text(b) &
+                        // ' is not a frame (massless) body')
+                    return
+                end if
+                associate (fb => self%flex(f))
+                    do a = 1, size(fr%nodes)
+                        node = fr%nodes(a)
+                        if (node < 1 .or. node > fb%mesh%node_count()) then
+                            call status%set(status_bad_input, where // ': node ' // &
+                                int_text(node) // ' outside the mesh')
+                            return
+                        end if
+                        if (any(fb%dof(:, node) == 0) .or. &
+                            fb%dof(2, node) /= fb%dof(1, node) + 1 .or. &
+                            fb%dof(3, node) /= fb%dof(1, node) + 2) then
+                            call status%set(status_bad_input, where // ': node ' // &
+                                int_text(node) // ' is fixed (a node frame needs free nodes)')
+                            return
+                        end if
+                    end do
+                    call new_flexible_marker(fit, fb%mesh%x, fr%nodes, status)
+                    if (.not. status%ok()) then
+                        call status%set(status_bad_input, where // ': ' // status%text())
+                        return
+                    end if
+                    fr%s = fit%dx_ref
+                    fr%weight = fit%weight
+                    fr%iq = rigid_body_nq * (b - 1)
+                    fr%iv = rigid_body_nv * (b - 1)
+                    allocate (fr%nq(size(fr%nodes)), fr%nv(size(fr%nodes)))
+                    do a = 1, size(fr%nodes)
+                        fr%nq(a) = self%flex_q(f) + fb%dof(1, fr%nodes(a)) - 1
+                        fr%nv(a) = self%flex_v(f) + fb%dof(1, fr%nodes(a)) - 1
+                    end do
+                end associate
+                fr%row0 = row0
+                row0 = row0 + node_frame_rows
+            end associate
+        end do
+    end subroutine place_frames
+
+    !> First row of joint k in c (rows joint_first_row(k) + 0 .. nrows - 1);
+    !> k = size(joints) + i: node frame i (6 rows).
     pure integer function system_joint_first_row(self, k) result(row)
         class(mbs_system_t), intent(in) :: self
         integer, intent(in) :: k
-        row = self%joints(k)%row0 + 1
+        if (k > size(self%joints)) then
+            row = self%frames(k - size(self%joints))%row0 + 1
+        else
+            row = self%joints(k)%row0 + 1
+        end if
     end function system_joint_first_row
+
+    !> Global column of frame fr's local column l (flexmbs_mbs_node_frame).
+    pure integer function frame_column(fr, l, position_space) result(c)
+        type(node_frame_t), intent(in) :: fr
+        integer, intent(in) :: l
+        logical, intent(in) :: position_space
+        integer :: nb, a
+        nb = merge(rigid_body_nq, rigid_body_nv, position_space)
+        if (l <= nb) then
+            c = merge(fr%iq, fr%iv, position_space) + l
+        else
+            a = (l - nb - 1) / 3 + 1
+            c = merge(fr%nq(a), fr%nv(a), position_space) + l - nb - 3 * (a - 1)
+        end if
+    end function frame_column
+
+    !> out(:, global columns) += block (local columns of frame fr).
+    pure subroutine add_frame_columns(fr, position_space, block, out)
+        type(node_frame_t), intent(in) :: fr
+        logical, intent(in) :: position_space
+        real(wp), intent(in) :: block(:, :)
+        real(wp), intent(inout) :: out(:, :)
+        integer :: l, c
+        do l = 1, size(block, 2)
+            c = frame_column(fr, l, position_space)
+            out(:, c) = out(:, c) + block(:, l)
+        end do
+    end subroutine add_frame_columns
+
+    !> Frame i's rows of G (velocity space) or c_q, local columns.
+    subroutine frame_first_derivatives(self, i, q, position_space, block)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: i
+        real(wp), intent(in) :: q(:)
+        logical, intent(in) :: position_space
+        real(wp), intent(out) :: block(:, :)
+        if (self%derivatives == constraint_derivatives_analytic) then
+            call frame_jacobian(self%frames(i), q, position_space, block)
+        else
+            call frame_jacobian_ad(self%frames(i), q, position_space, block)
+        end if
+    end subroutine frame_first_derivatives
 
     ! ------------------------------------------------ sparse (CSC) forms
 
@@ -503,6 +641,9 @@ contains
                 nt = nt + self%joints(k)%joint%nrows * marker_columns(self, mk, .false.)
             end do
         end do
+        do k = 1, size(self%frames)
+            nt = nt + node_frame_rows * frame_columns(self%frames(k), .false.)
+        end do
         allocate (rows(nt), cols(nt))
         n = 0
         do k = 1, size(self%joints)
@@ -515,6 +656,15 @@ contains
                         rows(n) = self%joints(k)%row0 + r
                         cols(n) = iv + c
                     end do
+                end do
+            end do
+        end do
+        do k = 1, size(self%frames)
+            do c = 1, frame_columns(self%frames(k), .false.)
+                do r = 1, node_frame_rows
+                    n = n + 1
+                    rows(n) = self%frames(k)%row0 + r
+                    cols(n) = frame_column(self%frames(k), c, .false.)
                 end do
             end do
         end do
@@ -546,6 +696,18 @@ contains
                     values(self%jacobian_csc%triplet_map(n)) = cj(r, c)
                 end do
             end do
+        end do
+        do k = 1, size(self%frames)
+            block
+                real(wp) :: fb(node_frame_rows, frame_columns(self%frames(k), .false.))
+                call frame_first_derivatives(self, k, q, .false., fb)
+                do c = 1, size(fb, 2)
+                    do r = 1, node_frame_rows
+                        n = n + 1
+                        values(self%jacobian_csc%triplet_map(n)) = fb(r, c)
+                    end do
+                end do
+            end block
         end do
     end subroutine system_constraint_jacobian_sparse
 
@@ -1238,6 +1400,11 @@ contains
                                  g(jt%row0 + 1:jt%row0 + jt%joint%nrows))
             end associate
         end do
+        do k = 1, size(self%frames)
+            associate (fr => self%frames(k))
+                call frame_value(fr, q, g(fr%row0 + 1:fr%row0 + node_frame_rows))
+            end associate
+        end do
     end subroutine system_constraint
 
     !> G = c_q T, nc x nv.
@@ -1277,6 +1444,15 @@ contains
                                  out(r0 + 1:r0 + nr, :))
             end associate
         end do
+        do k = 1, size(self%frames)
+            block
+                real(wp) :: fb(node_frame_rows, frame_columns(self%frames(k), position_space))
+                call frame_first_derivatives(self, k, q, position_space, fb)
+                r0 = self%frames(k)%row0
+                call add_frame_columns(self%frames(k), position_space, fb, &
+                                       out(r0 + 1:r0 + node_frame_rows, :))
+            end block
+        end do
     end subroutine assemble_first_derivative
 
     !> c_t = ∂c/∂t.
@@ -1292,6 +1468,10 @@ contains
                 call joint_first_derivatives(self, k, t, q, .false., ci, cj, ni, nj, ct)
                 gt(jt%row0 + 1:jt%row0 + jt%joint%nrows) = ct(1:jt%joint%nrows)
             end associate
+        end do
+        ! node frames do not depend on t
+        do k = 1, size(self%frames)
+            gt(self%frames(k)%row0 + 1:self%frames(k)%row0 + node_frame_rows) = 0.0_wp
         end do
     end subroutine system_constraint_time_derivative
 
@@ -1342,6 +1522,16 @@ contains
                              + dot_product(cjd(r, 1:nj), v(ivj + 1:ivj + nj))
                         gamma(r0 + r) = cv%der(1) + 2.0_wp * cv%der(2) + ctd(r)%der(2)
                     end do
+                end if
+            end associate
+        end do
+        do k = 1, size(self%frames)
+            associate (fr => self%frames(k))
+                if (self%derivatives == constraint_derivatives_analytic) then
+                    call frame_curvature(fr, q, v, gamma(fr%row0 + 1:fr%row0 + node_frame_rows))
+                else
+                    call frame_curvature_ad(fr, q, v, &
+                                            gamma(fr%row0 + 1:fr%row0 + node_frame_rows))
                 end if
             end associate
         end do
@@ -1396,6 +1586,26 @@ contains
                                       dot_product(cjd(1:nr, l), lambda(r0 + 1:r0 + nr)), &
                                       qi, iqi, qj, iqj)
                 end do
+            end associate
+        end do
+        do k = 1, size(self%frames)
+            associate (fr => self%frames(k))
+                block
+                    real(wp) :: bq(node_frame_rows, frame_columns(fr, .true.)), &
+                        bl(frame_columns(fr, .false.), frame_columns(fr, .true.))
+                    integer :: c
+                    call frame_rate_q(fr, q, w, bq)
+                    call add_frame_columns(fr, .true., bq, &
+                                           gwq(fr%row0 + 1:fr%row0 + node_frame_rows, :))
+                    call frame_gtl_q(fr, q, lambda(fr%row0 + 1:fr%row0 + node_frame_rows), bl)
+                    do l = 1, size(bl, 2)
+                        c = frame_column(fr, l, .true.)
+                        do r = 1, size(bl, 1)
+                            gtlq(frame_column(fr, r, .false.), c) = &
+                                gtlq(frame_column(fr, r, .false.), c) + bl(r, l)
+                        end do
+                    end do
+                end block
             end associate
         end do
     end subroutine system_constraint_jacobian_derivatives
@@ -1473,6 +1683,19 @@ contains
                         end if
                     end do
                 end do
+            end associate
+        end do
+        do k = 1, size(self%frames)
+            associate (fr => self%frames(k))
+                block
+                    real(wp) :: bq(node_frame_rows, frame_columns(fr, .true.)), &
+                        bv(node_frame_rows, frame_columns(fr, .false.))
+                    call frame_curvature_qv(fr, q, v, bq, bv)
+                    call add_frame_columns(fr, .true., bq, &
+                                           gq(fr%row0 + 1:fr%row0 + node_frame_rows, :))
+                    call add_frame_columns(fr, .false., bv, &
+                                           gv(fr%row0 + 1:fr%row0 + node_frame_rows, :))
+                end block
             end associate
         end do
     end subroutine system_constraint_curvature_derivatives
