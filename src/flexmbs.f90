@@ -35,7 +35,8 @@ module flexmbs
     use flexmbs_mbs_rigid_body, only: rigid_bodies_t, rigid_body_t, new_rigid_bodies, &
         rigid_body_energy, rigid_body_momenta
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
-        constraint_derivatives_analytic, constraint_derivatives_ad, driver_t, driver_values
+        constraint_derivatives_analytic, constraint_derivatives_ad, driver_t, driver_values, &
+        node_frame_t
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, new_rigid_chain, chain_body_t, &
         chain_marker_t, chain_joint_revolute, chain_joint_prismatic
     use flexmbs_problems_mechanisms, only: new_mechanism, mechanism_slider_crank, &

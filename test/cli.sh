@@ -191,5 +191,13 @@ sed -e "s/node_set = 'xmin'/node_set = 'xmn'/" "$root/inputs/rigid_flexible_pend
 bad rigid-flexible-unknown-set "rigidflex_bad.nml: &joint 'root': marker_j 'root': mesh: no node set named 'xmn'" \
     rigidflex_bad.nml
 
+# A rigid link hinged to the face of a soft cantilever (inputs/face_hinge.nml:
+# a revolute joint on a node-set marker, through a node frame)
+for s in radau5 ida mexax; do
+    sed -e "s/name = 'radau5'/name = '$s'/" -e "s/^&output/\&output file = 'out\/run.h5',/" \
+        "$root/inputs/face_hinge.nml" > "hinge_$s.nml"
+    kept "face-hinge-$s" 0 "$s: NST=" out/run.h5 run "hinge_$s.nml" --quiet
+done
+
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

@@ -11,6 +11,7 @@ module test_multibody_scene
     use flexmbs_problems_mechanisms, only: four_bar_exact, crank_angle, bar_b
     use flexmbs_io_chain_input, only: build_rigid_chain
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
+    use flexmbs_mbs_flexible_marker, only: flexible_marker_t, new_flexible_marker
     use testing, only: test_case_t, new_test, error_t, check
     implicit none
     private
@@ -29,7 +30,8 @@ contains
                  new_test('rigid_flexible_file', test_rigid_flexible), &
                  new_test('rigid_flexible_bad_scenes', test_rigid_flexible_bad), &
                  new_test('monitor_drift_energy', test_monitor), &
-                 new_test('four_bar_chain_file', test_four_bar_chain)]
+                 new_test('four_bar_chain_file', test_four_bar_chain), &
+                 new_test('face_hinge_file', test_face_hinge)]
     end function collect_multibody_scene
 
     !> inputs/four_bar.nml with each solver: the coupler end at t = 1
@@ -212,11 +214,61 @@ contains
             &''xmn'' /' // nl // '&joint type = ''attach'', marker_i = ''tip'', marker_j = &
             &''root'' /', "marker_j 'root': mesh: no node set named 'xmn'")
         call expect(error, base // '&marker name = ''root'', body = ''bar'', node_set = &
-            &''xmin'' /' // nl // '&joint type = ''spherical'', marker_i = ''tip'', marker_j = &
-            &''root'' /', "'attach' joins a marker of a rigid body or the ground")
+            &''xmin'' /' // nl // '&joint type = ''attach'', marker_i = ''root'', marker_j = &
+            &''tip'' /', "'attach' joins a marker of a rigid body or the ground")
+        call expect(error, base // '&marker name = ''root'', body = ''bar'', node_set = &
+            &''xmn'' /' // nl // '&joint type = ''revolute'', marker_i = ''tip'', marker_j = &
+            &''root'' /', "&marker 'root': mesh: no node set named 'xmn'")
         call expect(error, base // '&marker name = ''m2'', body = ''link'', node_set = &
             &''xmin'' /', "&marker: node_set = 'xmin': only for markers on the &flexible_body")
     end subroutine test_rigid_flexible_bad
+    !> inputs/face_hinge.nml, a revolute joint on a node-set marker: the
+    !> frame sits on the Kabsch fit of the bar's xmax face, the link's hub on
+    !> the frame's origin with parallel hinge axes; RADAU5, DDASSL and IDA
+    !> agree (1e-5).
+    subroutine test_face_hinge(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=8), parameter :: solvers(3) = ['radau5', 'ddassl', 'ida   ']
+        type(scene_input_t) :: scene
+        type(run_result_t) :: result
+        type(status_t) :: status
+        type(flexible_marker_t) :: fit
+        real(wp), allocatable :: y_ref(:)
+        real(wp) :: x_ref(3, 4), x(3, 4), origin(3), axes(3, 3), rl(3, 3), rf(3, 3), &
+            dfit, djoint
+        integer :: k, a
+        do k = 1, size(solvers)
+            call run_file(error, 'inputs/face_hinge.nml', solvers(k), scene, result)
+            if (allocated(error)) return
+            if (k > 1) then
+                call check(error, maxval(abs(result%y(1:14) - y_ref(1:14))) <= 1.0e-5_wp, &
+                           trim(solvers(k)) // ': link and frame differ from RADAU5')
+                cycle
+            end if
+            y_ref = result%y
+            ! xmax face: nodes 5, 10, 15, 20 of the 5 x 2 x 2 grid, free nodes
+            ! 4, 8, 12, 16 (xmin is clamped), after the link's and frame's q
+            do a = 1, 4
+                x_ref(:, a) = [0.4_wp, merge(-0.025_wp, 0.025_wp, mod(a - 1, 2) == 0), &
+                               merge(-0.025_wp, 0.025_wp, a <= 2)]
+                x(:, a) = result%y(14 + 12 * a - 2:14 + 12 * a)
+            end do
+            call new_flexible_marker(fit, x_ref, [1, 2, 3, 4], status)
+            call fit%pose(x, origin, axes, status)
+            rf = rotation_matrix(result%y(11:14))
+            dfit = max(norm2(origin - result%y(8:10)), maxval(abs(axes - rf)))
+            rl = rotation_matrix(result%y(4:7))
+            djoint = max(norm2(result%y(1:3) + matmul(rl, [-0.1_wp, 0.0_wp, 0.0_wp]) - &
+                               result%y(8:10)), norm2(rl(:, 3) - rf(:, 3)))
+            print '(4x,a,es9.2,a,es9.2,a,f7.4)', 'face hinge: frame off the fit ', dfit, &
+                ', hinge off the frame ', djoint, ', tip deflection ', 0.0_wp - origin(2)
+            call check(error, status%ok(), 'fit: ' // status%text())
+            call check(error, dfit <= 1.0e-6_wp, 'the frame left the fit of the face')
+            call check(error, djoint <= 1.0e-6_wp, 'the hinge opened')
+            call check(error, -origin(2) > 0.01_wp, 'the bar did not bend')
+        end do
+    end subroutine test_face_hinge
+
     !> Read the scene file, run it with `solver` (no output file).
     subroutine run_file(error, path, solver, scene, result)
         type(error_t), allocatable, intent(inout) :: error

@@ -22,7 +22,7 @@ module flexmbs_io_multibody_input
     use flexmbs_mbs_primitive_kinds, only: primitive_angle_driver, &
         primitive_translation_driver, primitive_distance
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
-        driver_t
+        driver_t, node_frame_t
     use flexmbs_io_namelist, only: scene_input_t
     use flexmbs_io_body_input, only: build_flexible_body
     use flexmbs_io_chain_input, only: build_rigid_chain
@@ -49,14 +49,28 @@ contains
         type(mbs_joint_t), allocatable :: joints(:)
         type(flexible_body_t), allocatable :: flex(:)
         type(rigid_chain_t), allocatable :: chains(:)
+        type(node_frame_t), allocatable :: frames(:)
         real(wp), allocatable :: qf(:), vf(:), qc(:), vc(:)
-        integer, allocatable :: nodes(:)
-        character(len=:), allocatable :: labels(:)
+        integer, allocatable :: nodes(:), frame_of(:)
+        character(len=:), allocatable :: labels(:), frame_labels(:)
         real(wp) :: p(4), r(3, 3), anchor(3)
         integer :: i, nb, k, n, b, mi
-        nb = size(scene%rigid_bodies)
-        allocate (bodies(nb), q0(7 * nb), v0(6 * nb))
-        do i = 1, nb
+        ! node-set markers that a joint other than 'attach' or a driver uses
+        ! get a node frame (a massless body after the scene's rigid bodies)
+        allocate (frame_of(size(scene%markers)), source=0)
+        do i = 1, size(scene%joints)
+            if (scene%joints(i)%type == 'attach') cycle
+            call use_frame(scene%joints(i)%marker_i)
+            call use_frame(scene%joints(i)%marker_j)
+        end do
+        do i = 1, size(scene%drivers)
+            call use_frame(scene%drivers(i)%marker_i)
+            call use_frame(scene%drivers(i)%marker_j)
+        end do
+        nb = size(scene%rigid_bodies) + count(frame_of > 0)
+        allocate (bodies(nb))
+        allocate (q0(7 * nb), v0(6 * nb), source=0.0_wp)
+        do i = 1, size(scene%rigid_bodies)
             associate (b => scene%rigid_bodies(i))
                 bodies(i)%mass = b%mass
                 bodies(i)%inertia = reshape([b%inertia(1), b%inertia_products(1), &
@@ -92,12 +106,45 @@ contains
             q0 = [q0, qf]
             v0 = [v0, vf]
         end if
-        ! scene markers first (those on the flexible body are placeholders:
-        ! an 'attach' joint expands into node markers, appended below)
+        ! node frames: at the set's centroid with the reference axes (the
+        ! flexible body starts in its reference configuration), moving with
+        ! the mean velocity of the set and the body's initial spin
+        allocate (frames(count(frame_of > 0)))
+        allocate (character(len=80) :: frame_labels(size(frames)))
+        do i = 1, size(scene%markers)
+            k = frame_of(i)
+            if (k == 0) cycle
+            call flex(1)%mesh%node_set(trim(scene%markers(i)%node_set), nodes, status)
+            if (.not. status%ok()) then
+                call status%set(status_bad_input, scene%path // ': &marker ''' // &
+                    trim(scene%markers(i)%name) // ''': ' // status%text())
+                return
+            end if
+            b = size(scene%rigid_bodies) + k
+            bodies(b)%frame = .true.
+            frames(k) = node_frame_t(flexible=1, body=b, nodes=nodes)
+            frame_labels(k) = '&marker ''' // trim(scene%markers(i)%name) // ''' (node frame)'
+            anchor = sum(flex(1)%mesh%x(:, nodes), dim=2) / size(nodes)
+            q0(7 * b - 6:7 * b) = [anchor, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+            v0(6 * b - 5:6 * b) = [mean_velocity(nodes), scene%body%initial_angular_velocity]
+        end do
+        ! scene markers first (node-set markers of 'attach' joints are
+        ! placeholders: the joint expands into node markers, appended below)
         allocate (markers(size(scene%markers)))
         do i = 1, size(markers)
             associate (m => scene%markers(i))
                 markers(i)%body = 0
+                if (frame_of(i) > 0) then
+                    ! on the frame: the origin relative to the centroid, the
+                    ! reference axes (the frame's at the start)
+                    b = size(scene%rigid_bodies) + frame_of(i)
+                    markers(i)%body = b
+                    markers(i)%position = 0.0_wp
+                    if (m%position_given) markers(i)%position = m%position - &
+                        q0(7 * b - 6:7 * b - 4)
+                    markers(i)%axes = axes_from(m%z_axis, m%x_axis)
+                    cycle
+                end if
                 if (m%body /= 'ground' .and. len_trim(m%node_set) == 0) &
                     markers(i)%body = body_index(scene, m%body)
                 if (markers(i)%body == 0 .and. m%body /= 'ground') then
@@ -166,12 +213,38 @@ contains
         end do
         sys = new_mbs_system(bodies, markers, joints, gravity=scene%multibody%gravity, &
             constraint_derivatives=trim(scene%multibody%constraint_derivatives), status=status, &
-            flexible=flex, chains=chains)
+            flexible=flex, chains=chains, frames=frames)
         if (.not. status%ok()) then
             call status%set(status_bad_input, scene%path // ': ' // status%text())
             return
         end if
-        call check_rank(scene, sys, q0, labels, status)
+        call check_rank(scene, sys, q0, [character(len=80) :: labels, frame_labels], status)
+
+    contains
+
+        !> Marker `name` gets a node frame if it is a node-set marker.
+        subroutine use_frame(name)
+            character(len=*), intent(in) :: name
+            integer :: k
+            k = marker_index(scene, name)
+            if (k == 0) return
+            if (len_trim(scene%markers(k)%node_set) == 0 .or. frame_of(k) > 0) return
+            frame_of(k) = maxval(frame_of) + 1
+        end subroutine use_frame
+
+        !> Mean initial velocity of nodes (fixed nodes at rest).
+        function mean_velocity(set) result(u)
+            integer, intent(in) :: set(:)
+            real(wp) :: u(3)
+            integer :: a, l
+            u = 0.0_wp
+            do a = 1, size(set)
+                do l = 1, 3
+                    if (flex(1)%dof(l, set(a)) > 0) u(l) = u(l) + vf(flex(1)%dof(l, set(a)))
+                end do
+            end do
+            u = u / size(set)
+        end function mean_velocity
     end subroutine build_multibody
 
     !> G(t0, q0) must have full row rank: otherwise the constraints are

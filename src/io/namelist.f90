@@ -228,6 +228,7 @@ module flexmbs_io_namelist
         real(wp) :: z_axis(3) = [0.0_wp, 0.0_wp, 1.0_wp]
         real(wp) :: x_axis(3) = 0.0_wp              !! 0: any normal to z
         character(len=len_name) :: node_set = ''    !! on the flexible body: its nodes
+        logical :: position_given = .false.         !! (node-set markers default to the centroid)
         integer :: line = 0
     end type marker_input_t
 
@@ -1236,7 +1237,7 @@ contains
         namelist /marker/ name, body, position, z_axis, x_axis, node_set
         name = input%name
         body = input%body
-        position = input%position
+        position = huge(1.0_wp)   ! tells whether the group sets it
         z_axis = input%z_axis
         x_axis = input%x_axis
         node_set = input%node_set
@@ -1245,7 +1246,8 @@ contains
         read (lines, nml=marker, iostat=ios, iomsg=msg)
         input%name = name
         input%body = body
-        input%position = position
+        input%position_given = any(position /= huge(1.0_wp))
+        input%position = merge(position, input%position, position /= huge(1.0_wp))
         input%z_axis = z_axis
         input%x_axis = x_axis
         input%node_set = node_set
@@ -1748,11 +1750,11 @@ contains
                 else
                     call check_markers('joint', i, jt%marker_i, jt%marker_j)
                 end if
-                if (status%ok()) then
-                    if ((jt%type == 'attach') .neqv. (on_flexible(jt%marker_j) .and. &
-                        .not. on_flexible(jt%marker_i))) call bad('joint', 'type', i, &
-                        '''attach'' joins a marker of a rigid body or the ground (marker_i) to &
-                        &a node-set marker of the flexible body (marker_j), and only it does')
+                if (status%ok() .and. jt%type == 'attach') then
+                    if (.not. (on_flexible(jt%marker_j) .and. .not. on_flexible(jt%marker_i))) &
+                        call bad('joint', 'type', i, '''attach'' joins a marker of a rigid &
+                        &body or the ground (marker_i) to a node-set marker of the flexible &
+                        &body (marker_j)')
                 end if
                 if (.not. status%ok()) return
             end associate
@@ -1768,8 +1770,6 @@ contains
                 else
                     call check_markers('driver', i, d%marker_i, d%marker_j)
                 end if
-                if (status%ok() .and. (on_flexible(d%marker_i) .or. on_flexible(d%marker_j))) &
-                    call bad('driver', 'marker_j', i, 'drivers act between rigid markers only')
                 if (.not. status%ok()) return
             end associate
         end do

@@ -89,7 +89,7 @@ contains
         type(formulation_t) :: formulation
         real(wp), allocatable :: q0(:), v0(:), yp0(:)
         integer :: nq
-        logical :: klu
+        logical :: klu, massless
         klu = scene%linear_solver == 'klu'
         allocate (blocks(0))
         if (present(mechanical)) then
@@ -157,19 +157,23 @@ contains
             allocate (problem, source=formulation)
         case ('multibody')
             allocate (mbs_system_t :: mechanical)
+            massless = .false.
             select type (sys => mechanical)
             type is (mbs_system_t)
                 call build_multibody(scene, sys, q0, v0, status)
+                massless = size(sys%frames) > 0
             end select
             if (.not. status%ok()) return
             ! Rigid and flexible bodies have a constant M (body-fixed ω'):
-            ! y = (q, v, λ[, μ]); a chain's M(q) needs the acceleration layout
-            ! y = (q, v, a, λ[, μ]). MEXAX integrates y = (q, v, λ) (index 2).
+            ! y = (q, v, λ[, μ]); a chain's M(q) and the zero M of node frames
+            ! need the acceleration layout y = (q, v, a, λ[, μ]), where the
+            ! constraints determine a through [M Gᵀ; G 0]. MEXAX integrates
+            ! y = (q, v, λ) (index 2).
             formulation = new_formulation(mechanical, merge(formulation_index2, &
                 mechanical_formulation(scene%multibody%formulation), &
-                scene%solver_name == 'mexax'), q0, constant_mass=size(scene%chain) == 0 &
-                .or. scene%solver_name == 'mexax', projection=scene%multibody%projection, &
-                status=status)
+                scene%solver_name == 'mexax'), q0, constant_mass=(size(scene%chain) == 0 &
+                .and. .not. massless) .or. scene%solver_name == 'mexax', &
+                projection=scene%multibody%projection, status=status)
             if (.not. status%ok()) then
                 status%message = scene%path // ': &multibody: ' // status%message
                 return
