@@ -84,13 +84,14 @@ contains
     !> G, c_q, c_t and γ with chain markers: 'ad' equals 'analytic' (1e-12).
     subroutine test_ad(error)
         type(error_t), allocatable, intent(out) :: error
-        type(mbs_system_t) :: hand, ad
+        type(mbs_system_t) :: hand, ad, full
         type(status_t) :: status
         real(wp) :: q0(9), q(9), v(8), worst
         integer(i8) :: seed
         integer :: trial
         call make('analytic', hand, q0, status)
         if (status%ok()) call make('ad', ad, q0, status)
+        if (status%ok()) call make('ad_full', full, q0, status)
         call check(error, status%ok() .and. hand%nc == 8 .and. hand%nv == 8, &
                    'systems: ' // status%text())
         if (allocated(error)) return
@@ -101,9 +102,10 @@ contains
             q = q0 + q
             q(4:7) = q(4:7) / norm2(q(4:7))
             call fill_random(v, seed, -1.0_wp, 1.0_wp)
-            worst = max(worst, ad_deviation(hand, ad, 0.2_wp, q, v, status))
+            worst = max(worst, ad_deviation(hand, ad, 0.2_wp, q, v, status), &
+                        ad_deviation(hand, full, 0.2_wp, q, v, status))
         end do
-        print '(4x,a,es9.2)', 'chain markers: AD vs analytic ', worst
+        print '(4x,a,es9.2)', 'chain markers: AD (ad, ad_full) vs analytic ', worst
         call check(error, status%ok(), 'evaluations: ' // status%text())
         call check(error, worst <= 1.0e-12_wp, 'AD differs from analytic')
     end subroutine test_ad
@@ -179,7 +181,7 @@ contains
     !> differences (1e-6), and the energy over 0.5 s (RADAU5, rtol 1e-8).
     subroutine test_spherical(error)
         type(error_t), allocatable, intent(out) :: error
-        type(mbs_system_t), target :: hand, ad
+        type(mbs_system_t), target :: hand, ad, full
         type(formulation_t) :: gen
         type(radau5_t) :: solver
         type(dae_options_t) :: options
@@ -191,6 +193,7 @@ contains
         integer :: trial
         call make_pair('analytic', hand, q0, status)
         if (status%ok()) call make_pair('ad', ad, q0, status)
+        if (status%ok()) call make_pair('ad_full', full, q0, status)
         call check(error, status%ok() .and. hand%nq == 12 .and. hand%nv == 10 .and. &
                    hand%nc == 3, 'systems: ' // status%text())
         if (allocated(error)) return
@@ -202,9 +205,10 @@ contains
             q(4:7) = q(4:7) / norm2(q(4:7))
             q(8:11) = q(8:11) / norm2(q(8:11))
             call fill_random(v, seed, -1.0_wp, 1.0_wp)
-            worst = max(worst, ad_deviation(hand, ad, 0.2_wp, q, v, status))
+            worst = max(worst, ad_deviation(hand, ad, 0.2_wp, q, v, status), &
+                        ad_deviation(hand, full, 0.2_wp, q, v, status))
         end do
-        print '(4x,a,es9.2)', 'spherical chain markers: AD vs analytic ', worst
+        print '(4x,a,es9.2)', 'spherical chain markers: AD (ad, ad_full) vs analytic ', worst
         call check(error, worst <= 1.0e-12_wp, 'AD differs from analytic')
         gen = new_formulation(hand, formulation_ggl, q0, status=status)
         allocate (y(gen%n), yp(gen%n), jac(gen%n, gen%n), jfd(gen%n, gen%n))

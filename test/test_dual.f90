@@ -14,6 +14,8 @@ module test_dual
     use flexmbs_mbs_rotation_dual, only: rotation_matrix_d => rotation_matrix, &
         quat_normalize_d => quat_normalize
     use mbs_random, only: random_state_t, random_vector, random_quaternion
+    use flexmbs_mbs_jet, only: jet_t, operator(+), operator(-), operator(*), operator(/), &
+        operator(**), sqrt, sin, cos, matmul
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
     private
@@ -29,7 +31,8 @@ contains
         tests = [new_test('scalar_composition', test_scalar_composition), &
                  new_test('comparisons_branches', test_comparisons), &
                  new_test('array_helpers', test_array_helpers), &
-                 new_test('rotation_identities_ad', test_rotation_ad)]
+                 new_test('rotation_identities_ad', test_rotation_ad), &
+                 new_test('jet_second_derivatives', test_jet)]
     end function collect_dual
 
     !> f(x, y) built from every overloaded scalar operation; df/dx, df/dy by hand.
@@ -185,4 +188,49 @@ contains
         call check_close(error, worst_t, 0.0_wp, tol_ad, 'AD d(A^T s)/dp')
         call check_close(error, worst_v, 0.0_wp, tol_ad, 'AD d(A s)/dt along T w_b')
     end subroutine test_rotation_ad
+
+    !> Jets along s: f(s) = sin(x) sqrt(y) / z + x**3 − cos(x y), with x, y, z
+    !> quadratics in s, and a 2 × 2 matrix-vector product: value, f' and f''
+    !> against the closed forms and central differences of the real formula.
+    subroutine test_jet(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(jet_t) :: x, y, z, f, m(2, 2), u(2), w(2)
+        real(wp) :: h, fp, fm, f0, d1, d2
+        x = jet_t(0.7_wp, 1.3_wp, -0.4_wp)
+        y = jet_t(2.1_wp, -0.6_wp, 0.9_wp)
+        z = jet_t(1.5_wp, 0.2_wp, 0.3_wp)
+        f = sin(x) * sqrt(y) / z - cos(x * y) + x**3
+        h = 1.0e-4_wp
+        f0 = real_f(0.0_wp)
+        fp = real_f(h)
+        fm = real_f(-h)
+        d1 = (fp - fm) / (2.0_wp * h)
+        d2 = (fp - 2.0_wp * f0 + fm) / h**2
+        call check_close(error, f%f0, f0, 1.0e-14_wp, 'jet value')
+        if (allocated(error)) return
+        call check_close(error, f%f1, d1, 1.0e-7_wp, 'jet first derivative')
+        if (allocated(error)) return
+        call check_close(error, f%f2, d2, 1.0e-5_wp, 'jet second derivative')
+        if (allocated(error)) return
+        ! (M u)'' for M(s) = M0 + s M1, u(s) = u0 + s u1 + s² u2 / 2: 2 M1 u1 + M0 u2
+        m = reshape([jet_t(1.0_wp, 2.0_wp, 0.0_wp), jet_t(3.0_wp, -1.0_wp, 0.0_wp), &
+                     jet_t(0.5_wp, 0.0_wp, 0.0_wp), jet_t(-2.0_wp, 1.0_wp, 0.0_wp)], [2, 2])
+        u = [jet_t(1.0_wp, 1.0_wp, 2.0_wp), jet_t(-1.0_wp, 0.5_wp, 1.0_wp)]
+        w = matmul(m, u)
+        call check(error, abs(w(1)%f2 - (2.0_wp * (2.0_wp * 1.0_wp + 0.0_wp * 0.5_wp) + &
+                   (1.0_wp * 2.0_wp + 0.5_wp * 1.0_wp))) <= 1.0e-14_wp .and. &
+                   abs(w(2)%f2 - (2.0_wp * (-1.0_wp * 1.0_wp + 1.0_wp * 0.5_wp) + &
+                   (3.0_wp * 2.0_wp - 2.0_wp * 1.0_wp))) <= 1.0e-14_wp, 'jet matmul')
+
+    contains
+
+        real(wp) function real_f(s)
+            real(wp), intent(in) :: s
+            real(wp) :: xr, yr, zr
+            xr = 0.7_wp + 1.3_wp * s - 0.2_wp * s**2
+            yr = 2.1_wp - 0.6_wp * s + 0.45_wp * s**2
+            zr = 1.5_wp + 0.2_wp * s + 0.15_wp * s**2
+            real_f = sin(xr) * sqrt(yr) / zr - cos(xr * yr) + xr**3
+        end function real_f
+    end subroutine test_jet
 end module test_dual

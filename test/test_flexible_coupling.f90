@@ -106,7 +106,7 @@ contains
     !> with rigid–flexible and flexible–flexible spherical joints.
     subroutine test_ad(error)
         type(error_t), allocatable, intent(out) :: error
-        type(mbs_system_t) :: hand, ad
+        type(mbs_system_t) :: hand, ad, full
         type(status_t) :: status
         real(wp), allocatable :: q0(:), q(:), v(:)
         real(wp) :: worst
@@ -114,6 +114,7 @@ contains
         integer :: trial
         call make_loop('analytic', hand, q0, status, .true., 0.0_wp)
         if (status%ok()) call make_loop('ad', ad, q0, status, .true., 0.0_wp)
+        if (status%ok()) call make_loop('ad_full', full, q0, status, .true., 0.0_wp)
         call check(error, status%ok(), 'systems: ' // status%text())
         if (allocated(error)) return
         associate (nc => hand%nc, nq => hand%nq, nv => hand%nv)
@@ -127,9 +128,10 @@ contains
             q = q0 + q
             q(4:7) = q(4:7) / norm2(q(4:7))
             call fill_random(v, seed, -1.0_wp, 1.0_wp)
-            worst = max(worst, ad_deviation(hand, ad, 0.2_wp, q, v, status))
+            worst = max(worst, ad_deviation(hand, ad, 0.2_wp, q, v, status), &
+                        ad_deviation(hand, full, 0.2_wp, q, v, status))
         end do
-        print '(4x,a,es9.2)', 'node joints: AD vs analytic ', worst
+        print '(4x,a,es9.2)', 'node joints: AD (ad, ad_full) vs analytic ', worst
         call check(error, status%ok(), 'evaluations: ' // status%text())
         call check(error, worst <= 1.0e-12_wp, 'AD differs from analytic')
     end subroutine test_ad

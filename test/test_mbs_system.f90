@@ -123,10 +123,19 @@ contains
 
     ! ------------------------------------------------------------------ tests
 
-    !> The assembled G, c_q, c_t and γ of the analytic and the AD system agree
-    !> on random configurations; G = c_q T; c equal.
+    !> The assembled G, c_q, c_t and γ of the analytic and the AD systems
+    !> ('ad': AD of the vector relations on the marker frames; 'ad_full':
+    !> through the quaternions too) agree on random configurations; G = c_q T;
+    !> c equal.
     subroutine test_ad_vs_analytic(error)
         type(error_t), allocatable, intent(out) :: error
+        call ad_vs_analytic(error, 'ad')
+        if (.not. allocated(error)) call ad_vs_analytic(error, 'ad_full')
+    end subroutine test_ad_vs_analytic
+
+    subroutine ad_vs_analytic(error, source)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: source
         type(random_state_t) :: rng, rng_a, rng_d
         type(mbs_system_t) :: hand, ad
         type(status_t) :: status
@@ -140,7 +149,7 @@ contains
         rng_d = rng
         hand = all_joints_system(rng_a, 'analytic', status)
         call check(error, status%ok(), status%text())
-        ad = all_joints_system(rng_d, 'ad', status)
+        ad = all_joints_system(rng_d, source, status)
         call check(error, status%ok(), status%text())
         if (allocated(error)) return
         rng = rng_a
@@ -178,12 +187,12 @@ contains
             e_y = max(e_y, rel_err(reshape(yd, [nc, 1]), reshape(yh, [nc, 1])))
             e_gt = max(e_gt, rel_err(gt, gh))
         end do
-        write (msg, '(a,6es10.2)') 'AD vs analytic: c, G, c_q, c_t, γ; c_q T vs G:', e_c, &
-            e_g, e_q, e_t, e_y, e_gt
+        write (msg, '(a,6es10.2)') source // ' vs analytic: c, G, c_q, c_t, γ; c_q T vs G:', &
+            e_c, e_g, e_q, e_t, e_y, e_gt
         print '(a)', '    ' // trim(msg)
         call check(error, status%ok(), status%text())
         call check(error, max(e_c, e_g, e_q, e_t, e_y, e_gt) <= tol_ad, trim(msg))
-    end subroutine test_ad_vs_analytic
+    end subroutine ad_vs_analytic
 
     pure function unit(n, j) result(e)
         integer, intent(in) :: n, j

@@ -80,7 +80,7 @@ contains
     subroutine test_driver_rows(error)
         type(error_t), allocatable, intent(out) :: error
         type(random_state_t) :: rng
-        type(mbs_system_t) :: hand, ad
+        type(mbs_system_t) :: hand, ad, full
         type(status_t) :: status
         type(marker_t) :: markers(4)
         type(mbs_joint_t) :: joints(3)
@@ -103,6 +103,8 @@ contains
                               constraint_derivatives='analytic', status=status)
         if (status%ok()) ad = new_mbs_system([rigid_body_t(), rigid_body_t()], markers, &
             joints, constraint_derivatives='ad', status=status)
+        if (status%ok()) full = new_mbs_system([rigid_body_t(), rigid_body_t()], markers, &
+            joints, constraint_derivatives='ad_full', status=status)
         call check(error, status%ok() .and. hand%nc == 3, 'systems: ' // status%text())
         if (allocated(error)) return
         worst = 0.0_wp
@@ -114,7 +116,8 @@ contains
                 q(7 * k - 3:7 * k) = random_quaternion(rng)
                 v(6 * k - 5:6 * k) = random_vector(rng, 6, -2.0_wp, 2.0_wp)
             end do
-            worst = max(worst, ad_deviation(hand, ad, t, q, v, status))
+            worst = max(worst, ad_deviation(hand, ad, t, q, v, status), &
+                        ad_deviation(hand, full, t, q, v, status))
             call hand%constraint_time_derivative(t, q, th, status)
             call hand%constraint(t + 1.0e-6_wp, q, cp, status)
             call hand%constraint(t - 1.0e-6_wp, q, cm, status)

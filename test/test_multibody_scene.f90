@@ -117,6 +117,13 @@ contains
             'the inertia tensor is not positive definite')
         call expect(error, '&simulation problem = ''pendulum'', t_end = 1 /' // nl // &
             '&rigid_body mass = 1 /', "&rigid_body: given, but problem = 'pendulum'")
+        call expect(error, pendulum(bar, markers, hinge, '&multibody constraint_derivatives = &
+            &''fd'' /'), "constraint_derivatives = 'fd': must be 'analytic', 'ad' or 'ad_full'")
+        ! the full AD path runs from a scene too
+        call parse_scene(pendulum(bar, markers, hinge, '&multibody constraint_derivatives = &
+            &''ad_full'' /'), 'mb.nml', scene, status)
+        if (status%ok()) call run_scene(scene, .true., result, status)
+        call check(error, status%ok(), 'ad_full pendulum: ' // status%text())
         call expect(error, pendulum(bar, markers, hinge, '&multibody formulation = ''idx2'' /'), &
             "&multibody: formulation = 'idx2': must be one of")
     end subroutine test_bad_scenes

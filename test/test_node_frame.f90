@@ -250,7 +250,7 @@ contains
     !> revolute (rigid–flexible) and fixed (flexible–flexible) joints.
     subroutine test_ad(error)
         type(error_t), allocatable, intent(out) :: error
-        type(mbs_system_t) :: hand, ad
+        type(mbs_system_t) :: hand, ad, full
         type(status_t) :: status
         real(wp), allocatable :: q0(:), q(:), v(:)
         real(wp) :: worst
@@ -258,6 +258,7 @@ contains
         integer :: trial, i
         call make('analytic', .true., 0.0_wp, hand, q0, status)
         if (status%ok()) call make('ad', .true., 0.0_wp, ad, q0, status)
+        if (status%ok()) call make('ad_full', .true., 0.0_wp, full, q0, status)
         call check(error, status%ok(), 'systems: ' // status%text())
         if (allocated(error)) return
         call check(error, hand%nc == 5 + 5 + 6 + 3 * 6, 'rows')
@@ -271,9 +272,10 @@ contains
                 q(7 * i - 3:7 * i) = q(7 * i - 3:7 * i) / norm2(q(7 * i - 3:7 * i))
             end do
             call fill_random(v, seed, -1.0_wp, 1.0_wp)
-            worst = max(worst, ad_deviation(hand, ad, 0.2_wp, q, v, status))
+            worst = max(worst, ad_deviation(hand, ad, 0.2_wp, q, v, status), &
+                        ad_deviation(hand, full, 0.2_wp, q, v, status))
         end do
-        print '(4x,a,es9.2)', 'joints on node frames: AD vs analytic ', worst
+        print '(4x,a,es9.2)', 'joints on node frames: AD (ad, ad_full) vs analytic ', worst
         call check(error, status%ok(), 'evaluations: ' // status%text())
         call check(error, worst <= 1.0e-12_wp, 'AD differs from analytic')
     end subroutine test_ad

@@ -1676,9 +1676,10 @@ contains
             if (all(formulation_names /= mb%formulation)) then
                 call bad('multibody', 'formulation', 1, 'must be one of ' // &
                          choices(formulation_names))
-            else if (all([character(len=8) :: 'analytic', 'ad'] /= &
+            else if (all([character(len=8) :: 'analytic', 'ad', 'ad_full'] /= &
                           mb%constraint_derivatives)) then
-                call bad('multibody', 'constraint_derivatives', 1, 'must be ''analytic'' or ''ad''')
+                call bad('multibody', 'constraint_derivatives', 1, 'must be ''analytic'', ''ad'' &
+                         &or ''ad_full''')
             else if (size(scene%rigid_bodies) + size(scene%chain) == 0) then
                 call status%set(status_bad_input, path // ': &simulation: problem = &
                     &''multibody'': needs at least one &rigid_body or &rigid_chain group')

@@ -64,6 +64,9 @@ module flexmbs_mbs_system
         chain_marker_state_d => chain_marker_state, &
         chain_marker_jacobian_d => chain_marker_jacobian
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, chain_joint_spherical
+    use flexmbs_mbs_jet, only: jet_t
+    use flexmbs_mbs_constraint_primitives_jet, only: marker_state_j => marker_state_t, &
+        ground_marker_state_j => ground_marker_state, joint_value_j => joint_value
     use flexmbs_mbs_flexible_marker, only: flexible_marker_t, new_flexible_marker
     use flexmbs_mbs_node_frame, only: node_frame_t, node_frame_rows, frame_columns, &
         frame_value, frame_jacobian, frame_curvature, frame_jacobian_ad, frame_curvature_ad, &
@@ -73,8 +76,13 @@ module flexmbs_mbs_system
 
     !> constraint_derivatives: hand-coded first derivatives of the joint rows.
     integer, parameter, public :: constraint_derivatives_analytic = 1
-    !> constraint_derivatives: the same formulas' values on dual numbers.
+    !> constraint_derivatives: AD of the joints' vector relations on the
+    !> marker frames (dual numbers seeded with the markers' Jacobians; jets
+    !> along the markers' motion for γ).
     integer, parameter, public :: constraint_derivatives_ad = 2
+    !> constraint_derivatives: AD through the body coordinates (quaternions,
+    !> chain angles) as well: slower, verifies the markers' Jacobians too.
+    integer, parameter, public :: constraint_derivatives_ad_full = 3
 
     ! marker_offsets reports a chain marker's body as -(chain_body_flag + chain).
     integer, parameter :: chain_body_flag = 1000
@@ -225,9 +233,12 @@ contains
                 self%derivatives = constraint_derivatives_analytic
             case ('ad')
                 self%derivatives = constraint_derivatives_ad
+            case ('ad_full')
+                self%derivatives = constraint_derivatives_ad_full
             case default
                 call status%set(status_bad_input, 'mbs system: constraint_derivatives = ''' &
-                                // constraint_derivatives // ''': use ''analytic'' or ''ad''')
+                                // constraint_derivatives // ''': use ''analytic'', ''ad'' or &
+                                &''ad_full''')
                 return
             end select
         end if
@@ -1368,12 +1379,24 @@ contains
                                     jxj(:, 1:nj), jaj(:, 1:nj, :), drv, ci(1:nr, 1:ni), &
                                     cj(1:nr, 1:nj))
                 call joint_rows(joint_part_time_derivative, jt%joint, mi, mj, drv, ct(1:nr))
+            else if (self%derivatives == constraint_derivatives_ad) then
+                ! the frames' tangents are the markers' Jacobian columns: AD of the
+                ! vector relations only
+                call marker_state(self, jt%marker_i, q, self%zero_v, mi)
+                call marker_state(self, jt%marker_j, q, self%zero_v, mj)
+                call marker_jacobian(self, jt%marker_i, q, position_space, jxi, jai, ni)
+                call marker_jacobian(self, jt%marker_j, q, position_space, jxj, jaj, nj)
+                call seeded_frame(mi, jxi(:, 1:ni), jai(:, 1:ni, :), 0, mid)
+                call seeded_frame(mj, jxj(:, 1:nj), jaj(:, 1:nj, :), ni, mjd)
             else
                 seed = merge(seed_position, seed_velocity_space, position_space)
                 call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed, 1, mid, pd, ni, &
                                        pose_only=.true.)
                 call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed, 1 + ni, mjd, &
                                        pd, nj, pose_only=.true.)
+            end if
+            if (self%derivatives /= constraint_derivatives_analytic) then
+                ! tangents: marker i's columns, marker j's, time
                 td = ni + nj + 1
                 call joint_value_d(jt%joint, mid, mjd, driver_dual(drv, td), cd(1:nr))
                 do r = 1, nr
@@ -1384,6 +1407,42 @@ contains
             end if
         end associate
     end subroutine joint_first_derivatives
+
+    !> The dual pose of a marker with frame m: tangent d of x is jx(:, d), of
+    !> axis k ja(:, d, k), in directions off + d (its motion is left unset).
+    pure subroutine seeded_frame(m, jx, ja, off, md)
+        type(marker_state_t), intent(in) :: m
+        real(wp), intent(in) :: jx(:, :), ja(:, :, :)
+        integer, intent(in) :: off
+        type(marker_state_d), intent(out) :: md
+        integer :: l, k, n
+        ! the pose only (the vector relations' values use nothing else)
+        n = size(jx, 2)
+        md%x = m%x
+        md%a = m%a
+        do l = 1, 3
+            md%x(l)%der(off + 1:off + n) = jx(l, :)
+            do k = 1, 3
+                md%a(l, k)%der(off + 1:off + n) = ja(l, :, k)
+            end do
+        end do
+    end subroutine seeded_frame
+
+    !> The jet pose of a marker along its motion at zero accelerations: x, ẋ
+    !> and the convective acceleration, for the origin and the axes.
+    pure subroutine moving_frame(m, mj)
+        type(marker_state_t), intent(in) :: m
+        type(marker_state_j), intent(out) :: mj
+        type(jet_t) :: x(3), a(3, 3)
+        integer :: l, k
+        do l = 1, 3
+            x(l) = jet_t(m%x(l), m%xd(l), m%gx(l))
+            do k = 1, 3
+                a(l, k) = jet_t(m%a(l, k), m%ad(l, k), m%ga(l, k))
+            end do
+        end do
+        call ground_marker_state_j(x, a, mj)
+    end subroutine moving_frame
 
     subroutine system_constraint(self, t, q, g, status)
         class(mbs_system_t), intent(inout) :: self
@@ -1488,6 +1547,8 @@ contains
         type(dual_t) :: pi(rigid_body_nq), pj(rigid_body_nq), jxi(3, rigid_body_nq), &
             jai(3, rigid_body_nq, 3), jxj(3, rigid_body_nq), jaj(3, rigid_body_nq, 3), &
             cid(max_rows, rigid_body_nq), cjd(max_rows, rigid_body_nq), ctd(max_rows), drvd(3), cv
+        type(marker_state_j) :: mij, mjj
+        type(jet_t) :: drvj(3), cjet(max_rows)
         real(wp) :: drv(3), tt(max_rows)
         integer :: k, r0, nr, ni, nj, r, bi, bj, iqi, iqj, ivi, ivj
         do k = 1, size(self%joints)
@@ -1502,6 +1563,18 @@ contains
                                     gamma(r0 + 1:r0 + nr))
                     call joint_rows(joint_part_time_terms, jt%joint, mi, mj, drv, tt(1:nr))
                     gamma(r0 + 1:r0 + nr) = gamma(r0 + 1:r0 + nr) + tt(1:nr)
+                else if (self%derivatives == constraint_derivatives_ad) then
+                    ! c(s) along the markers' motion and t + s: γ = c''(0)
+                    call marker_state(self, jt%marker_i, q, v, mi)
+                    call marker_state(self, jt%marker_j, q, v, mj)
+                    call moving_frame(mi, mij)
+                    call moving_frame(mj, mjj)
+                    ! s(t + σ) to second order (the values use s only)
+                    drvj(1) = jet_t(drv(1), drv(2), drv(3))
+                    drvj(2) = jet_t(drv(2), drv(3), 0.0_wp)
+                    drvj(3) = jet_t(drv(3), 0.0_wp, 0.0_wp)
+                    call joint_value_j(jt%joint, mij, mjj, drvj, cjet(1:nr))
+                    gamma(r0 + 1:r0 + nr) = cjet(1:nr)%f2
                 else
                     call marker_state_dual(self, jt%marker_i, q, v, seed_rate, 1, mid, pi, ni)
                     call marker_state_dual(self, jt%marker_j, q, v, seed_rate, 1, mjd, pj, nj)
