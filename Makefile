@@ -42,7 +42,7 @@ SYSLIBS      := -lsundials_fida_mod -lsundials_fnvecserial_mod \
                 -lsundials_generic \
                 -lklu -lcholmod -lamd -lcolamd -lbtf -lsuitesparseconfig \
                 -lhdf5_serial_fortran -lhdf5_serial -llapack -lblas
-MAIN_INPUT   := inputs/van_der_pol.nml
+MAIN_INPUT   := inputs/five_body.nml
 
 .PHONY: run test bench deps build build-debug install legacy-test clean help
 

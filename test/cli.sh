@@ -199,5 +199,12 @@ for s in radau5 ida mexax; do
     kept "face-hinge-$s" 0 "$s: NST=" out/run.h5 run "hinge_$s.nml" --quiet
 done
 
+# The five-body mechanism (inputs/five_body.nml), its first instants
+for s in radau5 mexax; do
+    sed -e "s/name = 'radau5'/name = '$s'/" -e "s/^&output/\&output file = 'out\/run.h5',/" \
+        -e "s/t_end   = 1.0 /t_end   = 0.02 /" "$root/inputs/five_body.nml" > "five_$s.nml"
+    kept "five-body-$s" 0 "$s: NST=" out/run.h5 run "five_$s.nml" --quiet
+done
+
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

@@ -31,7 +31,8 @@ contains
                  new_test('rigid_flexible_bad_scenes', test_rigid_flexible_bad), &
                  new_test('monitor_drift_energy', test_monitor), &
                  new_test('four_bar_chain_file', test_four_bar_chain), &
-                 new_test('face_hinge_file', test_face_hinge)]
+                 new_test('face_hinge_file', test_face_hinge), &
+                 new_test('five_body_file', test_five_body)]
     end function collect_multibody_scene
 
     !> inputs/four_bar.nml with each solver: the coupler end at t = 1
@@ -275,6 +276,46 @@ contains
             call check(error, -origin(2) > 0.01_wp, 'the bar did not bend')
         end do
     end subroutine test_face_hinge
+
+    !> inputs/five_body.nml over its first 0.1 s: RADAU5, DDASSL and IDA
+    !> reach the same state (1e-6), the constraints hold (GGL) and the rocker
+    !> has begun to fall (its quaternion's x component grows).
+    subroutine test_five_body(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=8), parameter :: solvers(3) = ['radau5', 'ddassl', 'ida   ']
+        type(scene_input_t) :: scene
+        type(run_result_t) :: result
+        type(status_t) :: status
+        real(wp), allocatable :: y_ref(:)
+        integer :: k, nq
+        ! q: rocker, slider, two node frames (4 x 7), chain (2), coupler (135)
+        nq = 4 * 7 + 2 + 135
+        do k = 1, size(solvers)
+            call read_scene('inputs/five_body.nml', scene, status)
+            call check(error, status%ok(), 'read: ' // status%text())
+            if (allocated(error)) return
+            scene%t_end = 0.1_wp
+            scene%output_file = ''
+            scene%progress = .false.
+            scene%solver_name = solvers(k)
+            call run_scene(scene, .true., result, status)
+            call check(error, status%ok(), trim(solvers(k)) // ': ' // status%text())
+            if (allocated(error)) return
+            call check(error, result%has_drift .and. result%drift_end(1) <= 1.0e-8_wp .and. &
+                       result%drift_end(2) <= 1.0e-6_wp, trim(solvers(k)) // ': drift')
+            if (k == 1) then
+                y_ref = result%y
+                print '(4x,a,i0,a,es9.2,a,f8.5)', 'five-body: ', size(result%y), &
+                    ' unknowns, RADAU5 drift ', result%drift_end(1), ', rocker e1 ', result%y(5)
+                call check(error, result%y(5) > 1.0e-3_wp, 'the rocker did not start to fall')
+            else
+                print '(4x,a,es9.2)', trim(solvers(k)) // ': positions off RADAU5 by ', &
+                    maxval(abs(result%y(1:nq) - y_ref(1:nq)))
+                call check(error, maxval(abs(result%y(1:nq) - y_ref(1:nq))) <= 1.0e-5_wp, &
+                           trim(solvers(k)) // ': positions differ from RADAU5')
+            end if
+        end do
+    end subroutine test_five_body
 
     !> Read the scene file, run it with `solver` (no output file).
     subroutine run_file(error, path, solver, scene, result)
