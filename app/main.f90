@@ -1,6 +1,8 @@
 !> The flexmbs command line.
 !>
-!>   flexmbs run FILE.nml [--quiet]   run a scene
+!>   flexmbs run FILE.nml [--quiet]          run a scene
+!>   flexmbs reference STUDY.nml [--quiet]   a study's reference solution
+!>   flexmbs sweep STUDY.nml [--quiet]       a study's grid of runs against it
 !>   flexmbs --help | --version
 !>
 !> Exit codes: 0 success, 2 bad input (nothing written), 3 solver failure
@@ -11,6 +13,9 @@ program flexmbs_main
         status_solver_failure, status_io_error, status_interrupted, reason_name, reason_none
     use flexmbs_io_namelist, only: scene_input_t, read_scene
     use flexmbs_io_scene, only: run_result_t, run_scene
+    use flexmbs_io_namelist, only: study_input_t, read_study
+    use flexmbs_io_study, only: make_reference, run_sweep, sweep_run_t
+    use flexmbs_io_table, only: table_text, table_markdown, stats_row_t
     implicit none
 
     character(len=*), parameter :: version = '0.1.0'
@@ -35,7 +40,7 @@ program flexmbs_main
     case ('--version', '-V')
         write (output_unit, '(a)') 'flexmbs ' // version
         call finish(exit_ok)
-    case ('run')
+    case ('run', 'reference', 'sweep')
         quiet = .false.
         file = ''
         do i = 2, nargs
@@ -48,14 +53,23 @@ program flexmbs_main
             else if (arg(1:min(1, len(arg))) == '-') then
                 call fail_usage('unknown option ''' // arg // '''')
             else if (len(file) > 0) then
-                call fail_usage('run takes one scene file, got ''' // file // ''' and ''' // &
-                                arg // '''')
+                call fail_usage(command // ' takes one file, got ''' // file // ''' and ''' &
+                                // arg // '''')
             else
                 file = arg
             end if
         end do
-        if (len(file) == 0) call fail_usage('run needs a scene file')
-        call run(file, quiet)
+        select case (command)
+        case ('run')
+            if (len(file) == 0) call fail_usage('run needs a scene file')
+            call run(file, quiet)
+        case ('reference')
+            if (len(file) == 0) call fail_usage('reference needs a study file')
+            call reference(file, quiet)
+        case ('sweep')
+            if (len(file) == 0) call fail_usage('sweep needs a study file')
+            call sweep(file, quiet)
+        end select
     case default
         call fail_usage('unknown command ''' // command // '''')
     end select
@@ -90,6 +104,49 @@ contains
             call stop_on(status)
         end select
     end subroutine run
+
+    !> The reference solution of a study, cross-checked.
+    subroutine reference(path, quiet)
+        character(len=*), intent(in) :: path
+        logical, intent(in) :: quiet
+        type(study_input_t) :: study
+        type(status_t) :: status
+        character(len=:), allocatable :: log
+        call read_study(path, study, status)
+        if (.not. status%ok()) call stop_on(status)
+        call make_reference(study, version, quiet, log, status)
+        if (.not. status%ok()) call stop_on(status)
+        write (output_unit, '(a)', advance='no') log
+        call finish(exit_ok)
+    end subroutine reference
+
+    !> A study's grid of runs against its reference: a line per run, then
+    !> the table (also written to the study's table file, if named).
+    subroutine sweep(path, quiet)
+        character(len=*), intent(in) :: path
+        logical, intent(in) :: quiet
+        type(study_input_t) :: study
+        type(status_t) :: status
+        type(sweep_run_t), allocatable :: runs(:)
+        type(stats_row_t), allocatable :: rows(:)
+        integer :: k
+        call read_study(path, study, status)
+        if (.not. status%ok()) call stop_on(status)
+        call run_sweep(study, quiet, runs, status)
+        if (allocated(runs)) then
+            do k = 1, size(runs)
+                write (output_unit, '(a)') runs(k)%summary
+            end do
+            rows = runs%row
+            write (output_unit, '(a)', advance='no') table_text(rows, table_markdown)
+            write (output_unit, '(i0,a,i0,a)') count(runs%ok), ' runs finished, ', &
+                count(.not. runs%ok), ' failed'
+            if (len(study%table) > 0 .and. status%ok()) &
+                write (output_unit, '(a)') 'table: ' // study%table
+        end if
+        if (.not. status%ok()) call stop_on(status)
+        call finish(exit_ok)
+    end subroutine sweep
 
     !> Statistics line and final state on standard output.
     subroutine report(result, scene)
@@ -154,15 +211,20 @@ contains
             ' - flexible multibody dynamics and stiff DAE solvers', &
             '', &
             'usage:', &
-            '  flexmbs run FILE.nml [--quiet]   run the scene described by FILE.nml', &
-            '  flexmbs --help                   show this text', &
-            '  flexmbs --version                show the version', &
+            '  flexmbs run FILE.nml [--quiet]          run the scene described by FILE.nml', &
+            '  flexmbs reference STUDY.nml [--quiet]   integrate the study''s scene at tight', &
+            '                                          tolerance, cross-check, keep in HDF5', &
+            '  flexmbs sweep STUDY.nml [--quiet]       run the study''s grid of solvers and', &
+            '                                          tolerances, ERR against the reference', &
+            '  flexmbs --help                          show this text', &
+            '  flexmbs --version                       show the version', &
             '', &
             'FILE.nml holds the namelist groups &simulation, &solver and &output,', &
             'and for a flexible body &flexible_body with one or more &material;', &
             'for rigid bodies and joints &multibody, &rigid_body, &marker, &joint, &driver;', &
             'for a chain in relative coordinates &rigid_chain', &
             '(see README.md for every variable, its type, unit and default).', &
+            'STUDY.nml holds one &study group naming a scene file and the grid.', &
             '--quiet turns the progress display on standard error off.', &
             '', &
             'exit codes: 0 success, 2 bad input (no output written),', &

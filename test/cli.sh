@@ -206,5 +206,18 @@ for s in radau5 mexax; do
     kept "five-body-$s" 0 "$s: NST=" out/run.h5 run "five_$s.nml" --quiet
 done
 
+# Studies: a reference with its cross-check, a sweep against it, bad input
+sed -e "s#scene               = '../four_bar.nml'#scene = '$root/inputs/four_bar.nml'#" \
+    -e "s/solvers             = 'radau5', 'ddassl', 'ida', 'mexax'/solvers = 'radau5', 'mexax'/" \
+    "$root/inputs/paper/four_bar_study.nml" > study.nml
+expect study-reference 0 "written: study_reference.h5" reference study.nml --quiet
+expect study-sweep 0 "6 runs finished, 0 failed" sweep study.nml --quiet
+printf "&study scene = 'x.nml', solvers = 'rk4' /\n" > bad_study.nml
+expect study-bad 2 "bad_study.nml: &study: solvers: 'rk4': must be one of" sweep bad_study.nml
+printf "&study scene = '%s/inputs/four_bar.nml', reference_file = 'none.h5' /\n" "$root" \
+    > no_reference.nml
+expect study-no-reference 2 "no reference file (make it with 'flexmbs reference' first)" \
+    sweep no_reference.nml --quiet
+
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

@@ -36,6 +36,7 @@ program flexmbs_tests
     use test_multibody_scene, only: collect_multibody_scene
     use test_flexible_coupling, only: collect_flexible_coupling
     use test_node_frame, only: collect_node_frame
+    use test_study, only: collect_study
     use test_chain_coupling, only: collect_chain_coupling
     implicit none
     integer :: npassed, nfailed, nargs
@@ -83,6 +84,7 @@ program flexmbs_tests
                    nfailed)
     call run_suite('chain_coupling', collect_chain_coupling(), filter, npassed, nfailed)
     call run_suite('node_frame', collect_node_frame(), filter, npassed, nfailed)
+    call run_suite('study', collect_study(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests

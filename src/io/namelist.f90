@@ -22,6 +22,8 @@ module flexmbs_io_namelist
 
     integer, parameter :: kind_string = 1, kind_real = 2, kind_integer = 3, kind_logical = 4
     integer, parameter :: len_title = 256, len_name = 32, len_path = 512
+    !> Longest lists of a study (`&study`).
+    integer, parameter, public :: max_study_solvers = 4, max_study_tolerances = 16
 
     !> At most this many node-set names in `&flexible_body fixed`.
     integer, parameter, public :: max_fixed_sets = 6
@@ -34,6 +36,8 @@ module flexmbs_io_namelist
         !> values: 1 for a scalar; an array of reals or integers takes
         !> exactly `count`, an array of strings 1..count
         integer :: count = 1
+        !> a list: 1..count values of any kind
+        logical :: list = .false.
     end type var_spec_t
 
     type(var_spec_t), parameter :: schema(*) = [ &
@@ -146,11 +150,23 @@ module flexmbs_io_namelist
         var_spec_t('rigid_chain', 'rate', kind_real), &
         var_spec_t('rigid_chain', 'rotation_axis', kind_real, 3), &
         var_spec_t('rigid_chain', 'rotation_angle', kind_real), &
-        var_spec_t('rigid_chain', 'angular_rate', kind_real, 3)]
+        var_spec_t('rigid_chain', 'angular_rate', kind_real, 3), &
+        var_spec_t('study', 'scene', kind_string), &
+        var_spec_t('study', 'reference_file', kind_string), &
+        var_spec_t('study', 'reference_solver', kind_string), &
+        var_spec_t('study', 'reference_tolerance', kind_real), &
+        var_spec_t('study', 'check_solver', kind_string), &
+        var_spec_t('study', 'solvers', kind_string, max_study_solvers), &
+        var_spec_t('study', 'stabilisations', kind_string, 3), &
+        var_spec_t('study', 'tolerances', kind_real, max_study_tolerances, .true.), &
+        var_spec_t('study', 'pmax', kind_integer, 5, .true.), &
+        var_spec_t('study', 'derivatives', kind_string, 3), &
+        var_spec_t('study', 'table', kind_string), &
+        var_spec_t('study', 'cpu_reference', kind_integer)]
 
     character(len=16), parameter :: group_names(*) = [character(len=16) :: &
         'simulation', 'solver', 'output', 'flexible_body', 'material', 'multibody', &
-        'rigid_body', 'marker', 'joint', 'driver', 'rigid_chain']
+        'rigid_body', 'marker', 'joint', 'driver', 'rigid_chain', 'study']
     !> The groups that may be given several times (one item each).
     character(len=16), parameter :: repeatable_groups(*) = [character(len=16) :: &
         'material', 'rigid_body', 'marker', 'joint', 'driver', 'rigid_chain']
@@ -241,6 +257,24 @@ module flexmbs_io_namelist
     end type joint_input_t
 
     !> One `&driver`: an angle, translation or distance following s(t).
+    !> A study file (`flexmbs reference`, `flexmbs sweep`): one `&study`
+    !> naming a scene and the grid of runs over it.
+    type, public :: study_input_t
+        character(len=:), allocatable :: path            !! the study file
+        character(len=:), allocatable :: scene           !! scene file, resolved
+        character(len=:), allocatable :: reference_file  !! HDF5 reference, resolved
+        character(len=len_name) :: reference_solver = 'radau5'
+        real(wp) :: reference_tolerance = 1.0e-10_wp
+        character(len=len_name) :: check_solver = 'ddassl' !! '' or 'none': no check
+        character(len=len_name), allocatable :: solvers(:)
+        character(len=len_name), allocatable :: stabilisations(:)
+        real(wp), allocatable :: tolerances(:)
+        integer, allocatable :: pmax(:)
+        character(len=len_name), allocatable :: derivatives(:)
+        character(len=:), allocatable :: table            !! '' = no file, resolved
+        integer :: cpu_reference = 1  !! the row whose CPU is 1 in the table
+    end type study_input_t
+
     type, public :: driver_input_t
         character(len=len_name) :: name = ''
         character(len=len_name) :: type = ''        !! 'angle' | 'translation' | 'distance'
@@ -365,7 +399,8 @@ module flexmbs_io_namelist
         integer :: line = 0      !! line of '&name'
     end type span_t
 
-    public :: read_scene, parse_scene, scene_dae_options, controller_code
+    public :: read_scene, parse_scene, scene_dae_options, controller_code, read_study, &
+        parse_study
 
 contains
 
@@ -399,6 +434,12 @@ contains
         if (.not. status%ok()) return
         call check_types(entries, path, status)
         if (.not. status%ok()) return
+        if (any(spans%group == find_group('study'))) then
+            call status%set(status_bad_input, path // ': &study: belongs in a study file ' // &
+                '(flexmbs reference, flexmbs sweep), not in a scene' // &
+                at(spans(findloc(spans%group, find_group('study'), dim=1))%line))
+            return
+        end if
         allocate (scene%materials(count(spans%group == find_group('material'))), &
                   scene%rigid_bodies(count(spans%group == find_group('rigid_body'))), &
                   scene%markers(count(spans%group == find_group('marker'))), &
@@ -458,6 +499,179 @@ contains
         if (.not. status%ok()) return
         call resolve_output(scene, entries, path, status)
     end subroutine parse_scene
+
+    !> Read a study file (see study_input_t).
+    subroutine read_study(path, study, status)
+        character(len=*), intent(in) :: path
+        type(study_input_t), intent(out) :: study
+        type(status_t), intent(out) :: status
+        character(len=:), allocatable :: text
+        call read_text_file(path, text, status)
+        if (.not. status%ok()) return
+        call parse_study(text, path, study, status)
+    end subroutine read_study
+
+    !> Validate and read a study's text: exactly one `&study` group; paths
+    !> in it are relative to the study file's folder.
+    subroutine parse_study(text, path, input, status)
+        character(len=*), intent(in) :: text, path
+        type(study_input_t), intent(out) :: input
+        type(status_t), intent(out) :: status
+        character(len=8), parameter :: solver_choices(4) = [character(len=8) :: 'radau5', &
+            'ddassl', 'ida', 'mexax']
+        character(len=10), parameter :: stab_choices(3) = [character(len=10) :: 'none', &
+            'ggl', 'projection']
+        character(len=8), parameter :: derivative_choices(3) = [character(len=8) :: &
+            'analytic', 'ad', 'ad_full']
+        type(entry_t), allocatable :: entries(:)
+        type(span_t), allocatable :: spans(:)
+        character(len=:), allocatable :: clean, lines(:), dir, where
+        character(len=len_path) :: scene, reference_file, table
+        character(len=len_name) :: reference_solver, check_solver, &
+            solvers(max_study_solvers), stabilisations(3), derivatives(3)
+        real(wp) :: reference_tolerance, tolerances(max_study_tolerances)
+        integer :: pmax(5), cpu_reference, ios, i
+        character(len=256) :: msg
+        namelist /study/ scene, reference_file, reference_solver, reference_tolerance, &
+            check_solver, solvers, stabilisations, tolerances, pmax, derivatives, table, &
+            cpu_reference
+
+        input%path = path
+        call tokenise(text, path, entries, spans, clean, status)
+        if (.not. status%ok()) return
+        call check_types(entries, path, status)
+        if (.not. status%ok()) return
+        do i = 1, size(spans)
+            if (group_names(spans(i)%group) /= 'study') then
+                call status%set(status_bad_input, path // ': &' // &
+                    trim(group_names(spans(i)%group)) // ': a study file holds only &study &
+                    &(its scene = names the scene file)' // at(spans(i)%line))
+                return
+            end if
+        end do
+        if (size(spans) /= 1) then
+            call status%set(status_bad_input, path // ': needs one &study group')
+            return
+        end if
+        where = path // ': &study: '
+        scene = ''
+        reference_file = ''
+        table = ''
+        reference_solver = input%reference_solver
+        reference_tolerance = input%reference_tolerance
+        check_solver = input%check_solver
+        solvers = ''
+        stabilisations = ''
+        derivatives = ''
+        tolerances = -1.0_wp
+        pmax = 0
+        cpu_reference = input%cpu_reference
+        lines = split_lines(clean(spans(1)%first:spans(1)%last))
+        msg = ''
+        read (lines, nml=study, iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+            call status%set(status_bad_input, path // ': &study: ' // trim(msg))
+            return
+        end if
+        input%reference_solver = reference_solver
+        input%reference_tolerance = reference_tolerance
+        input%check_solver = check_solver
+        if (input%check_solver == 'none') input%check_solver = ''
+        input%cpu_reference = cpu_reference
+        input%solvers = pack(solvers, solvers /= '')
+        if (size(input%solvers) == 0) input%solvers = [character(len=len_name) :: 'radau5', &
+            'ddassl', 'ida', 'mexax']
+        input%stabilisations = pack(stabilisations, stabilisations /= '')
+        if (size(input%stabilisations) == 0) input%stabilisations = &
+            [character(len=len_name) :: 'none', 'ggl']
+        input%derivatives = pack(derivatives, derivatives /= '')
+        if (size(input%derivatives) == 0) input%derivatives = [character(len=len_name) :: &
+            'analytic']
+        input%tolerances = pack(tolerances, tolerances /= -1.0_wp)
+        if (size(input%tolerances) == 0) input%tolerances = [1.0e-6_wp]
+        input%pmax = pack(pmax, pmax /= 0)
+        if (size(input%pmax) == 0) input%pmax = [5]
+
+        if (len_trim(scene) == 0) then
+            call status%set(status_bad_input, where // 'scene: required (the scene file)')
+        else if (.not. any(solver_choices == input%reference_solver)) then
+            call status%set(status_bad_input, where // 'reference_solver = ''' // &
+                trim(input%reference_solver) // ''': must be one of ' // choices(solver_choices))
+        else if (len_trim(input%check_solver) > 0 .and. &
+                 .not. any(solver_choices == input%check_solver)) then
+            call status%set(status_bad_input, where // 'check_solver = ''' // &
+                trim(input%check_solver) // ''': must be one of ' // &
+                choices(solver_choices) // ', or ''none''')
+        else if (.not. (input%reference_tolerance > 0.0_wp .and. &
+                        input%reference_tolerance < 1.0_wp)) then
+            call status%set(status_bad_input, where // 'reference_tolerance: must lie in (0, 1)')
+        else if (input%cpu_reference < 1) then
+            call status%set(status_bad_input, where // 'cpu_reference: must be a row, >= 1')
+        end if
+        if (.not. status%ok()) return
+        do i = 1, size(input%solvers)
+            if (.not. any(solver_choices == input%solvers(i))) then
+                call status%set(status_bad_input, where // 'solvers: ''' // &
+                    trim(input%solvers(i)) // ''': must be one of ' // choices(solver_choices))
+                return
+            end if
+        end do
+        do i = 1, size(input%stabilisations)
+            if (.not. any(stab_choices == input%stabilisations(i))) then
+                call status%set(status_bad_input, where // 'stabilisations: ''' // &
+                    trim(input%stabilisations(i)) // ''': must be one of ' // &
+                    choices(stab_choices))
+                return
+            end if
+        end do
+        do i = 1, size(input%derivatives)
+            if (.not. any(derivative_choices == input%derivatives(i))) then
+                call status%set(status_bad_input, where // 'derivatives: ''' // &
+                    trim(input%derivatives(i)) // ''': must be one of ' // &
+                    choices(derivative_choices))
+                return
+            end if
+        end do
+        if (any(.not. (input%tolerances > 0.0_wp .and. input%tolerances < 1.0_wp))) then
+            call status%set(status_bad_input, where // 'tolerances: each must lie in (0, 1)')
+            return
+        end if
+        if (any(input%pmax < 1 .or. input%pmax > 5)) then
+            call status%set(status_bad_input, where // 'pmax: each must be 1 .. 5')
+            return
+        end if
+        ! paths relative to the study's folder
+        dir = ''
+        if (index(path, '/', back=.true.) > 0) dir = path(1:index(path, '/', back=.true.))
+        input%scene = relative(trim(scene))
+        if (len_trim(reference_file) > 0) then
+            input%reference_file = relative(trim(reference_file))
+        else
+            i = index(path, '.', back=.true.)
+            if (i <= index(path, '/', back=.true.)) i = len(path) + 1
+            input%reference_file = path(1:i - 1) // '_reference.h5'
+        end if
+        input%table = ''
+        if (len_trim(table) > 0) then
+            input%table = relative(trim(table))
+            i = index(input%table, '.', back=.true.)
+            if (i == 0) i = len(input%table)
+            if (all([character(len=4) :: 'md', 'csv', 'tex'] /= input%table(i + 1:))) then
+                call status%set(status_bad_input, where // 'table = ''' // trim(table) // &
+                    ''': the name must end in .md, .csv or .tex (the format)')
+                return
+            end if
+        end if
+
+    contains
+
+        function relative(name) result(full)
+            character(len=*), intent(in) :: name
+            character(len=:), allocatable :: full
+            full = name
+            if (name(1:1) /= '/') full = dir // name
+        end function relative
+    end subroutine parse_study
 
     ! ------------------------------------------------------------------
     ! Tokenising: find groups, names and raw values, with line numbers.
@@ -603,7 +817,7 @@ contains
                             name // ' = ' // value // ': unterminated string' // at(vline))
                         return
                     end if
-                    if (schema(spec)%kind /= kind_string .and. &
+                    if (schema(spec)%kind /= kind_string .and. .not. schema(spec)%list .and. &
                         size(items) /= schema(spec)%count) then
                         call status%set(status_bad_input, path // ': &' // group // ': ' // &
                             name // ' = ' // value // ': needs ' // itoa(schema(spec)%count) &

@@ -11,6 +11,7 @@ module flexmbs_io_scene
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_solver, only: dae_solver_t
+    use flexmbs_dae_sink, only: sink_t
     use flexmbs_dae_radau5, only: radau5_t
     use flexmbs_dae_ida, only: ida_t
     use flexmbs_dae_ddassl, only: ddassl_t
@@ -63,6 +64,8 @@ module flexmbs_io_scene
         logical :: has_drift = .false.
         real(wp) :: drift_end(2) = 0.0_wp
         integer :: constraints = 0
+        !> the positions in y (block 'q'), all of y when there is none
+        integer :: q_first = 0, q_last = 0
     end type run_result_t
 
     public :: build_problem, build_solver, scene_stab, run_scene
@@ -319,11 +322,13 @@ contains
     !> store the statistics. `status` is ok, bad_input (before any file is
     !> created), solver_failure (outputs kept, `result` says how far it
     !> got) or io_error.
-    subroutine run_scene(scene, quiet, result, status)
+    subroutine run_scene(scene, quiet, result, status, record)
         type(scene_input_t), intent(in) :: scene
         logical, intent(in) :: quiet             !! no progress display
         type(run_result_t), intent(out) :: result
         type(status_t), intent(out) :: status
+        !> also given the solution at every output time
+        class(sink_t), intent(inout), target, optional :: record
         class(dae_problem_t), allocatable, target :: problem
         type(monitor_sink_t), target :: monitor
         class(mechanical_problem_t), allocatable, target :: mechanical
@@ -341,6 +346,13 @@ contains
 
         call build_problem(scene, problem, result%y, blocks, status, mechanical)
         if (.not. status%ok()) return
+        result%q_first = 1
+        result%q_last = size(result%y)
+        do i = 1, size(blocks)
+            if (blocks(i)%name /= 'q') cycle
+            result%q_first = blocks(i)%first
+            result%q_last = blocks(i)%last
+        end do
         call build_solver(scene, solver, status)
         if (.not. status%ok()) return
         result%solver_name = solver%name()
@@ -387,6 +399,7 @@ contains
             call progress%watch(solver%native%nstep, solver%native%naccpt)
         end select
         call sinks%attach(progress)
+        if (present(record)) call sinks%attach(record)
         ! drift and energy of formulated mechanical scenes, at the output times
         select type (p => problem)
         type is (formulation_t)

@@ -33,6 +33,8 @@ module flexmbs_io_table
         real(wp) :: tol = 0.0_wp                !! the tolerance asked for
         real(wp) :: err = -1.0_wp               !! ERR of eq. (13); negative = not measured
         type(dae_stats_t) :: stats
+        !> > 0: the CPU column shows stats%cpu / cpu_unit (normalised)
+        real(wp) :: cpu_unit = 0.0_wp
     end type stats_row_t
 
     public :: new_stats_row, table_format, table_text, write_table
@@ -195,7 +197,11 @@ contains
         cells(6)%s = itoa(row%stats%nac)
         cells(7)%s = itoa(row%stats%nfe)
         cells(8)%s = itoa(row%stats%nje)
-        write (buf, '(f0.3)') row%stats%cpu
+        if (row%cpu_unit > 0.0_wp) then
+            write (buf, '(f0.2)') row%stats%cpu / row%cpu_unit
+        else
+            write (buf, '(f0.3)') row%stats%cpu
+        end if
         if (buf(1:1) == '.') buf = '0' // trim(buf)
         cells(9)%s = trim(buf)
         cells(10)%s = itoa(row%stats%nrj)

@@ -1,0 +1,311 @@
+!> Studies over a scene (`flexmbs reference`, `flexmbs sweep`).
+!>
+!> A reference is the scene integrated by `reference_solver` at rtol = atol
+!> = `reference_tolerance`, kept at the scene's output times in an HDF5
+!> trajectory file (/time, /y, /q) with its provenance: the study and scene
+!> files, the solver and tolerance, the cross-check (a second solver at the
+!> same tolerance and the ERR between the two), the flexmbs version and the
+!> date (text datasets).
+!>
+!> A sweep runs the grid solvers × stabilisations × tolerances × p_max
+!> (DDASSL only) × derivative sources (multibody scenes only), each at
+!> rtol = atol = TOL, and measures ERR of eq. (13) against the reference over
+!> the positions (block q; all of y for problems without one) at every
+!> output time. Stabilisations of multibody scenes: 'none' is the index-2
+!> formulation, 'ggl' GGL (eq. 10), 'projection' index 2 with coordinate
+!> projection (eqs. 11-12); MEXAX always projects internally and runs once
+!> per tolerance ('projection'). A run that fails is a row with ERR '-' and
+!> the reason on its summary line. CPU in the table is normalised to the
+!> row `cpu_reference` (the paper's Tables 2 and 3 normalise to one run).
+module flexmbs_io_study
+    use hdf5
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_bad_input, status_io_error, &
+        status_solver_failure
+    use flexmbs_core_text, only: int_text, real_text
+    use flexmbs_dae_error_measure, only: paper_error
+    use flexmbs_io_namelist, only: study_input_t, scene_input_t, read_scene
+    use flexmbs_io_scene, only: run_result_t, run_scene
+    use flexmbs_io_record_sink, only: record_sink_t
+    use flexmbs_io_hdf5_sink, only: hdf5_sink_t
+    use flexmbs_io_table, only: stats_row_t, new_stats_row, write_table
+    implicit none
+    private
+
+    !> One run of a sweep: its table row and a line for the log.
+    type, public :: sweep_run_t
+        type(stats_row_t) :: row
+        logical :: ok = .false.
+        character(len=:), allocatable :: summary
+    end type sweep_run_t
+
+    public :: make_reference, run_sweep, read_reference
+
+contains
+
+    !> The scene of a study with one run's settings: solver, rtol = atol =
+    !> tol, and (multibody) the formulation and projection of `stab`, the
+    !> derivative source; no HDF5 file, no table.
+    subroutine configure(base, solver, tol, stab, pmax, derivatives, scene)
+        type(scene_input_t), intent(in) :: base
+        character(len=*), intent(in) :: solver, stab, derivatives
+        real(wp), intent(in) :: tol
+        integer, intent(in) :: pmax
+        type(scene_input_t), intent(out) :: scene
+        scene = base
+        scene%solver_name = solver
+        scene%rtol = tol
+        scene%atol = tol
+        scene%pmax = pmax
+        scene%output_file = ''
+        scene%table = ''
+        if (scene%problem /= 'multibody') return
+        select case (stab)
+        case ('none')
+            scene%multibody%formulation = 'index2'
+            scene%multibody%projection = .false.
+        case ('ggl')
+            scene%multibody%formulation = 'ggl'
+            scene%multibody%projection = .false.
+        case ('projection')
+            scene%multibody%formulation = 'index2'
+            scene%multibody%projection = .true.
+        end select
+        if (len_trim(derivatives) > 0) scene%multibody%constraint_derivatives = derivatives
+    end subroutine configure
+
+    !> The reference of a study (module header); `log` gets one line per
+    !> run. Nothing is written unless both runs succeed.
+    subroutine make_reference(study, version, quiet, log, status)
+        type(study_input_t), intent(in) :: study
+        character(len=*), intent(in) :: version   !! flexmbs version, for the provenance
+        logical, intent(in) :: quiet
+        character(len=:), allocatable, intent(out) :: log
+        type(status_t), intent(out) :: status
+        type(scene_input_t) :: base, scene
+        type(run_result_t) :: ref, chk
+        type(record_sink_t) :: rec, rec_check
+        type(hdf5_sink_t) :: h5
+        type(status_t) :: close_status
+        character(len=:), allocatable :: check_text
+        character(len=8) :: date
+        character(len=10) :: time
+        real(wp) :: err
+        integer :: k
+        character, parameter :: nl = new_line('a')
+
+        call read_scene(study%scene, base, status)
+        if (.not. status%ok()) return
+        call configure(base, trim(study%reference_solver), study%reference_tolerance, '', &
+                       base%pmax, '', scene)
+        call run_scene(scene, quiet, ref, status, rec)
+        if (.not. status%ok()) then
+            call status%set(status%code, study%path // ': reference run (' // &
+                trim(study%reference_solver) // ') failed: ' // status%text(), status%reason)
+            return
+        end if
+        log = 'reference: ' // ref%solver_name // ' at ' // real_text(study%reference_tolerance) &
+            // ': ' // ref%stats%summary() // nl
+        check_text = 'none'
+        if (len_trim(study%check_solver) > 0) then
+            call configure(base, trim(study%check_solver), study%reference_tolerance, '', &
+                           base%pmax, '', scene)
+            call run_scene(scene, quiet, chk, status, rec_check)
+            if (.not. status%ok()) then
+                call status%set(status%code, study%path // ': check run (' // &
+                    trim(study%check_solver) // ') failed: ' // status%text(), status%reason)
+                return
+            end if
+            if (rec_check%records /= rec%records) then
+                call status%set(status_solver_failure, study%path // ': the check run has ' &
+                    // int_text(rec_check%records) // ' output records, the reference ' // &
+                    int_text(rec%records))
+                return
+            end if
+            err = series_error(rec_check%y(ref%q_first:ref%q_last, 1:rec%records), &
+                               rec%y(ref%q_first:ref%q_last, 1:rec%records), &
+                               study%reference_tolerance)
+            check_text = trim(study%check_solver) // ' at the same tolerance: ERR = ' // &
+                real_text(err) // ' (' // real_text(err / study%reference_tolerance) // ' TOL)'
+            log = log // 'check: ' // chk%solver_name // ': ' // chk%stats%summary() // nl // &
+                'check: ERR of ' // check_text // nl
+        end if
+
+        call h5%create(study%reference_file, size(rec%y, 1), status, input_text=base%text)
+        if (status%ok()) call h5%add_block('q', ref%q_first, ref%q_last, status)
+        do k = 1, rec%records
+            if (.not. status%ok()) exit
+            call h5%output(rec%t(k), rec%y(:, k), status)
+        end do
+        call date_and_time(date, time)
+        if (status%ok()) call h5%write_text('study_file', study%path, status)
+        if (status%ok()) call h5%write_text('scene_file', study%scene, status)
+        if (status%ok()) call h5%write_text('reference_solver', ref%solver_name, status)
+        if (status%ok()) call h5%write_text('reference_tolerance', &
+                                            real_text(study%reference_tolerance), status)
+        if (status%ok()) call h5%write_text('check', check_text, status)
+        if (status%ok()) call h5%write_text('flexmbs_version', version, status)
+        if (status%ok()) call h5%write_text('created', date(1:4) // '-' // date(5:6) // '-' // &
+            date(7:8) // ' ' // time(1:2) // ':' // time(3:4) // ':' // time(5:6), status)
+        if (status%ok()) call h5%write_statistics(ref%stats, status, ref%solver_name, 'ok')
+        call h5%close(close_status)
+        if (status%ok()) status = close_status
+        if (.not. status%ok()) then
+            call status%set(status_io_error, study%reference_file // ': ' // status%text())
+            return
+        end if
+        log = log // 'written: ' // study%reference_file // ' (' // int_text(rec%records) // &
+            ' output times)' // nl
+    end subroutine make_reference
+
+    !> /time and /y of a trajectory file.
+    subroutine read_reference(path, t, y, status)
+        character(len=*), intent(in) :: path
+        real(wp), allocatable, intent(out) :: t(:), y(:, :)
+        type(status_t), intent(out) :: status
+        integer(hid_t) :: file, dset, space
+        integer(hsize_t) :: dims(2), maxdims(2)
+        integer :: err
+        logical :: exists
+        inquire (file=path, exist=exists)
+        if (.not. exists) then
+            call status%set(status_bad_input, path // ': no reference file (make it with ' // &
+                '''flexmbs reference'' first)')
+            return
+        end if
+        call h5open_f(err)
+        call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
+        if (err < 0) then
+            call status%set(status_io_error, path // ': not an HDF5 file')
+            return
+        end if
+        call h5dopen_f(file, 'time', dset, err)
+        if (err >= 0) then
+            call h5dget_space_f(dset, space, err)
+            call h5sget_simple_extent_dims_f(space, dims(1:1), maxdims(1:1), err)
+            allocate (t(dims(1)))
+            call h5dread_f(dset, H5T_NATIVE_DOUBLE, t, dims(1:1), err)
+            call h5sclose_f(space, err)
+            call h5dclose_f(dset, err)
+        end if
+        if (err >= 0) call h5dopen_f(file, 'y', dset, err)
+        if (err >= 0) then
+            call h5dget_space_f(dset, space, err)
+            call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
+            allocate (y(dims(1), dims(2)))
+            call h5dread_f(dset, H5T_NATIVE_DOUBLE, y, dims, err)
+            call h5sclose_f(space, err)
+            call h5dclose_f(dset, err)
+        end if
+        if (err < 0) call status%set(status_io_error, path // ': cannot read /time and /y')
+        call h5fclose_f(file, err)
+    end subroutine read_reference
+
+    !> Every run of the study's grid against its reference (module header).
+    subroutine run_sweep(study, quiet, runs, status)
+        type(study_input_t), intent(in) :: study
+        logical, intent(in) :: quiet
+        type(sweep_run_t), allocatable, intent(out) :: runs(:)
+        type(status_t), intent(out) :: status
+        type(scene_input_t) :: base
+        real(wp), allocatable :: t_ref(:), y_ref(:, :)
+        character(len=32), allocatable :: stabs(:), sources(:)
+        character(len=:), allocatable :: solver
+        integer :: is, ib, it, ip, id, np
+        logical :: multibody
+
+        call read_scene(study%scene, base, status)
+        if (.not. status%ok()) return
+        call read_reference(study%reference_file, t_ref, y_ref, status)
+        if (.not. status%ok()) return
+        multibody = base%problem == 'multibody'
+        stabs = [character(len=32) :: '-']
+        sources = [character(len=32) :: '']
+        if (multibody) then
+            stabs = [character(len=32) :: study%stabilisations]
+            sources = [character(len=32) :: study%derivatives]
+        end if
+        allocate (runs(0))
+        do is = 1, size(study%solvers)
+            solver = trim(study%solvers(is))
+            block
+                do ib = 1, size(stabs)
+                    ! MEXAX projects internally: once per tolerance
+                    if (solver == 'mexax' .and. ib > 1) exit
+                    do it = 1, size(study%tolerances)
+                        np = merge(size(study%pmax), 1, solver == 'ddassl')
+                        do ip = 1, np
+                            do id = 1, size(sources)
+                                call one_run(solver, trim(stabs(ib)), study%tolerances(it), &
+                                             study%pmax(ip), trim(sources(id)))
+                            end do
+                        end do
+                    end do
+                end do
+            end block
+        end do
+        if (study%cpu_reference <= size(runs)) then
+            if (runs(study%cpu_reference)%ok) runs%row%cpu_unit = &
+                runs(study%cpu_reference)%row%stats%cpu
+        end if
+        if (len(study%table) > 0) call write_table(study%table, runs%row, status)
+
+    contains
+
+        subroutine one_run(solver, stab, tol, pmax, source)
+            character(len=*), intent(in) :: solver, stab, source
+            real(wp), intent(in) :: tol
+            integer, intent(in) :: pmax
+            type(scene_input_t) :: scene
+            type(run_result_t) :: result
+            type(record_sink_t) :: rec
+            type(status_t) :: run_status
+            type(sweep_run_t) :: run
+            character(len=:), allocatable :: label, stab_label
+            real(wp) :: err
+            label = solver
+            if (solver == 'ddassl') label = label // ' p_max=' // int_text(pmax)
+            if (len(source) > 0 .and. source /= 'analytic') label = label // ' (' // source // ')'
+            stab_label = stab
+            if (solver == 'mexax' .and. multibody) stab_label = 'projection'
+            call configure(base, solver, tol, stab, pmax, source, scene)
+            call run_scene(scene, quiet, result, run_status, rec)
+            run%ok = run_status%ok()
+            err = -1.0_wp
+            if (run%ok) then
+                if (rec%records /= size(t_ref) .or. &
+                    size(y_ref, 1) < result%q_last) then
+                    run%ok = .false.
+                    call run_status%set(status_bad_input, 'output times or size differ from &
+                        &the reference (was it made from this scene?)')
+                else if (maxval(abs(rec%t(1:rec%records) - t_ref)) > &
+                         1.0e-12_wp * max(1.0_wp, maxval(abs(t_ref)))) then
+                    run%ok = .false.
+                    call run_status%set(status_bad_input, 'output times differ from the &
+                        &reference')
+                else
+                    err = series_error(rec%y(result%q_first:result%q_last, 1:rec%records), &
+                                       y_ref(result%q_first:result%q_last, :), tol)
+                end if
+            end if
+            run%row = new_stats_row(label, tol, stab_label, result%stats)
+            run%row%err = err
+            if (run%ok) then
+                run%summary = label // ' ' // stab_label // ' TOL ' // real_text(tol) // &
+                    ': ERR ' // real_text(err) // ' = ' // real_text(err / tol) // ' TOL, ' // &
+                    result%stats%summary()
+            else
+                run%summary = label // ' ' // stab_label // ' TOL ' // real_text(tol) // &
+                    ': failed at t = ' // real_text(result%stats%t_reached) // ': ' // &
+                    run_status%text() // '; ' // result%stats%summary()
+            end if
+            runs = [runs, run]
+        end subroutine one_run
+    end subroutine run_sweep
+
+    !> ERR of eq. (13) over all components and output times, rtol = atol = tol.
+    pure real(wp) function series_error(y, y_ref, tol) result(err)
+        real(wp), intent(in) :: y(:, :), y_ref(:, :), tol
+        err = paper_error(reshape(y, [size(y)]), reshape(y_ref, [size(y_ref)]), tol, tol)
+    end function series_error
+end module flexmbs_io_study
