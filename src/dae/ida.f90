@@ -30,7 +30,7 @@ module flexmbs_dae_ida
         FIDAGetConsistentIC, FIDASolve, FIDAGetDky, FIDAGetNumSteps, FIDAGetNumResEvals, &
         FIDAGetNumLinResEvals, FIDAGetNumJacEvals, FIDAGetNumLinSolvSetups, &
         FIDAGetNumNonlinSolvIters, FIDAGetNumErrTestFails, FIDAGetNumNonlinSolvConvFails, &
-        FIDAGetLastStep, FIDAGetLastOrder, IDA_NORMAL, IDA_ONE_STEP, IDA_YA_YDP_INIT, &
+        FIDAGetLastStep, FIDAGetLastOrder, FIDAGetCurrentStep, IDA_NORMAL, IDA_ONE_STEP, IDA_YA_YDP_INIT, &
         IDA_TSTOP_RETURN, IDA_TOO_MUCH_WORK, IDA_TOO_MUCH_ACC, IDA_ERR_FAIL, IDA_CONV_FAIL, &
         IDA_LINIT_FAIL, IDA_LSETUP_FAIL, IDA_LSOLVE_FAIL, IDA_RES_FAIL, IDA_REP_RES_ERR, &
         IDA_FIRST_RES_FAIL, IDA_LINESEARCH_FAIL, IDA_NO_RECOVERY, IDA_BAD_EWT
@@ -101,6 +101,12 @@ module flexmbs_dae_ida
         integer(i8), allocatable :: colptr(:), rowind(:) !! its pattern
         integer(i8), allocatable :: jac_slot(:), mass_slot(:) !! entry -> its slot
         real(wp), allocatable :: f(:), rtol(:), atol(:)
+        !> suppressed correction components (GGL's μ): weights divided by |h|,
+        !> so that their Newton corrections count as h δ (dae_problem_t%
+        !> correction_flags)
+        logical, allocatable :: scaled(:)
+        real(wp) :: h_start = 0.0_wp   !! |h| before the first step (IDA's rule)
+        type(c_ptr) :: mem = c_null_ptr
         type(status_t) :: failure               !! first failing callback
         character(len=:), allocatable :: message !! IDA's last error message
     end type callback_data_t
@@ -231,6 +237,9 @@ contains
         call problem%index_classes(classes)
         call problem%differential_flags(flags)
         suppress = self%suppress_alg .and. any(classes > 1)
+        allocate (data%scaled(n))
+        call problem%correction_flags(data%scaled)
+        data%scaled = data%scaled .and. suppress .and. classes > 1
         if (any(classes >= 3)) stats%warning = index3_warning('ida')
 
         run: block
@@ -238,6 +247,7 @@ contains
             if (.not. status%ok()) exit run
             call initial_derivative(status)
             if (.not. status%ok()) exit run
+            call first_step_estimate()
 
             if (FSUNContext_Create(c_null_ptr, ctx) /= 0) then
                 call sundials_failure('SUNContext_Create')
@@ -254,6 +264,7 @@ contains
                 exit run
             end if
             mem = FIDACreate(ctx)
+            data%mem = mem
             if (.not. c_associated(mem)) then
                 call sundials_failure('IDACreate')
                 exit run
@@ -465,6 +476,33 @@ contains
         end subroutine build_iteration_pattern
 
         !> y'0: given, F (M = I), guessed for IDACalcIC, or the problem's.
+        !> |h| of IDA's first step, which the weights of the correction
+        !> components need before IDA has one: the one asked for, or IDA's
+        !> rule min(0.001 |t_out - t0|, 0.5/‖y0'‖), the norm over the
+        !> components in the error test.
+        subroutine first_step_estimate()
+            real(wp) :: tfirst, ypnorm
+            integer :: k
+            if (options%h0 > 0.0_wp) then
+                data%h_start = options%h0
+                return
+            end if
+            tfirst = t_end
+            if (allocated(options%output_times)) then
+                do k = 1, size(options%output_times)
+                    if ((options%output_times(k) - x) * posneg > 0.0_wp) then
+                        if ((options%output_times(k) - tfirst) * posneg < 0.0_wp) &
+                            tfirst = options%output_times(k)
+                        exit
+                    end if
+                end do
+            end if
+            data%h_start = 0.001_wp * abs(tfirst - x)
+            ypnorm = sqrt(sum(merge((ypw / (data%rtol * abs(yw) + data%atol))**2, 0.0_wp, &
+                                    classes == 1 .or. .not. suppress)) / real(n, wp))
+            if (ypnorm > 0.5_wp / data%h_start) data%h_start = 0.5_wp / ypnorm
+        end subroutine first_step_estimate
+
         subroutine initial_derivative(st)
             type(status_t), intent(inout) :: st
             type(status_t) :: fst
@@ -497,6 +535,10 @@ contains
             type(status_t), intent(inout) :: st
             logical :: ok
             if (.not. st%ok()) return
+            if (any(data%scaled)) then
+                ok = check(FIDAWFtolerances(mem, c_funloc(ida_weights)), 'IDAWFtolerances')
+                return
+            end if
             if (allocated(options%rtol_vector)) then
                 if (any(options%rtol_vector /= options%rtol_vector(1))) then
                     ok = check(FIDAWFtolerances(mem, c_funloc(ida_weights)), 'IDAWFtolerances')
@@ -889,6 +931,7 @@ contains
         type(c_ptr), value, intent(in) :: user_data
         type(callback_data_t), pointer :: data
         real(c_double), pointer :: y(:), w(:)
+        real(c_double) :: hcur(1)
         call c_f_pointer(user_data, data)
         y => FN_VGetArrayPointer(nv_y)
         w => FN_VGetArrayPointer(nv_w)
@@ -896,6 +939,15 @@ contains
         if (.not. all(w > 0.0_wp)) then
             ierr = -1
             return
+        end if
+        ! correction components (out of the error test) count as h δ in the
+        ! Newton test, as in DDASSL's (dae_problem_t%correction_flags)
+        if (allocated(data%scaled) .and. c_associated(data%mem)) then
+            if (any(data%scaled)) then
+                if (FIDAGetCurrentStep(data%mem, hcur) /= 0) hcur = 0.0_wp
+                if (hcur(1) == 0.0_wp) hcur = data%h_start
+                if (hcur(1) /= 0.0_wp) where (data%scaled) w = w / abs(hcur(1))
+            end if
         end if
         w = 1.0_wp / w
         ierr = 0
