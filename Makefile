@@ -3,6 +3,7 @@
 #   make run     install what is missing, build (release), run the main example
 #   make test    install what is missing, build (debug, bounds checks), run every suite
 #   make bench   install what is missing, build (release), run the benchmarks
+#   make paper   the paper's studies on the five-body mechanism into results/
 #   make install PREFIX=...   install library, modules and the classic faces
 #   OPENMP=1     (with any of them) thread the finite-element assembly
 #   LTO=1        (with any of them) link-time optimisation
@@ -44,10 +45,10 @@ SYSLIBS      := -lsundials_fida_mod -lsundials_fnvecserial_mod \
                 -lhdf5_serial_fortran -lhdf5_serial -llapack -lblas
 MAIN_INPUT   := inputs/five_body.nml
 
-.PHONY: run test bench deps build build-debug install legacy-test clean help
+.PHONY: run test bench paper deps build build-debug install legacy-test clean help
 
 help:
-	@echo "make run | make test | make bench | make install PREFIX=dir | make clean"
+	@echo "make run | make test | make bench | make paper | make install PREFIX=dir | make clean"
 
 # Install the system packages and fpm when they are missing.
 deps:
@@ -122,6 +123,26 @@ legacy-test:
 install: deps
 	$(FPM) install --no-prune --profile release --prefix $(PREFIX)
 	cd legacy && $(FPM) install --profile release --prefix $(PREFIX)
+
+# The paper's studies (inputs/paper/five_body_*.nml) into results/: the
+# references, then the sweeps in two processes; each sweep's log and table.
+PAPER_SWEEPS := five_body_table3 five_body_table2 five_body_figure6 five_body_table2_undamped
+paper: deps
+	$(FPM) build --profile release
+	@mkdir -p results
+	@bin=$$($(FPM) run --profile release flexmbs --runner echo 2>/dev/null | tail -1); \
+	export OPENBLAS_NUM_THREADS=1; \
+	( $$bin reference inputs/paper/five_body_table3.nml --quiet > results/reference.txt 2>&1 & \
+	  $$bin reference inputs/paper/five_body_table2_undamped.nml --quiet \
+	      > results/reference_undamped.txt 2>&1 & wait ) ; \
+	cat results/reference.txt results/reference_undamped.txt; \
+	grep -q '^written' results/reference.txt && grep -q '^written' results/reference_undamped.txt \
+	    || { echo 'make paper: a reference failed' >&2; exit 1; }; \
+	for s in $(PAPER_SWEEPS); do \
+	    $$bin sweep inputs/paper/$$s.nml -j 2 --quiet > results/$$s.txt 2>&1 \
+	        || { cat results/$$s.txt; exit 1; }; \
+	    cat results/$$s.txt; \
+	done
 
 bench: deps
 	$(FPM) build --profile release

@@ -2,7 +2,8 @@
 !>
 !>   flexmbs run FILE.nml [--quiet]          run a scene
 !>   flexmbs reference STUDY.nml [--quiet]   a study's reference solution
-!>   flexmbs sweep STUDY.nml [--quiet]       a study's grid of runs against it
+!>   flexmbs sweep STUDY.nml [-j N] [--quiet]  a study's grid of runs against it
+!>   (sweep --point K runs point K alone and prints its record: the child of -j)
 !>   flexmbs --help | --version
 !>
 !> Exit codes: 0 success, 2 bad input (nothing written), 3 solver failure
@@ -14,7 +15,7 @@ program flexmbs_main
     use flexmbs_io_namelist, only: scene_input_t, read_scene
     use flexmbs_io_scene, only: run_result_t, run_scene
     use flexmbs_io_namelist, only: study_input_t, read_study
-    use flexmbs_io_study, only: make_reference, run_sweep, sweep_run_t
+    use flexmbs_io_study, only: make_reference, run_sweep, run_sweep_point, sweep_run_t
     use flexmbs_io_table, only: table_text, table_markdown, stats_row_t
     implicit none
 
@@ -23,9 +24,9 @@ program flexmbs_main
     !> Largest state printed whole; larger ones are summarised.
     integer, parameter :: max_printed = 12
 
-    character(len=:), allocatable :: command, file, arg
+    character(len=:), allocatable :: command, file, arg, value
     logical :: quiet
-    integer :: i, nargs
+    integer :: i, nargs, jobs, point, ios
 
     nargs = command_argument_count()
     if (nargs == 0) then
@@ -43,10 +44,27 @@ program flexmbs_main
     case ('run', 'reference', 'sweep')
         quiet = .false.
         file = ''
-        do i = 2, nargs
+        jobs = 1
+        point = 0
+        i = 1
+        do while (i < nargs)
+            i = i + 1
             arg = argument(i)
             if (arg == '--quiet' .or. arg == '-q') then
                 quiet = .true.
+            else if (command == 'sweep' .and. (arg == '-j' .or. arg == '--point')) then
+                if (i == nargs) call fail_usage(arg // ' needs a number')
+                i = i + 1
+                value = argument(i)
+                if (arg == '-j') then
+                    read (value, *, iostat=ios) jobs
+                    if (ios /= 0 .or. jobs < 1) call fail_usage('-j ' // value // &
+                        ': needs a whole number >= 1')
+                else
+                    read (value, *, iostat=ios) point
+                    if (ios /= 0 .or. point < 1) call fail_usage('--point ' // value // &
+                        ': needs a whole number >= 1')
+                end if
             else if (arg == '--help' .or. arg == '-h') then
                 call usage(output_unit)
                 call finish(exit_ok)
@@ -68,7 +86,11 @@ program flexmbs_main
             call reference(file, quiet)
         case ('sweep')
             if (len(file) == 0) call fail_usage('sweep needs a study file')
-            call sweep(file, quiet)
+            if (point > 0) then
+                call sweep_point(file, point)
+            else
+                call sweep(file, quiet, jobs)
+            end if
         end select
     case default
         call fail_usage('unknown command ''' // command // '''')
@@ -122,9 +144,10 @@ contains
 
     !> A study's grid of runs against its reference: a line per run, then
     !> the table (also written to the study's table file, if named).
-    subroutine sweep(path, quiet)
+    subroutine sweep(path, quiet, jobs)
         character(len=*), intent(in) :: path
         logical, intent(in) :: quiet
+        integer, intent(in) :: jobs
         type(study_input_t) :: study
         type(status_t) :: status
         type(sweep_run_t), allocatable :: runs(:)
@@ -132,7 +155,7 @@ contains
         integer :: k
         call read_study(path, study, status)
         if (.not. status%ok()) call stop_on(status)
-        call run_sweep(study, quiet, runs, status)
+        call run_sweep(study, quiet, runs, status, jobs, argument(0))
         if (allocated(runs)) then
             do k = 1, size(runs)
                 write (output_unit, '(a)') runs(k)%summary
@@ -147,6 +170,21 @@ contains
         if (.not. status%ok()) call stop_on(status)
         call finish(exit_ok)
     end subroutine sweep
+
+    !> One point of a study's grid, as a record line (a parallel sweep's child).
+    subroutine sweep_point(path, k)
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: k
+        type(study_input_t) :: study
+        type(status_t) :: status
+        character(len=:), allocatable :: line
+        call read_study(path, study, status)
+        if (.not. status%ok()) call stop_on(status)
+        call run_sweep_point(study, k, line, status)
+        if (.not. status%ok()) call stop_on(status)
+        write (output_unit, '(a)') line
+        call finish(exit_ok)
+    end subroutine sweep_point
 
     !> Statistics line and final state on standard output.
     subroutine report(result, scene)
@@ -214,8 +252,10 @@ contains
             '  flexmbs run FILE.nml [--quiet]          run the scene described by FILE.nml', &
             '  flexmbs reference STUDY.nml [--quiet]   integrate the study''s scene at tight', &
             '                                          tolerance, cross-check, keep in HDF5', &
-            '  flexmbs sweep STUDY.nml [--quiet]       run the study''s grid of solvers and', &
-            '                                          tolerances, ERR against the reference', &
+            '  flexmbs sweep STUDY.nml [-j N] [--quiet]', &
+            '                                          run the study''s grid of solvers and', &
+            '                                          tolerances, ERR against the reference;', &
+            '                                          -j N: N processes at a time', &
             '  flexmbs --help                          show this text', &
             '  flexmbs --version                       show the version', &
             '', &

@@ -212,6 +212,11 @@ sed -e "s#scene               = '../four_bar.nml'#scene = '$root/inputs/four_bar
     "$root/inputs/paper/four_bar_study.nml" > study.nml
 expect study-reference 0 "written: study_reference.h5" reference study.nml --quiet
 expect study-sweep 0 "6 runs finished, 0 failed" sweep study.nml --quiet
+# in two processes: the same table, the CPU column apart
+"$exe" sweep study.nml --quiet 2>&1 | grep '^|' | cut -d'|' -f1-9,11- > serial.txt
+"$exe" sweep study.nml -j 2 --quiet 2>&1 | grep '^|' | cut -d'|' -f1-9,11- > parallel.txt
+if [ -s serial.txt ] && cmp -s serial.txt parallel.txt; then pass study-sweep-parallel
+else fail study-sweep-parallel "tables differ: $(diff serial.txt parallel.txt | head -5)"; fi
 printf "&study scene = 'x.nml', solvers = 'rk4' /\n" > bad_study.nml
 expect study-bad 2 "bad_study.nml: &study: solvers: 'rk4': must be one of" sweep bad_study.nml
 printf "&study scene = '%s/inputs/four_bar.nml', reference_file = 'none.h5' /\n" "$root" \

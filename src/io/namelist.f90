@@ -156,6 +156,7 @@ module flexmbs_io_namelist
         var_spec_t('study', 'reference_solver', kind_string), &
         var_spec_t('study', 'reference_tolerance', kind_real), &
         var_spec_t('study', 'check_solver', kind_string), &
+        var_spec_t('study', 'check_tolerance', kind_real), &
         var_spec_t('study', 'solvers', kind_string, max_study_solvers), &
         var_spec_t('study', 'stabilisations', kind_string, 3), &
         var_spec_t('study', 'tolerances', kind_real, max_study_tolerances, .true.), &
@@ -266,6 +267,7 @@ module flexmbs_io_namelist
         character(len=len_name) :: reference_solver = 'radau5'
         real(wp) :: reference_tolerance = 1.0e-10_wp
         character(len=len_name) :: check_solver = 'ddassl' !! '' or 'none': no check
+        real(wp) :: check_tolerance = 0.0_wp  !! 0: the reference tolerance
         character(len=len_name), allocatable :: solvers(:)
         character(len=len_name), allocatable :: stabilisations(:)
         real(wp), allocatable :: tolerances(:)
@@ -529,12 +531,12 @@ contains
         character(len=len_path) :: scene, reference_file, table
         character(len=len_name) :: reference_solver, check_solver, &
             solvers(max_study_solvers), stabilisations(3), derivatives(3)
-        real(wp) :: reference_tolerance, tolerances(max_study_tolerances)
+        real(wp) :: reference_tolerance, check_tolerance, tolerances(max_study_tolerances)
         integer :: pmax(5), cpu_reference, ios, i
         character(len=256) :: msg
         namelist /study/ scene, reference_file, reference_solver, reference_tolerance, &
-            check_solver, solvers, stabilisations, tolerances, pmax, derivatives, table, &
-            cpu_reference
+            check_solver, check_tolerance, solvers, stabilisations, tolerances, pmax, &
+            derivatives, table, cpu_reference
 
         input%path = path
         call tokenise(text, path, entries, spans, clean, status)
@@ -560,6 +562,7 @@ contains
         reference_solver = input%reference_solver
         reference_tolerance = input%reference_tolerance
         check_solver = input%check_solver
+        check_tolerance = 0.0_wp
         solvers = ''
         stabilisations = ''
         derivatives = ''
@@ -577,6 +580,8 @@ contains
         input%reference_tolerance = reference_tolerance
         input%check_solver = check_solver
         if (input%check_solver == 'none') input%check_solver = ''
+        input%check_tolerance = check_tolerance
+        if (input%check_tolerance == 0.0_wp) input%check_tolerance = reference_tolerance
         input%cpu_reference = cpu_reference
         input%solvers = pack(solvers, solvers /= '')
         if (size(input%solvers) == 0) input%solvers = [character(len=len_name) :: 'radau5', &
@@ -605,6 +610,9 @@ contains
         else if (.not. (input%reference_tolerance > 0.0_wp .and. &
                         input%reference_tolerance < 1.0_wp)) then
             call status%set(status_bad_input, where // 'reference_tolerance: must lie in (0, 1)')
+        else if (.not. (input%check_tolerance > 0.0_wp .and. input%check_tolerance < 1.0_wp)) &
+            then
+            call status%set(status_bad_input, where // 'check_tolerance: must lie in (0, 1)')
         else if (input%cpu_reference < 1) then
             call status%set(status_bad_input, where // 'cpu_reference: must be a row, >= 1')
         end if
@@ -1150,7 +1158,7 @@ contains
         character(len=*), intent(in) :: name
         select case (name)
         case ('title'); string_length = len_title
-        case ('file', 'table', 'mesh_file'); string_length = len_path
+        case ('file', 'table', 'mesh_file', 'scene', 'reference_file'); string_length = len_path
         case default; string_length = len_name
         end select
     end function string_length

@@ -3,8 +3,8 @@
 !> A reference is the scene integrated by `reference_solver` at rtol = atol
 !> = `reference_tolerance`, kept at the scene's output times in an HDF5
 !> trajectory file (/time, /y, /q) with its provenance: the study and scene
-!> files, the solver and tolerance, the cross-check (a second solver at the
-!> same tolerance and the ERR between the two), the flexmbs version and the
+!> files, the solver and tolerance, the cross-check (a second solver at
+!> `check_tolerance` and the ERR between the two), the flexmbs version and the
 !> date (text datasets).
 !>
 !> A sweep runs the grid solvers × stabilisations × tolerances × p_max
@@ -32,6 +32,14 @@ module flexmbs_io_study
     implicit none
     private
 
+    !> One point of a sweep's grid.
+    type :: sweep_point_t
+        character(len=32) :: solver = '', stab = ''
+        real(wp) :: tol = 0.0_wp
+        integer :: pmax = 5
+        character(len=32) :: source = ''
+    end type sweep_point_t
+
     !> One run of a sweep: its table row and a line for the log.
     type, public :: sweep_run_t
         type(stats_row_t) :: row
@@ -39,7 +47,7 @@ module flexmbs_io_study
         character(len=:), allocatable :: summary
     end type sweep_run_t
 
-    public :: make_reference, run_sweep, read_reference
+    public :: make_reference, run_sweep, run_sweep_point, read_reference
 
 contains
 
@@ -108,7 +116,7 @@ contains
             // ': ' // ref%stats%summary() // nl
         check_text = 'none'
         if (len_trim(study%check_solver) > 0) then
-            call configure(base, trim(study%check_solver), study%reference_tolerance, '', &
+            call configure(base, trim(study%check_solver), study%check_tolerance, '', &
                            base%pmax, '', scene)
             call run_scene(scene, quiet, chk, status, rec_check)
             if (.not. status%ok()) then
@@ -124,9 +132,10 @@ contains
             end if
             err = series_error(rec_check%y(ref%q_first:ref%q_last, 1:rec%records), &
                                rec%y(ref%q_first:ref%q_last, 1:rec%records), &
-                               study%reference_tolerance)
-            check_text = trim(study%check_solver) // ' at the same tolerance: ERR = ' // &
-                real_text(err) // ' (' // real_text(err / study%reference_tolerance) // ' TOL)'
+                               study%check_tolerance)
+            check_text = trim(study%check_solver) // ' at ' // real_text(study%check_tolerance) &
+                // ': ERR = ' // real_text(err) // ' (' // &
+                real_text(err / study%check_tolerance) // ' of its TOL)'
             log = log // 'check: ' // chk%solver_name // ': ' // chk%stats%summary() // nl // &
                 'check: ERR of ' // check_text // nl
         end if
@@ -201,107 +210,245 @@ contains
         call h5fclose_f(file, err)
     end subroutine read_reference
 
-    !> Every run of the study's grid against its reference (module header).
-    subroutine run_sweep(study, quiet, runs, status)
+    !> The grid of a study, in the order of the table: solvers, then
+    !> stabilisations, tolerances, p_max (DDASSL), derivative sources.
+    subroutine sweep_points(study, base, points)
+        type(study_input_t), intent(in) :: study
+        type(scene_input_t), intent(in) :: base
+        type(sweep_point_t), allocatable, intent(out) :: points(:)
+        character(len=32), allocatable :: stabs(:), sources(:)
+        character(len=:), allocatable :: solver
+        integer :: is, ib, it, ip, id, np
+        stabs = [character(len=32) :: '-']
+        sources = [character(len=32) :: '']
+        if (base%problem == 'multibody') then
+            stabs = [character(len=32) :: study%stabilisations]
+            sources = [character(len=32) :: study%derivatives]
+        end if
+        allocate (points(0))
+        do is = 1, size(study%solvers)
+            solver = trim(study%solvers(is))
+            do ib = 1, size(stabs)
+                ! MEXAX projects internally: once per tolerance
+                if (solver == 'mexax' .and. ib > 1) exit
+                do it = 1, size(study%tolerances)
+                    np = merge(size(study%pmax), 1, solver == 'ddassl')
+                    do ip = 1, np
+                        do id = 1, size(sources)
+                            points = [points, sweep_point_t(solver, stabs(ib), &
+                                study%tolerances(it), study%pmax(ip), sources(id))]
+                        end do
+                    end do
+                end do
+            end do
+        end do
+    end subroutine sweep_points
+
+    !> Every run of the study's grid against its reference (module header);
+    !> with jobs > 1, in that many processes of `exe` at a time (`exe sweep
+    !> STUDY --point K`, through xargs -P): the same rows, CPU apart.
+    subroutine run_sweep(study, quiet, runs, status, jobs, exe)
         type(study_input_t), intent(in) :: study
         logical, intent(in) :: quiet
         type(sweep_run_t), allocatable, intent(out) :: runs(:)
         type(status_t), intent(out) :: status
+        integer, intent(in), optional :: jobs
+        character(len=*), intent(in), optional :: exe
         type(scene_input_t) :: base
+        type(sweep_point_t), allocatable :: points(:)
+        type(stats_row_t), allocatable :: rows(:)
         real(wp), allocatable :: t_ref(:), y_ref(:, :)
-        character(len=32), allocatable :: stabs(:), sources(:)
-        character(len=:), allocatable :: solver
-        integer :: is, ib, it, ip, id, np
-        logical :: multibody
+        integer :: k, njobs
 
         call read_scene(study%scene, base, status)
         if (.not. status%ok()) return
         call read_reference(study%reference_file, t_ref, y_ref, status)
         if (.not. status%ok()) return
-        multibody = base%problem == 'multibody'
-        stabs = [character(len=32) :: '-']
-        sources = [character(len=32) :: '']
-        if (multibody) then
-            stabs = [character(len=32) :: study%stabilisations]
-            sources = [character(len=32) :: study%derivatives]
+        call sweep_points(study, base, points)
+        njobs = 1
+        if (present(jobs)) njobs = jobs
+        allocate (runs(size(points)))
+        if (njobs > 1 .and. present(exe)) then
+            call run_in_processes(study, exe, njobs, runs, status)
+            if (.not. status%ok()) return
+        else
+            do k = 1, size(points)
+                runs(k) = point_run(base, points(k), t_ref, y_ref, quiet)
+            end do
         end if
-        allocate (runs(0))
-        do is = 1, size(study%solvers)
-            solver = trim(study%solvers(is))
-            block
-                do ib = 1, size(stabs)
-                    ! MEXAX projects internally: once per tolerance
-                    if (solver == 'mexax' .and. ib > 1) exit
-                    do it = 1, size(study%tolerances)
-                        np = merge(size(study%pmax), 1, solver == 'ddassl')
-                        do ip = 1, np
-                            do id = 1, size(sources)
-                                call one_run(solver, trim(stabs(ib)), study%tolerances(it), &
-                                             study%pmax(ip), trim(sources(id)))
-                            end do
-                        end do
-                    end do
-                end do
-            end block
-        end do
         if (study%cpu_reference <= size(runs)) then
             if (runs(study%cpu_reference)%ok) runs%row%cpu_unit = &
                 runs(study%cpu_reference)%row%stats%cpu
         end if
-        if (len(study%table) > 0) call write_table(study%table, runs%row, status)
-
-    contains
-
-        subroutine one_run(solver, stab, tol, pmax, source)
-            character(len=*), intent(in) :: solver, stab, source
-            real(wp), intent(in) :: tol
-            integer, intent(in) :: pmax
-            type(scene_input_t) :: scene
-            type(run_result_t) :: result
-            type(record_sink_t) :: rec
-            type(status_t) :: run_status
-            type(sweep_run_t) :: run
-            character(len=:), allocatable :: label, stab_label
-            real(wp) :: err
-            label = solver
-            if (solver == 'ddassl') label = label // ' p_max=' // int_text(pmax)
-            if (len(source) > 0 .and. source /= 'analytic') label = label // ' (' // source // ')'
-            stab_label = stab
-            if (solver == 'mexax' .and. multibody) stab_label = 'projection'
-            call configure(base, solver, tol, stab, pmax, source, scene)
-            call run_scene(scene, quiet, result, run_status, rec)
-            run%ok = run_status%ok()
-            err = -1.0_wp
-            if (run%ok) then
-                if (rec%records /= size(t_ref) .or. &
-                    size(y_ref, 1) < result%q_last) then
-                    run%ok = .false.
-                    call run_status%set(status_bad_input, 'output times or size differ from &
-                        &the reference (was it made from this scene?)')
-                else if (maxval(abs(rec%t(1:rec%records) - t_ref)) > &
-                         1.0e-12_wp * max(1.0_wp, maxval(abs(t_ref)))) then
-                    run%ok = .false.
-                    call run_status%set(status_bad_input, 'output times differ from the &
-                        &reference')
-                else
-                    err = series_error(rec%y(result%q_first:result%q_last, 1:rec%records), &
-                                       y_ref(result%q_first:result%q_last, :), tol)
-                end if
-            end if
-            run%row = new_stats_row(label, tol, stab_label, result%stats)
-            run%row%err = err
-            if (run%ok) then
-                run%summary = label // ' ' // stab_label // ' TOL ' // real_text(tol) // &
-                    ': ERR ' // real_text(err) // ' = ' // real_text(err / tol) // ' TOL, ' // &
-                    result%stats%summary()
-            else
-                run%summary = label // ' ' // stab_label // ' TOL ' // real_text(tol) // &
-                    ': failed at t = ' // real_text(result%stats%t_reached) // ': ' // &
-                    run_status%text() // '; ' // result%stats%summary()
-            end if
-            runs = [runs, run]
-        end subroutine one_run
+        rows = runs%row
+        if (len(study%table) > 0) call write_table(study%table, rows, status)
     end subroutine run_sweep
+
+    !> Point k of the study's grid alone (the child of a parallel sweep):
+    !> `line` is its record (record_line).
+    subroutine run_sweep_point(study, k, line, status)
+        type(study_input_t), intent(in) :: study
+        integer, intent(in) :: k
+        character(len=:), allocatable, intent(out) :: line
+        type(status_t), intent(out) :: status
+        type(scene_input_t) :: base
+        type(sweep_point_t), allocatable :: points(:)
+        real(wp), allocatable :: t_ref(:), y_ref(:, :)
+        call read_scene(study%scene, base, status)
+        if (.not. status%ok()) return
+        call read_reference(study%reference_file, t_ref, y_ref, status)
+        if (.not. status%ok()) return
+        call sweep_points(study, base, points)
+        if (k < 1 .or. k > size(points)) then
+            call status%set(status_bad_input, study%path // ': --point ' // int_text(k) // &
+                ': the grid has points 1 .. ' // int_text(size(points)))
+            return
+        end if
+        line = record_line(point_run(base, points(k), t_ref, y_ref, .true.))
+    end subroutine run_sweep_point
+
+    !> The points in processes: each writes its record to a file of a
+    !> scratch folder beside the reference; xargs -P keeps `jobs` running.
+    subroutine run_in_processes(study, exe, jobs, runs, status)
+        type(study_input_t), intent(in) :: study
+        character(len=*), intent(in) :: exe
+        integer, intent(in) :: jobs
+        type(sweep_run_t), intent(inout) :: runs(:)
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: dir, command, text
+        integer :: k, stat, unit, ios
+        character(len=4096) :: buffer
+        dir = study%reference_file // '.sweep'
+        command = 'rm -rf "' // dir // '" && mkdir -p "' // dir // '" && seq 1 ' // &
+            int_text(size(runs)) // ' | xargs -P ' // int_text(jobs) // &
+            ' -I{} sh -c ''"$0" sweep "$1" --point {} > "$2/{}.txt" 2>&1'' "' // exe // &
+            '" "' // study%path // '" "' // dir // '"'
+        call execute_command_line(command, exitstat=stat)
+        if (stat /= 0) then
+            call status%set(status_io_error, study%path // ': the sweep processes failed ' // &
+                '(exit ' // int_text(stat) // '): ' // command)
+            return
+        end if
+        do k = 1, size(runs)
+            open (newunit=unit, file=dir // '/' // int_text(k) // '.txt', action='read', &
+                  iostat=ios)
+            text = ''
+            if (ios == 0) then
+                do
+                    read (unit, '(a)', iostat=ios) buffer
+                    if (ios /= 0) exit
+                    if (buffer(1:7) == 'record ') text = trim(buffer)
+                end do
+                close (unit)
+            end if
+            if (len(text) == 0) then
+                call status%set(status_io_error, study%path // ': point ' // int_text(k) // &
+                    ' left no record in ' // dir)
+                return
+            end if
+            call parse_record(text, runs(k), status)
+            if (.not. status%ok()) return
+        end do
+        call execute_command_line('rm -rf "' // dir // '"')
+    end subroutine run_in_processes
+
+    !> One point of the grid against the reference.
+    function point_run(base, point, t_ref, y_ref, quiet) result(run)
+        type(scene_input_t), intent(in) :: base
+        type(sweep_point_t), intent(in) :: point
+        real(wp), intent(in) :: t_ref(:), y_ref(:, :)
+        logical, intent(in) :: quiet
+        type(sweep_run_t) :: run
+        type(scene_input_t) :: scene
+        type(run_result_t) :: result
+        type(record_sink_t) :: rec
+        type(status_t) :: run_status
+        character(len=:), allocatable :: label, stab_label, solver, source
+        real(wp) :: err, tol
+        solver = trim(point%solver)
+        source = trim(point%source)
+        tol = point%tol
+        label = solver
+        if (solver == 'ddassl') label = label // ' p_max=' // int_text(point%pmax)
+        if (len(source) > 0 .and. source /= 'analytic') label = label // ' (' // source // ')'
+        stab_label = trim(point%stab)
+        if (solver == 'mexax' .and. base%problem == 'multibody') stab_label = 'projection'
+        call configure(base, solver, tol, trim(point%stab), point%pmax, source, scene)
+        call run_scene(scene, quiet, result, run_status, rec)
+        run%ok = run_status%ok()
+        err = -1.0_wp
+        if (run%ok) then
+            if (rec%records /= size(t_ref) .or. size(y_ref, 1) < result%q_last) then
+                run%ok = .false.
+                call run_status%set(status_bad_input, 'output times or size differ from &
+                    &the reference (was it made from this scene?)')
+            else if (maxval(abs(rec%t(1:rec%records) - t_ref)) > &
+                     1.0e-12_wp * max(1.0_wp, maxval(abs(t_ref)))) then
+                run%ok = .false.
+                call run_status%set(status_bad_input, 'output times differ from the reference')
+            else
+                err = series_error(rec%y(result%q_first:result%q_last, 1:rec%records), &
+                                   y_ref(result%q_first:result%q_last, :), tol)
+            end if
+        end if
+        run%row = new_stats_row(label, tol, stab_label, result%stats)
+        run%row%err = err
+        if (run%ok) then
+            run%summary = label // ' ' // stab_label // ' TOL ' // real_text(tol) // ': ERR ' &
+                // real_text(err) // ' = ' // real_text(err / tol) // ' TOL, ' // &
+                result%stats%summary()
+            if (result%has_drift) run%summary = run%summary // ' drift |g| ' // &
+                real_text(result%drift_end(1)) // ' |Gv+gI| ' // real_text(result%drift_end(2))
+        else
+            run%summary = label // ' ' // stab_label // ' TOL ' // real_text(tol) // &
+                ': failed at t = ' // real_text(result%stats%t_reached) // ': ' // &
+                run_status%text() // '; ' // result%stats%summary()
+        end if
+    end function point_run
+
+    !> A run as one line: 'record', ok, ERR, tolerance, t reached, counters,
+    !> CPU, wall, last step (exact decimal forms), then label | stab | summary.
+    function record_line(run) result(line)
+        type(sweep_run_t), intent(in) :: run
+        character(len=:), allocatable :: line
+        character(len=1024) :: buf
+        associate (st => run%row%stats)
+            write (buf, '(a,l1,3es25.16e3,9(1x,i0),3es25.16e3)') 'record ', run%ok, &
+                run%row%err, run%row%tol, st%t_reached, st%nst, st%nac, st%nrj, st%nfe, &
+                st%nfe_jac, st%nje, st%ndec, st%nsol, st%nprj, st%cpu, st%wall, st%h_last
+        end associate
+        line = trim(buf) // ' | ' // run%row%solver // ' | ' // run%row%stab // ' | ' // &
+            run%summary
+    end function record_line
+
+    !> The run of a record_line.
+    subroutine parse_record(line, run, status)
+        character(len=*), intent(in) :: line
+        type(sweep_run_t), intent(inout) :: run
+        type(status_t), intent(inout) :: status
+        integer :: ios, b1, b2, b3
+        b1 = index(line, ' | ')
+        b2 = 0
+        b3 = 0
+        if (b1 > 0) b2 = b1 + 2 + index(line(b1 + 3:), ' | ')
+        if (b2 > b1 + 2) b3 = b2 + 2 + index(line(b2 + 3:), ' | ')
+        if (b1 == 0 .or. b2 <= b1 + 2 .or. b3 <= b2 + 2) then
+            call status%set(status_io_error, 'sweep: a point''s record is damaged: ' // line)
+            return
+        end if
+        associate (st => run%row%stats)
+            read (line(8:b1 - 1), *, iostat=ios) run%ok, run%row%err, run%row%tol, &
+                st%t_reached, st%nst, st%nac, st%nrj, st%nfe, st%nfe_jac, st%nje, st%ndec, &
+                st%nsol, st%nprj, st%cpu, st%wall, st%h_last
+        end associate
+        if (ios /= 0) then
+            call status%set(status_io_error, 'sweep: a point''s record is damaged: ' // line)
+            return
+        end if
+        run%row%solver = line(b1 + 3:b2 - 1)
+        run%row%stab = line(b2 + 3:b3 - 1)
+        run%summary = line(b3 + 3:)
+    end subroutine parse_record
 
     !> ERR of eq. (13) over all components and output times, rtol = atol = tol.
     pure real(wp) function series_error(y, y_ref, tol) result(err)
