@@ -50,10 +50,11 @@ MAIN_INPUT   := inputs/five_body.nml
 help:
 	@echo "make run | make test | make bench | make paper | make install PREFIX=dir | make clean"
 
-# Install the system packages and fpm when they are missing.
+# Install the system packages and fpm when they are missing (make paper
+# adds gnuplot for its plots).
 deps:
 	@missing=""; \
-	for p in $(APT_PACKAGES); do \
+	for p in $(APT_PACKAGES) $(EXTRA_PACKAGES); do \
 	    dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" \
 	        || missing="$$missing $$p"; \
 	done; \
@@ -127,7 +128,11 @@ install: deps
 # The paper's studies (inputs/paper/five_body_*.nml) into results/: the
 # references, then the sweeps in two processes; each sweep's log and table.
 PAPER_SWEEPS := five_body_table3 five_body_table2 five_body_figure6 five_body_table2_undamped
-paper: deps
+# x of the coupler's middle node (node 23 of its 3 x 5 x 3 grid) in y: after
+# 4 bodies x 7 coordinates and the chain's 2, its x is free coordinate 67
+MIDDLE_NODE_X := 97
+paper:
+	@$(MAKE) --no-print-directory deps EXTRA_PACKAGES=gnuplot-nox
 	$(FPM) build --profile release
 	@mkdir -p results
 	@bin=$$($(FPM) run --profile release flexmbs --runner echo 2>/dev/null | tail -1); \
@@ -142,7 +147,11 @@ paper: deps
 	    $$bin sweep inputs/paper/$$s.nml -j 2 --quiet > results/$$s.txt 2>&1 \
 	        || { cat results/$$s.txt; exit 1; }; \
 	    cat results/$$s.txt; \
-	done
+	done; \
+	$$bin columns results/five_body_reference.h5 $(MIDDLE_NODE_X) > results/figure5_damped.txt && \
+	$$bin columns results/five_body_undamped_reference.h5 $(MIDDLE_NODE_X) \
+	    > results/figure5_undamped.txt && \
+	gnuplot inputs/paper/plots.gp && ls results/*.png
 
 bench: deps
 	$(FPM) build --profile release

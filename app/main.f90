@@ -4,18 +4,22 @@
 !>   flexmbs reference STUDY.nml [--quiet]   a study's reference solution
 !>   flexmbs sweep STUDY.nml [-j N] [--quiet]  a study's grid of runs against it
 !>   (sweep --point K runs point K alone and prints its record: the child of -j)
+!>   flexmbs columns FILE.h5 K [K ...]           t and y(K) of a trajectory as text
 !>   flexmbs --help | --version
 !>
 !> Exit codes: 0 success, 2 bad input (nothing written), 3 solver failure
 !> (outputs kept), 4 I/O error. Only this program decides exit codes.
 program flexmbs_main
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_text, only: int_text
     use flexmbs_core_status, only: status_t, status_ok, status_bad_input, &
         status_solver_failure, status_io_error, status_interrupted, reason_name, reason_none
     use flexmbs_io_namelist, only: scene_input_t, read_scene
     use flexmbs_io_scene, only: run_result_t, run_scene
     use flexmbs_io_namelist, only: study_input_t, read_study
-    use flexmbs_io_study, only: make_reference, run_sweep, run_sweep_point, sweep_run_t
+    use flexmbs_io_study, only: make_reference, run_sweep, run_sweep_point, sweep_run_t, &
+        read_reference
     use flexmbs_io_table, only: table_text, table_markdown, stats_row_t
     implicit none
 
@@ -92,6 +96,8 @@ program flexmbs_main
                 call sweep(file, quiet, jobs)
             end if
         end select
+    case ('columns')
+        call columns()
     case default
         call fail_usage('unknown command ''' // command // '''')
     end select
@@ -170,6 +176,37 @@ contains
         if (.not. status%ok()) call stop_on(status)
         call finish(exit_ok)
     end subroutine sweep
+
+    !> `columns FILE.h5 K...`: t and the components K of y at every record
+    !> of a trajectory file, as text columns (for plots).
+    subroutine columns()
+        type(status_t) :: status
+        real(wp), allocatable :: t(:), y(:, :)
+        integer, allocatable :: k(:)
+        integer :: i, j, ios
+        character(len=:), allocatable :: value
+        if (nargs < 3) call fail_usage('columns needs a trajectory file and component numbers')
+        allocate (k(nargs - 2))
+        do i = 3, nargs
+            value = argument(i)
+            read (value, *, iostat=ios) k(i - 2)
+            if (ios /= 0) call fail_usage('columns: ''' // value // ''' is not a component &
+                &number')
+        end do
+        call read_reference(argument(2), t, y, status)
+        if (.not. status%ok()) call stop_on(status)
+        do i = 1, size(k)
+            if (k(i) < 1 .or. k(i) > size(y, 1)) then
+                call status%set(status_bad_input, argument(2) // ': component ' // &
+                    argument(i + 2) // ' outside 1 .. ' // int_text(size(y, 1)))
+                call stop_on(status)
+            end if
+        end do
+        do j = 1, size(t)
+            write (output_unit, '(*(es24.15e3))') t(j), (y(k(i), j), i=1, size(k))
+        end do
+        call finish(exit_ok)
+    end subroutine columns
 
     !> One point of a study's grid, as a record line (a parallel sweep's child).
     subroutine sweep_point(path, k)
@@ -256,6 +293,8 @@ contains
             '                                          run the study''s grid of solvers and', &
             '                                          tolerances, ERR against the reference;', &
             '                                          -j N: N processes at a time', &
+            '  flexmbs columns FILE.h5 K [K ...]       t and components K of y of a', &
+            '                                          trajectory, as text columns', &
             '  flexmbs --help                          show this text', &
             '  flexmbs --version                       show the version', &
             '', &

@@ -217,6 +217,9 @@ expect study-sweep 0 "6 runs finished, 0 failed" sweep study.nml --quiet
 "$exe" sweep study.nml -j 2 --quiet 2>&1 | grep '^|' | cut -d'|' -f1-9,11- > parallel.txt
 if [ -s serial.txt ] && cmp -s serial.txt parallel.txt; then pass study-sweep-parallel
 else fail study-sweep-parallel "tables differ: $(diff serial.txt parallel.txt | head -5)"; fi
+# components of a trajectory as text columns
+expect columns 0 "1.000000000000000E+000" columns study_reference.h5 1 2
+expect columns-range 2 "component 999 outside 1 .. " columns study_reference.h5 999
 printf "&study scene = 'x.nml', solvers = 'rk4' /\n" > bad_study.nml
 expect study-bad 2 "bad_study.nml: &study: solvers: 'rk4': must be one of" sweep bad_study.nml
 printf "&study scene = '%s/inputs/four_bar.nml', reference_file = 'none.h5' /\n" "$root" \
