@@ -227,5 +227,17 @@ printf "&study scene = '%s/inputs/four_bar.nml', reference_file = 'none.h5' /\n"
 expect study-no-reference 2 "no reference file (make it with 'flexmbs reference' first)" \
     sweep no_reference.nml --quiet
 
+# ParaView output of a flexible body beside a rigid one
+sed -e "s/t_end   = 0.5 /t_end   = 0.02 /" -e "s#^&output#\&output vtk = 'out/vis', file = 'none',#" \
+    -e "s/n_output = 51/n_output = 3/" "$root/inputs/rigid_flexible_pendulum.nml" > vis.nml
+expect vtk-run 0 "radau5: NST=" run vis.nml --quiet
+if [ -f out/vis_0002.vtu ] && [ -f out/vis_bodies_0002.vtu ] && \
+   [ "$(grep -c '<DataSet' out/vis.pvd)" -eq 6 ] && \
+   grep -q 'NumberOfPoints="20" NumberOfCells="4"' out/vis_0002.vtu && \
+   grep -q 'Name="von_mises"' out/vis_0002.vtu; then pass vtk-files
+else fail vtk-files "$(ls out; head -c 400 out/vis.pvd 2>/dev/null)"; fi
+sed -e "s#^&output#\&output vtk = 'vdp',#" "$root/inputs/van_der_pol.nml" > vdp_vtk.nml
+bad vtk-no-bodies "&output: vtk: problem = 'van_der_pol' has no bodies to draw" vdp_vtk.nml
+
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

@@ -32,7 +32,8 @@ contains
                  new_test('momenta_kinetic_energy', test_momenta), &
                  new_test('strain_energy_gradient', test_strain_energy), &
                  new_test('tip_layers_and_nodal_loads', test_tip_layers), &
-                 new_test('formulation_jacobian_fd', test_formulation_jacobian)]
+                 new_test('formulation_jacobian_fd', test_formulation_jacobian), &
+                 new_test('element_stress_analytic', test_element_stress)]
     end function collect_fe_body
 
     subroutine make_body(kind, fixed_face, body, status, gravity, origin)
@@ -371,4 +372,55 @@ contains
             if (allocated(error)) return
         end do
     end subroutine test_formulation_jacobian
+    !> The Cauchy stress of a homogeneous stretch F = diag(s, 1, 1) (hex8 and
+    !> hex27, every element): σ_xx = μ (s − 1/s) + λ (s − 1), σ_yy = σ_zz =
+    !> λ (s − 1), no shear (S = μ (I − C⁻¹) + λ J (J − 1) C⁻¹, σ = F S Fᵀ/J);
+    !> a rigid rotation on top rotates it (σ' = Q σ Qᵀ: von Mises unchanged).
+    subroutine test_element_stress(error)
+        type(error_t), allocatable, intent(out) :: error
+        integer, parameter :: kinds(2) = [hex8, hex27]
+        type(mesh_t) :: mesh
+        type(neo_hooke_t) :: mat
+        type(flexible_body_t) :: body
+        type(status_t) :: status
+        real(wp), allocatable :: q(:), v(:), sigma(:, :), mises(:), mises0(:)
+        real(wp) :: s, expect(6), qrot(3, 3), dev
+        integer :: k, i, node
+        integer(i8) :: seed
+        s = 1.2_wp
+        dev = 0.0_wp
+        do k = 1, 2
+            call new_neo_hooke(mat, 7.0e5_wp, 0.3_wp, 920.0_wp, 1000.0_wp, status)
+            call box_mesh(mesh, kinds(k), [2, 1, 1], [0.4_wp, 0.1_wp, 0.1_wp], status)
+            call new_flexible_body(body, mesh, [mat], [integer ::], status)
+            call check(error, status%ok(), 'body: ' // status%text())
+            if (allocated(error)) return
+            q = body%free_positions()
+            allocate (v(body%nv), source=0.0_wp)
+            do node = 1, mesh%node_count()
+                q(body%dof(1, node)) = s * mesh%x(1, node)
+            end do
+            allocate (sigma(6, mesh%element_count()), mises(mesh%element_count()))
+            call body%element_stress(q, v, sigma, mises, status)
+            call check(error, status%ok(), 'stress: ' // status%text())
+            if (allocated(error)) return
+            expect = [mat%mu * (s - 1.0_wp / s) + mat%lambda * (s - 1.0_wp), &
+                      mat%lambda * (s - 1.0_wp), mat%lambda * (s - 1.0_wp), 0.0_wp, 0.0_wp, 0.0_wp]
+            do i = 1, mesh%element_count()
+                dev = max(dev, maxval(abs(sigma(:, i) - expect)) / abs(expect(1)))
+            end do
+            ! the same stretch, rotated: von Mises is invariant
+            mises0 = mises
+            seed = 3_i8
+            call random_rotation(seed, qrot)
+            do node = 1, mesh%node_count()
+                q(3 * node - 2:3 * node) = matmul(qrot, q(3 * node - 2:3 * node))
+            end do
+            call body%element_stress(q, v, sigma, mises, status)
+            dev = max(dev, maxval(abs(mises - mises0)) / maxval(mises0))
+            deallocate (v, sigma, mises)
+        end do
+        print '(4x,a,es9.2)', 'element stress against the analytic stretch: ', dev
+        call check(error, dev <= 1.0e-12_wp, 'element stress differs from the analytic one')
+    end subroutine test_element_stress
 end module test_fe_body

@@ -16,7 +16,7 @@ module flexmbs_fe_flexible_body
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_fe_tensor, only: identity3
     use flexmbs_fe_hexahedron, only: hexahedron_t, new_hexahedron, reference_gradients, &
-        deformation_gradient, max_nodes
+        deformation_gradient, nodal_gradient, max_nodes
     use flexmbs_fe_neo_hooke, only: neo_hooke_t
     use flexmbs_fe_element, only: element_mass, element_forces
     use flexmbs_fe_mesh, only: mesh_t
@@ -66,6 +66,7 @@ module flexmbs_fe_flexible_body
         procedure :: momenta => body_momenta
         procedure :: add_nodal_load => body_add_nodal_load
         procedure :: admissible => body_admissible
+        procedure :: element_stress => body_element_stress
         procedure :: force_derivatives => body_force_derivatives
         procedure :: kinematics_derivative => body_kinematics_derivative
         procedure :: mass_derivative => body_mass_derivative
@@ -536,6 +537,45 @@ contains
             end do
         end do
     end subroutine body_admissible
+
+    !> Cauchy stress σ = F (S_el + S_v) Fᵀ / J of every element, averaged
+    !> over its Gauss points with their volume weights, in Voigt order (xx,
+    !> yy, zz, xy, yz, xz), and its von Mises equivalent [Pa] (for output).
+    subroutine body_element_stress(self, q, v, sigma, von_mises, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(out) :: sigma(:, :)    !! (6, elements)
+        real(wp), intent(out) :: von_mises(:)   !! (elements)
+        type(status_t), intent(out) :: status
+        real(wp) :: f(3, 3), fdot(3, 3), detf, e(3, 3), edot(3, 3), s_el(3, 3), s_v(3, 3), &
+            c(3, 3), acc(3, 3), volume
+        integer :: el, g
+        call scatter(self, q, v)
+        do el = 1, self%mesh%element_count()
+            call gather(self, el, 1)
+            acc = 0.0_wp
+            volume = 0.0_wp
+            do g = 1, self%hex%ngauss
+                call deformation_gradient(self%hex%nnode, self%dndx(:, :, g, el), &
+                                          self%work(1)%xe, f, detf, status)
+                if (.not. status%ok()) then
+                    call name_element(status, el)
+                    return
+                end if
+                call nodal_gradient(self%hex%nnode, self%dndx(:, :, g, el), self%work(1)%ve, fdot)
+                e = 0.5_wp * (matmul(transpose(f), f) - identity3)
+                edot = 0.5_wp * (matmul(transpose(fdot), f) + matmul(transpose(f), fdot))
+                call self%materials(self%element_material(el))%stress(e, edot, s_el, s_v)
+                c = matmul(f, matmul(s_el + s_v, transpose(f))) / detf
+                acc = acc + self%wdv(g, el) * c
+                volume = volume + self%wdv(g, el)
+            end do
+            c = acc / volume
+            sigma(:, el) = [c(1, 1), c(2, 2), c(3, 3), c(1, 2), c(2, 3), c(1, 3)]
+            von_mises(el) = sqrt(0.5_wp * ((c(1, 1) - c(2, 2))**2 + (c(2, 2) - c(3, 3))**2 + &
+                (c(3, 3) - c(1, 1))**2) + 3.0_wp * (c(1, 2)**2 + c(2, 3)**2 + c(1, 3)**2))
+        end do
+    end subroutine body_element_stress
 
     !> Kinetic energy ½ vᵀ M v (fixed nodes are at rest).
     function body_kinetic_energy(self, v) result(energy)

@@ -85,6 +85,7 @@ module flexmbs_io_namelist
         var_spec_t('output', 'every_step', kind_logical), &
         var_spec_t('output', 'table', kind_string), &
         var_spec_t('output', 'progress', kind_logical), &
+        var_spec_t('output', 'vtk', kind_string), &
         var_spec_t('flexible_body', 'name', kind_string), &
         var_spec_t('flexible_body', 'element', kind_string), &
         var_spec_t('flexible_body', 'mesh_file', kind_string), &
@@ -362,6 +363,8 @@ module flexmbs_io_namelist
         logical :: every_step = .false.
         character(len=len_path) :: table = ''
         logical :: progress = .true.
+        !> ParaView files PREFIX_NNNN.vtu and PREFIX.pvd ('' = none)
+        character(len=len_path) :: vtk = ''
         ! &flexible_body and &material
         logical :: has_body = .false.                 !! a &flexible_body group was given
         type(body_input_t) :: body
@@ -1158,7 +1161,8 @@ contains
         character(len=*), intent(in) :: name
         select case (name)
         case ('title'); string_length = len_title
-        case ('file', 'table', 'mesh_file', 'scene', 'reference_file'); string_length = len_path
+        case ('file', 'table', 'mesh_file', 'scene', 'reference_file', 'vtk')
+            string_length = len_path
         case default; string_length = len_name
         end select
     end function string_length
@@ -1179,7 +1183,7 @@ contains
         character(len=len_title) :: title
         character(len=len_name) :: problem, pendulum_formulation, name, linear_solver, &
             jacobian, controller, mexax_base, sparse_ordering
-        character(len=len_path) :: file, table
+        character(len=len_path) :: file, table, vtk
         real(wp) :: t_start, t_end, vdp_eps, vdp_y1, vdp_y2, pendulum_length, pendulum_mass, &
             pendulum_angle, gravity, rtol, atol, h0, hmax, thet, fnewt, &
             quot1, quot2, safe, fac_min, fac_max
@@ -1193,7 +1197,7 @@ contains
             sparse_ordering, jacobian, &
             nit, thet, fnewt, quot1, quot2, safe, fac_min, fac_max, controller, zero_start, pmax, &
             initial_derivative, exclude_index23, netlib, max_extrapolation, mexax_base
-        namelist /output/ file, n_output, every_step, table, progress
+        namelist /output/ file, n_output, every_step, table, progress, vtk
 
         lines = split_lines(text)
         ios = 0
@@ -1287,12 +1291,14 @@ contains
             every_step = scene%every_step
             table = scene%table
             progress = scene%progress
+            vtk = scene%vtk
             read (lines, nml=output, iostat=ios, iomsg=msg)
             scene%output_file = trim(file)
             scene%n_output = n_output
             scene%every_step = every_step
             scene%table = table
             scene%progress = progress
+            scene%vtk = vtk
         end select
         if (ios /= 0) then
             ! Not expected after validation; report what the compiler says.

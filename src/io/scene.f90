@@ -39,6 +39,7 @@ module flexmbs_io_scene
     use flexmbs_io_progress, only: progress_t, new_progress
     use flexmbs_io_multi_sink, only: multi_sink_t
     use flexmbs_io_table, only: new_stats_row, write_table
+    use flexmbs_io_vtk_sink, only: vtk_sink_t
     implicit none
     private
 
@@ -331,6 +332,7 @@ contains
         class(sink_t), intent(inout), target, optional :: record
         class(dae_problem_t), allocatable, target :: problem
         type(monitor_sink_t), target :: monitor
+        type(vtk_sink_t), target :: vtk
         class(mechanical_problem_t), allocatable, target :: mechanical
         class(dae_solver_t), allocatable, target :: solver
         type(block_spec_t), allocatable :: blocks(:)
@@ -370,6 +372,11 @@ contains
             return
         end if
 
+        ! ParaView output is checked before any file is created
+        if (len_trim(scene%vtk) > 0) then
+            call setup_vtk()
+            if (.not. status%ok()) return
+        end if
         if (len(scene%output_file) > 0) then
             call h5%create(scene%output_file, problem%n, status, input_text=scene%text, &
                            every_step=scene%every_step)
@@ -400,6 +407,7 @@ contains
         end select
         call sinks%attach(progress)
         if (present(record)) call sinks%attach(record)
+        if (len_trim(scene%vtk) > 0) call sinks%attach(vtk)
         ! drift and energy of formulated mechanical scenes, at the output times
         select type (p => problem)
         type is (formulation_t)
@@ -462,6 +470,38 @@ contains
         end if
 
     contains
+
+        !> ParaView output of the flexible body and the rigid bodies (y starts
+        !> with q in every layout: the bodies' (r, p), then v behind q).
+        subroutine setup_vtk()
+            vtk%prefix = trim(scene%vtk)
+            if (.not. allocated(mechanical)) then
+                call status%set(status_bad_input, scene%path // ': &output: vtk: problem = ''' &
+                    // trim(scene%problem) // ''' has no bodies to draw')
+                return
+            end if
+            select type (m => mechanical)
+            type is (flexible_body_t)
+                vtk%body => m
+                vtk%oq = 0
+                vtk%ov = m%nq
+            type is (mbs_system_t)
+                vtk%bodies = size(m%rigid%bodies)
+                if (size(m%flex) > 0) then
+                    vtk%body => m%flex(1)
+                    vtk%oq = m%flex_q(1)
+                    vtk%ov = m%nq + m%flex_v(1)
+                    select type (p => problem)
+                    type is (formulation_t)
+                        vtk%oq = p%oq + m%flex_q(1)
+                        vtk%ov = p%ov + m%flex_v(1)
+                    end select
+                end if
+            class default
+                call status%set(status_bad_input, scene%path // ': &output: vtk: problem = ''' &
+                    // trim(scene%problem) // ''' has no bodies to draw')
+            end select
+        end subroutine setup_vtk
 
         !> MEXAX on the mechanical problem; y = (q, v, λ) as built by
         !> build_problem (the namelist admits mechanical scenes only).

@@ -1,0 +1,218 @@
+!> ParaView output: at every output time, the flexible body's mesh as an
+!> XML unstructured grid (`PREFIX_NNNN.vtu`: current node positions, the
+!> hexahedra in VTK order — hex8 cell type 12, hex27 type 29 —, point data
+!> displacement and velocity, cell data Cauchy stress (xx, yy, zz, xy, yz,
+!> xz) and its von Mises value) and the rigid bodies (`PREFIX_bodies_NNNN.vtu`:
+!> one vertex per body at its centre of mass, point data the body's three
+!> axes), listed with their times in `PREFIX.pvd` (part 0 the mesh, part 1
+!> the bodies). The .pvd is rewritten after every record, so a run that
+!> stops keeps a collection ParaView opens.
+module flexmbs_io_vtk_sink
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t, status_io_error
+    use flexmbs_core_text, only: int_text
+    use flexmbs_dae_sink, only: sink_t
+    use flexmbs_fe_flexible_body, only: flexible_body_t
+    use flexmbs_mbs_rotation, only: rotation_matrix
+    implicit none
+    private
+
+    type, extends(sink_t), public :: vtk_sink_t
+        character(len=:), allocatable :: prefix
+        type(flexible_body_t), pointer :: body => null() !! none: rigid bodies only
+        integer :: oq = 0, ov = 0     !! the body's q and v in y
+        integer :: bodies = 0         !! rigid bodies: (r, p) at y(7 b − 6 : 7 b)
+        integer :: records = 0
+        real(wp), allocatable :: times(:)
+    contains
+        procedure :: output => vtk_output
+    end type vtk_sink_t
+
+contains
+
+    subroutine vtk_output(self, t, y, status)
+        class(vtk_sink_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: stem
+        real(wp), allocatable :: tt(:)
+        if (.not. status%ok()) return
+        self%records = self%records + 1
+        stem = self%prefix // '_' // digits(self%records - 1)
+        if (associated(self%body)) call write_mesh(self, y, stem // '.vtu', status)
+        if (status%ok() .and. self%bodies > 0) call write_bodies(self, y, &
+            self%prefix // '_bodies_' // digits(self%records - 1) // '.vtu', status)
+        if (.not. status%ok()) return
+        if (.not. allocated(self%times)) allocate (self%times(0))
+        tt = [self%times, t]
+        call move_alloc(tt, self%times)
+        call write_collection(self, status)
+    end subroutine vtk_output
+
+    !> 0042: four digits at least.
+    pure function digits(k) result(s)
+        integer, intent(in) :: k
+        character(len=:), allocatable :: s
+        s = int_text(k)
+        if (len(s) < 4) s = repeat('0', 4 - len(s)) // s
+    end function digits
+
+    subroutine write_mesh(self, y, path, status)
+        class(vtk_sink_t), intent(inout) :: self
+        real(wp), intent(in) :: y(:)
+        character(len=*), intent(in) :: path
+        type(status_t), intent(inout) :: status
+        real(wp), allocatable :: x(:, :), v(:, :), sigma(:, :), mises(:)
+        type(status_t) :: stress_status
+        integer :: unit, ios, n, ne, nn, i, j, celltype
+        associate (body => self%body, mesh => self%body%mesh)
+            n = mesh%node_count()
+            ne = mesh%element_count()
+            nn = size(mesh%connectivity, 1)
+            allocate (x(3, n), v(3, n), sigma(6, ne), mises(ne))
+            x = mesh%x
+            v = 0.0_wp
+            do i = 1, n
+                do j = 1, 3
+                    if (body%dof(j, i) == 0) cycle
+                    x(j, i) = y(self%oq + body%dof(j, i))
+                    v(j, i) = y(self%ov + body%dof(j, i))
+                end do
+            end do
+            call body%element_stress(y(self%oq + 1:self%oq + body%nq), &
+                                     y(self%ov + 1:self%ov + body%nv), sigma, mises, &
+                                     stress_status)
+            if (.not. stress_status%ok()) then
+                sigma = 0.0_wp
+                mises = 0.0_wp
+            end if
+            celltype = merge(12, 29, nn == 8)
+            open (newunit=unit, file=path, action='write', status='replace', iostat=ios)
+            if (ios /= 0) then
+                call status%set(status_io_error, path // ': cannot write the ParaView file')
+                return
+            end if
+            write (unit, '(a)') '<?xml version="1.0"?>'
+            write (unit, '(a)') '<VTKFile type="UnstructuredGrid" version="0.1" ' // &
+                'byte_order="LittleEndian">'
+            write (unit, '(a)') '<UnstructuredGrid>'
+            write (unit, '(a)') '<Piece NumberOfPoints="' // int_text(n) // &
+                '" NumberOfCells="' // int_text(ne) // '">'
+            write (unit, '(a)') '<Points><DataArray type="Float64" NumberOfComponents="3" ' // &
+                'format="ascii">'
+            write (unit, '(3es24.15e3)') x
+            write (unit, '(a)') '</DataArray></Points>'
+            write (unit, '(a)') '<Cells><DataArray type="Int64" Name="connectivity" ' // &
+                'format="ascii">'
+            do i = 1, ne
+                write (unit, '(*(1x,i0))') mesh%connectivity(:, i) - 1
+            end do
+            write (unit, '(a)') '</DataArray><DataArray type="Int64" Name="offsets" ' // &
+                'format="ascii">'
+            write (unit, '(*(1x,i0))') (nn * i, i=1, ne)
+            write (unit, '(a)') '</DataArray><DataArray type="UInt8" Name="types" ' // &
+                'format="ascii">'
+            write (unit, '(*(1x,i0))') (celltype, i=1, ne)
+            write (unit, '(a)') '</DataArray></Cells>'
+            write (unit, '(a)') '<PointData Vectors="displacement">'
+            write (unit, '(a)') '<DataArray type="Float64" Name="displacement" ' // &
+                'NumberOfComponents="3" format="ascii">'
+            write (unit, '(3es24.15e3)') x - mesh%x
+            write (unit, '(a)') '</DataArray>'
+            write (unit, '(a)') '<DataArray type="Float64" Name="velocity" ' // &
+                'NumberOfComponents="3" format="ascii">'
+            write (unit, '(3es24.15e3)') v
+            write (unit, '(a)') '</DataArray></PointData>'
+            write (unit, '(a)') '<CellData Scalars="von_mises">'
+            write (unit, '(a)') '<DataArray type="Float64" Name="stress" ' // &
+                'NumberOfComponents="6" format="ascii">'
+            write (unit, '(6es24.15e3)') sigma
+            write (unit, '(a)') '</DataArray>'
+            write (unit, '(a)') '<DataArray type="Float64" Name="von_mises" format="ascii">'
+            write (unit, '(es24.15e3)') mises
+            write (unit, '(a)') '</DataArray></CellData>'
+            write (unit, '(a)') '</Piece></UnstructuredGrid></VTKFile>'
+            close (unit, iostat=ios)
+            if (ios /= 0) call status%set(status_io_error, path // ': cannot close')
+        end associate
+    end subroutine write_mesh
+
+    subroutine write_bodies(self, y, path, status)
+        class(vtk_sink_t), intent(inout) :: self
+        real(wp), intent(in) :: y(:)
+        character(len=*), intent(in) :: path
+        type(status_t), intent(inout) :: status
+        real(wp) :: a(3, 3)
+        integer :: unit, ios, b, k
+        open (newunit=unit, file=path, action='write', status='replace', iostat=ios)
+        if (ios /= 0) then
+            call status%set(status_io_error, path // ': cannot write the ParaView file')
+            return
+        end if
+        write (unit, '(a)') '<?xml version="1.0"?>'
+        write (unit, '(a)') '<VTKFile type="UnstructuredGrid" version="0.1" ' // &
+            'byte_order="LittleEndian">'
+        write (unit, '(a)') '<UnstructuredGrid>'
+        write (unit, '(a)') '<Piece NumberOfPoints="' // int_text(self%bodies) // &
+            '" NumberOfCells="' // int_text(self%bodies) // '">'
+        write (unit, '(a)') '<Points><DataArray type="Float64" NumberOfComponents="3" ' // &
+            'format="ascii">'
+        do b = 1, self%bodies
+            write (unit, '(3es24.15e3)') y(7 * b - 6:7 * b - 4)
+        end do
+        write (unit, '(a)') '</DataArray></Points>'
+        write (unit, '(a)') '<Cells><DataArray type="Int64" Name="connectivity" format="ascii">'
+        write (unit, '(*(1x,i0))') (b - 1, b=1, self%bodies)
+        write (unit, '(a)') '</DataArray><DataArray type="Int64" Name="offsets" format="ascii">'
+        write (unit, '(*(1x,i0))') (b, b=1, self%bodies)
+        write (unit, '(a)') '</DataArray><DataArray type="UInt8" Name="types" format="ascii">'
+        write (unit, '(*(1x,i0))') (1, b=1, self%bodies)
+        write (unit, '(a)') '</DataArray></Cells>'
+        write (unit, '(a)') '<PointData>'
+        do k = 1, 3
+            write (unit, '(a)') '<DataArray type="Float64" Name="axis_' // &
+                achar(iachar('x') + k - 1) // '" NumberOfComponents="3" format="ascii">'
+            do b = 1, self%bodies
+                a = rotation_matrix(y(7 * b - 3:7 * b))
+                write (unit, '(3es24.15e3)') a(:, k)
+            end do
+            write (unit, '(a)') '</DataArray>'
+        end do
+        write (unit, '(a)') '</PointData>'
+        write (unit, '(a)') '</Piece></UnstructuredGrid></VTKFile>'
+        close (unit, iostat=ios)
+        if (ios /= 0) call status%set(status_io_error, path // ': cannot close')
+    end subroutine write_bodies
+
+    !> PREFIX.pvd: every record so far, file names relative to the .pvd.
+    subroutine write_collection(self, status)
+        class(vtk_sink_t), intent(inout) :: self
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: base
+        character(len=32) :: tbuf
+        integer :: unit, ios, k
+        base = self%prefix(index(self%prefix, '/', back=.true.) + 1:)
+        open (newunit=unit, file=self%prefix // '.pvd', action='write', status='replace', &
+              iostat=ios)
+        if (ios /= 0) then
+            call status%set(status_io_error, self%prefix // '.pvd: cannot write')
+            return
+        end if
+        write (unit, '(a)') '<?xml version="1.0"?>'
+        write (unit, '(a)') '<VTKFile type="Collection" version="0.1">'
+        write (unit, '(a)') '<Collection>'
+        do k = 1, self%records
+            write (tbuf, '(es23.15e3)') self%times(k)
+            if (associated(self%body)) write (unit, '(a)') '<DataSet timestep="' // &
+                trim(adjustl(tbuf)) // '" part="0" file="' // base // '_' // digits(k - 1) // &
+                '.vtu"/>'
+            if (self%bodies > 0) write (unit, '(a)') '<DataSet timestep="' // &
+                trim(adjustl(tbuf)) // '" part="1" file="' // base // '_bodies_' // &
+                digits(k - 1) // '.vtu"/>'
+        end do
+        write (unit, '(a)') '</Collection>'
+        write (unit, '(a)') '</VTKFile>'
+        close (unit, iostat=ios)
+        if (ios /= 0) call status%set(status_io_error, self%prefix // '.pvd: cannot close')
+    end subroutine write_collection
+end module flexmbs_io_vtk_sink
