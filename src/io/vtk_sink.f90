@@ -87,19 +87,8 @@ contains
                 mises = 0.0_wp
             end if
             celltype = merge(12, 29, nn == 8)
-            open (newunit=unit, file=path, action='write', status='replace', iostat=ios)
-            if (ios /= 0) then
-                call status%set(status_io_error, path // ': cannot write the ParaView file')
-                return
-            end if
-            write (unit, '(a)') '<?xml version="1.0"?>'
-            write (unit, '(a)') '<VTKFile type="UnstructuredGrid" version="0.1" ' // &
-                'byte_order="LittleEndian">'
-            write (unit, '(a)') '<UnstructuredGrid>'
-            write (unit, '(a)') '<Piece NumberOfPoints="' // int_text(n) // &
-                '" NumberOfCells="' // int_text(ne) // '">'
-            write (unit, '(a)') '<Points><DataArray type="Float64" NumberOfComponents="3" ' // &
-                'format="ascii">'
+            call open_grid(path, n, ne, unit, status)
+            if (.not. status%ok()) return
             write (unit, '(3es24.15e3)') x
             write (unit, '(a)') '</DataArray></Points>'
             write (unit, '(a)') '<Cells><DataArray type="Int64" Name="connectivity" ' // &
@@ -144,19 +133,8 @@ contains
         type(status_t), intent(inout) :: status
         real(wp) :: a(3, 3)
         integer :: unit, ios, b, k
-        open (newunit=unit, file=path, action='write', status='replace', iostat=ios)
-        if (ios /= 0) then
-            call status%set(status_io_error, path // ': cannot write the ParaView file')
-            return
-        end if
-        write (unit, '(a)') '<?xml version="1.0"?>'
-        write (unit, '(a)') '<VTKFile type="UnstructuredGrid" version="0.1" ' // &
-            'byte_order="LittleEndian">'
-        write (unit, '(a)') '<UnstructuredGrid>'
-        write (unit, '(a)') '<Piece NumberOfPoints="' // int_text(self%bodies) // &
-            '" NumberOfCells="' // int_text(self%bodies) // '">'
-        write (unit, '(a)') '<Points><DataArray type="Float64" NumberOfComponents="3" ' // &
-            'format="ascii">'
+        call open_grid(path, self%bodies, self%bodies, unit, status)
+        if (.not. status%ok()) return
         do b = 1, self%bodies
             write (unit, '(3es24.15e3)') y(7 * b - 6:7 * b - 4)
         end do
@@ -183,6 +161,28 @@ contains
         close (unit, iostat=ios)
         if (ios /= 0) call status%set(status_io_error, path // ': cannot close')
     end subroutine write_bodies
+
+    !> Open an unstructured-grid file and write up to its points' values.
+    subroutine open_grid(path, npoints, ncells, unit, status)
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: npoints, ncells
+        integer, intent(out) :: unit
+        type(status_t), intent(inout) :: status
+        integer :: ios
+        open (newunit=unit, file=path, action='write', status='replace', iostat=ios)
+        if (ios /= 0) then
+            call status%set(status_io_error, path // ': cannot write the ParaView file')
+            return
+        end if
+        write (unit, '(a)') '<?xml version="1.0"?>'
+        write (unit, '(a)') '<VTKFile type="UnstructuredGrid" version="0.1" ' // &
+            'byte_order="LittleEndian">'
+        write (unit, '(a)') '<UnstructuredGrid>'
+        write (unit, '(a)') '<Piece NumberOfPoints="' // int_text(npoints) // &
+            '" NumberOfCells="' // int_text(ncells) // '">'
+        write (unit, '(a)') '<Points><DataArray type="Float64" NumberOfComponents="3" ' // &
+            'format="ascii">'
+    end subroutine open_grid
 
     !> PREFIX.pvd: every record so far, file names relative to the .pvd.
     subroutine write_collection(self, status)
