@@ -4,7 +4,8 @@
 module test_study
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t
-    use flexmbs_io_namelist, only: study_input_t, parse_study, parse_scene, scene_input_t
+    use flexmbs_io_namelist, only: study_input_t, parse_study, parse_scene, scene_input_t, &
+        read_study
     use flexmbs_io_study, only: make_reference, run_sweep, read_reference, sweep_run_t
     use flexmbs_io_table, only: table_text, table_markdown, stats_row_t
     use testing, only: test_case_t, new_test, error_t, check
@@ -19,7 +20,8 @@ contains
     function collect_study() result(tests)
         type(test_case_t), allocatable :: tests(:)
         tests = [new_test('bad_studies', test_bad), &
-                 new_test('reference_and_sweep', test_sweep)]
+                 new_test('reference_and_sweep', test_sweep), &
+                 new_test('five_body_quick', test_quick)]
     end function collect_study
 
     subroutine expect(error, text, message)
@@ -113,4 +115,29 @@ contains
                        'the sweep does not repeat: ' // again(k)%summary)
         end do
     end subroutine test_sweep
+    !> The quick variant of the paper's studies (inputs/paper/five_body_quick.nml:
+    !> the five-body mechanism over 0.05 s): the reference's cross-check
+    !> agrees, and every run finishes with ERR ≤ 10 TOL.
+    subroutine test_quick(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(study_input_t) :: study
+        type(status_t) :: status
+        type(sweep_run_t), allocatable :: runs(:)
+        character(len=:), allocatable :: log
+        integer :: k
+        call read_study('inputs/paper/five_body_quick.nml', study, status)
+        call check(error, status%ok(), 'study: ' // status%text())
+        if (allocated(error)) return
+        call make_reference(study, 'test', .true., log, status)
+        call check(error, status%ok(), 'reference: ' // status%text())
+        if (allocated(error)) return
+        call run_sweep(study, .true., runs, status)
+        call check(error, status%ok() .and. size(runs) == 6, 'sweep: ' // status%text())
+        if (allocated(error)) return
+        do k = 1, size(runs)
+            print '(a)', '    ' // runs(k)%summary(1:index(runs(k)%summary, ', NST') - 1)
+            call check(error, runs(k)%ok .and. runs(k)%row%err <= 10.0_wp * runs(k)%row%tol, &
+                       'ERR: ' // runs(k)%summary)
+        end do
+    end subroutine test_quick
 end module test_study

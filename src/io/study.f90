@@ -82,6 +82,23 @@ contains
         if (len_trim(derivatives) > 0) scene%multibody%constraint_derivatives = derivatives
     end subroutine configure
 
+    !> The study's scene, with the study's t_end when it sets one.
+    subroutine read_study_scene(study, scene, status)
+        type(study_input_t), intent(in) :: study
+        type(scene_input_t), intent(out) :: scene
+        type(status_t), intent(out) :: status
+        call read_scene(study%scene, scene, status)
+        if (.not. status%ok()) return
+        if (study%t_end > 0.0_wp) then
+            if (.not. study%t_end > scene%t_start) then
+                call status%set(status_bad_input, study%path // ': &study: t_end: must be ' // &
+                    'after the scene''s t_start')
+                return
+            end if
+            scene%t_end = study%t_end
+        end if
+    end subroutine read_study_scene
+
     !> The reference of a study (module header); `log` gets one line per
     !> run. Nothing is written unless both runs succeed.
     subroutine make_reference(study, version, quiet, log, status)
@@ -102,7 +119,7 @@ contains
         integer :: k
         character, parameter :: nl = new_line('a')
 
-        call read_scene(study%scene, base, status)
+        call read_study_scene(study, base, status)
         if (.not. status%ok()) return
         call configure(base, trim(study%reference_solver), study%reference_tolerance, '', &
                        base%pmax, '', scene)
@@ -260,7 +277,7 @@ contains
         real(wp), allocatable :: t_ref(:), y_ref(:, :)
         integer :: k, njobs
 
-        call read_scene(study%scene, base, status)
+        call read_study_scene(study, base, status)
         if (.not. status%ok()) return
         call read_reference(study%reference_file, t_ref, y_ref, status)
         if (.not. status%ok()) return
@@ -294,7 +311,7 @@ contains
         type(scene_input_t) :: base
         type(sweep_point_t), allocatable :: points(:)
         real(wp), allocatable :: t_ref(:), y_ref(:, :)
-        call read_scene(study%scene, base, status)
+        call read_study_scene(study, base, status)
         if (.not. status%ok()) return
         call read_reference(study%reference_file, t_ref, y_ref, status)
         if (.not. status%ok()) return
