@@ -151,7 +151,9 @@ paper:
 	$$bin columns results/five_body_reference.h5 $(MIDDLE_NODE_X) > results/figure5_damped.txt && \
 	$$bin columns results/five_body_undamped_reference.h5 $(MIDDLE_NODE_X) \
 	    > results/figure5_undamped.txt && \
-	gnuplot inputs/paper/plots.gp && ls results/*.png
+	gnuplot inputs/paper/plots.gp && \
+	bash inputs/paper/frames.sh $$bin results/five_body_reference.h5 results/five_body_frames.png && \
+	ls results/*.png
 
 bench: deps
 	$(FPM) build --profile release
