@@ -4,6 +4,7 @@
 #   make test    install what is missing, build (debug, bounds checks), run every suite
 #   make bench   install what is missing, build (release), run the benchmarks
 #   make paper   the paper's studies on the five-body mechanism into results/
+#   make extremes  every solver at extreme tolerances, materials and times
 #   make install PREFIX=...   install library, modules and the classic faces
 #   OPENMP=1     (with any of them) thread the finite-element assembly
 #   LTO=1        (with any of them) link-time optimisation
@@ -45,7 +46,7 @@ SYSLIBS      := -lsundials_fida_mod -lsundials_fnvecserial_mod \
                 -lhdf5_serial_fortran -lhdf5_serial -llapack -lblas
 MAIN_INPUT   := inputs/five_body.nml
 
-.PHONY: run test bench paper deps build build-debug install legacy-test clean help
+.PHONY: run test bench paper extremes deps build build-debug install legacy-test clean help
 
 help:
 	@echo "make run | make test | make bench | make paper | make install PREFIX=dir | make clean"
@@ -154,6 +155,12 @@ paper:
 	gnuplot inputs/paper/plots.gp && \
 	bash inputs/paper/frames.sh $$bin results/five_body_reference.h5 results/five_body_frames.png && \
 	ls results/*.png
+
+# The extremes study (inputs/paper/extremes.sh) into results/extremes/.
+extremes: deps
+	$(FPM) build --profile release
+	@bin=$$($(FPM) run --profile release flexmbs --runner echo 2>/dev/null | tail -1); \
+	OPENBLAS_NUM_THREADS=1 bash inputs/paper/extremes.sh $$bin results/extremes
 
 bench: deps
 	$(FPM) build --profile release

@@ -165,7 +165,8 @@ module flexmbs_io_namelist
         var_spec_t('study', 'derivatives', kind_string, 3), &
         var_spec_t('study', 'table', kind_string), &
         var_spec_t('study', 'cpu_reference', kind_integer), &
-        var_spec_t('study', 't_end', kind_real)]
+        var_spec_t('study', 't_end', kind_real), &
+        var_spec_t('study', 'max_steps', kind_integer)]
 
     character(len=16), parameter :: group_names(*) = [character(len=16) :: &
         'simulation', 'solver', 'output', 'flexible_body', 'material', 'multibody', &
@@ -278,6 +279,7 @@ module flexmbs_io_namelist
         character(len=:), allocatable :: table            !! '' = no file, resolved
         integer :: cpu_reference = 1  !! the row whose CPU is 1 in the table
         real(wp) :: t_end = 0.0_wp    !! > 0: the scene's t_end for every run
+        integer :: max_steps = 0      !! > 0: every run's step limit
     end type study_input_t
 
     type, public :: driver_input_t
@@ -537,11 +539,11 @@ contains
         character(len=len_name) :: reference_solver, check_solver, &
             solvers(max_study_solvers), stabilisations(3), derivatives(3)
         real(wp) :: reference_tolerance, check_tolerance, tolerances(max_study_tolerances), t_end
-        integer :: pmax(5), cpu_reference, ios, i
+        integer :: pmax(5), cpu_reference, max_steps, ios, i
         character(len=256) :: msg
         namelist /study/ scene, reference_file, reference_solver, reference_tolerance, &
             check_solver, check_tolerance, solvers, stabilisations, tolerances, pmax, &
-            derivatives, table, cpu_reference, t_end
+            derivatives, table, cpu_reference, t_end, max_steps
 
         input%path = path
         call tokenise(text, path, entries, spans, clean, status)
@@ -569,6 +571,7 @@ contains
         check_solver = input%check_solver
         check_tolerance = 0.0_wp
         t_end = 0.0_wp
+        max_steps = 0
         solvers = ''
         stabilisations = ''
         derivatives = ''
@@ -588,6 +591,7 @@ contains
         if (input%check_solver == 'none') input%check_solver = ''
         input%check_tolerance = check_tolerance
         input%t_end = t_end
+        input%max_steps = max_steps
         if (input%check_tolerance == 0.0_wp) input%check_tolerance = reference_tolerance
         input%cpu_reference = cpu_reference
         input%solvers = pack(solvers, solvers /= '')
@@ -620,6 +624,9 @@ contains
         else if (.not. (input%check_tolerance > 0.0_wp .and. input%check_tolerance < 1.0_wp)) &
             then
             call status%set(status_bad_input, where // 'check_tolerance: must lie in (0, 1)')
+        else if (input%max_steps < 0) then
+            call status%set(status_bad_input, where // 'max_steps: must be positive (0: the &
+                &scene''s)')
         else if (input%t_end < 0.0_wp) then
             call status%set(status_bad_input, where // 't_end: must be positive (0: the scene''s)')
         else if (input%cpu_reference < 1) then

@@ -279,6 +279,8 @@ contains
 
         call read_study_scene(study, base, status)
         if (.not. status%ok()) return
+        ! the step limit is the sweep's (not the reference's)
+        if (study%max_steps > 0) base%max_steps = study%max_steps
         call read_reference(study%reference_file, t_ref, y_ref, status)
         if (.not. status%ok()) return
         call sweep_points(study, base, points)
@@ -313,6 +315,8 @@ contains
         real(wp), allocatable :: t_ref(:), y_ref(:, :)
         call read_study_scene(study, base, status)
         if (.not. status%ok()) return
+        ! the step limit is the sweep's (not the reference's)
+        if (study%max_steps > 0) base%max_steps = study%max_steps
         call read_reference(study%reference_file, t_ref, y_ref, status)
         if (.not. status%ok()) return
         call sweep_points(study, base, points)

@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# The extremes study of the five-body mechanism (`make extremes`): every
+# solver with GGL from TOL 1e-2 to 1e-12 on the damped scene, undamped, with
+# a soft (E = 1e3 Pa) and a stiff (E = 1e10 Pa) coupler, and over ten times
+# the end time. Each variant gets its RADAU5 reference at 1e-10 (checked by
+# DDASSL at 1e-8); every run is capped at 20000 steps. The logs say for each
+# run whether it finished, its ERR and drift, or why and where it stopped.
+#   extremes.sh FLEXMBS OUTDIR [VARIANT ...]   (default: all five variants)
+set -u
+exe=$1 out=$2
+shift 2
+only=" $* "
+root=$(cd "$(dirname "$0")/../.." && pwd)
+mkdir -p "$out"
+
+variant() {  # name tolerances solvers [sed expressions ...]
+    local name=$1 tols=$2 solvers=$3; shift 3
+    if [ "$only" != "  " ] && [[ "$only" != *" $name "* ]]; then return; fi
+    local summary="$out/$name.md"
+    : > "$summary"
+    sed -e "s/^//" "$@" "$root/inputs/five_body.nml" > "$out/$name.nml"
+    cat > "$out/$name-study.nml" <<STUDY
+&study
+    scene               = '$name.nml'
+    reference_solver    = 'radau5'
+    reference_tolerance = 1.0e-10
+    check_solver        = 'ddassl'
+    check_tolerance     = 1.0e-8
+    solvers             = $solvers
+    stabilisations      = 'ggl'
+    tolerances          = $tols
+    pmax                = 5
+    max_steps           = 20000
+/
+STUDY
+    {
+        echo
+        echo "## $name"
+        echo
+        echo '```'
+        if "$exe" reference "$out/$name-study.nml" --quiet 2>&1 | grep -v '^Note'; then :; fi
+        echo '```'
+    } >> "$summary"
+    if [ -f "$out/$name-study_reference.h5" ]; then
+        {
+            echo
+            "$exe" sweep "$out/$name-study.nml" -j 2 --quiet 2>&1 | grep -v '^Note'
+        } >> "$summary"
+    else
+        echo "(no reference: the sweep is skipped)" >> "$summary"
+    fi
+}
+
+all="'radau5', 'ddassl', 'ida', 'mexax'"
+wide="1.0e-2, 1.0e-4, 1.0e-6, 1.0e-8, 1.0e-10, 1.0e-12"
+variant damped "$wide" "$all"
+variant undamped "$wide" "$all" -e "s/viscosity = 1000.0/viscosity = 0.0/g"
+variant soft "1.0e-2, 1.0e-4, 1.0e-6, 1.0e-8" "$all" \
+    -e "s/youngs_modulus = 7.0e5/youngs_modulus = 1.0e3/"
+variant stiff "1.0e-2, 1.0e-4, 1.0e-6, 1.0e-8" "$all" \
+    -e "s/youngs_modulus = 7.0e5/youngs_modulus = 1.0e10/"
+variant long "1.0e-4, 1.0e-6" "'radau5', 'ddassl'" -e "s/t_end   = 1.0 /t_end   = 10.0/"
+{
+    echo "# Extremes of the five-body mechanism"
+    for name in damped undamped soft stiff long; do
+        [ -f "$out/$name.md" ] && cat "$out/$name.md"
+    done
+} > "$out/extremes.md"
+cat "$out/extremes.md"
