@@ -5,6 +5,8 @@
 # the end time. Each variant gets its RADAU5 reference at 1e-10 (checked by
 # DDASSL at 1e-8); every run is capped at 20000 steps. The logs say for each
 # run whether it finished, its ERR and drift, or why and where it stopped.
+# (The stiff variant's reference goes unchecked: DDASSL at 1e-8 needs more
+# than 100000 steps there.)
 #   extremes.sh FLEXMBS OUTDIR [VARIANT ...]   (default: all five variants)
 set -u
 exe=$1 out=$2
@@ -13,8 +15,8 @@ only=" $* "
 root=$(cd "$(dirname "$0")/../.." && pwd)
 mkdir -p "$out"
 
-variant() {  # name tolerances solvers [sed expressions ...]
-    local name=$1 tols=$2 solvers=$3; shift 3
+variant() {  # name tolerances solvers check [sed expressions ...]
+    local name=$1 tols=$2 solvers=$3 check=$4; shift 4
     if [ "$only" != "  " ] && [[ "$only" != *" $name "* ]]; then return; fi
     local summary="$out/$name.md"
     : > "$summary"
@@ -24,7 +26,7 @@ variant() {  # name tolerances solvers [sed expressions ...]
     scene               = '$name.nml'
     reference_solver    = 'radau5'
     reference_tolerance = 1.0e-10
-    check_solver        = 'ddassl'
+    check_solver        = '$check'
     check_tolerance     = 1.0e-8
     solvers             = $solvers
     stabilisations      = 'ggl'
@@ -53,13 +55,15 @@ STUDY
 
 all="'radau5', 'ddassl', 'ida', 'mexax'"
 wide="1.0e-2, 1.0e-4, 1.0e-6, 1.0e-8, 1.0e-10, 1.0e-12"
-variant damped "$wide" "$all"
-variant undamped "$wide" "$all" -e "s/viscosity = 1000.0/viscosity = 0.0/g"
-variant soft "1.0e-2, 1.0e-4, 1.0e-6, 1.0e-8" "$all" \
+variant damped "$wide" "$all" ddassl
+variant undamped "$wide" "$all" ddassl -e "s/viscosity = 1000.0/viscosity = 0.0/g"
+variant soft "1.0e-2, 1.0e-4, 1.0e-6, 1.0e-8" "$all" ddassl \
     -e "s/youngs_modulus = 7.0e5/youngs_modulus = 1.0e3/"
-variant stiff "1.0e-2, 1.0e-4, 1.0e-6, 1.0e-8" "$all" \
+# stiff: DDASSL needs more than 100000 steps at 1e-8 here, so no check
+variant stiff "1.0e-2, 1.0e-4, 1.0e-6, 1.0e-8" "$all" none \
     -e "s/youngs_modulus = 7.0e5/youngs_modulus = 1.0e10/"
-variant long "1.0e-4, 1.0e-6" "'radau5', 'ddassl'" -e "s/t_end   = 1.0 /t_end   = 10.0/"
+variant long "1.0e-4, 1.0e-6" "'radau5', 'ddassl'" ddassl \
+    -e "s/t_end   = 1.0 /t_end   = 10.0/"
 {
     echo "# Extremes of the five-body mechanism"
     for name in damped undamped soft stiff long; do
