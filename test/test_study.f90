@@ -7,7 +7,7 @@ module test_study
     use flexmbs_io_namelist, only: study_input_t, parse_study, parse_scene, scene_input_t, &
         read_study
     use flexmbs_io_study, only: make_reference, run_sweep, read_reference, sweep_run_t
-    use flexmbs_io_table, only: table_text, table_markdown, stats_row_t
+    use flexmbs_io_table, only: table_text, table2_text, table_markdown, stats_row_t
     use testing, only: test_case_t, new_test, error_t, check
     implicit none
     private
@@ -53,6 +53,8 @@ contains
         call expect(error, '&simulation t_end = 1 /' // nl // '&study scene = ''a.nml'' /', &
                     '&simulation: a study file holds only &study')
         call expect(error, '&study scene = ''a.nml'', tolerance = 1e-4 /', 'tolerance')
+        call expect(error, '&study scene = ''a.nml'', layout = ''table4'' /', &
+                    "layout = 'table4': must be 'table3' or 'table2'")
         ! defaults and paths relative to the study's folder
         call parse_study('&study scene = ''a.nml'', table = ''t.csv'' /', 'dir/s.nml', study, &
                          status)
@@ -107,6 +109,11 @@ contains
         rows = runs%row
         text = table_text(rows, table_markdown)
         call check(error, index(text, '| 1.00 |') > 0, 'CPU not normalised to the first row')
+        ! the Table 2 layout: a column per run, rows ERR … CPU
+        text = table2_text(rows, table_markdown)
+        call check(error, index(text, '| ddassl p_max=2 | ddassl p_max=5 |') > 0 .and. &
+                   index(text, '| rejected/NST |') > 0 .and. index(text, '| CPU ') > 0, &
+                   'Table 2 layout: ' // text)
         call run_sweep(study, .true., again, status)
         do k = 1, size(runs)
             call check(error, again(k)%row%err == runs(k)%row%err .and. &

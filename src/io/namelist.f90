@@ -166,7 +166,8 @@ module flexmbs_io_namelist
         var_spec_t('study', 'table', kind_string), &
         var_spec_t('study', 'cpu_reference', kind_integer), &
         var_spec_t('study', 't_end', kind_real), &
-        var_spec_t('study', 'max_steps', kind_integer)]
+        var_spec_t('study', 'max_steps', kind_integer), &
+        var_spec_t('study', 'layout', kind_string)]
 
     character(len=16), parameter :: group_names(*) = [character(len=16) :: &
         'simulation', 'solver', 'output', 'flexible_body', 'material', 'multibody', &
@@ -280,6 +281,7 @@ module flexmbs_io_namelist
         integer :: cpu_reference = 1  !! the row whose CPU is 1 in the table
         real(wp) :: t_end = 0.0_wp    !! > 0: the scene's t_end for every run
         integer :: max_steps = 0      !! > 0: every run's step limit
+        character(len=len_name) :: layout = 'table3' !! 'table3' or 'table2' (the table's)
     end type study_input_t
 
     type, public :: driver_input_t
@@ -537,13 +539,13 @@ contains
         character(len=:), allocatable :: clean, lines(:), dir, where
         character(len=len_path) :: scene, reference_file, table
         character(len=len_name) :: reference_solver, check_solver, &
-            solvers(max_study_solvers), stabilisations(3), derivatives(3)
+            solvers(max_study_solvers), stabilisations(3), derivatives(3), layout
         real(wp) :: reference_tolerance, check_tolerance, tolerances(max_study_tolerances), t_end
         integer :: pmax(5), cpu_reference, max_steps, ios, i
         character(len=256) :: msg
         namelist /study/ scene, reference_file, reference_solver, reference_tolerance, &
             check_solver, check_tolerance, solvers, stabilisations, tolerances, pmax, &
-            derivatives, table, cpu_reference, t_end, max_steps
+            derivatives, table, cpu_reference, t_end, max_steps, layout
 
         input%path = path
         call tokenise(text, path, entries, spans, clean, status)
@@ -572,6 +574,7 @@ contains
         check_tolerance = 0.0_wp
         t_end = 0.0_wp
         max_steps = 0
+        layout = input%layout
         solvers = ''
         stabilisations = ''
         derivatives = ''
@@ -592,6 +595,7 @@ contains
         input%check_tolerance = check_tolerance
         input%t_end = t_end
         input%max_steps = max_steps
+        input%layout = layout
         if (input%check_tolerance == 0.0_wp) input%check_tolerance = reference_tolerance
         input%cpu_reference = cpu_reference
         input%solvers = pack(solvers, solvers /= '')
@@ -624,6 +628,9 @@ contains
         else if (.not. (input%check_tolerance > 0.0_wp .and. input%check_tolerance < 1.0_wp)) &
             then
             call status%set(status_bad_input, where // 'check_tolerance: must lie in (0, 1)')
+        else if (input%layout /= 'table3' .and. input%layout /= 'table2') then
+            call status%set(status_bad_input, where // 'layout = ''' // trim(input%layout) // &
+                ''': must be ''table3'' or ''table2''')
         else if (input%max_steps < 0) then
             call status%set(status_bad_input, where // 'max_steps: must be positive (0: the &
                 &scene''s)')

@@ -300,7 +300,8 @@ contains
                 runs(study%cpu_reference)%row%stats%cpu
         end if
         rows = runs%row
-        if (len(study%table) > 0) call write_table(study%table, rows, status)
+        if (len(study%table) > 0) call write_table(study%table, rows, status, &
+                                                   study%layout == 'table2')
     end subroutine run_sweep
 
     !> Point k of the study's grid alone (the child of a parallel sweep):

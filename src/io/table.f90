@@ -37,7 +37,7 @@ module flexmbs_io_table
         real(wp) :: cpu_unit = 0.0_wp
     end type stats_row_t
 
-    public :: new_stats_row, table_format, table_text, write_table
+    public :: new_stats_row, table_format, table_text, table2_text, write_table
 
 contains
 
@@ -77,8 +77,7 @@ contains
         integer, intent(in) :: format !! table_markdown, table_csv or table_latex
         character(len=:), allocatable :: text
         type(cell_t), allocatable :: cells(:, :)
-        integer :: i, j, width(ncol)
-        character, parameter :: nl = new_line('a')
+        integer :: i, j
 
         allocate (cells(ncol, 0:size(rows)))
         do j = 1, ncol
@@ -87,11 +86,59 @@ contains
         do i = 1, size(rows)
             call fill_cells(rows(i), format, cells(:, i))
         end do
+        text = render(cells, numeric, format)
+    end function table_text
+
+    !> The paper's Table 2 layout: one column per run (its solver label),
+    !> rows ERR, NST, rejected/NST, NJE and CPU.
+    function table2_text(rows, format) result(text)
+        type(stats_row_t), intent(in) :: rows(:)
+        integer, intent(in) :: format
+        character(len=:), allocatable :: text
+        character(len=12), parameter :: names(5) = [character(len=12) :: 'ERR', 'NST', &
+            'rejected/NST', 'NJE', 'CPU']
+        type(cell_t), allocatable :: cells(:, :), run(:)
+        logical :: flags(size(rows) + 1)
+        character(len=32) :: buf
+        integer :: i, k
+        allocate (cells(size(rows) + 1, 0:5), run(ncol))
+        cells(1, 0)%s = ''
+        do k = 1, 5
+            cells(1, k)%s = trim(names(k))
+        end do
+        do i = 1, size(rows)
+            call fill_cells(rows(i), format, run)
+            cells(i + 1, 0)%s = run(1)%s
+            cells(i + 1, 1)%s = run(4)%s
+            cells(i + 1, 2)%s = run(5)%s
+            write (buf, '(f0.1,a)') 100.0_wp * rows(i)%stats%nrj / max(rows(i)%stats%nst, 1), &
+                merge(' \%', ' % ', format == table_latex)
+            if (buf(1:1) == '.') buf = '0' // trim(buf)
+            cells(i + 1, 3)%s = trim(buf)
+            cells(i + 1, 4)%s = run(8)%s
+            cells(i + 1, 5)%s = run(9)%s
+        end do
+        flags = .true.
+        flags(1) = .false.
+        text = render(cells, flags, format)
+    end function table2_text
+
+    !> Cells (column, row 0 = header) as Markdown, CSV or LaTeX; numeric
+    !> columns right-aligned.
+    function render(cells, numeric, format) result(text)
+        type(cell_t), intent(in) :: cells(:, 0:)
+        logical, intent(in) :: numeric(:)
+        integer, intent(in) :: format
+        character(len=:), allocatable :: text
+        integer :: i, j, width(size(cells, 1)), ncol, nrow
+        character, parameter :: nl = new_line('a')
+        ncol = size(cells, 1)
+        nrow = size(cells, 2) - 1
         text = ''
         select case (format)
         case (table_markdown)
             do j = 1, ncol
-                width(j) = max(3, maxval([(len(cells(j, i)%s), i=0, size(rows))]))
+                width(j) = max(3, maxval([(len(cells(j, i)%s), i=0, nrow)]))
             end do
             text = md_line(cells(:, 0), width)
             text = text // '|'
@@ -103,11 +150,11 @@ contains
                 end if
             end do
             text = text // nl
-            do i = 1, size(rows)
+            do i = 1, nrow
                 text = text // md_line(cells(:, i), width)
             end do
         case (table_csv)
-            do i = 0, size(rows)
+            do i = 0, nrow
                 do j = 1, ncol
                     if (j > 1) text = text // ','
                     text = text // csv_field(cells(j, i)%s)
@@ -120,7 +167,7 @@ contains
                 text = text // merge('r', 'l', numeric(j))
             end do
             text = text // '}' // nl // '\hline' // nl
-            do i = 0, size(rows)
+            do i = 0, nrow
                 do j = 1, ncol
                     if (j > 1) text = text // ' & '
                     text = text // cells(j, i)%s
@@ -149,13 +196,14 @@ contains
             end do
             line = line // nl
         end function md_line
-    end function table_text
+    end function render
 
     !> Write the table to `path` in the format of its extension.
-    subroutine write_table(path, rows, status)
+    subroutine write_table(path, rows, status, table2)
         character(len=*), intent(in) :: path
         type(stats_row_t), intent(in) :: rows(:)
         type(status_t), intent(out) :: status
+        logical, intent(in), optional :: table2 !! the Table 2 layout (table2_text)
         integer :: format, unit, ios
         character(len=256) :: msg
         format = table_format(path)
@@ -167,7 +215,15 @@ contains
         open (newunit=unit, file=path, access='stream', form='unformatted', &
               status='replace', action='write', iostat=ios, iomsg=msg)
         if (ios == 0) then
-            write (unit, iostat=ios, iomsg=msg) table_text(rows, format)
+            if (present(table2)) then
+                if (table2) then
+                    write (unit, iostat=ios, iomsg=msg) table2_text(rows, format)
+                else
+                    write (unit, iostat=ios, iomsg=msg) table_text(rows, format)
+                end if
+            else
+                write (unit, iostat=ios, iomsg=msg) table_text(rows, format)
+            end if
             close (unit)
         end if
         if (ios /= 0) call status%set(status_io_error, path // ': cannot write: ' // trim(msg))
