@@ -236,6 +236,13 @@ if [ -f out/vis_0002.vtu ] && [ -f out/vis_bodies_0002.vtu ] && \
    grep -q 'NumberOfPoints="20" NumberOfCells="4"' out/vis_0002.vtu && \
    grep -q 'Name="von_mises"' out/vis_0002.vtu; then pass vtk-files
 else fail vtk-files "$(ls out; head -c 400 out/vis.pvd 2>/dev/null)"; fi
+# a chain's links beside the rigid bodies (two bodies and a one-link chain)
+sed -e "s/t_end   = 1.0 /t_end   = 0.02 /" -e "s#^&output#\&output vtk = 'out/chain', file = 'none',#" \
+    -e "s/n_output = 101/n_output = 2/" "$root/inputs/four_bar_chain.nml" > chain_vtk.nml
+expect vtk-chain-run 0 "radau5: NST=" run chain_vtk.nml --quiet
+if grep -q 'NumberOfPoints="3" NumberOfCells="3"' out/chain_bodies_0001.vtu 2>/dev/null; then
+    pass vtk-chain-links
+else fail vtk-chain-links "$(head -c 300 out/chain_bodies_0001.vtu 2>/dev/null)"; fi
 sed -e "s#^&output#\&output vtk = 'vdp',#" "$root/inputs/van_der_pol.nml" > vdp_vtk.nml
 bad vtk-no-bodies "&output: vtk: problem = 'van_der_pol' has no bodies to draw" vdp_vtk.nml
 

@@ -487,6 +487,10 @@ contains
                 vtk%ov = m%nq
             type is (mbs_system_t)
                 vtk%bodies = size(m%rigid%bodies)
+                if (size(m%chains) > 0) then
+                    vtk%chain => m%chains(1)
+                    vtk%chain_q = m%chain_q(1)
+                end if
                 if (size(m%flex) > 0) then
                     vtk%body => m%flex(1)
                     vtk%oq = m%flex_q(1)

@@ -3,7 +3,8 @@
 !> hexahedra in VTK order — hex8 cell type 12, hex27 type 29 —, point data
 !> displacement and velocity, cell data Cauchy stress (xx, yy, zz, xy, yz,
 !> xz) and its von Mises value) and the rigid bodies (`PREFIX_bodies_NNNN.vtu`:
-!> one vertex per body at its centre of mass, point data the body's three
+!> one vertex per body at its centre of mass, the bodies in absolute
+!> coordinates first, then a chain's links; point data the body's three
 !> axes), listed with their times in `PREFIX.pvd` (part 0 the mesh, part 1
 !> the bodies). The .pvd is rewritten after every record, so a run that
 !> stops keeps a collection ParaView opens.
@@ -14,6 +15,7 @@ module flexmbs_io_vtk_sink
     use flexmbs_dae_sink, only: sink_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_mbs_rotation, only: rotation_matrix
+    use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     implicit none
     private
 
@@ -22,6 +24,8 @@ module flexmbs_io_vtk_sink
         type(flexible_body_t), pointer :: body => null() !! none: rigid bodies only
         integer :: oq = 0, ov = 0     !! the body's q and v in y
         integer :: bodies = 0         !! rigid bodies: (r, p) at y(7 b − 6 : 7 b)
+        type(rigid_chain_t), pointer :: chain => null() !! its links after them
+        integer :: chain_q = 0        !! the chain's coordinates in y
         integer :: records = 0
         real(wp), allocatable :: times(:)
     contains
@@ -40,7 +44,7 @@ contains
         self%records = self%records + 1
         stem = self%prefix // '_' // digits(self%records - 1)
         if (associated(self%body)) call write_mesh(self, y, stem // '.vtu', status)
-        if (status%ok() .and. self%bodies > 0) call write_bodies(self, y, &
+        if (status%ok() .and. self%bodies + links(self) > 0) call write_bodies(self, y, &
             self%prefix // '_bodies_' // digits(self%records - 1) // '.vtu', status)
         if (.not. status%ok()) return
         if (.not. allocated(self%times)) allocate (self%times(0))
@@ -131,29 +135,37 @@ contains
         real(wp), intent(in) :: y(:)
         character(len=*), intent(in) :: path
         type(status_t), intent(inout) :: status
-        real(wp) :: a(3, 3)
-        integer :: unit, ios, b, k
-        call open_grid(path, self%bodies, self%bodies, unit, status)
-        if (.not. status%ok()) return
+        real(wp) :: a(3, 3), centre(3, self%bodies + links(self)), &
+            axes(3, 3, self%bodies + links(self))
+        integer :: unit, ios, b, k, n
+        n = self%bodies + links(self)
         do b = 1, self%bodies
-            write (unit, '(3es24.15e3)') y(7 * b - 6:7 * b - 4)
+            centre(:, b) = y(7 * b - 6:7 * b - 4)
+            axes(:, :, b) = rotation_matrix(y(7 * b - 3:7 * b))
         end do
+        do b = 1, links(self)
+            associate (ch => self%chain, c => centre(:, self%bodies + b))
+                call ch%body_frame(y(self%chain_q + 1:self%chain_q + ch%nq), b, c, a)
+                c = c + matmul(a, ch%bodies(b)%centre)
+                axes(:, :, self%bodies + b) = a
+            end associate
+        end do
+        call open_grid(path, n, n, unit, status)
+        if (.not. status%ok()) return
+        write (unit, '(3es24.15e3)') centre
         write (unit, '(a)') '</DataArray></Points>'
         write (unit, '(a)') '<Cells><DataArray type="Int64" Name="connectivity" format="ascii">'
-        write (unit, '(*(1x,i0))') (b - 1, b=1, self%bodies)
+        write (unit, '(*(1x,i0))') (b - 1, b=1, n)
         write (unit, '(a)') '</DataArray><DataArray type="Int64" Name="offsets" format="ascii">'
-        write (unit, '(*(1x,i0))') (b, b=1, self%bodies)
+        write (unit, '(*(1x,i0))') (b, b=1, n)
         write (unit, '(a)') '</DataArray><DataArray type="UInt8" Name="types" format="ascii">'
-        write (unit, '(*(1x,i0))') (1, b=1, self%bodies)
+        write (unit, '(*(1x,i0))') (1, b=1, n)
         write (unit, '(a)') '</DataArray></Cells>'
         write (unit, '(a)') '<PointData>'
         do k = 1, 3
             write (unit, '(a)') '<DataArray type="Float64" Name="axis_' // &
                 achar(iachar('x') + k - 1) // '" NumberOfComponents="3" format="ascii">'
-            do b = 1, self%bodies
-                a = rotation_matrix(y(7 * b - 3:7 * b))
-                write (unit, '(3es24.15e3)') a(:, k)
-            end do
+            write (unit, '(3es24.15e3)') (axes(:, k, b), b=1, n)
             write (unit, '(a)') '</DataArray>'
         end do
         write (unit, '(a)') '</PointData>'
@@ -161,6 +173,13 @@ contains
         close (unit, iostat=ios)
         if (ios /= 0) call status%set(status_io_error, path // ': cannot close')
     end subroutine write_bodies
+
+    !> Links of the chain (none without one).
+    pure integer function links(self)
+        class(vtk_sink_t), intent(in) :: self
+        links = 0
+        if (associated(self%chain)) links = size(self%chain%bodies)
+    end function links
 
     !> Open an unstructured-grid file and write up to its points' values.
     subroutine open_grid(path, npoints, ncells, unit, status)
@@ -206,7 +225,7 @@ contains
             if (associated(self%body)) write (unit, '(a)') '<DataSet timestep="' // &
                 trim(adjustl(tbuf)) // '" part="0" file="' // base // '_' // digits(k - 1) // &
                 '.vtu"/>'
-            if (self%bodies > 0) write (unit, '(a)') '<DataSet timestep="' // &
+            if (self%bodies + links(self) > 0) write (unit, '(a)') '<DataSet timestep="' // &
                 trim(adjustl(tbuf)) // '" part="1" file="' // base // '_bodies_' // &
                 digits(k - 1) // '.vtu"/>'
         end do
