@@ -849,11 +849,15 @@ contains
         !> 1/h) stopped tight runs at t0 (the four-bar below 1e-7).
         real(wp) function newton_norm(v)
             real(wp), intent(in) :: v(:)
+            integer :: i
             if (.not. any(scaled)) then
                 newton_norm = vnorm(v)
                 return
             end if
-            ytmp = merge(abs(h) * v, v, scaled)
+            do i = 1, n
+                ytmp(i) = v(i)
+                if (scaled(i)) ytmp(i) = abs(h) * v(i)
+            end do
             newton_norm = vnorm(ytmp)
         end function newton_norm
 

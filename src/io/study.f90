@@ -121,26 +121,16 @@ contains
 
         call read_study_scene(study, base, status)
         if (.not. status%ok()) return
-        call configure(base, trim(study%reference_solver), study%reference_tolerance, '', &
-                       base%pmax, '', scene)
-        call run_scene(scene, quiet, ref, status, rec)
-        if (.not. status%ok()) then
-            call status%set(status%code, study%path // ': reference run (' // &
-                trim(study%reference_solver) // ') failed: ' // status%text(), status%reason)
-            return
-        end if
+        call one_run('reference', trim(study%reference_solver), study%reference_tolerance, &
+                     ref, rec)
+        if (.not. status%ok()) return
         log = 'reference: ' // ref%solver_name // ' at ' // real_text(study%reference_tolerance) &
             // ': ' // ref%stats%summary() // nl
         check_text = 'none'
         if (len_trim(study%check_solver) > 0) then
-            call configure(base, trim(study%check_solver), study%check_tolerance, '', &
-                           base%pmax, '', scene)
-            call run_scene(scene, quiet, chk, status, rec_check)
-            if (.not. status%ok()) then
-                call status%set(status%code, study%path // ': check run (' // &
-                    trim(study%check_solver) // ') failed: ' // status%text(), status%reason)
-                return
-            end if
+            call one_run('check', trim(study%check_solver), study%check_tolerance, chk, &
+                         rec_check)
+            if (.not. status%ok()) return
             if (rec_check%records /= rec%records) then
                 call status%set(status_solver_failure, study%path // ': the check run has ' &
                     // int_text(rec_check%records) // ' output records, the reference ' // &
@@ -182,6 +172,21 @@ contains
         end if
         log = log // 'written: ' // study%reference_file // ' (' // int_text(rec%records) // &
             ' output times)' // nl
+
+    contains
+
+        !> The scene with `solver` at rtol = atol = tol, recorded; a failure
+        !> says which run (`what`) failed.
+        subroutine one_run(what, solver, tol, result, rec)
+            character(len=*), intent(in) :: what, solver
+            real(wp), intent(in) :: tol
+            type(run_result_t), intent(out) :: result
+            type(record_sink_t), intent(inout) :: rec
+            call configure(base, solver, tol, '', base%pmax, '', scene)
+            call run_scene(scene, quiet, result, status, rec)
+            if (.not. status%ok()) call status%set(status%code, study%path // ': ' // what // &
+                ' run (' // solver // ') failed: ' // status%text(), status%reason)
+        end subroutine one_run
     end subroutine make_reference
 
     !> /time and /y of a trajectory file.
@@ -277,13 +282,8 @@ contains
         real(wp), allocatable :: t_ref(:), y_ref(:, :)
         integer :: k, njobs
 
-        call read_study_scene(study, base, status)
+        call prepare_sweep(study, base, t_ref, y_ref, points, status)
         if (.not. status%ok()) return
-        ! the step limit is the sweep's (not the reference's)
-        if (study%max_steps > 0) base%max_steps = study%max_steps
-        call read_reference(study%reference_file, t_ref, y_ref, status)
-        if (.not. status%ok()) return
-        call sweep_points(study, base, points)
         njobs = 1
         if (present(jobs)) njobs = jobs
         allocate (runs(size(points)))
@@ -304,6 +304,22 @@ contains
                                                    study%layout == 'table2')
     end subroutine run_sweep
 
+    !> What every sweep starts from: the study's scene with the sweep's step
+    !> limit (not the reference's), the reference, the grid's points.
+    subroutine prepare_sweep(study, base, t_ref, y_ref, points, status)
+        type(study_input_t), intent(in) :: study
+        type(scene_input_t), intent(out) :: base
+        real(wp), allocatable, intent(out) :: t_ref(:), y_ref(:, :)
+        type(sweep_point_t), allocatable, intent(out) :: points(:)
+        type(status_t), intent(out) :: status
+        call read_study_scene(study, base, status)
+        if (.not. status%ok()) return
+        if (study%max_steps > 0) base%max_steps = study%max_steps
+        call read_reference(study%reference_file, t_ref, y_ref, status)
+        if (.not. status%ok()) return
+        call sweep_points(study, base, points)
+    end subroutine prepare_sweep
+
     !> Point k of the study's grid alone (the child of a parallel sweep):
     !> `line` is its record (record_line).
     subroutine run_sweep_point(study, k, line, status)
@@ -314,13 +330,8 @@ contains
         type(scene_input_t) :: base
         type(sweep_point_t), allocatable :: points(:)
         real(wp), allocatable :: t_ref(:), y_ref(:, :)
-        call read_study_scene(study, base, status)
+        call prepare_sweep(study, base, t_ref, y_ref, points, status)
         if (.not. status%ok()) return
-        ! the step limit is the sweep's (not the reference's)
-        if (study%max_steps > 0) base%max_steps = study%max_steps
-        call read_reference(study%reference_file, t_ref, y_ref, status)
-        if (.not. status%ok()) return
-        call sweep_points(study, base, points)
         if (k < 1 .or. k > size(points)) then
             call status%set(status_bad_input, study%path // ': --point ' // int_text(k) // &
                 ': the grid has points 1 .. ' // int_text(size(points)))
