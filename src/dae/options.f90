@@ -23,6 +23,11 @@ module flexmbs_dae_options
         !> Fill-reducing ordering of KLU: 'auto' (AMD, nested dissection for
         !> large matrices on which AMD predicts much fill), 'amd' or 'nd'.
         character(len=8) :: sparse_ordering = 'auto'
+        !> Dense LU in the classic elimination order (column by column,
+        !> unblocked) instead of LAPACK's: round-off then does not depend on
+        !> the BLAS build. The classic faces set it to repeat the original
+        !> programs' counters on round-off-sensitive problems.
+        logical :: classic_lu = .false.
         real(wp), allocatable :: output_times(:)   !! dense output at these times
         logical :: output_steps = .false.          !! also every accepted step
     contains

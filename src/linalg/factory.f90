@@ -20,7 +20,8 @@ contains
     !> neither; negative = found by init) fix the bandwidths. Call
     !> `solver%init(mass, jac, status)` next. `ordering` ('auto' | 'amd' | 'nd',
     !> default 'auto') is KLU's fill-reducing ordering.
-    subroutine new_linear_solver(name, n, jac_storage, solver, status, lower, upper, ordering)
+    subroutine new_linear_solver(name, n, jac_storage, solver, status, lower, upper, ordering, &
+            classic_order)
         character(len=*), intent(in) :: name        !! 'auto' | 'dense' | 'klu' | 'band'
         integer, intent(in) :: n                    !! order of the iteration matrix
         integer, intent(in) :: jac_storage          !! storage_* of the Jacobian
@@ -29,6 +30,9 @@ contains
         integer, intent(in), optional :: lower      !! lower bandwidth for 'band'
         integer, intent(in), optional :: upper      !! upper bandwidth for 'band'
         character(len=*), intent(in), optional :: ordering !! KLU: 'auto' | 'amd' | 'nd'
+        !> dense: the classic elimination order, not LAPACK's (dense_solver_t)
+        logical, intent(in), optional :: classic_order
+        type(dense_solver_t), allocatable :: dense
         type(band_solver_t), allocatable :: band
         type(klu_solver_t), allocatable :: klu
         integer :: order
@@ -58,7 +62,9 @@ contains
                 allocate (dense_solver_t :: solver)
             end if
         case ('dense')
-            allocate (dense_solver_t :: solver)
+            allocate (dense)
+            if (present(classic_order)) dense%classic_order = classic_order
+            call move_alloc(dense, solver)
         case ('klu')
             ! KLU factors J as given; a difference Jacobian has no storage yet.
             if (jac_storage /= storage_sparse .and. jac_storage /= storage_dense) then

@@ -233,6 +233,7 @@ contains
             options%jacobian = 'analytic'
             if (info(5) == 0) options%jacobian = 'fd'
             options%linear_solver = 'dense'
+            options%classic_lu = .true.
             if (info(6) == 1) then
                 options%linear_solver = 'band'
                 options%band_lower = ml
