@@ -29,7 +29,8 @@ module flexmbs_dae_mexax
         reason_non_finite, reason_projection, reason_user_function, reason_det_f
     use flexmbs_core_text, only: real_text, int_text
     use flexmbs_core_timer, only: timer_t
-    use flexmbs_linalg_dense, only: dense_lu_factor, dense_lu_solve
+    use flexmbs_linalg_dense, only: dense_lu_factor, dense_lu_solve, classic_lu_factor, &
+        classic_lu_solve
     use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_linalg_klu, only: klu_factor_t, klu_ordering_auto
     use flexmbs_linalg_factory, only: klu_ordering_code
@@ -94,6 +95,10 @@ module flexmbs_dae_mexax
     integer, parameter :: stability_columns = 2
     ! §3.3/§3.5/§3.8: divergence, instability and non-finite values halve H.
     real(wp), parameter :: restart_factor = 0.5_wp
+    ! §3.5 [R counting]: a restart counts in NREJCT as well as in NSTEP,
+    ! calibrated on the §8 chain anchor, where the original's NSTEP equals
+    ! NACCPT + NREJCT at every tolerance (published: NSTEP only).
+    logical, parameter :: restart_is_rejection = .true.
     ! §3.8 [R]: stop when |H| ≤ 10 EPMACH |t| (the original's EPMACH = 1e-17);
     ! |t_end − t0| stands in for |t| near t = 0, where the rule never fires.
     real(wp), parameter :: epmach = 1.0e-17_wp, small_step_factor = 10.0_wp
@@ -138,7 +143,7 @@ module flexmbs_dae_mexax
         logical :: consistent_accelerations = .true.
         type(mexax_native_t) :: native
         integer :: nstab = 0        !! restarts by the stability check, divergence, NaN/Inf
-        integer :: nprj_reject = 0  !! rejections by the projection test (native counts 2 each)
+        integer :: nprj_reject = 0  !! rejections by the projection test (the classic face counts 2 each)
         real(wp) :: h_next = 0.0_wp !! proposed next step (classic H on return)
         integer :: column = 0       !! column used next (k)
         integer :: failed_in = mexax_failed_none !! mexax_failed_step | _projection
@@ -171,6 +176,7 @@ module flexmbs_dae_mexax
         ! augmented matrix: dense (LAPACK) in kmat, or sparse (KLU) in kpat, whose
         ! triplets are M's slots, then Gᵀ's, then G's (see setup_sparse)
         logical :: sparse = .false.
+        logical :: classic_lu = .false. !! dense LU in the classic elimination order (options)
         real(wp), allocatable :: kmat(:, :)
         type(csc_matrix_t) :: mpat, gpat, kpat
         type(klu_factor_t) :: klu
@@ -304,6 +310,7 @@ contains
         call setup_workspace(w, problem, self%base, km, options%linear_solver, status, &
             options%sparse_ordering)
         if (.not. status%ok()) return
+        w%classic_lu = options%classic_lu
         call options%tolerances(w%rtol, w%atol)
         allocate (yout(w%nq + w%nv + w%nc))
         w%p0 = q
@@ -462,8 +469,9 @@ contains
             case (do_stop)
                 exit main
             case (do_restart)
-                ! §3.3/§3.5: H/2, counted in NSTEP only.
+                ! §3.3/§3.5: H/2, counted in NSTEP and (calibrated) in NREJCT.
                 self%nstab = self%nstab + 1
+                if (restart_is_rejection) self%native%nrejct = self%native%nrejct + 1
                 h = h * restart_factor
                 reject = .true.
                 last = .false.
@@ -990,8 +998,13 @@ contains
     subroutine factor(w, status)
         type(workspace_t), intent(inout) :: w
         type(status_t), intent(out) :: status
+        integer :: info
         if (w%sparse) then
             call w%klu%refactor(w%kpat%values, status)
+        else if (w%classic_lu) then
+            call classic_lu_factor(w%kmat, w%ipiv, info)
+            if (info /= 0) call status%set(status_solver_failure, &
+                'dense LU: matrix is singular', reason_singular_matrix)
         else
             call dense_lu_factor(w%kmat, w%ipiv, status)
         end if
@@ -1005,6 +1018,8 @@ contains
         if (w%sparse) then
             ! fails only without a factorisation, which `factor` excluded
             call w%klu%solve(b, lst)
+        else if (w%classic_lu) then
+            call classic_lu_solve(w%kmat, w%ipiv, b)
         else
             call dense_lu_solve(w%kmat, w%ipiv, b)
         end if

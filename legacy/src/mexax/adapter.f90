@@ -146,6 +146,7 @@ contains
         end if
         options%h0 = abs(h)
         options%max_steps = nmax
+        options%classic_lu = .true.
         solver%max_extrapolation = kdmax
         solver%base = merge(mexax_base_midpoint, mexax_base_euler, mxjob(slot_base) == 1)
         ! the original's a and λ: extrapolated, no extra decomposition a step
