@@ -20,7 +20,7 @@ program flexmbs_main
     use flexmbs_io_namelist, only: study_input_t, read_study
     use flexmbs_io_study, only: make_reference, run_sweep, run_sweep_point, sweep_run_t, &
         read_reference
-    use flexmbs_io_table, only: table_text, table2_text, table_markdown, stats_row_t
+    use flexmbs_io_table, only: layout_text, table_markdown, stats_row_t
     implicit none
 
     character(len=*), parameter :: version = '0.1.0'
@@ -167,11 +167,8 @@ contains
                 write (output_unit, '(a)') runs(k)%summary
             end do
             rows = runs%row
-            if (study%layout == 'table2') then
-                write (output_unit, '(a)', advance='no') table2_text(rows, table_markdown)
-            else
-                write (output_unit, '(a)', advance='no') table_text(rows, table_markdown)
-            end if
+            write (output_unit, '(a)', advance='no') layout_text(rows, table_markdown, &
+                trim(study%layout))
             write (output_unit, '(i0,a,i0,a)') count(runs%ok), ' runs finished, ', &
                 count(.not. runs%ok), ' failed'
             if (len(study%table) > 0 .and. status%ok()) &

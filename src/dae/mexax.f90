@@ -29,8 +29,7 @@ module flexmbs_dae_mexax
         reason_non_finite, reason_projection, reason_user_function, reason_det_f
     use flexmbs_core_text, only: real_text, int_text
     use flexmbs_core_timer, only: timer_t
-    use flexmbs_linalg_dense, only: dense_lu_factor, dense_lu_solve, classic_lu_factor, &
-        classic_lu_solve
+    use flexmbs_linalg_dense, only: dense_lu_factor, dense_lu_solve
     use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_linalg_klu, only: klu_factor_t, klu_ordering_auto
     use flexmbs_linalg_factory, only: klu_ordering_code
@@ -998,15 +997,10 @@ contains
     subroutine factor(w, status)
         type(workspace_t), intent(inout) :: w
         type(status_t), intent(out) :: status
-        integer :: info
         if (w%sparse) then
             call w%klu%refactor(w%kpat%values, status)
-        else if (w%classic_lu) then
-            call classic_lu_factor(w%kmat, w%ipiv, info)
-            if (info /= 0) call status%set(status_solver_failure, &
-                'dense LU: matrix is singular', reason_singular_matrix)
         else
-            call dense_lu_factor(w%kmat, w%ipiv, status)
+            call dense_lu_factor(w%kmat, w%ipiv, status, w%classic_lu)
         end if
     end subroutine factor
 
@@ -1018,10 +1012,8 @@ contains
         if (w%sparse) then
             ! fails only without a factorisation, which `factor` excluded
             call w%klu%solve(b, lst)
-        else if (w%classic_lu) then
-            call classic_lu_solve(w%kmat, w%ipiv, b)
         else
-            call dense_lu_solve(w%kmat, w%ipiv, b)
+            call dense_lu_solve(w%kmat, w%ipiv, b, w%classic_lu)
         end if
     end subroutine solve
 

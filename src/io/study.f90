@@ -301,7 +301,7 @@ contains
         end if
         rows = runs%row
         if (len(study%table) > 0) call write_table(study%table, rows, status, &
-                                                   study%layout == 'table2')
+                                                   trim(study%layout))
     end subroutine run_sweep
 
     !> What every sweep starts from: the study's scene with the sweep's step

@@ -37,7 +37,7 @@ module flexmbs_io_table
         real(wp) :: cpu_unit = 0.0_wp
     end type stats_row_t
 
-    public :: new_stats_row, table_format, table_text, table2_text, write_table
+    public :: new_stats_row, table_format, table_text, table2_text, layout_text, write_table
 
 contains
 
@@ -107,6 +107,7 @@ contains
             cells(1, k)%s = trim(names(k))
         end do
         do i = 1, size(rows)
+            ! fill_cells' columns: 1 solver, 4 ERR, 5 NST, 8 NJE, 9 CPU
             call fill_cells(rows(i), format, run)
             cells(i + 1, 0)%s = run(1)%s
             cells(i + 1, 1)%s = run(4)%s
@@ -122,6 +123,20 @@ contains
         flags(1) = .false.
         text = render(cells, flags, format)
     end function table2_text
+
+    !> The table in a study's layout: 'table2' (table2_text), otherwise the
+    !> row per run of table_text.
+    function layout_text(rows, format, layout) result(text)
+        type(stats_row_t), intent(in) :: rows(:)
+        integer, intent(in) :: format
+        character(len=*), intent(in) :: layout !! 'table3' | 'table2'
+        character(len=:), allocatable :: text
+        if (layout == 'table2') then
+            text = table2_text(rows, format)
+        else
+            text = table_text(rows, format)
+        end if
+    end function layout_text
 
     !> Cells (column, row 0 = header) as Markdown, CSV or LaTeX; numeric
     !> columns right-aligned.
@@ -199,11 +214,11 @@ contains
     end function render
 
     !> Write the table to `path` in the format of its extension.
-    subroutine write_table(path, rows, status, table2)
+    subroutine write_table(path, rows, status, layout)
         character(len=*), intent(in) :: path
         type(stats_row_t), intent(in) :: rows(:)
         type(status_t), intent(out) :: status
-        logical, intent(in), optional :: table2 !! the Table 2 layout (table2_text)
+        character(len=*), intent(in), optional :: layout !! layout_text's; default 'table3'
         integer :: format, unit, ios
         character(len=256) :: msg
         format = table_format(path)
@@ -215,12 +230,8 @@ contains
         open (newunit=unit, file=path, access='stream', form='unformatted', &
               status='replace', action='write', iostat=ios, iomsg=msg)
         if (ios == 0) then
-            if (present(table2)) then
-                if (table2) then
-                    write (unit, iostat=ios, iomsg=msg) table2_text(rows, format)
-                else
-                    write (unit, iostat=ios, iomsg=msg) table_text(rows, format)
-                end if
+            if (present(layout)) then
+                write (unit, iostat=ios, iomsg=msg) layout_text(rows, format, layout)
             else
                 write (unit, iostat=ios, iomsg=msg) table_text(rows, format)
             end if

@@ -131,12 +131,7 @@ contains
     subroutine dense_solve_real(self, b)
         class(dense_solver_t), intent(inout) :: self
         real(wp), intent(inout) :: b(:)
-        integer :: info
-        if (self%classic_order) then
-            call classic_lu_solve(self%a, self%ipiv, b)
-        else
-            call dgetrs('N', self%n, 1, self%a, self%n, self%ipiv, b, self%n, info)
-        end if
+        call dense_lu_solve(self%a, self%ipiv, b, self%classic_order)
     end subroutine dense_solve_real
 
     subroutine dense_solve_complex(self, b)
@@ -152,25 +147,43 @@ contains
         name = 'dense'
     end function dense_name
 
-    !> Plain LU of a general dense matrix in place (pivots in ipiv).
-    subroutine dense_lu_factor(a, ipiv, status)
+    !> Plain LU of a general dense matrix in place (pivots in ipiv); with
+    !> `classic_order`, by `classic_lu_factor` instead of LAPACK.
+    subroutine dense_lu_factor(a, ipiv, status, classic_order)
         real(wp), intent(inout) :: a(:, :)
         integer, intent(out) :: ipiv(:)
         type(status_t), intent(out) :: status
+        logical, intent(in), optional :: classic_order
         integer :: info
-        call dgetrf(size(a, 1), size(a, 2), a, size(a, 1), ipiv, info)
+        if (optional_true(classic_order)) then
+            call classic_lu_factor(a, ipiv, info)
+        else
+            call dgetrf(size(a, 1), size(a, 2), a, size(a, 1), ipiv, info)
+        end if
         if (info /= 0) call status%set(status_solver_failure, 'dense LU: matrix is singular', &
             reason_singular_matrix)
     end subroutine dense_lu_factor
 
-    !> Solve with a factor from dense_lu_factor, b overwritten.
-    subroutine dense_lu_solve(a, ipiv, b)
+    !> Solve with a factor from dense_lu_factor (the same `classic_order`),
+    !> b overwritten.
+    subroutine dense_lu_solve(a, ipiv, b, classic_order)
         real(wp), intent(in) :: a(:, :)
         integer, intent(in) :: ipiv(:)
         real(wp), intent(inout) :: b(:)
+        logical, intent(in), optional :: classic_order
         integer :: info
-        call dgetrs('N', size(a, 1), 1, a, size(a, 1), ipiv, b, size(a, 1), info)
+        if (optional_true(classic_order)) then
+            call classic_lu_solve(a, ipiv, b)
+        else
+            call dgetrs('N', size(a, 1), 1, a, size(a, 1), ipiv, b, size(a, 1), info)
+        end if
     end subroutine dense_lu_solve
+
+    pure logical function optional_true(flag)
+        logical, intent(in), optional :: flag
+        optional_true = .false.
+        if (present(flag)) optional_true = flag
+    end function optional_true
 
     !> Gaussian elimination with partial pivoting in the classic column
     !> order (Golub & Van Loan's kji form, as LINPACK's factoriser): at step
