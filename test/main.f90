@@ -38,6 +38,7 @@ program flexmbs_tests
     use test_node_frame, only: collect_node_frame
     use test_study, only: collect_study
     use test_chain_coupling, only: collect_chain_coupling
+    use test_sparse_formulation, only: collect_sparse_formulation
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -83,6 +84,8 @@ program flexmbs_tests
     call run_suite('flexible_coupling', collect_flexible_coupling(), filter, npassed, &
                    nfailed)
     call run_suite('chain_coupling', collect_chain_coupling(), filter, npassed, nfailed)
+    call run_suite('sparse_formulation', collect_sparse_formulation(), filter, npassed, &
+                   nfailed)
     call run_suite('node_frame', collect_node_frame(), filter, npassed, nfailed)
     call run_suite('study', collect_study(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'

@@ -17,12 +17,30 @@
 !> the `*_derivative(s)` bindings with analytic ones; the defaults difference
 !> the base bindings by forward differences (step sqrt(eps) max(1, |x_j|)),
 !> one evaluation per column, so they are accurate to about sqrt(eps).
+!>
+!> Large models (flexible bodies) also provide those derivatives sparse
+!> (`has_sparse_derivatives` true): `derivative_patterns` reports the fixed
+!> CSC patterns of every block once (mechanical_patterns_t), and the
+!> `*_sparse` bindings refill their values in place. The formulations then
+!> assemble a sparse ∂F/∂y without any n x n array.
 module flexmbs_dae_mechanical_problem
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_linalg_csc, only: csc_matrix_t
     implicit none
     private
+
+    !> The fixed CSC patterns of a mechanical problem's blocks (values unused).
+    type, public :: mechanical_patterns_t
+        type(csc_matrix_t) :: mass           !! M, nv x nv
+        type(csc_matrix_t) :: constraint_v   !! G and ∂γ/∂v, nc x nv
+        type(csc_matrix_t) :: constraint_q   !! g_q, ∂(G w)/∂q, ∂g_I/∂q, ∂γ/∂q, nc x nq
+        type(csc_matrix_t) :: reaction_q     !! ∂(Gᵀλ)/∂q, nv x nq
+        type(csc_matrix_t) :: kinematics     !! T, nq x nv
+        type(csc_matrix_t) :: kinematics_q   !! ∂(T w)/∂q, nq x nq
+        type(csc_matrix_t) :: force_q        !! ∂f/∂q and ∂(M w)/∂q, nv x nq
+        type(csc_matrix_t) :: force_v        !! ∂f/∂v, nv x nv
+    end type mechanical_patterns_t
 
     type, abstract, public :: mechanical_problem_t
         integer :: nq = 0 !! positions
@@ -51,6 +69,20 @@ module flexmbs_dae_mechanical_problem
         procedure :: constraint_time_derivative_jacobian => &
             default_constraint_time_derivative_jacobian
         procedure :: constraint_curvature_derivatives => default_constraint_curvature_derivatives
+        procedure :: has_sparse_derivatives => default_has_sparse_derivatives
+        procedure :: derivative_patterns => default_derivative_patterns
+        procedure :: kinematics_sparse => default_kinematics_sparse
+        procedure :: kinematics_derivative_sparse => default_kinematics_derivative_sparse
+        procedure :: mass_derivative_sparse => default_mass_derivative_sparse
+        procedure :: force_derivatives_sparse => default_force_derivatives_sparse
+        procedure :: constraint_position_jacobian_sparse => &
+            default_constraint_position_jacobian_sparse
+        procedure :: constraint_jacobian_derivatives_sparse => &
+            default_constraint_jacobian_derivatives_sparse
+        procedure :: constraint_time_derivative_jacobian_sparse => &
+            default_constraint_time_derivative_jacobian_sparse
+        procedure :: constraint_curvature_derivatives_sparse => &
+            default_constraint_curvature_derivatives_sparse
     end type mechanical_problem_t
 
     abstract interface
@@ -339,4 +371,112 @@ contains
         values = 0.0_wp
         call status%set(status_bad_input, 'mechanical problem has no sparse constraint Jacobian')
     end subroutine default_constraint_jacobian_sparse
+    ! ------------------------------------------------ sparse derivatives
+
+    !> True when `derivative_patterns` and every `*_sparse` binding below
+    !> are provided (and has_sparse, for M and G).
+    logical function default_has_sparse_derivatives(self)
+        class(mechanical_problem_t), intent(in) :: self
+        default_has_sparse_derivatives = .false.
+    end function default_has_sparse_derivatives
+
+    !> The patterns of every block (called once per formulation).
+    subroutine default_derivative_patterns(self, patterns, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        type(mechanical_patterns_t), intent(inout) :: patterns
+        type(status_t), intent(inout) :: status
+        call not_sparse(status, 'derivative patterns')
+    end subroutine default_derivative_patterns
+
+    !> Values of T(t, q) (pattern `kinematics`).
+    subroutine default_kinematics_sparse(self, t, q, values, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        values = 0.0_wp
+        call not_sparse(status, 'T')
+    end subroutine default_kinematics_sparse
+
+    !> Values of ∂(T w)/∂q (pattern `kinematics_q`).
+    subroutine default_kinematics_derivative_sparse(self, t, q, w, values, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        values = 0.0_wp
+        call not_sparse(status, 'd(T w)/dq')
+    end subroutine default_kinematics_derivative_sparse
+
+    !> Values of ∂(M w)/∂q (pattern `force_q`).
+    subroutine default_mass_derivative_sparse(self, t, q, w, values, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        values = 0.0_wp
+        call not_sparse(status, 'd(M w)/dq')
+    end subroutine default_mass_derivative_sparse
+
+    !> Values of ∂f/∂q (pattern `force_q`) and ∂f/∂v (pattern `force_v`).
+    subroutine default_force_derivatives_sparse(self, t, q, v, fq, fv, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: fq(:), fv(:)
+        type(status_t), intent(inout) :: status
+        fq = 0.0_wp
+        fv = 0.0_wp
+        call not_sparse(status, 'df/dq, df/dv')
+    end subroutine default_force_derivatives_sparse
+
+    !> Values of g_q (pattern `constraint_q`).
+    subroutine default_constraint_position_jacobian_sparse(self, t, q, values, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        values = 0.0_wp
+        call not_sparse(status, 'g_q')
+    end subroutine default_constraint_position_jacobian_sparse
+
+    !> Values of ∂(G w)/∂q (pattern `constraint_q`) and ∂(Gᵀλ)/∂q (pattern
+    !> `reaction_q`).
+    subroutine default_constraint_jacobian_derivatives_sparse(self, t, q, w, lambda, gwq, &
+                                                              gtlq, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:), lambda(:)
+        real(wp), intent(out) :: gwq(:), gtlq(:)
+        type(status_t), intent(inout) :: status
+        gwq = 0.0_wp
+        gtlq = 0.0_wp
+        call not_sparse(status, 'd(G w)/dq, d(G^T lambda)/dq')
+    end subroutine default_constraint_jacobian_derivatives_sparse
+
+    !> Values of ∂g_I/∂q (pattern `constraint_q`).
+    subroutine default_constraint_time_derivative_jacobian_sparse(self, t, q, values, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        values = 0.0_wp
+        call not_sparse(status, 'dg_I/dq')
+    end subroutine default_constraint_time_derivative_jacobian_sparse
+
+    !> Values of ∂γ/∂q (pattern `constraint_q`) and ∂γ/∂v (pattern
+    !> `constraint_v`).
+    subroutine default_constraint_curvature_derivatives_sparse(self, t, q, v, gq, gv, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: gq(:), gv(:)
+        type(status_t), intent(inout) :: status
+        gq = 0.0_wp
+        gv = 0.0_wp
+        call not_sparse(status, 'dgamma/dq, dgamma/dv')
+    end subroutine default_constraint_curvature_derivatives_sparse
+
+    subroutine not_sparse(status, what)
+        type(status_t), intent(inout) :: status
+        character(len=*), intent(in) :: what
+        call status%set(status_bad_input, 'mechanical problem provides no sparse ' // what)
+    end subroutine not_sparse
 end module flexmbs_dae_mechanical_problem

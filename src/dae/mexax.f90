@@ -30,7 +30,7 @@ module flexmbs_dae_mexax
     use flexmbs_core_text, only: real_text, int_text
     use flexmbs_core_timer, only: timer_t
     use flexmbs_linalg_dense, only: dense_lu_factor, dense_lu_solve
-    use flexmbs_linalg_csc, only: csc_matrix_t
+    use flexmbs_linalg_csc, only: csc_matrix_t, pattern_matvec
     use flexmbs_linalg_klu, only: klu_factor_t, klu_ordering_auto
     use flexmbs_linalg_factory, only: klu_ordering_code
     use flexmbs_dae_problem, only: dae_problem_t
@@ -1415,26 +1415,11 @@ contains
         real(wp), intent(in) :: x(:)
         real(wp), intent(out) :: y(:)
         if (w%sparse) then
-            call sparse_matvec(pat, b%values, x, y)
+            call pattern_matvec(pat, b%values, x, y)
         else
             call matvec(b%dense, x, y)
         end if
     end subroutine block_times
-
-    !> y = A x, A the pattern `pat` with the given slot values.
-    pure subroutine sparse_matvec(pat, values, x, y)
-        type(csc_matrix_t), intent(in) :: pat
-        real(wp), intent(in) :: values(:), x(:)
-        real(wp), intent(out) :: y(:)
-        integer :: j
-        integer(i8) :: p
-        y = 0.0_wp
-        do j = 1, pat%ncol
-            do p = pat%colptr(j) + 1, pat%colptr(j + 1)
-                y(pat%rowind(p) + 1) = y(pat%rowind(p) + 1) + values(p) * x(j)
-            end do
-        end do
-    end subroutine sparse_matvec
 
     !> y = a x without temporaries.
     pure subroutine matvec(a, x, y)

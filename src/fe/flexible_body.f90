@@ -13,7 +13,7 @@ module flexmbs_fe_flexible_body
     use flexmbs_core_text, only: int_text
     !$ use omp_lib, only: omp_get_max_threads, omp_get_thread_num
     use flexmbs_linalg_csc, only: csc_matrix_t
-    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t, mechanical_patterns_t
     use flexmbs_fe_tensor, only: identity3
     use flexmbs_fe_hexahedron, only: hexahedron_t, new_hexahedron, reference_gradients, &
         deformation_gradient, nodal_gradient, max_nodes
@@ -60,6 +60,7 @@ module flexmbs_fe_flexible_body
         procedure :: constraint_jacobian => body_constraint_jacobian
         procedure :: internal_forces => body_internal_forces
         procedure :: tangents => body_tangents
+        procedure :: assemble_tangents => body_assemble_tangents
         procedure :: free_positions => body_free_positions
         procedure :: strain_energy => body_strain_energy
         procedure :: kinetic_energy => body_kinetic_energy
@@ -70,6 +71,21 @@ module flexmbs_fe_flexible_body
         procedure :: force_derivatives => body_force_derivatives
         procedure :: kinematics_derivative => body_kinematics_derivative
         procedure :: mass_derivative => body_mass_derivative
+        procedure :: has_sparse => body_has_sparse
+        procedure :: has_sparse_derivatives => body_has_sparse
+        procedure :: mass_pattern => body_mass_pattern
+        procedure :: mass_sparse => body_mass_sparse
+        procedure :: constraint_jacobian_pattern => body_constraint_jacobian_pattern
+        procedure :: constraint_jacobian_sparse => body_no_values
+        procedure :: constraint_position_jacobian_sparse => body_no_values
+        procedure :: constraint_time_derivative_jacobian_sparse => body_no_values
+        procedure :: derivative_patterns => body_derivative_patterns
+        procedure :: kinematics_sparse => body_kinematics_sparse
+        procedure :: kinematics_derivative_sparse => body_no_values_w
+        procedure :: mass_derivative_sparse => body_no_values_w
+        procedure :: force_derivatives_sparse => body_force_derivatives_sparse
+        procedure :: constraint_jacobian_derivatives_sparse => body_no_second_derivatives
+        procedure :: constraint_curvature_derivatives_sparse => body_no_curvature_derivatives
     end type flexible_body_t
 
     public :: new_flexible_body
@@ -451,6 +467,14 @@ contains
         call assemble(self, q, v, k, status, .false.)
     end subroutine body_internal_forces
 
+    !> ∂k/∂q, ∂k/∂v into self%stiffness, self%damping (k itself unused).
+    subroutine body_assemble_tangents(self, q, v, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        type(status_t), intent(out) :: status
+        call assemble(self, q, v, self%force_work, status, .true.)
+    end subroutine body_assemble_tangents
+
     !> k(q, v), and ∂k/∂q, ∂k/∂v into self%stiffness, self%damping.
     subroutine body_tangents(self, q, v, k, status)
         class(flexible_body_t), intent(inout) :: self
@@ -709,4 +733,111 @@ contains
         real(wp), intent(out) :: gmat(:, :)
         type(status_t), intent(inout) :: status
     end subroutine body_constraint_jacobian
+    ! ------------------------------------------------ sparse form (formulations)
+
+    logical function body_has_sparse(self)
+        class(flexible_body_t), intent(in) :: self
+        body_has_sparse = .true.
+    end function body_has_sparse
+
+    subroutine body_mass_pattern(self, pattern, status)
+        class(flexible_body_t), intent(inout) :: self
+        type(csc_matrix_t), intent(inout) :: pattern
+        type(status_t), intent(inout) :: status
+        pattern = self%mass_matrix
+    end subroutine body_mass_pattern
+
+    subroutine body_mass_sparse(self, t, q, values, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        values = self%mass_matrix%values
+    end subroutine body_mass_sparse
+
+    !> No constraint rows: an empty 0 x nv pattern.
+    subroutine body_constraint_jacobian_pattern(self, pattern, status)
+        class(flexible_body_t), intent(inout) :: self
+        type(csc_matrix_t), intent(inout) :: pattern
+        type(status_t), intent(inout) :: status
+        integer :: empty(0)
+        call pattern%build(0, self%nv, empty, empty, status)
+    end subroutine body_constraint_jacobian_pattern
+
+    !> Blocks without entries (no constraints, T = I constant).
+    subroutine body_no_values(self, t, q, values, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        values = 0.0_wp
+    end subroutine body_no_values
+
+    subroutine body_no_values_w(self, t, q, w, values, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        values = 0.0_wp
+    end subroutine body_no_values_w
+
+    subroutine body_no_second_derivatives(self, t, q, w, lambda, gwq, gtlq, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:), lambda(:)
+        real(wp), intent(out) :: gwq(:), gtlq(:)
+        type(status_t), intent(inout) :: status
+        gwq = 0.0_wp
+        gtlq = 0.0_wp
+    end subroutine body_no_second_derivatives
+
+    subroutine body_no_curvature_derivatives(self, t, q, v, gq, gv, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: gq(:), gv(:)
+        type(status_t), intent(inout) :: status
+        gq = 0.0_wp
+        gv = 0.0_wp
+    end subroutine body_no_curvature_derivatives
+
+    !> M; T = I; ∂f/∂q and ∂f/∂v on the tangent pattern; empty rest.
+    subroutine body_derivative_patterns(self, patterns, status)
+        class(flexible_body_t), intent(inout) :: self
+        type(mechanical_patterns_t), intent(inout) :: patterns
+        type(status_t), intent(inout) :: status
+        integer :: empty(0), i
+        integer, allocatable :: diag(:)
+        patterns%mass = self%mass_matrix
+        patterns%force_q = self%stiffness
+        patterns%force_v = self%damping
+        diag = [(i, i = 1, self%nv)]
+        call patterns%kinematics%build(self%nq, self%nv, diag, diag, status)
+        if (status%ok()) call patterns%kinematics_q%build(self%nq, self%nq, empty, empty, status)
+        if (status%ok()) call patterns%constraint_v%build(0, self%nv, empty, empty, status)
+        if (status%ok()) call patterns%constraint_q%build(0, self%nq, empty, empty, status)
+        if (status%ok()) call patterns%reaction_q%build(self%nv, self%nq, empty, empty, status)
+    end subroutine body_derivative_patterns
+
+    subroutine body_kinematics_sparse(self, t, q, values, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        values = 1.0_wp
+    end subroutine body_kinematics_sparse
+
+    !> −∂k/∂q and −∂k/∂v in the slots of the tangent pattern.
+    subroutine body_force_derivatives_sparse(self, t, q, v, fq, fv, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: fq(:), fv(:)
+        type(status_t), intent(inout) :: status
+        type(status_t) :: local
+        call assemble(self, q, v, self%force_work, local, .true.)
+        if (.not. local%ok()) then
+            status = local
+            return
+        end if
+        fq = -self%stiffness%values
+        fv = -self%damping%values
+    end subroutine body_force_derivatives_sparse
 end module flexmbs_fe_flexible_body

@@ -148,7 +148,7 @@ contains
             ! M is constant in absolute nodal coordinates: y = (q, v[, λ]).
             formulation = new_formulation(mechanical, &
                 mechanical_formulation(scene%body%formulation), q0, constant_mass=.true., &
-                status=status)
+                status=status, sparse=scene%linear_solver /= 'dense')
             if (.not. status%ok()) then
                 status%message = scene%path // ': &flexible_body: ' // status%message
                 return
@@ -177,7 +177,8 @@ contains
                 mechanical_formulation(scene%multibody%formulation), &
                 scene%solver_name == 'mexax'), q0, constant_mass=(size(scene%chain) == 0 &
                 .and. .not. massless) .or. scene%solver_name == 'mexax', &
-                projection=scene%multibody%projection, status=status)
+                projection=scene%multibody%projection, status=status, &
+                sparse=scene%linear_solver /= 'dense')
             if (.not. status%ok()) then
                 status%message = scene%path // ': &multibody: ' // status%message
                 return

@@ -10,6 +10,8 @@ module flexmbs_linalg_csc
     implicit none
     private
 
+    public :: pattern_matvec, pattern_matvec_transpose
+
     !> A sparse matrix in CSC form (0-based 64-bit indices).
     type, public :: csc_matrix_t
         integer :: nrow = 0
@@ -179,6 +181,39 @@ contains
             end if
         end do
     end function csc_find
+
+    !> y = A x, A the pattern `a` with the given slot values (a's own values
+    !> unused): for patterns shared by several value arrays.
+    pure subroutine pattern_matvec(a, values, x, y)
+        type(csc_matrix_t), intent(in) :: a
+        real(wp), intent(in) :: values(:) !! one per slot
+        real(wp), intent(in) :: x(:)      !! size ncol
+        real(wp), intent(out) :: y(:)     !! size nrow
+        integer :: j
+        integer(i8) :: p
+        y = 0.0_wp
+        do j = 1, a%ncol
+            do p = a%colptr(j) + 1, a%colptr(j + 1)
+                y(a%rowind(p) + 1) = y(a%rowind(p) + 1) + values(p) * x(j)
+            end do
+        end do
+    end subroutine pattern_matvec
+
+    !> y = Aᵀ x, A the pattern `a` with the given slot values.
+    pure subroutine pattern_matvec_transpose(a, values, x, y)
+        type(csc_matrix_t), intent(in) :: a
+        real(wp), intent(in) :: values(:) !! one per slot
+        real(wp), intent(in) :: x(:)      !! size nrow
+        real(wp), intent(out) :: y(:)     !! size ncol
+        integer :: j
+        integer(i8) :: p
+        do j = 1, a%ncol
+            y(j) = 0.0_wp
+            do p = a%colptr(j) + 1, a%colptr(j + 1)
+                y(j) = y(j) + values(p) * x(a%rowind(p) + 1)
+            end do
+        end do
+    end subroutine pattern_matvec_transpose
 
     !> True once a pattern exists.
     pure logical function csc_is_built(self)

@@ -21,7 +21,14 @@
 !> the range of T, so that invariants of q' = T w (a quaternion's unit length)
 !> are not disturbed by it. On the exact solution μ = 0 either way.
 !>
-!> Jacobians ∂F/∂y are dense and analytic in the unknowns that enter F
+!> Sparse path (`sparse` at construction, for problems that provide sparse
+!> derivative blocks: the multibody systems): ∂F/∂y, the DAE mass matrix and
+!> [M Gᵀ; G 0] are CSC values on patterns built once
+!> (flexmbs_mbs_formulation_sparse), and F uses sparse products with G and M;
+!> no n x n or nc x nq array is allocated. Index 1 in the constant-mass
+!> layout stays dense (its rows need M⁻¹).
+!>
+!> Dense Jacobians ∂F/∂y are analytic in the unknowns that enter F
 !> linearly (a, λ, μ and T's, G's and M's action on them); the derivatives in
 !> q and v come from the mechanical problem's `*_derivative(s)` bindings,
 !> which are analytic when the problem overrides them and forward differences
@@ -39,10 +46,12 @@ module flexmbs_mbs_formulation
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         reason_singular_matrix, reason_projection
-    use flexmbs_linalg_matrix, only: storage_dense
+    use flexmbs_linalg_matrix, only: storage_dense, storage_sparse
+    use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_linalg_lapack, only: dgetrf, dgetrs
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    use flexmbs_mbs_formulation_sparse, only: sparse_formulation_t, sparse_layout_t
     implicit none
     private
 
@@ -83,12 +92,18 @@ module flexmbs_mbs_formulation
         real(wp), allocatable :: kkt(:, :), kkt_rhs(:)
         integer, allocatable :: mass_pivots(:), kkt_pivots(:)
         logical :: mass_factored = .false.
+        logical :: sparse = .false.          !! the sparse path (module header)
+        type(sparse_formulation_t) :: sp
     contains
         procedure :: rhs => formulation_rhs
         procedure :: jacobian_storage => formulation_jacobian_storage
         procedure :: jacobian_dense => formulation_jacobian_dense
+        procedure :: jacobian_pattern => formulation_jacobian_pattern
+        procedure :: jacobian_sparse => formulation_jacobian_sparse
         procedure :: mass_storage => formulation_mass_storage
         procedure :: mass_dense => formulation_mass_dense
+        procedure :: mass_sparse => formulation_mass_sparse
+        procedure :: is_sparse => formulation_is_sparse
         procedure :: index_classes => formulation_index_classes
         procedure :: differential_flags => formulation_differential_flags
         procedure :: correction_flags => formulation_correction_flags
@@ -107,9 +122,12 @@ contains
     !> the formulation) in formulation `form`. `constant_mass` selects the
     !> layout y = (q, v, λ[, μ]) with DAE mass diag(I, M, 0), M evaluated at
     !> q0 (the caller asserts M does not depend on q); otherwise accelerations
-    !> are unknowns. On bad arguments `status` says why and n = 0.
+    !> are unknowns. `sparse` asks for the sparse path, which is taken when
+    !> the mechanical problem provides sparse derivatives (has_sparse_derivatives)
+    !> and the formulation is not index 1 in the constant-mass layout; see
+    !> `is_sparse`. On bad arguments `status` says why and n = 0.
     function new_formulation(mechanical, form, q0, constant_mass, baumgarte_zeta, &
-                             baumgarte_omega, projection, status) result(self)
+                             baumgarte_omega, projection, status, sparse) result(self)
         class(mechanical_problem_t), target, intent(inout) :: mechanical
         integer, intent(in) :: form                  !! formulation_index1/2/3, formulation_ggl
         real(wp), intent(in) :: q0(:)                !! a configuration (size nq)
@@ -118,6 +136,7 @@ contains
         real(wp), intent(in), optional :: baumgarte_omega !! index 1 only, >= 0
         logical, intent(in), optional :: projection  !! offer the post-step projection
         type(status_t), intent(out) :: status
+        logical, intent(in), optional :: sparse      !! sparse matrices (default false)
         type(formulation_t) :: self
         integer :: nq, nv, nc, nk
         character(len=160) :: msg
@@ -161,6 +180,24 @@ contains
         if (form == formulation_ggl) self%n = self%om + nc
         self%q_mass = q0
         nk = nv + nc
+        if (present(sparse)) self%sparse = sparse .and. mechanical%has_sparse() .and. &
+            mechanical%has_sparse_derivatives() .and. &
+            .not. (form == formulation_index1 .and. .not. self%accelerations)
+        if (self%sparse) then
+            call self%sp%init(mechanical, sparse_layout_t(form=form, &
+                accelerations=self%accelerations, ggl=form == formulation_ggl, n=self%n, &
+                nq=nq, nv=nv, nc=nc, oq=self%oq, ov=self%ov, oa=self%oa, ol=self%ol, &
+                om=self%om, baumgarte_zeta=self%baumgarte_zeta, &
+                baumgarte_omega=self%baumgarte_omega), q0, status)
+            if (.not. status%ok()) then
+                status%message = 'formulation: ' // status%message
+                self%n = 0
+                return
+            end if
+            allocate (self%force(nv), self%w(nv), self%b(nv), self%c(nc), self%ct(nc), &
+                      self%tq(nq), self%q0(nq), self%kkt_rhs(nk))
+            return
+        end if
         allocate (self%m(nv, nv), self%gmat(nc, nv), self%force(nv), self%w(nv), self%b(nv), &
                   self%c(nc), self%ct(nc), self%qq(nq, nq), self%vq(nv, nq), self%vv(nv, nv), &
                   self%cq(nc, nq), self%cq2(nc, nq), self%cv(nc, nv), self%tq(nq), &
@@ -221,18 +258,21 @@ contains
                    fq => f(self%oq + 1:self%oq + self%nq), fv => f(self%ov + 1:self%ov + self%nv), &
                    fc => f(self%ol + 1:self%ol + self%nc))
             call mech%forces(t, q, v, self%force, status)
-            call mech%constraint_jacobian(t, q, self%gmat, status)
+            call eval_g(self, t, q, status)
             ! q' = T v, or T (v - Gᵀμ) in GGL
             self%w = v
-            if (self%form == formulation_ggl) &
-                self%w = v - matmul(y(self%om + 1:self%om + nc), self%gmat)
+            if (self%form == formulation_ggl) then
+                call gt_times(self, y(self%om + 1:self%om + nc), self%b)
+                self%w = v - self%b
+            end if
             call mech%kinematics(t, q, self%w, fq, status)
-            self%b = self%force - matmul(lam, self%gmat)
+            call gt_times(self, lam, self%b)
+            self%b = self%force - self%b
             if (self%accelerations) then
                 associate (a => y(self%oa + 1:self%oa + nv), fa => f(self%oa + 1:self%oa + nv))
                     fv = a
-                    call mech%mass(t, q, self%m, status)
-                    fa = self%b - matmul(self%m, a)
+                    call mass_times(self, t, q, a, fa, status)
+                    fa = self%b - fa
                     self%b = a
                 end associate
             else
@@ -250,7 +290,8 @@ contains
                 ! b = a, or M⁻¹(f - Gᵀλ) with the constant M
                 if (.not. self%accelerations) call solve_mass(self, t, self%b, status)
                 call mech%constraint_curvature(t, q, v, fc, status)
-                fc = fc + matmul(self%gmat, self%b)
+                call g_times(self, self%b, self%c)
+                fc = fc + self%c
                 if (self%baumgarte_omega > 0.0_wp) then
                     call velocity_constraint(self, t, q, v, self%c, status)
                     fc = fc + 2.0_wp * self%baumgarte_zeta * self%baumgarte_omega * self%c
@@ -261,20 +302,102 @@ contains
         end associate
     end subroutine formulation_rhs
 
-    !> G v + g_I with self%gmat = G(t, q) already evaluated.
+    !> G v + g_I with G(t, q) already evaluated (eval_g).
     subroutine velocity_constraint(self, t, q, v, c, status)
         class(formulation_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: c(:)
         type(status_t), intent(inout) :: status
         call self%mechanical%constraint_time_derivative(t, q, self%ct, status)
-        c = matmul(self%gmat, v) + self%ct
+        call g_times(self, v, c)
+        c = c + self%ct
     end subroutine velocity_constraint
+
+    !> G(t, q), dense (self%gmat) or sparse (self%sp).
+    subroutine eval_g(self, t, q, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        type(status_t), intent(inout) :: status
+        if (self%sparse) then
+            call self%sp%constraint_jacobian(self%mechanical, t, q, status)
+        else
+            call self%mechanical%constraint_jacobian(t, q, self%gmat, status)
+        end if
+    end subroutine eval_g
+
+    !> y = G x with the G of the last eval_g.
+    subroutine g_times(self, x, y)
+        class(formulation_t), intent(in) :: self
+        real(wp), intent(in) :: x(:)
+        real(wp), intent(out) :: y(:)
+        if (self%sparse) then
+            call self%sp%g_times(x, y)
+        else
+            y = matmul(self%gmat, x)
+        end if
+    end subroutine g_times
+
+    !> y = Gᵀ x with the G of the last eval_g.
+    subroutine gt_times(self, x, y)
+        class(formulation_t), intent(in) :: self
+        real(wp), intent(in) :: x(:)
+        real(wp), intent(out) :: y(:)
+        if (self%sparse) then
+            call self%sp%gt_times(x, y)
+        else
+            y = matmul(x, self%gmat)
+        end if
+    end subroutine gt_times
+
+    !> y = M(t, q) x.
+    subroutine mass_times(self, t, q, x, y, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), x(:)
+        real(wp), intent(out) :: y(:)
+        type(status_t), intent(inout) :: status
+        if (self%sparse) then
+            call self%sp%m_times(self%mechanical, t, q, x, y, status)
+        else
+            call self%mechanical%mass(t, q, self%m, status)
+            y = matmul(self%m, x)
+        end if
+    end subroutine mass_times
 
     integer function formulation_jacobian_storage(self)
         class(formulation_t), intent(in) :: self
-        formulation_jacobian_storage = storage_dense
+        formulation_jacobian_storage = merge(storage_sparse, storage_dense, self%sparse)
     end function formulation_jacobian_storage
+
+    !> Whether the sparse path was taken (new_formulation's `sparse`).
+    pure logical function formulation_is_sparse(self)
+        class(formulation_t), intent(in) :: self
+        formulation_is_sparse = self%sparse
+    end function formulation_is_sparse
+
+    !> The fixed CSC pattern of ∂F/∂y (sparse path).
+    subroutine formulation_jacobian_pattern(self, pattern, status)
+        class(formulation_t), intent(inout) :: self
+        type(csc_matrix_t), intent(inout) :: pattern
+        type(status_t), intent(inout) :: status
+        pattern = self%sp%jac%matrix
+    end subroutine formulation_jacobian_pattern
+
+    !> ∂F/∂y's values in its pattern (sparse path).
+    subroutine formulation_jacobian_sparse(self, t, y, values, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        call self%sp%jacobian(self%mechanical, t, y, values, status)
+    end subroutine formulation_jacobian_sparse
+
+    !> The DAE mass matrix in CSC (sparse path).
+    subroutine formulation_mass_sparse(self, m, status)
+        class(formulation_t), intent(inout) :: self
+        type(csc_matrix_t), intent(inout) :: m
+        type(status_t), intent(inout) :: status
+        call self%sp%mass_matrix(m)
+    end subroutine formulation_mass_sparse
 
     !> ∂F/∂y, block by block (module header).
     subroutine formulation_jacobian_dense(self, t, y, jac, status)
@@ -433,7 +556,7 @@ contains
 
     integer function formulation_mass_storage(self)
         class(formulation_t), intent(in) :: self
-        formulation_mass_storage = storage_dense
+        formulation_mass_storage = merge(storage_sparse, storage_dense, self%sparse)
     end function formulation_mass_storage
 
     !> diag(I, I, 0, ...) or diag(I, M, 0, ...).
@@ -507,12 +630,16 @@ contains
                                     y(self%ov + 1:self%ov + self%nv), status)
     end subroutine formulation_project
 
-    !> Factor K = [M Gᵀ; G 0] at q into self%kkt.
+    !> Factor K = [M Gᵀ; G 0] at q into self%kkt (or the sparse one).
     subroutine factor_kkt(self, t, q, status)
         class(formulation_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:)
         type(status_t), intent(inout) :: status
         integer :: info, nv, nc
+        if (self%sparse) then
+            call self%sp%factor_kkt(self%mechanical, t, q, status)
+            return
+        end if
         nv = self%nv
         nc = self%nc
         call self%mechanical%mass(t, q, self%m, status)
@@ -531,6 +658,11 @@ contains
     subroutine solve_kkt(self)
         class(formulation_t), intent(inout) :: self
         integer :: info, nk
+        type(status_t) :: status
+        if (self%sparse) then
+            call self%sp%solve_kkt(self%kkt_rhs, status)
+            return
+        end if
         nk = self%nv + self%nc
         call dgetrs('N', nk, 1, self%kkt, nk, self%kkt_pivots, self%kkt_rhs, nk, info)
     end subroutine solve_kkt
@@ -638,7 +770,7 @@ contains
         associate (q => y(self%oq + 1:self%oq + self%nq), v => y(self%ov + 1:self%ov + self%nv))
             call self%mechanical%constraint(t, q, self%c, status)
             position = maxval(abs(self%c))
-            call self%mechanical%constraint_jacobian(t, q, self%gmat, status)
+            call eval_g(self, t, q, status)
             call velocity_constraint(self, t, q, v, self%c, status)
             velocity = maxval(abs(self%c))
         end associate

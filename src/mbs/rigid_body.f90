@@ -54,7 +54,8 @@ module flexmbs_mbs_rigid_body
         procedure :: force_derivatives => bodies_force_derivatives
     end type rigid_bodies_t
 
-    public :: new_rigid_bodies, rigid_body_energy, rigid_body_momenta
+    public :: new_rigid_bodies, rigid_body_energy, rigid_body_momenta, quaternion_rate_derivative, &
+        gyroscopic_derivative
 
 contains
 
@@ -173,13 +174,26 @@ contains
         do i = 1, size(self%bodies)
             iq = rigid_body_nq * (i - 1)
             iv = rigid_body_nv * (i - 1)
-            associate (om => w(iv + 4:iv + 6))
-                dq(iq + 4, iq + 5:iq + 7) = -0.5_wp * om
-                dq(iq + 5:iq + 7, iq + 4) = 0.5_wp * om
-                dq(iq + 5:iq + 7, iq + 5:iq + 7) = -0.5_wp * skew(om)
-            end associate
+            dq(iq + 4:iq + 7, iq + 4:iq + 7) = quaternion_rate_derivative(w(iv + 4:iv + 6))
         end do
     end subroutine bodies_kinematics_derivative
+
+    !> ∂(L(p)ᵀ ω / 2)/∂p, 4 x 4 (it does not depend on p).
+    pure function quaternion_rate_derivative(om) result(d)
+        real(wp), intent(in) :: om(3)
+        real(wp) :: d(4, 4)
+        d(1, 1) = 0.0_wp
+        d(1, 2:4) = -0.5_wp * om
+        d(2:4, 1) = 0.5_wp * om
+        d(2:4, 2:4) = -0.5_wp * skew(om)
+    end function quaternion_rate_derivative
+
+    !> ∂(-ω × J ω)/∂ω = skew(J ω) - skew(ω) J.
+    pure function gyroscopic_derivative(inertia, om) result(d)
+        real(wp), intent(in) :: inertia(3, 3), om(3)
+        real(wp) :: d(3, 3)
+        d = skew(matmul(inertia, om)) - matmul(skew(om), inertia)
+    end function gyroscopic_derivative
 
     !> M = diag(m₁ I₃, J₁, m₂ I₃, J₂, ...).
     subroutine bodies_mass(self, t, q, m, status)
@@ -234,10 +248,8 @@ contains
         fv = 0.0_wp
         do i = 1, size(self%bodies)
             iv = rigid_body_nv * (i - 1)
-            associate (b => self%bodies(i), om => v(iv + 4:iv + 6))
-                fv(iv + 4:iv + 6, iv + 4:iv + 6) = skew(matmul(b%inertia, om)) &
-                    - matmul(skew(om), b%inertia)
-            end associate
+            fv(iv + 4:iv + 6, iv + 4:iv + 6) = gyroscopic_derivative(self%bodies(i)%inertia, &
+                                                                     v(iv + 4:iv + 6))
         end do
     end subroutine bodies_force_derivatives
 

@@ -41,14 +41,18 @@ module flexmbs_mbs_system
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_text, only: int_text
-    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t, difference_step
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t, mechanical_patterns_t, &
+        difference_step
     use flexmbs_linalg_csc, only: csc_matrix_t
+    use flexmbs_linalg_accumulator, only: accumulator_t
+    use flexmbs_linalg_triplets, only: triplets_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_mbs_primitive_kinds, only: primitive_distance
-    use flexmbs_mbs_rotation, only: rotation_matrix, quat_rate_matrix, cross
+    use flexmbs_mbs_rotation, only: rotation_matrix, quat_rate_matrix, cross, quat_l
     use flexmbs_mbs_dual, only: dual_t, operator(+), assignment(=), dot_product
     use flexmbs_mbs_rigid_body, only: rigid_body_t, rigid_bodies_t, new_rigid_bodies, &
-        rigid_body_nq, rigid_body_nv, rigid_body_energy, rigid_body_momenta
+        rigid_body_nq, rigid_body_nv, rigid_body_energy, rigid_body_momenta, &
+        quaternion_rate_derivative, gyroscopic_derivative
     use flexmbs_mbs_joint, only: joint_t, new_joint, new_primitive_joint, joint_primitive, &
         joint_spherical, &
         joint_part_time_derivative, &
@@ -170,6 +174,10 @@ module flexmbs_mbs_system
         real(wp), allocatable :: zero_v(:) !! v = 0 for position-only evaluations
         !> copies of the CSC patterns handed out (their triplet maps place values)
         type(csc_matrix_t) :: mass_csc, jacobian_csc
+        !> the derivative blocks' patterns (derivative_patterns) and two
+        !> accumulators the derivative code adds into, dense or sparse
+        type(mechanical_patterns_t) :: patterns
+        type(accumulator_t) :: acc(2)
     contains
         procedure :: kinematics => system_kinematics
         procedure :: has_sparse => system_has_sparse
@@ -193,6 +201,20 @@ module flexmbs_mbs_system
         procedure :: constraint_time_derivative_jacobian => &
             system_constraint_time_derivative_jacobian
         procedure :: constraint_curvature_derivatives => system_constraint_curvature_derivatives
+        procedure :: has_sparse_derivatives => system_has_sparse_derivatives
+        procedure :: derivative_patterns => system_derivative_patterns
+        procedure :: kinematics_sparse => system_kinematics_sparse
+        procedure :: kinematics_derivative_sparse => system_kinematics_derivative_sparse
+        procedure :: mass_derivative_sparse => system_mass_derivative_sparse
+        procedure :: force_derivatives_sparse => system_force_derivatives_sparse
+        procedure :: constraint_position_jacobian_sparse => &
+            system_constraint_position_jacobian_sparse
+        procedure :: constraint_jacobian_derivatives_sparse => &
+            system_constraint_jacobian_derivatives_sparse
+        procedure :: constraint_time_derivative_jacobian_sparse => &
+            system_constraint_time_derivative_jacobian_sparse
+        procedure :: constraint_curvature_derivatives_sparse => &
+            system_constraint_curvature_derivatives_sparse
         procedure :: joint_first_row => system_joint_first_row
         procedure :: joint_reaction => system_joint_reaction
         procedure :: energy => system_energy
@@ -501,16 +523,19 @@ contains
         end if
     end function frame_column
 
-    !> out(:, global columns) += block (local columns of frame fr).
-    pure subroutine add_frame_columns(fr, position_space, block, out)
+    !> out(row0 + rows, global columns) += block (local columns of frame fr).
+    pure subroutine add_frame_columns(fr, position_space, block, row0, out)
         type(node_frame_t), intent(in) :: fr
         logical, intent(in) :: position_space
         real(wp), intent(in) :: block(:, :)
-        real(wp), intent(inout) :: out(:, :)
-        integer :: l, c
+        integer, intent(in) :: row0
+        type(accumulator_t), intent(inout) :: out
+        integer :: l, r, c
         do l = 1, size(block, 2)
             c = frame_column(fr, l, position_space)
-            out(:, c) = out(:, c) + block(:, l)
+            do r = 1, size(block, 1)
+                call out%add(row0 + r, c, block(r, l))
+            end do
         end do
     end subroutine add_frame_columns
 
@@ -722,6 +747,225 @@ contains
         end do
     end subroutine system_constraint_jacobian_sparse
 
+    ! ------------------------------------------------ sparse derivative blocks
+
+    logical function system_has_sparse_derivatives(self)
+        class(mbs_system_t), intent(in) :: self
+        system_has_sparse_derivatives = .true.
+    end function system_has_sparse_derivatives
+
+    !> Patterns of the derivative blocks (mechanical_patterns_t): rigid
+    !> bodies' quaternion and gyroscopic blocks, the chains' full blocks, the
+    !> flexible bodies' tangent patterns, and per joint or node frame its rows
+    !> times the columns of its markers' bodies.
+    subroutine system_derivative_patterns(self, patterns, status)
+        class(mbs_system_t), intent(inout) :: self
+        type(mechanical_patterns_t), intent(inout) :: patterns
+        type(status_t), intent(inout) :: status
+        type(triplets_t) :: cq, rq, tk, tq, fq, fv
+        integer :: b, f, k, side, mk, iq, iv, nq, nv, i, other, oq, ov, bo
+        call self%mass_pattern(patterns%mass, status)
+        if (status%ok()) call self%constraint_jacobian_pattern(patterns%constraint_v, status)
+        if (.not. status%ok()) return
+        do b = 1, size(self%rigid%bodies)
+            iq = rigid_body_nq * (b - 1)
+            iv = rigid_body_nv * (b - 1)
+            do i = 1, 3
+                call tk%add(iq + i, iv + i)
+            end do
+            call tk%add_range(iq + 3, iv + 3, 4, 3)
+            call tq%add_range(iq + 3, iq + 3, 4, 4)
+            call fv%add_range(iv + 3, iv + 3, 3, 3)
+        end do
+        do f = 1, size(self%chains)
+            nq = self%chains(f)%nq
+            nv = self%chains(f)%nv
+            call tk%add_range(self%chain_q(f), self%chain_v(f), nq, nv)
+            call tq%add_range(self%chain_q(f), self%chain_q(f), nq, nq)
+            call fq%add_range(self%chain_v(f), self%chain_q(f), nv, nq)
+            call fv%add_range(self%chain_v(f), self%chain_v(f), nv, nv)
+        end do
+        do f = 1, size(self%flex)
+            do i = 1, self%flex(f)%nv
+                call tk%add(self%flex_q(f) + i, self%flex_v(f) + i)
+            end do
+            call fq%add_pattern(self%flex_v(f), self%flex_q(f), self%flex(f)%stiffness)
+            call fv%add_pattern(self%flex_v(f), self%flex_v(f), self%flex(f)%damping)
+        end do
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                do side = 1, 2
+                    mk = merge(jt%marker_i, jt%marker_j, side == 1)
+                    call marker_offsets(self, mk, b, iq, iv)
+                    if (marker_columns(self, mk, .true.) == 0) cycle
+                    call cq%add_range(jt%row0, iq, jt%joint%nrows, &
+                                      marker_columns(self, mk, .true.))
+                    do other = 1, 2
+                        call marker_offsets(self, merge(jt%marker_i, jt%marker_j, other == 1), &
+                                            bo, oq, ov)
+                        call rq%add_range(iv, oq, marker_columns(self, mk, .false.), &
+                            marker_columns(self, merge(jt%marker_i, jt%marker_j, other == 1), &
+                                           .true.))
+                    end do
+                end do
+            end associate
+        end do
+        do k = 1, size(self%frames)
+            associate (fr => self%frames(k))
+                do i = 1, frame_columns(fr, .true.)
+                    call cq%add_range(fr%row0, frame_column(fr, i, .true.) - 1, &
+                                      node_frame_rows, 1)
+                    do b = 1, frame_columns(fr, .false.)
+                        call rq%add(frame_column(fr, b, .false.), frame_column(fr, i, .true.))
+                    end do
+                end do
+            end associate
+        end do
+        call cq%build(self%nc, self%nq, patterns%constraint_q, status)
+        if (status%ok()) call rq%build(self%nv, self%nq, patterns%reaction_q, status)
+        if (status%ok()) call tk%build(self%nq, self%nv, patterns%kinematics, status)
+        if (status%ok()) call tq%build(self%nq, self%nq, patterns%kinematics_q, status)
+        if (status%ok()) call fq%build(self%nv, self%nq, patterns%force_q, status)
+        if (status%ok()) call fv%build(self%nv, self%nv, patterns%force_v, status)
+        if (.not. status%ok()) then
+            status%message = 'mbs system: derivative patterns: ' // status%message
+            return
+        end if
+        self%patterns = patterns
+    end subroutine system_derivative_patterns
+
+    !> T: I₃ and L(p)ᵀ/2 per rigid body, the chains' columns T e_l, I for
+    !> flexible bodies.
+    subroutine system_kinematics_sparse(self, t, q, values, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: e(rigid_body_nq), rate(rigid_body_nq), l(3, 4)
+        integer :: b, f, i, iq, iv
+        associate (acc => self%acc(1))
+            call acc%start_sparse(self%patterns%kinematics)
+            do b = 1, size(self%rigid%bodies)
+                iq = rigid_body_nq * (b - 1)
+                iv = rigid_body_nv * (b - 1)
+                do i = 1, 3
+                    call acc%add(iq + i, iv + i, 1.0_wp)
+                end do
+                l = quat_l(q(iq + 4:iq + 7))
+                call acc%add_range(iq + 3, iv + 3, 0.5_wp * transpose(l))
+            end do
+            do f = 1, size(self%chains)
+                associate (cq => self%chain_q(f), nq => self%chains(f)%nq, &
+                           nv => self%chains(f)%nv)
+                    do i = 1, nv
+                        e(1:nv) = 0.0_wp
+                        e(i) = 1.0_wp
+                        call chain_rates(self, f, q(cq + 1:cq + nq), e(1:nv), rate(1:nq))
+                        call acc%add_range(cq, self%chain_v(f) + i - 1, &
+                                           reshape(rate(1:nq), [nq, 1]))
+                    end do
+                end associate
+            end do
+            do f = 1, size(self%flex)
+                do i = 1, self%flex(f)%nv
+                    call acc%add(self%flex_q(f) + i, self%flex_v(f) + i, 1.0_wp)
+                end do
+            end do
+            call acc%get_values(values, 'mbs system: T', status)
+        end associate
+    end subroutine system_kinematics_sparse
+
+    !> ∂(T w)/∂q: the quaternion blocks of the rigid bodies, the chains' blocks.
+    subroutine system_kinematics_derivative_sparse(self, t, q, w, values, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: blk(rigid_body_nq, rigid_body_nq)
+        integer :: b, f, iq, iv
+        associate (acc => self%acc(1))
+            call acc%start_sparse(self%patterns%kinematics_q)
+            do b = 1, size(self%rigid%bodies)
+                iq = rigid_body_nq * (b - 1)
+                iv = rigid_body_nv * (b - 1)
+                call acc%add_range(iq + 3, iq + 3, quaternion_rate_derivative(w(iv + 4:iv + 6)))
+            end do
+            do f = 1, size(self%chains)
+                associate (cq => self%chain_q(f), cv => self%chain_v(f), &
+                           nq => self%chains(f)%nq, nv => self%chains(f)%nv)
+                    call self%chains(f)%kinematics_derivative(t, q(cq + 1:cq + nq), &
+                        w(cv + 1:cv + nv), blk(1:nq, 1:nq), status)
+                    call acc%add_range(cq, cq, blk(1:nq, 1:nq))
+                end associate
+            end do
+            call acc%get_values(values, 'mbs system: d(T w)/dq', status)
+        end associate
+    end subroutine system_kinematics_derivative_sparse
+
+    subroutine system_mass_derivative_sparse(self, t, q, w, values, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        call self%acc(1)%start_sparse(self%patterns%force_q)
+        call mass_derivative_into(self, t, q, w, self%acc(1), status)
+        call self%acc(1)%get_values(values, 'mbs system: d(M w)/dq', status)
+    end subroutine system_mass_derivative_sparse
+
+    !> ∂f/∂q, ∂f/∂v: gyroscopic blocks, the chains' blocks, and −∂k/∂q,
+    !> −∂k/∂v of the flexible bodies from their analytic tangents.
+    subroutine system_force_derivatives_sparse(self, t, q, v, fq, fv, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: fq(:), fv(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: bq(rigid_body_nq, rigid_body_nq), bv(rigid_body_nq, rigid_body_nq)
+        type(status_t) :: local
+        integer :: b, iv
+        associate (aq => self%acc(1), av => self%acc(2))
+            call aq%start_sparse(self%patterns%force_q)
+            call av%start_sparse(self%patterns%force_v)
+            do b = 1, size(self%rigid%bodies)
+                iv = rigid_body_nv * (b - 1)
+                call av%add_range(iv + 3, iv + 3, gyroscopic_derivative( &
+                    self%rigid%bodies(b)%inertia, v(iv + 4:iv + 6)))
+            end do
+            do b = 1, size(self%chains)
+                associate (cq => self%chain_q(b), cv => self%chain_v(b), &
+                           nq => self%chains(b)%nq, nv => self%chains(b)%nv)
+                    call self%chains(b)%force_derivatives(t, q(cq + 1:cq + nq), &
+                        v(cv + 1:cv + nv), bq(1:nv, 1:nq), bv(1:nv, 1:nv), status)
+                    call aq%add_range(cv, cq, bq(1:nv, 1:nq))
+                    call av%add_range(cv, cv, bv(1:nv, 1:nv))
+                end associate
+            end do
+            do b = 1, size(self%flex)
+                associate (fq0 => self%flex_q(b), fv0 => self%flex_v(b), n => self%flex(b)%nv)
+                    call self%flex(b)%assemble_tangents(q(fq0 + 1:fq0 + n), v(fv0 + 1:fv0 + n), &
+                                                        local)
+                    if (.not. local%ok()) then
+                        status = local
+                        return
+                    end if
+                    call aq%add_csc(fv0, fq0, self%flex(b)%stiffness, -1.0_wp)
+                    call av%add_csc(fv0, fv0, self%flex(b)%damping, -1.0_wp)
+                end associate
+            end do
+            call aq%get_values(fq, 'mbs system: df/dq', status)
+            call av%get_values(fv, 'mbs system: df/dv', status)
+        end associate
+    end subroutine system_force_derivatives_sparse
+
+    subroutine system_constraint_position_jacobian_sparse(self, t, q, values, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        call self%acc(1)%start_sparse(self%patterns%constraint_q)
+        call assemble_first_derivative(self, t, q, .true., self%acc(1))
+        call self%acc(1)%get_values(values, 'mbs system: g_q', status)
+    end subroutine system_constraint_position_jacobian_sparse
+
     ! ------------------------------------------------ bodies (delegated)
 
     subroutine system_kinematics(self, t, q, w, qdot, status)
@@ -784,17 +1028,26 @@ contains
         end do
     end subroutine system_mass
 
-    !> ∂(M w)/∂q: zero for rigid and flexible bodies (constant M), central
-    !> differences of the chains' M(q) w (at most 7 coordinates each).
     subroutine system_mass_derivative(self, t, q, w, dq, status)
         class(mbs_system_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:), w(:)
         real(wp), intent(out) :: dq(:, :)
         type(status_t), intent(inout) :: status
+        call self%acc(1)%start_dense(self%nv, self%nq)
+        call mass_derivative_into(self, t, q, w, self%acc(1), status)
+        call self%acc(1)%get_dense(dq)
+    end subroutine system_mass_derivative
+
+    !> ∂(M w)/∂q added into dq: zero for rigid and flexible bodies (constant
+    !> M), central differences of the chains' M(q) w (at most 7 coordinates each).
+    subroutine mass_derivative_into(self, t, q, w, dq, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        type(accumulator_t), intent(inout) :: dq
+        type(status_t), intent(inout) :: status
         real(wp) :: mp(rigid_body_nq, rigid_body_nq), mm(rigid_body_nq, rigid_body_nq), &
-            qc(rigid_body_nq), h
-        integer :: f, j
-        dq = 0.0_wp
+            qc(rigid_body_nq), h, col(rigid_body_nq)
+        integer :: f, j, i
         do f = 1, size(self%chains)
             associate (iq => self%chain_q(f), iv => self%chain_v(f), n => self%chains(f)%nv, &
                        nq => self%chains(f)%nq)
@@ -805,12 +1058,14 @@ contains
                     call self%chains(f)%mass(t, qc(1:nq), mp(1:n, 1:n), status)
                     qc(j) = q(iq + j) - h
                     call self%chains(f)%mass(t, qc(1:nq), mm(1:n, 1:n), status)
-                    dq(iv + 1:iv + n, iq + j) = matmul(mp(1:n, 1:n) - mm(1:n, 1:n), &
-                                                       w(iv + 1:iv + n)) / (2 * h)
+                    col(1:n) = matmul(mp(1:n, 1:n) - mm(1:n, 1:n), w(iv + 1:iv + n)) / (2 * h)
+                    do i = 1, n
+                        call dq%add(iv + i, iq + j, col(i))
+                    end do
                 end do
             end associate
         end do
-    end subroutine system_mass_derivative
+    end subroutine mass_derivative_into
 
     subroutine system_forces(self, t, q, v, f, status)
         class(mbs_system_t), intent(inout) :: self
@@ -1332,18 +1587,19 @@ contains
         end if
     end function driver_dual
 
-    !> out(:, columns of marker k's body) += block (velocity or position space).
-    pure subroutine add_columns(self, k, position_space, block, out)
+    !> out(row0 + rows, columns of marker k's body) += block (velocity or
+    !> position space).
+    pure subroutine add_columns(self, k, position_space, block, row0, out)
         class(mbs_system_t), intent(in) :: self
         integer, intent(in) :: k
         logical, intent(in) :: position_space
         real(wp), intent(in) :: block(:, :)
-        real(wp), intent(inout) :: out(:, :)
-        integer :: b, iq, iv, off
+        integer, intent(in) :: row0
+        type(accumulator_t), intent(inout) :: out
+        integer :: b, iq, iv
         call marker_offsets(self, k, b, iq, iv)
         if (b == 0) return
-        off = merge(iq, iv, position_space)
-        out(:, off + 1:off + size(block, 2)) = out(:, off + 1:off + size(block, 2)) + block
+        call out%add_range(row0, merge(iq, iv, position_space), block)
     end subroutine add_columns
 
     ! ------------------------------------------------ joint rows, first derivatives
@@ -1472,7 +1728,9 @@ contains
         real(wp), intent(in) :: t, q(:)
         real(wp), intent(out) :: gmat(:, :)
         type(status_t), intent(inout) :: status
-        call assemble_first_derivative(self, t, q, .false., gmat)
+        call self%acc(1)%start_dense(self%nc, self%nv)
+        call assemble_first_derivative(self, t, q, .false., self%acc(1))
+        call self%acc(1)%get_dense(gmat)
     end subroutine system_constraint_jacobian
 
     !> c_q, nc x nq.
@@ -1481,26 +1739,26 @@ contains
         real(wp), intent(in) :: t, q(:)
         real(wp), intent(out) :: gq(:, :)
         type(status_t), intent(inout) :: status
-        call assemble_first_derivative(self, t, q, .true., gq)
+        call self%acc(1)%start_dense(self%nc, self%nq)
+        call assemble_first_derivative(self, t, q, .true., self%acc(1))
+        call self%acc(1)%get_dense(gq)
     end subroutine system_constraint_position_jacobian
 
+    !> G (velocity space) or c_q (position space) added into out.
     subroutine assemble_first_derivative(self, t, q, position_space, out)
         class(mbs_system_t), intent(in) :: self
         real(wp), intent(in) :: t, q(:)
         logical, intent(in) :: position_space
-        real(wp), intent(out) :: out(:, :)
+        type(accumulator_t), intent(inout) :: out
         real(wp) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq), ct(max_rows)
         integer :: k, ni, nj, r0, nr
-        out = 0.0_wp
         do k = 1, size(self%joints)
             associate (jt => self%joints(k))
                 r0 = jt%row0
                 nr = jt%joint%nrows
                 call joint_first_derivatives(self, k, t, q, position_space, ci, cj, ni, nj, ct)
-                call add_columns(self, jt%marker_i, position_space, ci(1:nr, 1:ni), &
-                                 out(r0 + 1:r0 + nr, :))
-                call add_columns(self, jt%marker_j, position_space, cj(1:nr, 1:nj), &
-                                 out(r0 + 1:r0 + nr, :))
+                call add_columns(self, jt%marker_i, position_space, ci(1:nr, 1:ni), r0, out)
+                call add_columns(self, jt%marker_j, position_space, cj(1:nr, 1:nj), r0, out)
             end associate
         end do
         do k = 1, size(self%frames)
@@ -1508,8 +1766,7 @@ contains
                 real(wp) :: fb(node_frame_rows, frame_columns(self%frames(k), position_space))
                 call frame_first_derivatives(self, k, q, position_space, fb)
                 r0 = self%frames(k)%row0
-                call add_frame_columns(self%frames(k), position_space, fb, &
-                                       out(r0 + 1:r0 + node_frame_rows, :))
+                call add_frame_columns(self%frames(k), position_space, fb, r0, out)
             end block
         end do
     end subroutine assemble_first_derivative
@@ -1612,20 +1869,42 @@ contains
 
     ! ------------------------------------------------ second derivatives (AD)
 
-    !> ∂(G w)/∂q (nc x nq) and ∂(Gᵀλ)/∂q (nv x nq): AD of the hand-coded G
-    !> along the position unit vectors of the joint's two bodies.
     subroutine system_constraint_jacobian_derivatives(self, t, q, w, lambda, gwq, gtlq, status)
         class(mbs_system_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:), w(:), lambda(:)
         real(wp), intent(out) :: gwq(:, :), gtlq(:, :)
         type(status_t), intent(inout) :: status
+        call self%acc(1)%start_dense(self%nc, self%nq)
+        call self%acc(2)%start_dense(self%nv, self%nq)
+        call jacobian_derivatives_into(self, t, q, w, lambda, self%acc(1), self%acc(2))
+        call self%acc(1)%get_dense(gwq)
+        call self%acc(2)%get_dense(gtlq)
+    end subroutine system_constraint_jacobian_derivatives
+
+    subroutine system_constraint_jacobian_derivatives_sparse(self, t, q, w, lambda, gwq, &
+                                                             gtlq, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:), lambda(:)
+        real(wp), intent(out) :: gwq(:), gtlq(:)
+        type(status_t), intent(inout) :: status
+        call self%acc(1)%start_sparse(self%patterns%constraint_q)
+        call self%acc(2)%start_sparse(self%patterns%reaction_q)
+        call jacobian_derivatives_into(self, t, q, w, lambda, self%acc(1), self%acc(2))
+        call self%acc(1)%get_values(gwq, 'mbs system: d(G w)/dq', status)
+        call self%acc(2)%get_values(gtlq, 'mbs system: d(G^T lambda)/dq', status)
+    end subroutine system_constraint_jacobian_derivatives_sparse
+
+    !> ∂(G w)/∂q (nc x nq) and ∂(Gᵀλ)/∂q (nv x nq) added into gwq, gtlq: AD of
+    !> the hand-coded G along the position unit vectors of the joint's two bodies.
+    subroutine jacobian_derivatives_into(self, t, q, w, lambda, gwq, gtlq)
+        class(mbs_system_t), intent(in) :: self
+        real(wp), intent(in) :: t, q(:), w(:), lambda(:)
+        type(accumulator_t), intent(inout) :: gwq, gtlq
         type(marker_state_d) :: mid, mjd
         type(dual_t) :: pi(rigid_body_nq), pj(rigid_body_nq), jxi(3, rigid_body_nq), &
             jai(3, rigid_body_nq, 3), jxj(3, rigid_body_nq), jaj(3, rigid_body_nq, 3), &
             cid(max_rows, rigid_body_nq), cjd(max_rows, rigid_body_nq), s
         integer :: k, r0, nr, qi, qj, ni, nj, r, l, bi, bj, iqi, iqj, ivi, ivj
-        gwq = 0.0_wp
-        gtlq = 0.0_wp
         do k = 1, size(self%joints)
             associate (jt => self%joints(k))
                 r0 = jt%row0
@@ -1668,41 +1947,62 @@ contains
                         bl(frame_columns(fr, .false.), frame_columns(fr, .true.))
                     integer :: c
                     call frame_rate_q(fr, q, w, bq)
-                    call add_frame_columns(fr, .true., bq, &
-                                           gwq(fr%row0 + 1:fr%row0 + node_frame_rows, :))
+                    call add_frame_columns(fr, .true., bq, fr%row0, gwq)
                     call frame_gtl_q(fr, q, lambda(fr%row0 + 1:fr%row0 + node_frame_rows), bl)
                     do l = 1, size(bl, 2)
                         c = frame_column(fr, l, .true.)
                         do r = 1, size(bl, 1)
-                            gtlq(frame_column(fr, r, .false.), c) = &
-                                gtlq(frame_column(fr, r, .false.), c) + bl(r, l)
+                            call gtlq%add(frame_column(fr, r, .false.), c, bl(r, l))
                         end do
                     end do
                 end block
             end associate
         end do
-    end subroutine system_constraint_jacobian_derivatives
+    end subroutine jacobian_derivatives_into
 
     !> out(row, q columns of body i and j) += tangents of s (directions 1..qi
     !> for body i at offset iqi, qi+1..qi+qj for body j at offset iqj).
     pure subroutine add_tangents(out, row, s, qi, iqi, qj, iqj)
-        real(wp), intent(inout) :: out(:, :)
+        type(accumulator_t), intent(inout) :: out
         integer, intent(in) :: row, qi, iqi, qj, iqj
         type(dual_t), intent(in) :: s
-        out(row, iqi + 1:iqi + qi) = out(row, iqi + 1:iqi + qi) + s%der(1:qi)
-        out(row, iqj + 1:iqj + qj) = out(row, iqj + 1:iqj + qj) + s%der(qi + 1:qi + qj)
+        integer :: l
+        do l = 1, qi
+            call out%add(row, iqi + l, s%der(l))
+        end do
+        do l = 1, qj
+            call out%add(row, iqj + l, s%der(qi + l))
+        end do
     end subroutine add_tangents
 
-    !> ∂c_t/∂q: AD of the hand-coded c_t.
     subroutine system_constraint_time_derivative_jacobian(self, t, q, dq, status)
         class(mbs_system_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:)
         real(wp), intent(out) :: dq(:, :)
         type(status_t), intent(inout) :: status
+        call self%acc(1)%start_dense(self%nc, self%nq)
+        call time_derivative_jacobian_into(self, t, q, self%acc(1))
+        call self%acc(1)%get_dense(dq)
+    end subroutine system_constraint_time_derivative_jacobian
+
+    subroutine system_constraint_time_derivative_jacobian_sparse(self, t, q, values, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        call self%acc(1)%start_sparse(self%patterns%constraint_q)
+        call time_derivative_jacobian_into(self, t, q, self%acc(1))
+        call self%acc(1)%get_values(values, 'mbs system: dg_I/dq', status)
+    end subroutine system_constraint_time_derivative_jacobian_sparse
+
+    !> ∂c_t/∂q added into dq: AD of the hand-coded c_t.
+    subroutine time_derivative_jacobian_into(self, t, q, dq)
+        class(mbs_system_t), intent(in) :: self
+        real(wp), intent(in) :: t, q(:)
+        type(accumulator_t), intent(inout) :: dq
         type(marker_state_d) :: mid, mjd
         type(dual_t) :: pd(rigid_body_nq), ctd(max_rows)
         integer :: k, nr, qi, qj, r, bi, bj, iqi, iqj, ivi, ivj
-        dq = 0.0_wp
         do k = 1, size(self%joints)
             associate (jt => self%joints(k))
                 nr = jt%joint%nrows
@@ -1719,20 +2019,41 @@ contains
                 end do
             end associate
         end do
-    end subroutine system_constraint_time_derivative_jacobian
+    end subroutine time_derivative_jacobian_into
 
-    !> ∂γ/∂q and ∂γ/∂v: AD of the hand-coded γ, one pass along the positions
-    !> and one along the velocities of the joint's two bodies.
     subroutine system_constraint_curvature_derivatives(self, t, q, v, gq, gv, status)
         class(mbs_system_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: gq(:, :), gv(:, :)
         type(status_t), intent(inout) :: status
+        call self%acc(1)%start_dense(self%nc, self%nq)
+        call self%acc(2)%start_dense(self%nc, self%nv)
+        call curvature_derivatives_into(self, t, q, v, self%acc(1), self%acc(2))
+        call self%acc(1)%get_dense(gq)
+        call self%acc(2)%get_dense(gv)
+    end subroutine system_constraint_curvature_derivatives
+
+    subroutine system_constraint_curvature_derivatives_sparse(self, t, q, v, gq, gv, status)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: gq(:), gv(:)
+        type(status_t), intent(inout) :: status
+        call self%acc(1)%start_sparse(self%patterns%constraint_q)
+        call self%acc(2)%start_sparse(self%patterns%constraint_v)
+        call curvature_derivatives_into(self, t, q, v, self%acc(1), self%acc(2))
+        call self%acc(1)%get_values(gq, 'mbs system: dgamma/dq', status)
+        call self%acc(2)%get_values(gv, 'mbs system: dgamma/dv', status)
+    end subroutine system_constraint_curvature_derivatives_sparse
+
+    !> ∂γ/∂q and ∂γ/∂v added into gq, gv: AD of the hand-coded γ, one pass
+    !> along the positions and one along the velocities of the joint's two bodies.
+    subroutine curvature_derivatives_into(self, t, q, v, gq, gv)
+        class(mbs_system_t), intent(in) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        type(accumulator_t), intent(inout) :: gq, gv
         type(marker_state_d) :: mid, mjd
         type(dual_t) :: pd(rigid_body_nq), conv(max_rows), tt(max_rows), drvd(3)
         integer :: k, nr, ni, nj, r, bi, bj, iqi, iqj, ivi, ivj, pass, seed
-        gq = 0.0_wp
-        gv = 0.0_wp
         do k = 1, size(self%joints)
             associate (jt => self%joints(k))
                 nr = jt%joint%nrows
@@ -1764,14 +2085,12 @@ contains
                     real(wp) :: bq(node_frame_rows, frame_columns(fr, .true.)), &
                         bv(node_frame_rows, frame_columns(fr, .false.))
                     call frame_curvature_qv(fr, q, v, bq, bv)
-                    call add_frame_columns(fr, .true., bq, &
-                                           gq(fr%row0 + 1:fr%row0 + node_frame_rows, :))
-                    call add_frame_columns(fr, .false., bv, &
-                                           gv(fr%row0 + 1:fr%row0 + node_frame_rows, :))
+                    call add_frame_columns(fr, .true., bq, fr%row0, gq)
+                    call add_frame_columns(fr, .false., bv, fr%row0, gv)
                 end block
             end associate
         end do
-    end subroutine system_constraint_curvature_derivatives
+    end subroutine curvature_derivatives_into
 
     ! ------------------------------------------------ reactions
 

@@ -1,0 +1,324 @@
+!> The sparse form of a formulation's matrices (flexmbs_mbs_formulation):
+!> ∂F/∂y and the DAE mass matrix as values on CSC patterns built once from
+!> the mechanical problem's sparse derivative blocks (mechanical_patterns_t),
+!> the saddle-point matrix [M Gᵀ; G 0] of the projection and the consistent
+!> initial values, and the products with G and M that F needs.
+!>
+!> The blocks of ∂F/∂y are those of the dense Jacobian (formulation.f90's
+!> header): the rows q' = T w take ∂(T w)/∂q and T, and for GGL the products
+!> −T ∂(Gᵀμ)/∂q and −T Gᵀ (sparse products on fixed patterns); the force rows
+!> take ∂f/∂q − ∂(Gᵀλ)/∂q (− ∂(M a)/∂q), ∂f/∂v, −M, −Gᵀ; the constraint rows
+!> the derivatives of c, of G v + g_I, or of G a + γ, all of which share the
+!> pattern of g_q in q and of G in v. Blocks that share a pattern are summed
+!> before one scatter. No array of order n x n exists on this path.
+!>
+!> Not covered: index 1 in the constant-mass layout, whose constraint rows
+!> need G M⁻¹ (f_q, f_v, Gᵀ); the formulation keeps it dense.
+module flexmbs_mbs_formulation_sparse
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_status, only: status_t
+    use flexmbs_linalg_csc, only: csc_matrix_t, pattern_matvec, pattern_matvec_transpose
+    use flexmbs_linalg_block_assembly, only: block_assembly_t, product_pattern, &
+        product_values, transpose_pattern
+    use flexmbs_linalg_saddle_point, only: saddle_point_t
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t, mechanical_patterns_t
+    implicit none
+    private
+
+    !> The layout of the formulation's y (offsets as in formulation_t).
+    type, public :: sparse_layout_t
+        integer :: form = 0            !! formulation_index1/2/3, formulation_ggl
+        logical :: accelerations = .true.
+        logical :: ggl = .false.
+        integer :: n = 0, nq = 0, nv = 0, nc = 0
+        integer :: oq = 0, ov = 0, oa = 0, ol = 0, om = 0
+        real(wp) :: baumgarte_zeta = 0.0_wp, baumgarte_omega = 0.0_wp
+    end type sparse_layout_t
+
+    !> Patterns, maps and value workspaces of the sparse path.
+    type, public :: sparse_formulation_t
+        type(sparse_layout_t) :: lay
+        type(mechanical_patterns_t) :: pat
+        type(block_assembly_t) :: jac, mass
+        type(saddle_point_t) :: kkt
+        ! block ids in jac
+        integer :: id_tq = 0, id_t = 0, id_ggl_rq = 0, id_ggl_gt = 0
+        integer :: id_va = 0, id_fq = 0, id_rq = 0, id_fv = 0, id_m = 0, id_gt = 0
+        integer :: id_cq = 0, id_cv = 0, id_ca = 0, id_mq = 0
+        ! block ids in mass
+        integer :: id_mass_q = 0, id_mass_v = 0
+        ! block values
+        real(wp), allocatable :: t(:), tq(:), fq(:), fv(:), mq(:), m(:), g(:), gv(:)
+        real(wp), allocatable :: cq(:), cq2(:), rq(:), m0(:)
+        real(wp), allocatable :: wv(:), zc(:) !! a velocity-space vector, nc zeros
+        ! GGL: T, ∂(Gᵀμ)/∂q, Gᵀ and the products T·∂(Gᵀμ)/∂q, T·Gᵀ
+        type(csc_matrix_t) :: tmat, rmat, gtmat, trq, tgt
+        integer(i8), allocatable :: gt_map(:)
+    contains
+        procedure :: init => sparse_init
+        procedure :: jacobian => sparse_jacobian
+        procedure :: mass_matrix => sparse_mass_matrix
+        procedure :: constraint_jacobian => sparse_constraint_jacobian
+        procedure :: g_times => sparse_g_times
+        procedure :: gt_times => sparse_gt_times
+        procedure :: m_times => sparse_m_times
+        procedure :: factor_kkt => sparse_factor_kkt
+        procedure :: solve_kkt => sparse_solve_kkt
+    end type sparse_formulation_t
+
+    ! formulation codes (flexmbs_mbs_formulation's values)
+    integer, parameter :: index1 = 1, index2 = 2, index3 = 3, ggl = 4
+
+contains
+
+    !> Patterns from the mechanical problem, the global patterns of ∂F/∂y and
+    !> of the DAE mass matrix with their block maps, K's pattern.
+    subroutine sparse_init(self, mech, lay, q_mass, status)
+        class(sparse_formulation_t), intent(inout) :: self
+        class(mechanical_problem_t), intent(inout) :: mech
+        type(sparse_layout_t), intent(in) :: lay
+        real(wp), intent(in) :: q_mass(:) !! where the constant M is evaluated
+        type(status_t), intent(inout) :: status
+        integer :: rf
+        self%lay = lay
+        call mech%derivative_patterns(self%pat, status)
+        if (.not. status%ok()) return
+        associate (p => self%pat, j => self%jac, oq => lay%oq, ov => lay%ov, oa => lay%oa, &
+                   ol => lay%ol, om => lay%om)
+            ! rows q
+            call j%add_block(p%kinematics_q, oq, oq, self%id_tq)
+            call j%add_block(p%kinematics, oq, ov, self%id_t)
+            if (lay%ggl) then
+                self%tmat = p%kinematics
+                self%rmat = p%reaction_q
+                call product_pattern(self%tmat, self%rmat, self%trq, status)
+                if (status%ok()) call transpose_pattern(p%constraint_v, self%gtmat, &
+                                                        self%gt_map, status)
+                if (status%ok()) call product_pattern(self%tmat, self%gtmat, self%tgt, status)
+                if (.not. status%ok()) return
+                call j%add_block(self%trq, oq, oq, self%id_ggl_rq)
+                call j%add_block(self%tgt, oq, om, self%id_ggl_gt)
+            end if
+            ! force rows
+            rf = ov
+            if (lay%accelerations) then
+                call j%add_diagonal(lay%nv, ov, oa, self%id_va)
+                rf = oa
+                call j%add_block(p%mass, rf, oa, self%id_m)
+            end if
+            call j%add_block(p%force_q, rf, oq, self%id_fq)
+            call j%add_block(p%reaction_q, rf, oq, self%id_rq)
+            call j%add_block(p%force_v, rf, ov, self%id_fv)
+            call j%add_block(p%constraint_v, rf, ol, self%id_gt, transposed=.true.)
+            ! constraint rows: q columns share g_q's pattern, v columns G's
+            call j%add_block(p%constraint_q, ol, oq, self%id_cq)
+            select case (lay%form)
+            case (index2, ggl)
+                call j%add_block(p%constraint_v, ol, ov, self%id_cv)
+                if (lay%ggl) call j%add_block(p%constraint_q, om, oq, self%id_mq)
+            case (index1)
+                call j%add_block(p%constraint_v, ol, ov, self%id_cv)
+                call j%add_block(p%constraint_v, ol, oa, self%id_ca)
+            end select
+            call j%build(lay%n, lay%n, status)
+            if (.not. status%ok()) return
+            ! DAE mass: I on q (and v), M on v in the constant-mass layout
+            call self%mass%add_diagonal(lay%nq, oq, oq, self%id_mass_q)
+            if (lay%accelerations) then
+                call self%mass%add_diagonal(lay%nv, ov, ov, self%id_mass_v)
+            else
+                call self%mass%add_block(p%mass, ov, ov, self%id_mass_v)
+            end if
+            call self%mass%build(lay%n, lay%n, status)
+            if (.not. status%ok()) return
+        end associate
+        call self%kkt%init(self%pat%mass, self%pat%constraint_v, status)
+        if (.not. status%ok()) return
+        associate (p => self%pat)
+            allocate (self%t(p%kinematics%nnz), self%tq(p%kinematics_q%nnz), &
+                      self%fq(p%force_q%nnz), self%mq(p%force_q%nnz), self%fv(p%force_v%nnz), &
+                      self%m(p%mass%nnz), self%m0(p%mass%nnz), self%g(p%constraint_v%nnz), &
+                      self%gv(p%constraint_v%nnz), self%cq(p%constraint_q%nnz), &
+                      self%cq2(p%constraint_q%nnz), self%rq(p%reaction_q%nnz), &
+                      self%wv(lay%nv), self%zc(lay%nc))
+            self%zc = 0.0_wp
+        end associate
+        ! constant M of the constant-mass layout
+        call mech%mass_sparse(0.0_wp, q_mass, self%m0, status)
+        if (.not. status%ok()) return
+        call self%mass%zero()
+        call self%mass%scatter_diagonal(self%id_mass_q, 1.0_wp)
+        if (lay%accelerations) then
+            call self%mass%scatter_diagonal(self%id_mass_v, 1.0_wp)
+        else
+            call self%mass%scatter(self%id_mass_v, self%m0)
+        end if
+    end subroutine sparse_init
+
+    !> ∂F/∂y at (t, y) into values (one per slot of self%jac%matrix).
+    subroutine sparse_jacobian(self, mech, t, y, values, status)
+        class(sparse_formulation_t), intent(inout) :: self
+        class(mechanical_problem_t), intent(inout) :: mech
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: kz
+        associate (lay => self%lay, j => self%jac, nq => self%lay%nq, nv => self%lay%nv, &
+                   nc => self%lay%nc)
+            associate (q => y(lay%oq + 1:lay%oq + nq), v => y(lay%ov + 1:lay%ov + nv), &
+                       lam => y(lay%ol + 1:lay%ol + nc), &
+                       mu => y(lay%om + 1:lay%om + merge(nc, 0, lay%ggl)))
+                call j%zero()
+                call mech%constraint_jacobian_sparse(t, q, self%g, status)
+                call mech%kinematics_sparse(t, q, self%t, status)
+                call j%scatter(self%id_t, self%t)
+                ! ∂(T w)/∂q with w = v (- Gᵀμ)
+                if (lay%ggl) then
+                    call self%gt_times(mu, self%wv)
+                    self%wv = v - self%wv
+                    call mech%kinematics_derivative_sparse(t, q, self%wv, self%tq, status)
+                else
+                    call mech%kinematics_derivative_sparse(t, q, v, self%tq, status)
+                end if
+                call j%scatter(self%id_tq, self%tq)
+                if (lay%ggl) then
+                    ! -T ∂(Gᵀμ)/∂q and -T Gᵀ
+                    call mech%constraint_jacobian_derivatives_sparse(t, q, v, mu, self%cq, &
+                                                                     self%rq, status)
+                    self%tmat%values = self%t
+                    self%rmat%values = self%rq
+                    call product_values(self%tmat, self%rmat, self%trq)
+                    call j%scatter(self%id_ggl_rq, self%trq%values, -1.0_wp)
+                    self%gtmat%values = self%g(self%gt_map)
+                    call product_values(self%tmat, self%gtmat, self%tgt)
+                    call j%scatter(self%id_ggl_gt, self%tgt%values, -1.0_wp)
+                end if
+                ! force rows
+                call mech%force_derivatives_sparse(t, q, v, self%fq, self%fv, status)
+                call mech%constraint_jacobian_derivatives_sparse(t, q, v, lam, self%cq, &
+                                                                 self%rq, status)
+                call j%scatter(self%id_fq, self%fq)
+                call j%scatter(self%id_rq, self%rq, -1.0_wp)
+                call j%scatter(self%id_fv, self%fv)
+                call j%scatter(self%id_gt, self%g, -1.0_wp)
+                if (lay%accelerations) then
+                    call j%scatter_diagonal(self%id_va, 1.0_wp)
+                    associate (a => y(lay%oa + 1:lay%oa + nv))
+                        call mech%mass_derivative_sparse(t, q, a, self%mq, status)
+                        call j%scatter(self%id_fq, self%mq, -1.0_wp)
+                        call mech%mass_sparse(t, q, self%m, status)
+                        call j%scatter(self%id_m, self%m, -1.0_wp)
+                    end associate
+                end if
+                ! constraint rows
+                select case (lay%form)
+                case (index3)
+                    call mech%constraint_position_jacobian_sparse(t, q, self%cq, status)
+                    call j%scatter(self%id_cq, self%cq)
+                case (index2, ggl)
+                    call velocity_constraint_q(self, mech, t, q, v, status)
+                    call j%scatter(self%id_cq, self%cq)
+                    call j%scatter(self%id_cv, self%g)
+                    if (lay%ggl) then
+                        call mech%constraint_position_jacobian_sparse(t, q, self%cq, status)
+                        call j%scatter(self%id_mq, self%cq)
+                    end if
+                case (index1)
+                    call mech%constraint_curvature_derivatives_sparse(t, q, v, self%cq, &
+                                                                      self%gv, status)
+                    call j%scatter(self%id_cq, self%cq)
+                    call j%scatter(self%id_cv, self%gv)
+                    associate (a => y(lay%oa + 1:lay%oa + nv))
+                        call mech%constraint_jacobian_derivatives_sparse(t, q, a, lam, self%cq, &
+                                                                         self%rq, status)
+                    end associate
+                    call j%scatter(self%id_cq, self%cq)
+                    call j%scatter(self%id_ca, self%g)
+                    if (lay%baumgarte_omega > 0.0_wp) then
+                        kz = 2.0_wp * lay%baumgarte_zeta * lay%baumgarte_omega
+                        call velocity_constraint_q(self, mech, t, q, v, status)
+                        call j%scatter(self%id_cq, self%cq, kz)
+                        call j%scatter(self%id_cv, self%g, kz)
+                        call mech%constraint_position_jacobian_sparse(t, q, self%cq, status)
+                        call j%scatter(self%id_cq, self%cq, lay%baumgarte_omega**2)
+                    end if
+                end select
+                values = j%matrix%values
+            end associate
+        end associate
+    end subroutine sparse_jacobian
+
+    !> self%cq = ∂(G v + g_I)/∂q (self%rq, self%cq2 overwritten).
+    subroutine velocity_constraint_q(self, mech, t, q, v, status)
+        type(sparse_formulation_t), intent(inout) :: self
+        class(mechanical_problem_t), intent(inout) :: mech
+        real(wp), intent(in) :: t, q(:), v(:)
+        type(status_t), intent(inout) :: status
+        call mech%constraint_jacobian_derivatives_sparse(t, q, v, self%zc, self%cq, self%rq, &
+                                                         status)
+        call mech%constraint_time_derivative_jacobian_sparse(t, q, self%cq2, status)
+        self%cq = self%cq + self%cq2
+    end subroutine velocity_constraint_q
+    !> The DAE mass matrix (pattern and constant values).
+    subroutine sparse_mass_matrix(self, m)
+        class(sparse_formulation_t), intent(in) :: self
+        type(csc_matrix_t), intent(inout) :: m
+        m = self%mass%matrix
+    end subroutine sparse_mass_matrix
+
+    !> G(t, q) into self%g (for g_times, gt_times and the KKT matrix).
+    subroutine sparse_constraint_jacobian(self, mech, t, q, status)
+        class(sparse_formulation_t), intent(inout) :: self
+        class(mechanical_problem_t), intent(inout) :: mech
+        real(wp), intent(in) :: t, q(:)
+        type(status_t), intent(inout) :: status
+        call mech%constraint_jacobian_sparse(t, q, self%g, status)
+    end subroutine sparse_constraint_jacobian
+
+    !> y = G x with the G of the last constraint_jacobian or jacobian call.
+    pure subroutine sparse_g_times(self, x, y)
+        class(sparse_formulation_t), intent(in) :: self
+        real(wp), intent(in) :: x(:)
+        real(wp), intent(out) :: y(:)
+        call pattern_matvec(self%pat%constraint_v, self%g, x, y)
+    end subroutine sparse_g_times
+
+    !> y = Gᵀ x.
+    pure subroutine sparse_gt_times(self, x, y)
+        class(sparse_formulation_t), intent(in) :: self
+        real(wp), intent(in) :: x(:)
+        real(wp), intent(out) :: y(:)
+        call pattern_matvec_transpose(self%pat%constraint_v, self%g, x, y)
+    end subroutine sparse_gt_times
+
+    !> y = M(t, q) x (values refreshed from the mechanical problem).
+    subroutine sparse_m_times(self, mech, t, q, x, y, status)
+        class(sparse_formulation_t), intent(inout) :: self
+        class(mechanical_problem_t), intent(inout) :: mech
+        real(wp), intent(in) :: t, q(:), x(:)
+        real(wp), intent(out) :: y(:)
+        type(status_t), intent(inout) :: status
+        call mech%mass_sparse(t, q, self%m, status)
+        call pattern_matvec(self%pat%mass, self%m, x, y)
+    end subroutine sparse_m_times
+
+    !> Factor K = [M Gᵀ; G 0] at q (M and G evaluated there).
+    subroutine sparse_factor_kkt(self, mech, t, q, status)
+        class(sparse_formulation_t), intent(inout) :: self
+        class(mechanical_problem_t), intent(inout) :: mech
+        real(wp), intent(in) :: t, q(:)
+        type(status_t), intent(inout) :: status
+        call mech%mass_sparse(t, q, self%m, status)
+        call mech%constraint_jacobian_sparse(t, q, self%g, status)
+        if (.not. status%ok()) return
+        call self%kkt%factor(self%m, self%g, status)
+    end subroutine sparse_factor_kkt
+
+    !> rhs ← K⁻¹ rhs.
+    subroutine sparse_solve_kkt(self, rhs, status)
+        class(sparse_formulation_t), intent(inout) :: self
+        real(wp), intent(inout) :: rhs(:)
+        type(status_t), intent(inout) :: status
+        call self%kkt%solve(rhs, status)
+    end subroutine sparse_solve_kkt
+end module flexmbs_mbs_formulation_sparse
