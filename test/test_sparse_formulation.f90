@@ -32,7 +32,8 @@ contains
         type(test_case_t), allocatable :: tests(:)
         tests = [new_test('sparse_equals_dense', test_equals_dense), &
                  new_test('jacobian_vs_differences', test_differences), &
-                 new_test('trajectories_sparse_vs_dense', test_trajectories)]
+                 new_test('trajectories_sparse_vs_dense', test_trajectories), &
+                 new_test('fine_five_body', test_fine)]
     end function collect_sparse_formulation
 
     !> The scene at `path` with formulation `form` and linear solver `ls`
@@ -207,4 +208,61 @@ contains
                        status%text())
         end subroutine run
     end subroutine test_trajectories
+
+    !> inputs/five_body_fine.nml (2268 FE coordinates): built on the sparse
+    !> path, its Jacobian checked column-wise against differences of F on a
+    !> sample of columns, and a few RADAU5 steps run.
+    subroutine test_fine(error)
+        type(error_t), allocatable, intent(out) :: error
+        class(dae_problem_t), allocatable :: ps
+        class(mechanical_problem_t), allocatable, target :: ms
+        type(scene_input_t) :: scene
+        type(run_result_t) :: result
+        type(csc_matrix_t) :: pattern
+        type(status_t) :: status
+        real(wp), allocatable :: y(:), yp(:), fp(:), fm(:), col(:)
+        real(wp), parameter :: delta = 1.0e-6_wp
+        real(wp) :: dev
+        integer :: j, k, n
+        integer(8) :: p
+        call build(error, 'inputs/five_body_fine.nml', 'ggl', 'auto', ps, ms, y)
+        if (allocated(error)) return
+        n = size(y)
+        select type (ps)
+        type is (formulation_t)
+            call check(error, ps%is_sparse() .and. ps%nq == 4 * 7 + 2 + 3 * 756, &
+                       'fine five-body: sparse, 2268 FE coordinates')
+        end select
+        if (allocated(error)) return
+        call ps%jacobian_pattern(pattern, status)
+        call ps%jacobian_sparse(0.1_wp, y, pattern%values, status)
+        call check(error, real(pattern%nnz, wp) < 0.01_wp * real(n, wp)**2, &
+                   'fine five-body: dF/dy has under 1 % nonzeros')
+        allocate (yp(n), fp(n), fm(n), col(n))
+        dev = 0.0_wp
+        do k = 1, 25
+            j = 1 + mod(k * 977, n)
+            yp = y
+            yp(j) = y(j) + delta
+            call ps%rhs(0.1_wp, yp, fp, status)
+            yp(j) = y(j) - delta
+            call ps%rhs(0.1_wp, yp, fm, status)
+            col = 0.0_wp
+            do p = pattern%colptr(j) + 1, pattern%colptr(j + 1)
+                col(pattern%rowind(p) + 1) = pattern%values(p)
+            end do
+            dev = max(dev, maxval(abs(col - (fp - fm) / (2 * delta))) &
+                      / max(1.0_wp, maxval(abs(col))))
+        end do
+        call check(error, status%ok() .and. dev <= 1.0e-5_wp, &
+                   'fine five-body: sampled Jacobian columns vs differences ' // real_text(dev))
+        if (allocated(error)) return
+        call read_scene('inputs/five_body_fine.nml', scene, status)
+        scene%output_file = ''
+        scene%progress = .false.
+        scene%t_end = 2.0e-3_wp
+        call run_scene(scene, .true., result, status)
+        call check(error, status%ok() .and. result%t == scene%t_end, &
+                   'fine five-body: RADAU5 steps: ' // status%text())
+    end subroutine test_fine
 end module test_sparse_formulation

@@ -31,7 +31,8 @@ module flexmbs_dae_mexax
     use flexmbs_core_timer, only: timer_t
     use flexmbs_linalg_dense, only: dense_lu_factor, dense_lu_solve
     use flexmbs_linalg_csc, only: csc_matrix_t, pattern_matvec
-    use flexmbs_linalg_klu, only: klu_factor_t, klu_ordering_auto
+    use flexmbs_linalg_klu, only: klu_ordering_auto
+    use flexmbs_linalg_saddle_point, only: saddle_point_t
     use flexmbs_linalg_factory, only: klu_ordering_code
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
@@ -172,13 +173,12 @@ module flexmbs_dae_mexax
         real(wp), allocatable :: rtol(:), atol(:), wt(:), wst(:)
         real(wp), allocatable :: p0(:), v0(:), a0(:), lam0(:), f0(:), pdot0(:)
         type(block_t) :: m0, g0, mm, gm, gn
-        ! augmented matrix: dense (LAPACK) in kmat, or sparse (KLU) in kpat, whose
-        ! triplets are M's slots, then Gᵀ's, then G's (see setup_sparse)
+        ! augmented matrix: dense (LAPACK) in kmat, or sparse (KLU) in kkt
         logical :: sparse = .false.
         logical :: classic_lu = .false. !! dense LU in the classic elimination order (options)
         real(wp), allocatable :: kmat(:, :)
-        type(csc_matrix_t) :: mpat, gpat, kpat
-        type(klu_factor_t) :: klu
+        type(csc_matrix_t) :: mpat, gpat
+        type(saddle_point_t) :: kkt
         real(wp), allocatable :: p(:), pp(:), pn(:), v(:), vp(:), f(:), pdot(:), gt(:)
         real(wp), allocatable :: rhs(:), acc(:), lam(:), x(:), d(:), tab(:, :)
         real(wp), allocatable :: err(:), hh(:), work(:), awork(:)
@@ -804,57 +804,26 @@ contains
         end if
     end subroutine setup_workspace
 
-    !> KLU path: the patterns of M and G from the problem, the pattern of
-    !> K = [M Gᵀ; G 0] built from them once (triplets: M's slots, then Gᵀ's,
-    !> then G's; K's triplet map sends each to its slot, duplicates summed),
-    !> and its symbolic analysis. The (2,2) block has no slots: KLU's
-    !> maximum transversal (BTF) and threshold partial pivoting find nonzero
-    !> pivots for the constraint rows, so the zero block needs no shift.
+    !> KLU path: the patterns of M and G from the problem and the saddle-point
+    !> matrix K = [M Gᵀ; G 0] on them (flexmbs_linalg_saddle_point).
     subroutine setup_sparse(w, problem, status)
         type(workspace_t), intent(inout) :: w
         class(mechanical_problem_t), intent(inout) :: problem
         type(status_t), intent(out) :: status
-        integer, allocatable :: rows(:), cols(:)
-        integer(i8) :: nm, ng, p, k
-        integer :: j, nv, nc
+        integer :: nv, nc
         nv = w%nv
         nc = w%nc
         call problem%mass_pattern(w%mpat, status)
         if (.not. pattern_ok(w%mpat, nv, nv, 'mass_pattern')) return
         call problem%constraint_jacobian_pattern(w%gpat, status)
         if (.not. pattern_ok(w%gpat, nc, nv, 'constraint_jacobian_pattern')) return
-        nm = w%mpat%nnz
-        ng = w%gpat%nnz
-        allocate (rows(nm + 2 * ng), cols(nm + 2 * ng))
-        k = 0
-        do j = 1, nv
-            do p = w%mpat%colptr(j) + 1, w%mpat%colptr(j + 1)
-                k = k + 1
-                rows(k) = int(w%mpat%rowind(p)) + 1
-                cols(k) = j
-            end do
-        end do
-        do j = 1, nv
-            do p = w%gpat%colptr(j) + 1, w%gpat%colptr(j + 1)
-                rows(k + 1) = j                               ! Gᵀ(j, i) = G(i, j)
-                cols(k + 1) = nv + int(w%gpat%rowind(p)) + 1
-                rows(k + 1 + ng) = nv + int(w%gpat%rowind(p)) + 1
-                cols(k + 1 + ng) = j
-                k = k + 1
-            end do
-        end do
-        call w%kpat%build(w%na, w%na, rows, cols, status)
+        call w%kkt%init(w%mpat, w%gpat, status, w%klu_ordering)
         if (.not. status%ok()) then
-            status%message = 'mexax: pattern of [M G^T; G 0]: ' // status%message
+            status%message = 'mexax: ' // status%message
             return
         end if
-        call w%klu%analyse(w%na, w%kpat%colptr, w%kpat%rowind, status, w%klu_ordering)
-        if (.not. status%ok()) then
-            status%message = 'mexax: ' // status%message // ' (pattern of [M G^T; G 0])'
-            return
-        end if
-        allocate (w%m0%values(nm), w%mm%values(nm))
-        allocate (w%g0%values(ng), w%gm%values(ng), w%gn%values(ng))
+        allocate (w%m0%values(w%mpat%nnz), w%mm%values(w%mpat%nnz))
+        allocate (w%g0%values(w%gpat%nnz), w%gm%values(w%gpat%nnz), w%gn%values(w%gpat%nnz))
     contains
         logical function pattern_ok(pattern, nrow, ncol, what) result(ok)
             type(csc_matrix_t), intent(in) :: pattern
@@ -963,27 +932,15 @@ contains
         w%lam0 = w%rhs(nv + 1:)
     end subroutine consistent_acceleration
 
-    !> K = [mtop gtopᵀ; gbot 0] into w%kmat, or into the values of w%kpat
-    !> through its triplet map (no allocation).
+    !> K = [mtop gtopᵀ; gbot 0] into w%kmat, or into the saddle-point matrix
+    !> (no allocation).
     subroutine assemble(w, mtop, gtop, gbot)
         type(workspace_t), intent(inout) :: w
         type(block_t), intent(in) :: mtop, gtop, gbot
         integer :: nv
-        integer(i8) :: k, nm, ng
         nv = w%nv
         if (w%sparse) then
-            nm = size(mtop%values, kind=i8)
-            ng = size(gtop%values, kind=i8)
-            associate (map => w%kpat%triplet_map, kv => w%kpat%values)
-                kv = 0.0_wp
-                do k = 1, nm
-                    kv(map(k)) = kv(map(k)) + mtop%values(k)
-                end do
-                do k = 1, ng
-                    kv(map(nm + k)) = kv(map(nm + k)) + gtop%values(k)
-                    kv(map(nm + ng + k)) = kv(map(nm + ng + k)) + gbot%values(k)
-                end do
-            end associate
+            call w%kkt%assemble(mtop%values, gbot%values, gtop%values)
             return
         end if
         w%kmat(1:nv, 1:nv) = mtop%dense
@@ -998,7 +955,7 @@ contains
         type(workspace_t), intent(inout) :: w
         type(status_t), intent(out) :: status
         if (w%sparse) then
-            call w%klu%refactor(w%kpat%values, status)
+            call w%kkt%factor(status)
         else
             call dense_lu_factor(w%kmat, w%ipiv, status, w%classic_lu)
         end if
@@ -1011,7 +968,7 @@ contains
         type(status_t) :: lst
         if (w%sparse) then
             ! fails only without a factorisation, which `factor` excluded
-            call w%klu%solve(b, lst)
+            call w%kkt%solve(b, lst)
         else
             call dense_lu_solve(w%kmat, w%ipiv, b, w%classic_lu)
         end if

@@ -7,10 +7,12 @@
 !> and the consistent initial values of the formulations. K's pattern and
 !> the maps from the blocks into it are built once (`init`), KLU analyses it
 !> once (lazily: a copy made by assignment analyses again, see
-!> flexmbs_linalg_klu), and each `factor` refills values and factors
-!> without allocating. KLU's maximum transversal and threshold pivoting
-!> find nonzero pivots for the constraint rows, so the zero block needs no
-!> slots and no shift.
+!> flexmbs_linalg_klu); `assemble` refills the values and `factor` factors
+!> them, reusing the last pivot order while it stays good
+!> (klu_factor_t%refactor), without allocating. KLU's maximum transversal
+!> and threshold pivoting find nonzero pivots for the constraint rows, so
+!> the zero block needs no slots and no shift. MEXAX's augmented systems
+!> [M(q̃) G(q̃)ᵀ; G(q) 0] take B ≠ A on the same pattern.
 module flexmbs_linalg_saddle_point
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_solver_failure, reason_singular_matrix
@@ -27,9 +29,10 @@ module flexmbs_linalg_saddle_point
         type(block_assembly_t) :: k
         integer :: id_m = 0, id_bt = 0, id_a = 0
         type(klu_factor_t) :: lu
-        logical :: factored = .false.
+        integer :: ordering = klu_ordering_auto
     contains
         procedure :: init => saddle_init
+        procedure :: assemble => saddle_assemble
         procedure :: factor => saddle_factor
         procedure :: solve => saddle_solve
         procedure :: order => saddle_order
@@ -37,11 +40,14 @@ module flexmbs_linalg_saddle_point
 
 contains
 
-    !> The pattern of K from those of M (nv x nv) and A, B (nc x nv).
-    subroutine saddle_init(self, m_pattern, a_pattern, status)
+    !> The pattern of K from those of M (nv x nv) and A, B (nc x nv);
+    !> `ordering` is KLU's (klu_ordering_*, default auto).
+    subroutine saddle_init(self, m_pattern, a_pattern, status, ordering)
         class(saddle_point_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: m_pattern, a_pattern
         type(status_t), intent(out) :: status
+        integer, intent(in), optional :: ordering
+        if (present(ordering)) self%ordering = ordering
         self%nv = m_pattern%ncol
         self%nc = a_pattern%nrow
         call self%k%add_block(m_pattern, 0, 0, self%id_m)
@@ -51,22 +57,11 @@ contains
         if (.not. status%ok()) status%message = 'saddle point: ' // status%message
     end subroutine saddle_init
 
-    !> Factor K with the values of M, A and B (B = A when absent).
-    subroutine saddle_factor(self, m_values, a_values, status, b_values)
+    !> K's values from those of M, A and B (B = A when absent).
+    pure subroutine saddle_assemble(self, m_values, a_values, b_values)
         class(saddle_point_t), intent(inout) :: self
         real(wp), intent(in) :: m_values(:), a_values(:)
-        type(status_t), intent(inout) :: status
         real(wp), intent(in), optional :: b_values(:)
-        type(status_t) :: local
-        if (.not. self%lu%is_analysed()) then
-            call self%lu%analyse(self%nv + self%nc, self%k%matrix%colptr, &
-                                 self%k%matrix%rowind, local, klu_ordering_auto)
-            if (.not. local%ok()) then
-                status = local
-                status%message = 'saddle point: ' // status%message
-                return
-            end if
-        end if
         call self%k%zero()
         call self%k%scatter(self%id_m, m_values)
         call self%k%scatter(self%id_a, a_values)
@@ -75,8 +70,23 @@ contains
         else
             call self%k%scatter(self%id_bt, a_values)
         end if
-        call self%lu%factor(self%k%matrix%values, local)
-        self%factored = local%ok()
+    end subroutine saddle_assemble
+
+    !> LU of the assembled K; a singular K fails with reason_singular_matrix.
+    subroutine saddle_factor(self, status)
+        class(saddle_point_t), intent(inout) :: self
+        type(status_t), intent(inout) :: status
+        type(status_t) :: local
+        if (.not. self%lu%is_analysed()) then
+            call self%lu%analyse(self%nv + self%nc, self%k%matrix%colptr, &
+                                 self%k%matrix%rowind, local, self%ordering)
+            if (.not. local%ok()) then
+                status = local
+                status%message = 'saddle point: ' // status%message
+                return
+            end if
+        end if
+        call self%lu%refactor(self%k%matrix%values, local)
         if (.not. local%ok()) call status%set(status_solver_failure, 'saddle-point matrix &
             &[M G^T; G 0] is singular (redundant constraints?): ' // local%text(), &
             reason_singular_matrix)

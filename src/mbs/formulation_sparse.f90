@@ -311,7 +311,8 @@ contains
         call mech%mass_sparse(t, q, self%m, status)
         call mech%constraint_jacobian_sparse(t, q, self%g, status)
         if (.not. status%ok()) return
-        call self%kkt%factor(self%m, self%g, status)
+        call self%kkt%assemble(self%m, self%g)
+        call self%kkt%factor(status)
     end subroutine sparse_factor_kkt
 
     !> rhs ← K⁻¹ rhs.
