@@ -522,13 +522,13 @@ contains
             if (m == 3 .and. status%ok()) call mumps%factor(values, status)
             call system_clock(c1)
             t_refactor = min(t_refactor, real(c1 - c0, wp) / rate)
-            if (t_factor > max_seconds) exit ! one factorisation of minutes says enough
             x = 1.0_wp
             call system_clock(c0)
             if (m < 3 .and. status%ok()) call klu%solve(x, status)
             if (m == 3 .and. status%ok()) call mumps%solve(x, status)
             call system_clock(c1)
             t_solve = min(t_solve, real(c1 - c0, wp) / rate)
+            if (t_factor > max_seconds) exit ! one factorisation of minutes says enough
         end do
         if (m < 3) then
             solver = 'klu'
