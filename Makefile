@@ -13,11 +13,15 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := run
 
 APT_PACKAGES := gfortran libsundials-dev libsundials-fortran-dev libsuitesparse-dev \
-                liblapack-dev libopenblas-dev libhdf5-dev
+                liblapack-dev libopenblas-dev libhdf5-dev libmumps-seq-dev
 BUILD        := $(CURDIR)/build
 VENV         := $(BUILD)/venv
 # One set of flags for every fpm call: changing them makes fpm rebuild everything.
-export FPM_FFLAGS := -I/usr/include/hdf5/serial -I/usr/include/sundials/fortran
+# MUMPS's Fortran headers (dmumps_struc.h, ...) are in /usr/include, which
+# gfortran does not search for INCLUDE lines; the sequential library's
+# mpif.h is in /usr/include/mumps_seq.
+export FPM_FFLAGS := -I/usr/include/hdf5/serial -I/usr/include/sundials/fortran \
+                     -I/usr/include -I/usr/include/mumps_seq
 export FPM_CFLAGS := -I/usr/include/suitesparse
 # LTO=1 adds link-time optimisation (inlines the dual-number operators of
 # the AD mode across modules; fat objects keep the library linkable without it).
@@ -43,6 +47,7 @@ SYSLIBS      := -lsundials_fida_mod -lsundials_fnvecserial_mod \
                 -lsundials_sunmatrixsparse -lsundials_sunlinsoldense -lsundials_sunlinsolklu \
                 -lsundials_generic \
                 -lklu -lcholmod -lamd -lcolamd -lbtf -lsuitesparseconfig \
+                -ldmumps_seq -lzmumps_seq -lmumps_common_seq -lmpiseq_seq -lpord_seq \
                 -lhdf5_serial_fortran -lhdf5_serial -llapack -lblas
 MAIN_INPUT   := inputs/five_body.nml
 

@@ -6,6 +6,7 @@
 !>   flexmbs-bench reference PROBLEM N FILE [RTOL]
 !>   flexmbs-bench assembly hex8|hex27 NDOF
 !>   flexmbs-bench ad fourbar|slidercrank
+!>   flexmbs-bench sparse_lu hex NX NY NZ | sparse_lu rd1d|rd2d N
 !>
 !> INTEGRATOR: radau5 | ddassl | ddassl-p2 (maximal BDF order 2) | ida |
 !> mexax (midpoint base) | mexax-euler (half-explicit Euler base).
@@ -33,6 +34,15 @@
 !> their ratios; 'ad' differentiates the vector relations on the marker
 !> frames ('ad_full', through the body coordinates too, is the verification
 !> path and is timed beside them).
+!> The sparse_lu mode factors A = M - J on the node graph of NX × NY × NZ
+!> hex8 nodes (3 unknowns each, 27-point coupling, flexmbs_problems_node_graph;
+!> M positive diagonal), or A = I - J of the Brusselator (J at its initial
+!> value, N as for the integrators), with KLU (AMD and nested-dissection orderings) and MUMPS (its automatic
+!> ordering): one row each with the analysis time, the factorisation time
+!> (best of 3, fresh pivoting), the solve time (best of 3), the nonzeros of
+!> L+U (KLU: its analysis' count) and the ordering used; first the fill ratio
+!> (nnz(L)+nnz(U))/nnz(A) KLU's AMD analysis predicts and what `linear_solver
+!> = 'auto'` picks from it.
 !> bench/run.sh runs the grid of configurations; these are figures, not tests.
 program flexmbs_bench
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
@@ -67,6 +77,14 @@ program flexmbs_bench
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_ggl
     use flexmbs_problems_mechanisms, only: new_mechanism, mechanism_slider_crank, &
         mechanism_four_bar
+    use flexmbs_problems_node_graph, only: node_graph_jacobian, node_graph_mass
+    use flexmbs_linalg_matrix, only: matrix_t, storage_sparse, storage_identity
+    use flexmbs_linalg_shifted_pattern, only: shifted_pattern_t
+    use flexmbs_linalg_klu, only: klu_factor_t, klu_ordering_amd, klu_ordering_nd, &
+        klu_part_real
+    use flexmbs_linalg_mumps, only: mumps_real_t
+    use flexmbs_linalg_linear_solver, only: linear_solver_t
+    use flexmbs_linalg_factory, only: new_linear_solver, predicted_fill_ratio
     !$ use omp_lib, only: omp_get_max_threads
     implicit none
 
@@ -99,6 +117,13 @@ program flexmbs_bench
             stop
         end if
     end if
+    if (command_argument_count() >= 3) then
+        call get_command_argument(1, integrator_name)
+        if (integrator_name == 'sparse_lu') then
+            call run_sparse_lu()
+            stop
+        end if
+    end if
     if (command_argument_count() == 2) then
         call get_command_argument(1, integrator_name)
         if (integrator_name == 'ad') then
@@ -111,7 +136,8 @@ program flexmbs_bench
             // 'vdp|rd1d|rd2d|pend3|pend2|pendggl|pendmech|chain N dense|klu|band|auto ' // &
             '[MAX_STEPS] [RTOL] [REFERENCE]', &
             '       flexmbs-bench reference PROBLEM N FILE [RTOL]', &
-            '       flexmbs-bench assembly hex8|hex27 NDOF'
+            '       flexmbs-bench assembly hex8|hex27 NDOF', &
+            '       flexmbs-bench sparse_lu hex NX NY NZ | rd1d N | rd2d N'
         error stop 2
     end if
     call get_command_argument(1, integrator_name)
@@ -401,6 +427,129 @@ contains
             (mem1 - mem0) * 1048576.0_wp / body%nv, threads
 
     end subroutine run_assembly
+
+    !> `sparse_lu hex NX NY NZ | rd1d N | rd2d N`: KLU (AMD, ND) and MUMPS on
+    !> A = M - J of a node graph or of the Brusselator.
+    subroutine run_sparse_lu()
+        integer, parameter :: dofs = 3, repeats = 3
+        type(matrix_t) :: jac, mass
+        type(shifted_pattern_t) :: pattern
+        class(linear_solver_t), allocatable :: auto
+        real(wp), allocatable :: values(:)
+        real(wp) :: fill
+        integer :: nx, ny, nz, n, m
+        character(len=24) :: mesh
+        call get_command_argument(2, problem_name)
+        call get_command_argument(3, arg)
+        read (arg, *) nx
+        if (problem_name == 'hex') then
+            call get_command_argument(4, arg)
+            read (arg, *) ny
+            call get_command_argument(5, arg)
+            read (arg, *) nz
+            write (mesh, '("hex",i0,"x",i0,"x",i0)') nx, ny, nz
+            call node_graph_jacobian(nx, ny, nz, dofs, jac, status)
+            if (status%ok()) call node_graph_mass(jac%n, mass, status)
+        else
+            write (mesh, '(a,"-",i0)') trim(problem_name), nx
+            call make_problem(trim(problem_name), nx, 'klu') ! y: the initial value
+            jac%storage = storage_sparse
+            jac%n = problem%n
+            call problem%jacobian_pattern(jac%csc, status)
+            if (status%ok()) call problem%jacobian_sparse(0.0_wp, y, jac%csc%values, status)
+            mass%storage = storage_identity
+            mass%n = problem%n
+        end if
+        n = jac%n
+        if (status%ok()) call pattern%build(mass, jac, 'sparse_lu', status)
+        if (status%ok()) call predicted_fill_ratio(jac, fill, status, mass)
+        if (status%ok()) call new_linear_solver('auto', n, storage_sparse, auto, status, &
+            mass=mass, jac=jac)
+        if (.not. status%ok()) then
+            write (*, '(a)') 'sparse_lu: ' // status%text()
+            error stop 1
+        end if
+        allocate (values(pattern%nonzeros()))
+        call pattern%gather(mass, jac)
+        call pattern%real_values(1.0_wp, values)
+        write (*, '(a,1x,i0,1x,i0,a,f0.1,a)') trim(mesh), n, pattern%nonzeros(), &
+            ' predicted_fill(AMD) = ', fill, ' auto -> ' // auto%name()
+        ! m = 1, 2: KLU with AMD and ND; m = 3: MUMPS with its automatic ordering
+        do m = 1, 3
+            call time_sparse_lu(m, trim(mesh), n, pattern, values, repeats)
+        end do
+    end subroutine run_sparse_lu
+
+    !> One row of `sparse_lu`: KLU with AMD (m = 1) or ND (m = 2), MUMPS (m = 3).
+    subroutine time_sparse_lu(m, mesh, n, pattern, values, repeats)
+        integer, intent(in) :: m, n, repeats
+        character(len=*), intent(in) :: mesh
+        type(shifted_pattern_t), intent(in) :: pattern
+        real(wp), intent(in) :: values(:)
+        real(wp), parameter :: max_seconds = 10.0_wp
+        type(klu_factor_t) :: klu
+        type(mumps_real_t) :: mumps
+        real(wp) :: t_analyse, t_factor, t_refactor, t_solve, lnz, unz, x(n)
+        character(len=:), allocatable :: solver, ordering
+        integer(8) :: c0, c1, rate
+        integer :: r
+        call system_clock(c0, rate)
+        if (m < 3) then
+            call klu%analyse(n, pattern%column_pointers(), pattern%row_indices(), status, &
+                merge(klu_ordering_amd, klu_ordering_nd, m == 1))
+        else
+            call mumps%analyse(n, pattern%column_pointers(), pattern%row_indices(), status)
+        end if
+        call system_clock(c1)
+        t_analyse = real(c1 - c0, wp) / rate
+        t_factor = huge(1.0_wp)
+        t_refactor = huge(1.0_wp)
+        t_solve = huge(1.0_wp)
+        do r = 1, repeats
+            if (.not. status%ok()) exit
+            call system_clock(c0)
+            if (m < 3) then
+                call klu%factor(values, status)
+            else
+                call mumps%factor(values, status)
+            end if
+            call system_clock(c1)
+            t_factor = min(t_factor, real(c1 - c0, wp) / rate)
+            ! what an integrator pays for new values: KLU's refactor keeps the
+            ! pivot order, MUMPS factors numerically again (JOB = 2) each time
+            call system_clock(c0)
+            if (m < 3 .and. status%ok()) call klu%refactor(values, status)
+            if (m == 3 .and. status%ok()) call mumps%factor(values, status)
+            call system_clock(c1)
+            t_refactor = min(t_refactor, real(c1 - c0, wp) / rate)
+            x = 1.0_wp
+            call system_clock(c0)
+            if (m < 3 .and. status%ok()) call klu%solve(x, status)
+            if (m == 3 .and. status%ok()) call mumps%solve(x, status)
+            call system_clock(c1)
+            t_solve = min(t_solve, real(c1 - c0, wp) / rate)
+            if (t_factor > max_seconds) exit ! one factorisation of minutes says enough
+        end do
+        if (m < 3) then
+            solver = 'klu'
+            ordering = trim(merge('amd', 'nd ', klu%ordering_used() == klu_ordering_amd))
+            lnz = real(klu%factor_nonzeros(klu_part_real), wp)
+            unz = 0.0_wp
+        else
+            solver = 'mumps'
+            ordering = mumps%ordering_used()
+            lnz = real(mumps%factor_nonzeros(), wp)
+            unz = 0.0_wp
+        end if
+        if (.not. status%ok()) then
+            write (*, '(a)') mesh // ' ' // solver // ' ' // ordering // ' failed: ' // &
+                status%text()
+            return
+        end if
+        write (*, '(a,1x,i0,1x,a,1x,a,4(1x,es9.2),1x,es9.2,1x,f0.1)') mesh, n, solver, &
+            ordering, t_analyse, t_factor, t_refactor, t_solve, lnz + unz, &
+            (lnz + unz) / real(pattern%nonzeros(), wp)
+    end subroutine time_sparse_lu
 
     !> `ad MECHANISM`: derivative and whole-run cost, 'analytic' against 'ad'.
     subroutine run_ad()

@@ -9,6 +9,8 @@
 # in steps (outcome 'capped', ERR '-'); runs that cannot fit or would take far
 # too long are listed as 'skipped' with the reason. A run that fails prints
 # its row with outcome 'failed' (the reason goes to build/bench/errors.txt).
+# Last, sparse LU alone (flexmbs-bench sparse_lu): KLU against MUMPS on 3-D,
+# slender and Brusselator patterns, the figures behind linear_solver = 'auto'.
 set -u
 cd "$(dirname "$0")/.."
 FPM=${FPM:-fpm}
@@ -150,6 +152,15 @@ awk '$5 == "done" { key = $2" "$3" "$4; cpu[$1" "key] = $12; keys[key] = 1 }
                for (j = 1; j <= 3; j++) if ((ii[j] " " key) in cpu)
                    line = line sprintf("  %s %.2f", ii[j], cpu[ii[j] " " key] / cpu["radau5 " key])
                print line } }' "$RESULTS" | sort -k1,1 -k2,2n -k3,3
+echo
+echo "sparse LU of A = M - J: KLU (AMD, ND) and MUMPS (its automatic ordering) on the node"
+echo "graph of a 3-D hex8 block (20x20x20 nodes, n = 24000), a slender one (6x6x200) and the"
+echo "Brusselator; first per matrix its size, nnz(A), KLU's predicted fill and the choice of"
+echo "linear_solver = 'auto'; times best of 3 in seconds (KLU at minutes a factorisation: once)"
+echo "mesh n solver ordering analyse factor refactor solve nnz(L+U) nnz(L+U)/nnz(A)"
+for m in "hex 20 20 20" "hex 6 6 200" "hex 3 3 192" "hex 8 8 8" "rd2d 71" "rd1d 10000"; do
+    OPENBLAS_NUM_THREADS=1 "$BIN" sparse_lu $m 2>>"$ERRORS" | tee -a "$OUT/sparse_lu.txt"
+done
 if [ -s "$ERRORS" ]; then
     echo
     echo "messages of failed runs: $ERRORS"

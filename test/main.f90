@@ -4,6 +4,7 @@ program flexmbs_tests
     use testing, only: run_suite
     use test_linalg, only: collect_linalg
     use test_klu, only: collect_klu
+    use test_mumps, only: collect_mumps
     use test_band, only: collect_band
     use test_problems, only: collect_problems
     use test_radau5, only: collect_radau5
@@ -50,6 +51,7 @@ program flexmbs_tests
     nfailed = 0
     call run_suite('linalg', collect_linalg(), filter, npassed, nfailed)
     call run_suite('klu', collect_klu(), filter, npassed, nfailed)
+    call run_suite('mumps', collect_mumps(), filter, npassed, nfailed)
     call run_suite('band', collect_band(), filter, npassed, nfailed)
     call run_suite('problems', collect_problems(), filter, npassed, nfailed)
     call run_suite('radau5', collect_radau5(), filter, npassed, nfailed)

@@ -197,7 +197,7 @@ contains
         call expect(error, status, '&simulation: t_end: required')
         status = parse_status(vdp_sim() // '&solver linear_solver = ''lu'' /')
         call expect(error, status, &
-            'linear_solver = ''lu'': must be ''auto'', ''dense'', ''klu'' or ''band''')
+            'linear_solver = ''lu'': must be ''auto'', ''dense'', ''klu'', ''band'' or ''mumps''')
         status = parse_status(vdp_sim() // '&output table = ''x.txt'' /')
         call expect(error, status, 'table = ''x.txt'': must end in .md, .csv or .tex')
     end subroutine test_negative_tolerance

@@ -638,7 +638,8 @@ contains
             direct = .not. fd .and. res%has_iteration_matrix()
             call new_linear_solver(options%linear_solver, n, bmat%storage, ls, status, &
                 lower=options%band_lower, upper=options%band_upper, &
-                ordering=options%sparse_ordering, classic_order=options%classic_lu)
+                ordering=options%sparse_ordering, classic_order=options%classic_lu, &
+                mass=amat, jac=bmat)
             if (.not. status%ok()) return
             if (fd) then
                 ! The difference PD is held as −PD and factored with shift 0.

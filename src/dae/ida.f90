@@ -407,8 +407,9 @@ contains
                 use_klu = .true.
             case ('dense')
                 use_klu = .false.
-            case ('band')
-                call st%set(status_bad_input, "ida: linear_solver = 'band' is not offered " &
+            case ('band', 'mumps')
+                call st%set(status_bad_input, "ida: linear_solver = '" &
+                    // trim(options%linear_solver) // "' is not offered " &
                     // "with IDA (dense or KLU); use 'dense', 'klu' or 'auto'")
                 return
             case default

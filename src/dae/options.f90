@@ -2,6 +2,7 @@
 module flexmbs_dae_options
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_linalg_linear_solver, only: linear_solver_names, linear_solver_names_text
     implicit none
     private
 
@@ -14,7 +15,7 @@ module flexmbs_dae_options
         real(wp) :: hmax = 0.0_wp   !! maximal step; 0 = |t_end - t0|
         integer :: max_steps = 100000
         integer :: pmax = 5         !! maximal BDF order / extrapolation stages
-        character(len=8) :: linear_solver = 'auto' !! 'auto' | 'dense' | 'klu' | 'band'
+        character(len=8) :: linear_solver = 'auto' !! 'auto' | 'dense' | 'klu' | 'band' | 'mumps'
         !> Bandwidths of M and J for 'band' when the caller knows them; -1:
         !> found from the patterns (a dense Jacobian needs them given).
         integer :: band_lower = -1
@@ -77,10 +78,9 @@ contains
             call status%set(status_bad_input, 'options: max_steps must be positive')
         else if (self%pmax < 1) then
             call status%set(status_bad_input, 'options: pmax must be at least 1')
-        else if (all(self%linear_solver /= &
-                     [character(len=8) :: 'auto', 'dense', 'klu', 'band'])) then
+        else if (all(self%linear_solver /= linear_solver_names)) then
             call status%set(status_bad_input, "options: linear_solver = '" // &
-                trim(self%linear_solver) // "': must be 'auto', 'dense', 'klu' or 'band'")
+                trim(self%linear_solver) // "': must be " // linear_solver_names_text)
         else if (self%band_lower < -1 .or. self%band_upper < -1 .or. &
                  ((self%band_lower == -1) .neqv. (self%band_upper == -1))) then
             write (msg, '(a,i0,a,i0,a)') 'options: band_lower = ', self%band_lower, &

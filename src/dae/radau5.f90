@@ -279,7 +279,8 @@ contains
             return
         end if
         call new_linear_solver(options%linear_solver, n, jac%storage, ls, status, &
-            options%band_lower, options%band_upper, options%sparse_ordering)
+            options%band_lower, options%band_upper, options%sparse_ordering, mass=mass, &
+            jac=jac)
         if (.not. status%ok()) return
         call ls%init(mass, jac, status)
         if (.not. status%ok()) return

@@ -17,6 +17,7 @@ module flexmbs_io_namelist
     use flexmbs_core_files, only: read_text_file
     use flexmbs_core_text, only: lower
     use flexmbs_dae_options, only: dae_options_t
+    use flexmbs_linalg_linear_solver, only: linear_solver_names, linear_solver_names_text
     implicit none
     private
 
@@ -1749,9 +1750,8 @@ contains
             call bad(sol, 'hmax', 'must not be negative (0 = the whole interval)')
         else if (scene%max_steps < 1) then
             call bad(sol, 'max_steps', 'must be positive')
-        else if (all([character(len=8) :: 'auto', 'dense', 'klu', 'band'] &
-                     /= scene%linear_solver)) then
-            call bad(sol, 'linear_solver', 'must be ''auto'', ''dense'', ''klu'' or ''band''')
+        else if (all(linear_solver_names /= scene%linear_solver)) then
+            call bad(sol, 'linear_solver', 'must be ' // linear_solver_names_text)
         else if (all([character(len=8) :: 'auto', 'amd', 'nd'] /= scene%sparse_ordering)) then
             call bad(sol, 'sparse_ordering', 'must be ''auto'', ''amd'' or ''nd''')
         else if (all([character(len=8) :: 'analytic', 'fd'] /= scene%jacobian)) then

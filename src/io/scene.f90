@@ -94,7 +94,7 @@ contains
         real(wp), allocatable :: q0(:), v0(:), yp0(:)
         integer :: nq
         logical :: klu, massless
-        klu = scene%linear_solver == 'klu'
+        klu = scene%linear_solver == 'klu' .or. scene%linear_solver == 'mumps'
         allocate (blocks(0))
         if (present(mechanical)) then
             if (allocated(mechanical)) deallocate (mechanical)

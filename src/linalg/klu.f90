@@ -72,6 +72,8 @@ module flexmbs_linalg_klu
         procedure :: stats => klu_stats
         procedure :: order => klu_order
         procedure :: nonzeros => klu_nonzeros
+        procedure :: predicted_fill => klu_predicted_fill
+        procedure :: factor_nonzeros => klu_factor_nonzeros
         procedure :: is_analysed => klu_is_analysed
         procedure :: destroy => klu_destroy
         final :: klu_final
@@ -164,6 +166,22 @@ module flexmbs_linalg_klu
             integer(c_int), intent(out) :: factored
             integer(c_int) :: code
         end function shim_stats
+
+        function shim_predicted_fill(handle, lnz, unz) &
+            bind(C, name='flexmbs_klu_predicted_fill') result(code)
+            import :: c_ptr, c_int, c_double
+            type(c_ptr), value :: handle
+            real(c_double), intent(out) :: lnz, unz
+            integer(c_int) :: code
+        end function shim_predicted_fill
+
+        function shim_factor_nonzeros(handle, part) &
+            bind(C, name='flexmbs_klu_factor_nonzeros') result(nnz)
+            import :: c_ptr, c_int, c_int64_t
+            type(c_ptr), value :: handle
+            integer(c_int), value :: part
+            integer(c_int64_t) :: nnz
+        end function shim_factor_nonzeros
 
         function shim_degrade_ratio() bind(C, name='flexmbs_klu_refactor_degrade_ratio') &
             result(ratio)
@@ -326,6 +344,29 @@ contains
         class(klu_factor_t), intent(in) :: self
         klu_nonzeros = self%nnz
     end function klu_nonzeros
+
+    !> KLU's estimates of the nonzeros of L and U under the analysed
+    !> ordering (symbolic analysis, before any factorisation): the fill that
+    !> `linear_solver = 'auto'` compares with the pattern's own nonzeros.
+    !> Both are -1 before an analysis.
+    subroutine klu_predicted_fill(self, lnz, unz)
+        class(klu_factor_t), intent(in) :: self
+        real(wp), intent(out) :: lnz !! predicted nonzeros of L
+        real(wp), intent(out) :: unz !! predicted nonzeros of U
+        real(c_double) :: l, u
+        integer(c_int) :: code
+        code = shim_predicted_fill(handle_of(self), l, u)
+        lnz = l
+        unz = u
+    end subroutine klu_predicted_fill
+
+    !> Nonzeros of L + U of the real (klu_part_real) or complex
+    !> (klu_part_complex) factorisation; -1 when none is alive.
+    integer(i8) function klu_factor_nonzeros(self, part)
+        class(klu_factor_t), intent(in) :: self
+        integer, intent(in) :: part !! klu_part_real or klu_part_complex
+        klu_factor_nonzeros = shim_factor_nonzeros(handle_of(self), int(part, c_int))
+    end function klu_factor_nonzeros
 
     !> True once a pattern has been analysed.
     logical function klu_is_analysed(self)

@@ -230,6 +230,30 @@ int flexmbs_klu_analyse(void *handle, int64_t n, const int64_t *colptr,
     return FLEXMBS_KLU_OK;
 }
 
+/* KLU's estimates of the nonzeros of L and U from the symbolic analysis
+ * (Symbolic->lnz, ->unz, exact for the diagonal blocks when no pivoting
+ * beyond the diagonal occurs); -1 each before an analysis. */
+int flexmbs_klu_predicted_fill(const void *handle, double *lnz, double *unz)
+{
+    const flexmbs_klu *h = handle;
+    *lnz = -1.0;
+    *unz = -1.0;
+    if (h == NULL || h->symbolic == NULL) return FLEXMBS_KLU_NOT_ANALYSED;
+    *lnz = h->symbolic->lnz;
+    *unz = h->symbolic->unz;
+    return FLEXMBS_KLU_OK;
+}
+
+/* Nonzeros of L + U of a part's numeric factorisation (Numeric->lnz + unz,
+ * the off-diagonal blocks of the BTF form excluded); -1 when none is alive. */
+int64_t flexmbs_klu_factor_nonzeros(const void *handle, int part)
+{
+    const flexmbs_klu *h = handle;
+    if (h == NULL || (part != PART_REAL && part != PART_COMPLEX)) return -1;
+    const klu_l_numeric *numeric = h->part[part].numeric;
+    return numeric == NULL ? -1 : (int64_t)(numeric->lnz + numeric->unz);
+}
+
 /* Record rcond and rgrowth of the current numeric factorisation. */
 static int measure(flexmbs_klu *h, int which, double *values)
 {

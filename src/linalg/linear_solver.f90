@@ -5,6 +5,7 @@
 !> stay alive together. `init` sees the storage and pattern of M and J once;
 !> afterwards only values change.
 module flexmbs_linalg_linear_solver
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t
     use flexmbs_linalg_matrix, only: matrix_t
@@ -19,6 +20,37 @@ module flexmbs_linalg_linear_solver
     !> chosen: on the same banded problem it is 10-20 % slower than KLU at
     !> n = 1e2..1e5 (README, Benchmarks).
     integer, parameter, public :: auto_sparse_threshold = 20
+
+    !> For `linear_solver = 'auto'` with a sparse J of order n >=
+    !> auto_sparse_threshold: MUMPS (multifrontal) instead of KLU when
+    !> n >= auto_mumps_min_order and KLU's symbolic analysis (AMD) predicts
+    !> fill (nnz(L) + nnz(U)) / nnz(A) >= auto_mumps_min_fill, A the union
+    !> pattern of c*M - J. `flexmbs-bench sparse_lu` (1 BLAS thread, 2 cores),
+    !> time of KLU's refactor (old pivot order, what an integrator pays) /
+    !> MUMPS's numerical factorisation, with the predicted fill:
+    !> hex8 node graphs (3 dofs/node): 3³ nodes (n = 81, fill 1.2) 0.35,
+    !> 5³ (375, 2.4) 1.0, 6³ (648, 3.0) 1.7, 8³ (1536, 4.7) 3.1; slender
+    !> 2×2×400 (4800, 1.0) 0.35, 3×3×192 (5184, 1.7) 0.7, 4×4×100 (4800, 2.7)
+    !> 1.5, 6×6×200 (21600, 5.0) 2.6; 2-D Brusselator rd2d 15 (450, 7.4) 0.6,
+    !> 22 (968, 9.0) 0.96, 30 (1800, 12.5) 1.8, 71 (10082, 17.8) 5.1; 1-D
+    !> Brusselator (fill 1.5) 0.1 at n = 1e3 and 1e4. MUMPS wins from a fill of
+    !> about 2.5 once the factors are large enough to hide its per-call cost;
+    !> below n ~ 1000 its solves (2-10 x slower than KLU's there) eat the gain.
+    integer, parameter, public :: auto_mumps_min_order = 1000
+    real(wp), parameter, public :: auto_mumps_min_fill = 2.5_wp
+
+    !> Every value of `linear_solver`, and the same as text for messages.
+    character(len=5), parameter, public :: linear_solver_names(5) = &
+        [character(len=5) :: 'auto', 'dense', 'klu', 'band', 'mumps']
+    character(len=*), parameter, public :: linear_solver_names_text = &
+        "'auto', 'dense', 'klu', 'band' or 'mumps'"
+
+    !> Overwrite a right-hand side with NaN: what a solver's `solve` returns
+    !> without a valid factorisation, so that the failure cannot pass unseen.
+    interface fill_nan
+        module procedure fill_nan_real, fill_nan_complex
+    end interface fill_nan
+    public :: fill_nan
 
     type, abstract, public :: linear_solver_t
         integer :: n = 0
@@ -67,11 +99,24 @@ module flexmbs_linalg_linear_solver
             class(linear_solver_t), intent(inout) :: self
             complex(wp), intent(inout) :: b(:)
         end subroutine solve_complex_i
-        !> 'dense', 'klu' or 'band'.
+        !> 'dense', 'klu', 'band' or 'mumps'.
         function name_i(self) result(name)
             import :: linear_solver_t
             class(linear_solver_t), intent(in) :: self
             character(len=:), allocatable :: name
         end function name_i
     end interface
+
+contains
+
+    subroutine fill_nan_real(b)
+        real(wp), intent(out) :: b(:)
+        b = ieee_value(1.0_wp, ieee_quiet_nan)
+    end subroutine fill_nan_real
+
+    subroutine fill_nan_complex(b)
+        complex(wp), intent(out) :: b(:)
+        b = cmplx(ieee_value(1.0_wp, ieee_quiet_nan), ieee_value(1.0_wp, ieee_quiet_nan), &
+            kind=wp)
+    end subroutine fill_nan_complex
 end module flexmbs_linalg_linear_solver
