@@ -5,6 +5,10 @@ module test_linalg
     use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_linalg_matrix, only: matrix_t, storage_dense, storage_identity, storage_sparse
     use flexmbs_linalg_dense, only: dense_solver_t, classic_lu_factor, classic_lu_solve
+    use flexmbs_linalg_block_assembly, only: block_assembly_t, product_pattern, product_values, &
+        transpose_pattern
+    use flexmbs_linalg_accumulator, only: accumulator_t
+    use flexmbs_core_threads, only: default_blas_threads, blas_threads
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
     private
@@ -16,7 +20,10 @@ contains
         type(test_case_t), allocatable :: tests(:)
         tests = [new_test('csc_duplicates_summed', test_csc_duplicates), &
                  new_test('dense_real_complex_shift', test_dense_shift), &
-                 new_test('classic_lu', test_classic_lu)]
+                 new_test('classic_lu', test_classic_lu), &
+                 new_test('block_assembly', test_block_assembly), &
+                 new_test('accumulator_dense_sparse', test_accumulator), &
+                 new_test('blas_threads_default', test_blas_threads)]
     end function collect_linalg
 
     subroutine test_csc_duplicates(error)
@@ -151,4 +158,108 @@ contains
         call solver%solve_real(x)
         call check(error, all(x == bl), 'dense_solver_t%classic_order: the same bits')
     end subroutine test_classic_lu
+
+    !> Blocks placed (one transposed) into a global matrix and scattered with
+    !> scales equal the dense sum; a sparse product A B equals matmul.
+    subroutine test_block_assembly(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(block_assembly_t) :: asm
+        type(csc_matrix_t) :: a, b, c, at
+        type(status_t) :: status
+        integer(i8), allocatable :: map(:)
+        real(wp) :: da(3, 2), db(2, 3), g(5, 5), expect(5, 5)
+        integer :: ia, ib, id
+        call a%build(3, 2, [1, 3, 2, 3], [1, 1, 2, 2], status)
+        a%values = [1.0_wp, 2.0_wp, 3.0_wp, 4.0_wp]
+        call b%build(2, 3, [1, 2, 2], [1, 2, 3], status)
+        b%values = [5.0_wp, 6.0_wp, 7.0_wp]
+        call a%to_dense(da)
+        call b%to_dense(db)
+        call asm%add_block(a, 0, 0, ia)
+        call asm%add_block(a, 3, 0, ib, transposed=.true.)
+        call asm%add_diagonal(5, 0, 0, id)
+        call asm%build(5, 5, status)
+        call check(error, status%ok(), 'build: ' // status%text())
+        if (allocated(error)) return
+        call asm%zero()
+        call asm%scatter(ia, a%values)
+        call asm%scatter(ib, a%values, -2.0_wp)
+        call asm%scatter_diagonal(id, 0.5_wp)
+        expect = 0.0_wp
+        expect(1:3, 1:2) = da
+        expect(4:5, 1:3) = -2.0_wp * transpose(da)
+        expect(1, 1) = expect(1, 1) + 0.5_wp
+        expect(2, 2) = expect(2, 2) + 0.5_wp
+        expect(3, 3) = expect(3, 3) + 0.5_wp
+        expect(4, 4) = expect(4, 4) + 0.5_wp
+        expect(5, 5) = expect(5, 5) + 0.5_wp
+        call asm%matrix%to_dense(g)
+        call check(error, maxval(abs(g - expect)) <= 0.0_wp, 'assembled blocks')
+        call product_pattern(a, b, c, status)
+        call product_values(a, b, c)
+        block
+            real(wp) :: dc(3, 3)
+            call c%to_dense(dc)
+            call check(error, all(abs(dc - matmul(da, db)) <= 1e-14_wp), 'sparse product')
+        end block
+        call transpose_pattern(a, at, map, status)
+        at%values = a%values(map)
+        block
+            real(wp) :: dt(2, 3)
+            call at%to_dense(dt)
+            call check(error, maxval(abs(dt - transpose(da))) <= 0.0_wp, 'transpose and its map')
+        end block
+    end subroutine test_block_assembly
+
+    !> The same contributions give the same matrix dense and sparse; one
+    !> outside the sparse pattern is reported.
+    subroutine test_accumulator(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(accumulator_t) :: acc
+        type(csc_matrix_t) :: pattern
+        type(status_t) :: status
+        real(wp) :: d(3, 3), s(3, 3), values(4)
+        call pattern%build(3, 3, [1, 2, 3, 1], [1, 2, 3, 3], status)
+        call acc%start_dense(3, 3)
+        call contributions(acc)
+        call acc%get_dense(d)
+        call acc%start_sparse(pattern)
+        call contributions(acc)
+        call acc%get_values(values, 'test', status)
+        call check(error, status%ok(), 'sparse: ' // status%text())
+        pattern%values = values
+        call pattern%to_dense(s)
+        call check(error, maxval(abs(d - s)) <= 0.0_wp, 'dense and sparse agree')
+        call acc%start_sparse(pattern)
+        call acc%add(2, 1, 1.0_wp)
+        call acc%get_values(values, 'test', status)
+        call check(error, .not. status%ok(), 'a contribution outside the pattern is reported')
+    contains
+        subroutine contributions(a)
+            type(accumulator_t), intent(inout) :: a
+            call a%add(1, 1, 2.0_wp)
+            call a%add(1, 1, 1.0_wp)
+            call a%add(1, 3, -4.0_wp)
+            call a%add_range(1, 1, reshape([5.0_wp, 0.0_wp, 0.0_wp, 6.0_wp], [2, 2]))
+        end subroutine contributions
+    end subroutine test_accumulator
+
+    !> Without OPENBLAS_NUM_THREADS, GOTO_NUM_THREADS and OMP_NUM_THREADS in
+    !> the environment the solvers' set-up puts OpenBLAS on one thread; with
+    !> one of them set, its count stays (docs/performance.md).
+    subroutine test_blas_threads(error)
+        type(error_t), allocatable, intent(out) :: error
+        integer :: before, l1, l2, l3
+        call get_environment_variable('OPENBLAS_NUM_THREADS', length=l1)
+        call get_environment_variable('GOTO_NUM_THREADS', length=l2)
+        call get_environment_variable('OMP_NUM_THREADS', length=l3)
+        before = blas_threads()
+        call default_blas_threads()
+        if (before == 0) return ! not OpenBLAS: nothing is set
+        if (l1 + l2 + l3 == 0) then
+            call check(error, blas_threads() == 1, 'one BLAS thread by default')
+        else
+            call check(error, blas_threads() == before, 'the environment''s count stays')
+        end if
+    end subroutine test_blas_threads
 end module test_linalg

@@ -10,6 +10,9 @@ module test_sparse_formulation
     use flexmbs_core_status, only: status_t
     use flexmbs_core_text, only: real_text
     use flexmbs_linalg_csc, only: csc_matrix_t
+    use flexmbs_linalg_matrix, only: matrix_t, storage_sparse
+    use flexmbs_linalg_linear_solver, only: linear_solver_t
+    use flexmbs_linalg_factory, only: new_linear_solver
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_mbs_formulation, only: formulation_t, formulation_index1
@@ -33,7 +36,8 @@ contains
         tests = [new_test('sparse_equals_dense', test_equals_dense), &
                  new_test('jacobian_vs_differences', test_differences), &
                  new_test('trajectories_sparse_vs_dense', test_trajectories), &
-                 new_test('fine_five_body', test_fine)]
+                 new_test('fine_five_body', test_fine), &
+                 new_test('auto_klu_slender_mumps_bulky', test_auto_choice)]
     end function collect_sparse_formulation
 
     !> The scene at `path` with formulation `form` and linear solver `ls`
@@ -265,4 +269,52 @@ contains
         call check(error, status%ok() .and. result%t == scene%t_end, &
                    'fine five-body: RADAU5 steps: ' // status%text())
     end subroutine test_fine
+
+    !> `linear_solver = 'auto'` on the formulations' iteration matrices: KLU
+    !> for the five-body scene with the fine coupler mesh (slender, predicted
+    !> fill ~5), MUMPS for a bulky hex8 cube of 12 x 12 x 12 elements clamped
+    !> on one face (predicted fill ~13), as the measurements behind
+    !> auto_mumps_min_fill say.
+    subroutine test_auto_choice(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: chosen
+        call choice('inputs/five_body_fine.nml', .false., chosen)
+        call check(error, chosen == 'klu', "fine five-body: 'auto' chose " // chosen)
+        call choice('inputs/flexible_cantilever.nml', .true., chosen)
+        call check(error, chosen == 'mumps', "12^3 cube: 'auto' chose " // chosen)
+    contains
+        subroutine choice(path, cube, name)
+            character(len=*), intent(in) :: path
+            logical, intent(in) :: cube
+            character(len=:), allocatable, intent(out) :: name
+            type(scene_input_t) :: scene
+            class(dae_problem_t), allocatable :: problem
+            class(mechanical_problem_t), allocatable, target :: mech
+            class(linear_solver_t), allocatable :: solver
+            type(block_spec_t), allocatable :: blocks(:)
+            type(matrix_t) :: jac, mass
+            type(status_t) :: status
+            real(wp), allocatable :: y(:)
+            name = 'none'
+            call read_scene(path, scene, status)
+            if (cube) then
+                scene%body%divisions = [12, 12, 12]
+                scene%body%lengths = [0.4_wp, 0.4_wp, 0.4_wp]
+            end if
+            call build_problem(scene, problem, y, blocks, status, mech)
+            call check(error, status%ok(), path // ': ' // status%text())
+            if (allocated(error)) return
+            jac%storage = storage_sparse
+            jac%n = problem%n
+            call problem%jacobian_pattern(jac%csc, status)
+            mass%storage = storage_sparse
+            mass%n = problem%n
+            call problem%mass_sparse(mass%csc, status)
+            call new_linear_solver('auto', problem%n, storage_sparse, solver, status, &
+                                   mass=mass, jac=jac)
+            call check(error, status%ok(), path // ': ' // status%text())
+            if (allocated(error)) return
+            name = solver%name()
+        end subroutine choice
+    end subroutine test_auto_choice
 end module test_sparse_formulation

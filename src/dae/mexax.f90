@@ -33,6 +33,7 @@ module flexmbs_dae_mexax
     use flexmbs_linalg_csc, only: csc_matrix_t, pattern_matvec
     use flexmbs_linalg_klu, only: klu_ordering_auto
     use flexmbs_linalg_saddle_point, only: saddle_point_t
+    use flexmbs_core_threads, only: default_blas_threads
     use flexmbs_linalg_factory, only: klu_ordering_code
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
@@ -740,6 +741,7 @@ contains
         type(status_t), intent(out) :: status
         character(len=*), intent(in), optional :: ordering !! 'auto' | 'amd' | 'nd'
         integer :: j, nq, nv, nc
+        call default_blas_threads()
         nq = problem%nq
         nv = problem%nv
         nc = problem%nc

@@ -2,6 +2,7 @@
 module flexmbs_linalg_factory
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_threads, only: default_blas_threads
     use flexmbs_linalg_matrix, only: matrix_t, storage_sparse, storage_dense, storage_identity
     use flexmbs_linalg_linear_solver, only: linear_solver_t, auto_sparse_threshold, &
         auto_mumps_min_order, auto_mumps_min_fill, linear_solver_names_text
@@ -52,6 +53,7 @@ contains
         real(wp) :: fill
         character(len=160) :: msg
 
+        call default_blas_threads()
         if (n <= 0) then
             write (msg, '(a,i0,a)') 'linear solver: order n = ', n, ': must be positive'
             call status%set(status_bad_input, trim(msg))

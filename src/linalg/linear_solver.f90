@@ -33,11 +33,20 @@ module flexmbs_linalg_linear_solver
     !> 2×2×400 (4800, 1.0) 0.35, 3×3×192 (5184, 1.7) 0.7, 4×4×100 (4800, 2.7)
     !> 1.5, 6×6×200 (21600, 5.0) 2.6; 2-D Brusselator rd2d 15 (450, 7.4) 0.6,
     !> 22 (968, 9.0) 0.96, 30 (1800, 12.5) 1.8, 71 (10082, 17.8) 5.1; 1-D
-    !> Brusselator (fill 1.5) 0.1 at n = 1e3 and 1e4. MUMPS wins from a fill of
-    !> about 2.5 once the factors are large enough to hide its per-call cost;
-    !> below n ~ 1000 its solves (2-10 x slower than KLU's there) eat the gain.
+    !> Brusselator (fill 1.5) 0.1 at n = 1e3 and 1e4. On those matrices MUMPS
+    !> wins from a fill of about 2.5; below n ~ 1000 its solves (2-10 x slower
+    !> than KLU's there) eat the gain.
+    !> The formulations' iteration matrices are not node graphs: q and v (and
+    !> a) of every node are unknowns of their own, which KLU's left-looking LU
+    !> eliminates almost for free while MUMPS carries them into its fronts.
+    !> Whole RADAU5 runs (release, 1 BLAS thread; CPU KLU / MUMPS, with the
+    !> predicted fill): the five-body scene with its coupler meshed 4×8×4
+    !> (n = 2167, fill 4.0) 0.53, 6×12×6 (5875, 5.5) 0.29, 5×20×5 (6946, 5.2)
+    !> 0.31, 8×16×8 (12535, 7.9) 0.40; a bulky 12×12×12 hex8 cube clamped on
+    !> one face (12168, 12.8) 4.0. Hence MUMPS from a predicted fill of 10:
+    !> bulky 3-D meshes get it, slender and moderately refined bodies keep KLU.
     integer, parameter, public :: auto_mumps_min_order = 1000
-    real(wp), parameter, public :: auto_mumps_min_fill = 2.5_wp
+    real(wp), parameter, public :: auto_mumps_min_fill = 10.0_wp
 
     !> Every value of `linear_solver`, and the same as text for messages.
     character(len=5), parameter, public :: linear_solver_names(5) = &

@@ -18,10 +18,14 @@
 !>   percentage by which MUMPS enlarges its estimated workspace, multiplied
 !>   by `memory_growth`, at most `max_memory_retries` times; the larger value
 !>   stays for later factorisations.
-!> - Null pivots: ICNTL(24) = 1 makes MUMPS detect pivots smaller than its
-!>   threshold (CNTL(3) = 0: a tiny multiple of the machine epsilon times the
-!>   norm of the preprocessed matrix) instead of dividing by them; their count
-!>   INFOG(28) > 0 is reported as a singular matrix, like INFO(1) = -10.
+!> - Null pivots: ICNTL(24) = 1 makes MUMPS detect null pivots instead of
+!>   dividing by them; their count INFOG(28) > 0 is reported as a singular
+!>   matrix, like INFO(1) = -10. The threshold is absolute and tiny
+!>   (CNTL(3) = null_pivot_threshold < 0): as with KLU, only a pivot that is
+!>   zero counts. MUMPS's default, a multiple of eps times the norm of the
+!>   matrix, flags the legitimate pivots of the formulations' iteration
+!>   matrices, whose constraint rows pivot at O(h²) against O(1/h) entries
+!>   (measured: RADAU5 stopped at t0 on the fine five-body scene).
 !> - On request (`error_analysis`), ICNTL(11) = 1: after each single
 !>   right-hand-side solve MUMPS estimates the componentwise backward errors
 !>   ω1, ω2 (RINFOG(7:8)), the condition numbers cond1, cond2 (RINFOG(10:11))
@@ -44,6 +48,9 @@ module flexmbs_linalg_mumps
 
     include 'dmumps_struc.h'
     include 'zmumps_struc.h'
+
+    !> CNTL(3) of the null-pivot detection: |pivot| <= 1e-200 (absolute).
+    real(wp), parameter :: null_pivot_threshold = -1.0e-200_wp
 
     !> Fill-reducing orderings: MUMPS's ICNTL(7) codes. Debian's sequential
     !> build has AMD, AMF, QAMD, SCOTCH and PORD, not METIS; MUMPS falls back

@@ -15,6 +15,7 @@
 !> [M(q̃) G(q̃)ᵀ; G(q) 0] take B ≠ A on the same pattern.
 module flexmbs_linalg_saddle_point
     use flexmbs_core_kinds, only: wp
+    use flexmbs_core_threads, only: default_blas_threads
     use flexmbs_core_status, only: status_t, status_solver_failure, reason_singular_matrix
     use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_linalg_block_assembly, only: block_assembly_t
@@ -47,6 +48,7 @@ contains
         type(csc_matrix_t), intent(in) :: m_pattern, a_pattern
         type(status_t), intent(out) :: status
         integer, intent(in), optional :: ordering
+        call default_blas_threads()
         if (present(ordering)) self%ordering = ordering
         self%nv = m_pattern%ncol
         self%nc = a_pattern%nrow
