@@ -170,6 +170,7 @@ extremes: deps
 bench: deps
 	$(FPM) build --profile release
 	bash bench/run.sh
+	bash bench/sparse.sh
 
 clean:
 	rm -rf $(BUILD) legacy/build

@@ -1,0 +1,192 @@
+!> Bodies, delegated of flexmbs_mbs_system
+!> (the type and the procedures' interfaces are there).
+submodule (flexmbs_mbs_system) flexmbs_mbs_system_bodies
+    implicit none
+
+contains
+
+    ! ------------------------------------------------ bodies (delegated)
+
+    module procedure system_kinematics
+        integer :: f
+        call self%rigid%kinematics(t, q(1:self%nq_rigid), w(1:self%nv_rigid), &
+                                   qdot(1:self%nq_rigid), status)
+        do f = 1, size(self%chains)
+            call chain_rates(self, f, q(self%chain_q(f) + 1:self%chain_q(f) + self%chains(f)%nq), &
+                             w(self%chain_v(f) + 1:self%chain_v(f) + self%chains(f)%nv), &
+                             qdot(self%chain_q(f) + 1:self%chain_q(f) + self%chains(f)%nq))
+        end do
+        ! flexible bodies: q' = v
+        do f = 1, size(self%flex)
+            qdot(self%flex_q(f) + 1:self%flex_q(f) + self%flex(f)%nq) = &
+                w(self%flex_v(f) + 1:self%flex_v(f) + self%flex(f)%nv)
+        end do
+    end procedure system_kinematics
+
+    module procedure system_kinematics_derivative
+        integer :: f
+        dq = 0.0_wp
+        call self%rigid%kinematics_derivative(t, q(1:self%nq_rigid), w(1:self%nv_rigid), &
+                                              dq(1:self%nq_rigid, 1:self%nq_rigid), status)
+        do f = 1, size(self%chains)
+            associate (iq => self%chain_q(f), iv => self%chain_v(f), nq => self%chains(f)%nq, &
+                       nv => self%chains(f)%nv)
+                call self%chains(f)%kinematics_derivative(t, q(iq + 1:iq + nq), &
+                    w(iv + 1:iv + nv), dq(iq + 1:iq + nq, iq + 1:iq + nq), status)
+            end associate
+        end do
+    end procedure system_kinematics_derivative
+
+    module procedure system_mass
+        integer :: f
+        m = 0.0_wp
+        call self%rigid%mass(t, q(1:self%nq_rigid), m(1:self%nv_rigid, 1:self%nv_rigid), status)
+        do f = 1, size(self%chains)
+            associate (iq => self%chain_q(f), iv => self%chain_v(f), n => self%chains(f)%nv, &
+                       nq => self%chains(f)%nq)
+                call self%chains(f)%mass(t, q(iq + 1:iq + nq), m(iv + 1:iv + n, iv + 1:iv + n), &
+                                         status)
+            end associate
+        end do
+        do f = 1, size(self%flex)
+            associate (i0 => self%flex_v(f), n => self%flex(f)%nv)
+                call self%flex(f)%mass_matrix%to_dense(m(i0 + 1:i0 + n, i0 + 1:i0 + n))
+            end associate
+        end do
+    end procedure system_mass
+
+    module procedure system_mass_derivative
+        call self%acc(1)%start_dense(self%nv, self%nq)
+        call mass_derivative_into(self, t, q, w, self%acc(1), status)
+        call self%acc(1)%get_dense(dq)
+    end procedure system_mass_derivative
+
+    !> ∂(M w)/∂q added into dq: zero for rigid and flexible bodies (constant
+    !> M), central differences of the chains' M(q) w (at most 7 coordinates each).
+    module procedure mass_derivative_into
+        real(wp) :: mp(rigid_body_nq, rigid_body_nq), mm(rigid_body_nq, rigid_body_nq), &
+            qc(rigid_body_nq), h, col(rigid_body_nq)
+        integer :: f, j, i
+        do f = 1, size(self%chains)
+            associate (iq => self%chain_q(f), iv => self%chain_v(f), n => self%chains(f)%nv, &
+                       nq => self%chains(f)%nq)
+                do j = 1, nq
+                    qc(1:nq) = q(iq + 1:iq + nq)
+                    h = difference_step(qc(j))
+                    qc(j) = q(iq + j) + h
+                    call self%chains(f)%mass(t, qc(1:nq), mp(1:n, 1:n), status)
+                    qc(j) = q(iq + j) - h
+                    call self%chains(f)%mass(t, qc(1:nq), mm(1:n, 1:n), status)
+                    col(1:n) = matmul(mp(1:n, 1:n) - mm(1:n, 1:n), w(iv + 1:iv + n)) / (2 * h)
+                    do i = 1, n
+                        call dq%add(iv + i, iq + j, col(i))
+                    end do
+                end do
+            end associate
+        end do
+    end procedure mass_derivative_into
+
+    module procedure system_forces
+        integer :: b
+        call self%rigid%forces(t, q(1:self%nq_rigid), v(1:self%nv_rigid), &
+                               f(1:self%nv_rigid), status)
+        do b = 1, size(self%chains)
+            associate (iq => self%chain_q(b), iv => self%chain_v(b), n => self%chains(b)%nv, &
+                       nq => self%chains(b)%nq)
+                call self%chains(b)%forces(t, q(iq + 1:iq + nq), v(iv + 1:iv + n), &
+                                           f(iv + 1:iv + n), status)
+            end associate
+        end do
+        do b = 1, size(self%flex)
+            if (.not. status%ok()) return
+            associate (iq => self%flex_q(b), iv => self%flex_v(b), n => self%flex(b)%nv)
+                call self%flex(b)%forces(t, q(iq + 1:iq + n), v(iv + 1:iv + n), &
+                                         f(iv + 1:iv + n), status)
+            end associate
+        end do
+    end procedure system_forces
+
+    module procedure system_force_derivatives
+        integer :: b
+        fq = 0.0_wp
+        fv = 0.0_wp
+        call self%rigid%force_derivatives(t, q(1:self%nq_rigid), v(1:self%nv_rigid), &
+                                          fq(1:self%nv_rigid, 1:self%nq_rigid), &
+                                          fv(1:self%nv_rigid, 1:self%nv_rigid), status)
+        do b = 1, size(self%chains)
+            ! the chains' defaults: differences of their RNEA forces
+            associate (iq => self%chain_q(b), iv => self%chain_v(b), n => self%chains(b)%nv, &
+                       nq => self%chains(b)%nq)
+                call self%chains(b)%force_derivatives(t, q(iq + 1:iq + nq), v(iv + 1:iv + n), &
+                    fq(iv + 1:iv + n, iq + 1:iq + nq), fv(iv + 1:iv + n, iv + 1:iv + n), status)
+            end associate
+        end do
+        do b = 1, size(self%flex)
+            if (.not. status%ok()) return
+            associate (iq => self%flex_q(b), iv => self%flex_v(b), n => self%flex(b)%nv)
+                call self%flex(b)%force_derivatives(t, q(iq + 1:iq + n), v(iv + 1:iv + n), &
+                    fq(iv + 1:iv + n, iq + 1:iq + n), fv(iv + 1:iv + n, iv + 1:iv + n), status)
+            end associate
+        end do
+    end procedure system_force_derivatives
+
+    !> det F > 0 in every flexible body (see dae_problem_t%admissible).
+    module procedure system_admissible
+        integer :: b
+        call status%clear()
+        do b = 1, size(self%flex)
+            associate (iq => self%flex_q(b), n => self%flex(b)%nq)
+                call self%flex(b)%admissible(q(iq + 1:iq + n), status)
+            end associate
+            if (.not. status%ok()) return
+        end do
+    end procedure system_admissible
+
+    module procedure system_normalize
+        integer :: f
+        call self%rigid%normalize(q(1:self%nq_rigid))
+        do f = 1, size(self%chains)
+            call self%chains(f)%normalize(q(self%chain_q(f) + 1:self%chain_q(f) + &
+                                            self%chains(f)%nq))
+        end do
+    end procedure system_normalize
+
+    !> Kinetic plus potential energy; flexible bodies add kinetic and strain
+    !> energy and the potential −g·(q − X) of their constant applied forces.
+    module procedure system_energy
+        type(status_t) :: st
+        integer :: b
+        real(wp) :: ek, ep
+        e = rigid_body_energy(self%rigid, q(1:self%nq_rigid), v(1:self%nv_rigid))
+        do b = 1, size(self%chains)
+            associate (iq => self%chain_q(b), iv => self%chain_v(b), n => self%chains(b)%nv, &
+                       nq => self%chains(b)%nq)
+                call self%chains(b)%energy(q(iq + 1:iq + nq), v(iv + 1:iv + n), ek, ep)
+            end associate
+            e = e + ek + ep
+        end do
+        do b = 1, size(self%flex)
+            associate (iq => self%flex_q(b), iv => self%flex_v(b), n => self%flex(b)%nv)
+                e = e + self%flex(b)%kinetic_energy(v(iv + 1:iv + n)) &
+                    + self%flex(b)%strain_energy(q(iq + 1:iq + n), st) &
+                    - dot_product(self%flex(b)%applied_force, &
+                                  q(iq + 1:iq + n) - self%flex(b)%free_positions())
+            end associate
+        end do
+    end procedure system_energy
+
+    !> Total linear momentum and angular momentum about the global origin.
+    module procedure system_momenta
+        real(wp) :: lf(3), af(3)
+        integer :: b
+        call rigid_body_momenta(self%rigid, q(1:self%nq_rigid), v(1:self%nv_rigid), linear, &
+                                angular)
+        do b = 1, size(self%flex)
+            associate (iq => self%flex_q(b), iv => self%flex_v(b), n => self%flex(b)%nv)
+                call self%flex(b)%momenta(q(iq + 1:iq + n), v(iv + 1:iv + n), lf, af)
+            end associate
+            linear = linear + lf
+            angular = angular + af
+        end do
+    end procedure system_momenta
+end submodule flexmbs_mbs_system_bodies

@@ -1,0 +1,247 @@
+!> Joint rows and their first derivatives; reactions of flexmbs_mbs_system
+!> (the type and the procedures' interfaces are there).
+submodule (flexmbs_mbs_system) flexmbs_mbs_system_constraints
+    implicit none
+
+contains
+
+    ! ------------------------------------------------ joint rows, first derivatives
+
+    !> Joint k's blocks ci, cj of G (velocity space) or c_q (position space),
+    !> and its c_t, by the selected constraint_derivatives; ni, nj columns.
+    module procedure joint_first_derivatives
+        type(marker_state_t) :: mi, mj
+        type(marker_state_d) :: mid, mjd
+        real(wp) :: jxi(3, rigid_body_nq), jai(3, rigid_body_nq, 3), jxj(3, rigid_body_nq), &
+            jaj(3, rigid_body_nq, 3), drv(3)
+        type(dual_t) :: pd(rigid_body_nq), cd(max_rows)
+        integer :: seed, nr, r, td
+        ci = 0.0_wp
+        cj = 0.0_wp
+        ct = 0.0_wp
+        associate (jt => self%joints(k))
+            nr = jt%joint%nrows
+            drv = joint_driver(self, k, t)
+            if (self%derivatives == constraint_derivatives_analytic) then
+                call marker_state(self, jt%marker_i, q, self%zero_v, mi)
+                call marker_state(self, jt%marker_j, q, self%zero_v, mj)
+                call marker_jacobian(self, jt%marker_i, q, position_space, jxi, jai, ni)
+                call marker_jacobian(self, jt%marker_j, q, position_space, jxj, jaj, nj)
+                call joint_jacobian(jt%joint, mi, jxi(:, 1:ni), jai(:, 1:ni, :), mj, &
+                                    jxj(:, 1:nj), jaj(:, 1:nj, :), drv, ci(1:nr, 1:ni), &
+                                    cj(1:nr, 1:nj))
+                call joint_rows(joint_part_time_derivative, jt%joint, mi, mj, drv, ct(1:nr))
+            else if (self%derivatives == constraint_derivatives_ad) then
+                ! the frames' tangents are the markers' Jacobian columns: AD of the
+                ! vector relations only
+                call marker_state(self, jt%marker_i, q, self%zero_v, mi)
+                call marker_state(self, jt%marker_j, q, self%zero_v, mj)
+                call marker_jacobian(self, jt%marker_i, q, position_space, jxi, jai, ni)
+                call marker_jacobian(self, jt%marker_j, q, position_space, jxj, jaj, nj)
+                call seeded_frame(mi, jxi(:, 1:ni), jai(:, 1:ni, :), 0, mid)
+                call seeded_frame(mj, jxj(:, 1:nj), jaj(:, 1:nj, :), ni, mjd)
+            else
+                seed = merge(seed_position, seed_velocity_space, position_space)
+                call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed, 1, mid, pd, ni, &
+                                       pose_only=.true.)
+                call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed, 1 + ni, mjd, &
+                                       pd, nj, pose_only=.true.)
+            end if
+            if (self%derivatives /= constraint_derivatives_analytic) then
+                ! tangents: marker i's columns, marker j's, time
+                td = ni + nj + 1
+                call joint_value_d(jt%joint, mid, mjd, driver_dual(drv, td), cd(1:nr))
+                do r = 1, nr
+                    ci(r, 1:ni) = cd(r)%der(1:ni)
+                    cj(r, 1:nj) = cd(r)%der(ni + 1:ni + nj)
+                    ct(r) = cd(r)%der(td)
+                end do
+            end if
+        end associate
+    end procedure joint_first_derivatives
+
+    module procedure system_constraint
+        type(marker_state_t) :: mi, mj
+        integer :: k
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                call marker_state(self, jt%marker_i, q, self%zero_v, mi)
+                call marker_state(self, jt%marker_j, q, self%zero_v, mj)
+                call joint_value(jt%joint, mi, mj, joint_driver(self, k, t), &
+                                 g(jt%row0 + 1:jt%row0 + jt%joint%nrows))
+            end associate
+        end do
+        do k = 1, size(self%frames)
+            associate (fr => self%frames(k))
+                call frame_value(fr, q, g(fr%row0 + 1:fr%row0 + node_frame_rows))
+            end associate
+        end do
+    end procedure system_constraint
+
+    !> G = c_q T, nc x nv.
+    module procedure system_constraint_jacobian
+        call self%acc(1)%start_dense(self%nc, self%nv)
+        call assemble_first_derivative(self, t, q, .false., self%acc(1))
+        call self%acc(1)%get_dense(gmat)
+    end procedure system_constraint_jacobian
+
+    !> c_q, nc x nq.
+    module procedure system_constraint_position_jacobian
+        call self%acc(1)%start_dense(self%nc, self%nq)
+        call assemble_first_derivative(self, t, q, .true., self%acc(1))
+        call self%acc(1)%get_dense(gq)
+    end procedure system_constraint_position_jacobian
+
+    !> G (velocity space) or c_q (position space) added into out.
+    module procedure assemble_first_derivative
+        real(wp) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq), ct(max_rows)
+        integer :: k, ni, nj, r0, nr
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                r0 = jt%row0
+                nr = jt%joint%nrows
+                call joint_first_derivatives(self, k, t, q, position_space, ci, cj, ni, nj, ct)
+                call add_columns(self, jt%marker_i, position_space, ci(1:nr, 1:ni), r0, out)
+                call add_columns(self, jt%marker_j, position_space, cj(1:nr, 1:nj), r0, out)
+            end associate
+        end do
+        do k = 1, size(self%frames)
+            block
+                real(wp) :: fb(node_frame_rows, frame_columns(self%frames(k), position_space))
+                call frame_first_derivatives(self, k, q, position_space, fb)
+                r0 = self%frames(k)%row0
+                call add_frame_columns(self%frames(k), position_space, fb, r0, out)
+            end block
+        end do
+    end procedure assemble_first_derivative
+
+    !> c_t = ∂c/∂t.
+    module procedure system_constraint_time_derivative
+        real(wp) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq), ct(max_rows)
+        integer :: k, ni, nj
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                call joint_first_derivatives(self, k, t, q, .false., ci, cj, ni, nj, ct)
+                gt(jt%row0 + 1:jt%row0 + jt%joint%nrows) = ct(1:jt%joint%nrows)
+            end associate
+        end do
+        ! node frames do not depend on t
+        do k = 1, size(self%frames)
+            gt(self%frames(k)%row0 + 1:self%frames(k)%row0 + node_frame_rows) = 0.0_wp
+        end do
+    end procedure system_constraint_time_derivative
+
+    !> γ = (G v)_q T v + 2 G_t v + c_tt: hand-coded (convective accelerations
+    !> of the markers), or AD of the hand-coded G v along q' = T v (direction
+    !> 1) and t (direction 2).
+    module procedure system_constraint_curvature
+        type(marker_state_t) :: mi, mj
+        type(marker_state_d) :: mid, mjd
+        type(dual_t) :: pi(rigid_body_nq), pj(rigid_body_nq), jxi(3, rigid_body_nq), &
+            jai(3, rigid_body_nq, 3), jxj(3, rigid_body_nq), jaj(3, rigid_body_nq, 3), &
+            cid(max_rows, rigid_body_nq), cjd(max_rows, rigid_body_nq), ctd(max_rows), drvd(3), cv
+        type(marker_state_j) :: mij, mjj
+        type(jet_t) :: drvj(3), cjet(max_rows)
+        real(wp) :: drv(3), tt(max_rows)
+        integer :: k, r0, nr, ni, nj, r, bi, bj, iqi, iqj, ivi, ivj
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                r0 = jt%row0
+                nr = jt%joint%nrows
+                drv = joint_driver(self, k, t)
+                if (self%derivatives == constraint_derivatives_analytic) then
+                    call marker_state(self, jt%marker_i, q, v, mi)
+                    call marker_state(self, jt%marker_j, q, v, mj)
+                    call joint_rows(joint_part_convective, jt%joint, mi, mj, drv, &
+                                    gamma(r0 + 1:r0 + nr))
+                    call joint_rows(joint_part_time_terms, jt%joint, mi, mj, drv, tt(1:nr))
+                    gamma(r0 + 1:r0 + nr) = gamma(r0 + 1:r0 + nr) + tt(1:nr)
+                else if (self%derivatives == constraint_derivatives_ad) then
+                    ! c(s) along the markers' motion and t + s: γ = c''(0)
+                    call marker_state(self, jt%marker_i, q, v, mi)
+                    call marker_state(self, jt%marker_j, q, v, mj)
+                    call moving_frame(mi, mij)
+                    call moving_frame(mj, mjj)
+                    ! s(t + σ) to second order (the values use s only)
+                    drvj(1) = jet_t(drv(1), drv(2), drv(3))
+                    drvj(2) = jet_t(drv(2), drv(3), 0.0_wp)
+                    drvj(3) = jet_t(drv(3), 0.0_wp, 0.0_wp)
+                    call joint_value_j(jt%joint, mij, mjj, drvj, cjet(1:nr))
+                    gamma(r0 + 1:r0 + nr) = cjet(1:nr)%f2
+                else
+                    call marker_state_dual(self, jt%marker_i, q, v, seed_rate, 1, mid, pi, ni)
+                    call marker_state_dual(self, jt%marker_j, q, v, seed_rate, 1, mjd, pj, nj)
+                    call marker_jacobian_dual(self, jt%marker_i, pi, jxi, jai)
+                    call marker_jacobian_dual(self, jt%marker_j, pj, jxj, jaj)
+                    ni = marker_columns(self, jt%marker_i, .false.)
+                    nj = marker_columns(self, jt%marker_j, .false.)
+                    drvd = driver_dual(drv, 2)
+                    call joint_jacobian_d(jt%joint, mid, jxi(:, 1:ni), jai(:, 1:ni, :), mjd, &
+                                          jxj(:, 1:nj), jaj(:, 1:nj, :), drvd, &
+                                          cid(1:nr, 1:ni), cjd(1:nr, 1:nj))
+                    call joint_rows_d(joint_part_time_derivative, jt%joint, mid, mjd, drvd, &
+                                      ctd(1:nr))
+                    call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
+                    call marker_offsets(self, jt%marker_j, bj, iqj, ivj)
+                    do r = 1, nr
+                        cv = dot_product(cid(r, 1:ni), v(ivi + 1:ivi + ni)) &
+                             + dot_product(cjd(r, 1:nj), v(ivj + 1:ivj + nj))
+                        gamma(r0 + r) = cv%der(1) + 2.0_wp * cv%der(2) + ctd(r)%der(2)
+                    end do
+                end if
+            end associate
+        end do
+        do k = 1, size(self%frames)
+            associate (fr => self%frames(k))
+                if (self%derivatives == constraint_derivatives_analytic) then
+                    call frame_curvature(fr, q, v, gamma(fr%row0 + 1:fr%row0 + node_frame_rows))
+                else
+                    call frame_curvature_ad(fr, q, v, &
+                                            gamma(fr%row0 + 1:fr%row0 + node_frame_rows))
+                end if
+            end associate
+        end do
+    end procedure system_constraint_curvature
+
+    ! ------------------------------------------------ reactions
+
+    !> The force and torque joint k exerts on the body of marker i (column 1)
+    !> and of marker j (column 2), global components, the torque about the
+    !> marker's origin: the generalised force −C_bᵀλ_k of the equations of
+    !> motion M v' = f − Gᵀλ (module header). A ground side reports zeros
+    !> (the ground's share is the opposite of the body's for joints whose
+    !> markers' origins coincide).
+    module procedure system_joint_reaction
+        real(wp) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq), ct(max_rows)
+        real(wp) :: gen(6), a(3, 3)
+        integer :: ni, nj, side, b, iq, iv, mk, r0, nr
+        force = 0.0_wp
+        torque = 0.0_wp
+        associate (jt => self%joints(k))
+            r0 = jt%row0
+            nr = jt%joint%nrows
+            call joint_first_derivatives(self, k, t, q, .false., ci, cj, ni, nj, ct)
+            do side = 1, 2
+                mk = merge(jt%marker_i, jt%marker_j, side == 1)
+                call marker_offsets(self, mk, b, iq, iv)
+                if (b == 0) cycle
+                if (b < 0) then
+                    ! a node takes the force only
+                    if (side == 1) force(:, side) = -matmul(lambda(r0 + 1:r0 + nr), ci(1:nr, 1:3))
+                    if (side == 2) force(:, side) = -matmul(lambda(r0 + 1:r0 + nr), cj(1:nr, 1:3))
+                    cycle
+                end if
+                if (side == 1) then
+                    gen = -matmul(lambda(r0 + 1:r0 + nr), ci(1:nr, 1:6))
+                else
+                    gen = -matmul(lambda(r0 + 1:r0 + nr), cj(1:nr, 1:6))
+                end if
+                a = rotation_matrix(q(iq + 4:iq + 7))
+                force(:, side) = gen(1:3)
+                ! gen(4:6) = s_b × Aᵀ F + n′ (body-fixed moment about the centre)
+                torque(:, side) = matmul(a, gen(4:6) - cross(self%markers(mk)%position, &
+                                                              matmul(transpose(a), gen(1:3))))
+            end do
+        end associate
+    end procedure system_joint_reaction
+end submodule flexmbs_mbs_system_constraints

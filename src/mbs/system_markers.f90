@@ -1,0 +1,412 @@
+!> Markers, real and dual; drivers of flexmbs_mbs_system
+!> (the type and the procedures' interfaces are there).
+submodule (flexmbs_mbs_system) flexmbs_mbs_system_markers
+    implicit none
+
+contains
+
+    !> Global column of frame fr's local column l (flexmbs_mbs_node_frame).
+    module procedure frame_column
+        integer :: nb, a
+        nb = merge(rigid_body_nq, rigid_body_nv, position_space)
+        if (l <= nb) then
+            c = merge(fr%iq, fr%iv, position_space) + l
+        else
+            a = (l - nb - 1) / 3 + 1
+            c = merge(fr%nq(a), fr%nv(a), position_space) + l - nb - 3 * (a - 1)
+        end if
+    end procedure frame_column
+
+    !> out(row0 + rows, global columns) += block (local columns of frame fr).
+    module procedure add_frame_columns
+        integer :: l, r, c
+        do l = 1, size(block, 2)
+            c = frame_column(fr, l, position_space)
+            do r = 1, size(block, 1)
+                call out%add(row0 + r, c, block(r, l))
+            end do
+        end do
+    end procedure add_frame_columns
+
+    !> Frame i's rows of G (velocity space) or c_q, local columns.
+    module procedure frame_first_derivatives
+        if (self%derivatives == constraint_derivatives_analytic) then
+            call frame_jacobian(self%frames(i), q, position_space, block)
+        else
+            call frame_jacobian_ad(self%frames(i), q, position_space, block)
+        end if
+    end procedure frame_first_derivatives
+
+    ! ------------------------------------------------ markers, real and dual
+
+    !> Offsets of marker k's body in q and v; ground: body = 0.
+    !> A node marker reports body = −(its flexible body) and the offsets of
+    !> the node's x coordinate.
+    module procedure marker_offsets
+        integer :: f, d
+        if (self%markers(k)%chain > 0) then
+            ! negative like a node marker (not the ground, not a rigid body)
+            body = -chain_body_flag - self%markers(k)%chain
+            iq = self%chain_q(self%markers(k)%chain)
+            iv = self%chain_v(self%markers(k)%chain)
+            return
+        end if
+        f = self%markers(k)%flexible
+        if (f > 0) then
+            body = -f
+            d = self%flex(f)%dof(1, self%markers(k)%node) - 1
+            iq = self%flex_q(f) + d
+            iv = self%flex_v(f) + d
+            return
+        end if
+        body = self%markers(k)%body
+        iq = rigid_body_nq * (body - 1)
+        iv = rigid_body_nv * (body - 1)
+    end procedure marker_offsets
+
+    !> Columns of marker k's body in velocity space (6) or position space (7); 0 on ground.
+    module procedure marker_columns
+        n = 0
+        if (self%markers(k)%body > 0) n = merge(rigid_body_nq, rigid_body_nv, position_space)
+        if (self%markers(k)%flexible > 0) n = 3
+        if (self%markers(k)%chain > 0) n = merge(self%chains(self%markers(k)%chain)%nq, &
+            self%chains(self%markers(k)%chain)%nv, position_space)
+    end procedure marker_columns
+
+    !> Real frame and motion of marker k at (q, v).
+    module procedure marker_state
+        integer :: b, iq, iv
+        call marker_offsets(self, k, b, iq, iv)
+        associate (mk => self%markers(k))
+            if (mk%chain > 0) then
+                associate (g => self%chain_geom(mk%chain), nq => self%chains(mk%chain)%nq, &
+                           nv => self%chains(mk%chain)%nv)
+                    call chain_marker_state(g%parent, g%kinds, g%iq, g%iv, g%jpos, g%jrot, &
+                        g%axis, mk%link, mk%position, mk%axes, q(iq + 1:iq + nq), &
+                        v(iv + 1:iv + nv), m)
+                end associate
+            else if (b < 0) then
+                ! a node: its position and velocity, constant axes
+                call ground_marker_state(q(iq + 1:iq + 3), mk%axes, m)
+                m%xd = v(iv + 1:iv + 3)
+            else if (b == 0) then
+                call ground_marker_state(mk%position, mk%axes, m)
+            else
+                call rigid_marker_state(q(iq + 1:iq + 3), q(iq + 4:iq + 7), v(iv + 1:iv + 3), &
+                                        v(iv + 4:iv + 6), mk%position, mk%axes, m)
+            end if
+        end associate
+    end procedure marker_state
+
+    !> Hand-coded marker Jacobians of marker k: velocity space (3 x 6) or
+    !> position space (3 x 7) in the leading columns of jx, ja; n columns.
+    module procedure marker_jacobian
+        real(wp) :: jx6(3, 6), ja6(3, 6, 3)
+        integer :: b, iq, iv
+        call marker_offsets(self, k, b, iq, iv)
+        n = marker_columns(self, k, position_space)
+        jx = 0.0_wp
+        ja = 0.0_wp
+        if (b == 0) return
+        if (self%markers(k)%chain > 0) then
+            call chain_jacobian_real(self, k, q, iq, position_space, jx, ja)
+            return
+        end if
+        if (b < 0) then
+            ! a node: x = q_node in both spaces (T = I), axes constant
+            jx(1, 1) = 1.0_wp
+            jx(2, 2) = 1.0_wp
+            jx(3, 3) = 1.0_wp
+            return
+        end if
+        associate (mk => self%markers(k))
+            if (position_space) then
+                call rigid_marker_jacobian_q(q(iq + 4:iq + 7), mk%position, mk%axes, jx, ja)
+            else
+                call rigid_marker_jacobian(q(iq + 4:iq + 7), mk%position, mk%axes, jx6, ja6)
+                jx(:, 1:6) = jx6
+                ja(:, 1:6, :) = ja6
+            end if
+        end associate
+    end procedure marker_jacobian
+
+    !> Dual frame and motion of marker k at (q, v) with its body's tangents
+    !> `seed` in directions first, first+1, ...; p the dual quaternion (for the
+    !> dual marker Jacobians); n the directions used (0 on the ground).
+    module procedure marker_state_dual
+        !> the frame only (rigid markers): values and first derivatives of c
+        !> the pose coordinates the dual Jacobians need: the quaternion of a
+        !> rigid body (1:4), the coordinates of a chain (1:n)
+        type(dual_t) :: r(3), rd(3), wb(3), sb(3), ub(3, 3), x(3), a(3, 3)
+        real(wp) :: tp(4, 3)
+        integer :: b, iq, iv, l
+        call marker_offsets(self, k, b, iq, iv)
+        n = 0
+        p = 0.0_wp
+        associate (mk => self%markers(k))
+            if (mk%chain > 0) then
+                call chain_state_dual(self, k, q, v, seed, first, iq, iv, m, p, n)
+                return
+            end if
+            if (b == 0) then
+                x = mk%position
+                a = mk%axes
+                p = 0.0_wp
+                call ground_marker_state_d(x, a, m)
+                return
+            end if
+            if (b < 0) then
+                ! a node: x = q_node, ẋ = v_node; every seed space is (x, y, z)
+                x = q(iq + 1:iq + 3)
+                rd = v(iv + 1:iv + 3)
+                a = mk%axes
+                p = 0.0_wp
+                select case (seed)
+                case (seed_velocity_space, seed_position)
+                    n = 3
+                    do l = 1, 3
+                        x(l)%der(first + l - 1) = 1.0_wp
+                    end do
+                case (seed_velocity)
+                    n = 3
+                    do l = 1, 3
+                        rd(l)%der(first + l - 1) = 1.0_wp
+                    end do
+                case (seed_rate)
+                    n = 1
+                    x%der(first) = v(iv + 1:iv + 3)
+                end select
+                call ground_marker_state_d(x, a, m)
+                m%xd = rd
+                return
+            end if
+            r = q(iq + 1:iq + 3)
+            p(1:4) = q(iq + 4:iq + 7)
+            rd = v(iv + 1:iv + 3)
+            wb = v(iv + 4:iv + 6)
+            sb = mk%position
+            ub = mk%axes
+            tp = quat_rate_matrix(q(iq + 4:iq + 7))
+            select case (seed)
+            case (seed_velocity_space)
+                n = rigid_body_nv
+                do l = 1, 3
+                    r(l)%der(first + l - 1) = 1.0_wp
+                    p(1:4)%der(first + 2 + l) = tp(:, l)
+                end do
+            case (seed_position)
+                n = rigid_body_nq
+                do l = 1, 3
+                    r(l)%der(first + l - 1) = 1.0_wp
+                end do
+                do l = 1, 4
+                    p(l)%der(first + 2 + l) = 1.0_wp
+                end do
+            case (seed_velocity)
+                n = rigid_body_nv
+                do l = 1, 3
+                    rd(l)%der(first + l - 1) = 1.0_wp
+                    wb(l)%der(first + 2 + l) = 1.0_wp
+                end do
+            case (seed_rate)
+                n = 1
+                r%der(first) = v(iv + 1:iv + 3)
+                p(1:4)%der(first) = matmul(tp, v(iv + 4:iv + 6))
+            end select
+            if (present(pose_only)) then
+                if (pose_only) then
+                    call rigid_marker_pose_d(r, p(1:4), sb, ub, m)
+                    return
+                end if
+            end if
+            call rigid_marker_state_d(r, p(1:4), rd, wb, sb, ub, m)
+        end associate
+    end procedure marker_state_dual
+
+    !> Dual velocity-space Jacobians of marker k from its dual quaternion p.
+    module procedure marker_jacobian_dual
+        type(dual_t) :: sb(3), ub(3, 3), jx6(3, 6), ja6(3, 6, 3)
+        integer :: c
+        if (self%markers(k)%chain > 0) then
+            c = self%markers(k)%chain
+            associate (ch => self%chains(c), g => self%chain_geom(c))
+                jx = 0.0_wp
+                ja = 0.0_wp
+                call chain_marker_jacobian_d(g%parent, g%kinds, g%iq, g%iv, g%jpos, g%jrot, &
+                    g%axis, &
+                    self%markers(k)%link, self%markers(k)%position, self%markers(k)%axes, &
+                    p(1:ch%nq), jx(:, 1:ch%nv), ja(:, 1:ch%nv, :))
+            end associate
+            return
+        end if
+        if (self%markers(k)%body == 0 .or. self%markers(k)%flexible > 0) then
+            jx = 0.0_wp
+            ja = 0.0_wp
+            if (self%markers(k)%flexible > 0) then
+                jx(1, 1) = 1.0_wp
+                jx(2, 2) = 1.0_wp
+                jx(3, 3) = 1.0_wp
+            end if
+            return
+        end if
+        sb = self%markers(k)%position
+        ub = self%markers(k)%axes
+        call rigid_marker_jacobian_d(p(1:4), sb, ub, jx6, ja6)
+        jx(:, 1:6) = jx6
+        ja(:, 1:6, :) = ja6
+        jx(:, 7) = 0.0_wp
+        ja(:, 7, :) = 0.0_wp
+    end procedure marker_jacobian_dual
+
+    !> Dual state of chain marker k: the chain's coordinates (and rates)
+    !> seeded as for a body (T = I: velocity space = position space).
+    module procedure chain_state_dual
+        type(dual_t) :: vc(rigid_body_nq)
+        real(wp) :: tp(4, 3), rate(rigid_body_nq)
+        integer :: c, l, nq, nv, b, jq, jv
+        c = self%markers(k)%chain
+        nq = self%chains(c)%nq
+        nv = self%chains(c)%nv
+        p(1:nq) = q(iq + 1:iq + nq)
+        vc(1:nv) = v(iv + 1:iv + nv)
+        select case (seed)
+        case (seed_velocity_space)
+            ! the tangents T e_l: unit for single-coordinate joints, T(p) e_k
+            ! for a spherical joint's quaternion
+            n = nv
+            associate (g => self%chain_geom(c))
+                do b = 1, size(g%parent)
+                    jq = g%iq(b)
+                    jv = g%iv(b)
+                    if (g%kinds(b) == chain_joint_spherical) then
+                        tp = quat_rate_matrix(q(iq + jq + 1:iq + jq + 4))
+                        do l = 1, 3
+                            p(jq + 1:jq + 4)%der(first + jv + l - 1) = tp(:, l)
+                        end do
+                    else
+                        p(jq + 1)%der(first + jv) = 1.0_wp
+                    end if
+                end do
+            end associate
+        case (seed_position)
+            n = nq
+            do l = 1, nq
+                p(l)%der(first + l - 1) = 1.0_wp
+            end do
+        case (seed_velocity)
+            n = nv
+            do l = 1, nv
+                vc(l)%der(first + l - 1) = 1.0_wp
+            end do
+        case (seed_rate)
+            n = 1
+            call chain_rates(self, c, q(iq + 1:iq + nq), v(iv + 1:iv + nv), rate(1:nq))
+            p(1:nq)%der(first) = rate(1:nq)
+        end select
+        associate (g => self%chain_geom(c))
+            call chain_marker_state_d(g%parent, g%kinds, g%iq, g%iv, g%jpos, g%jrot, &
+                    g%axis, &
+                self%markers(k)%link, self%markers(k)%position, self%markers(k)%axes, &
+                p(1:nq), vc(1:nv), m)
+        end associate
+    end procedure chain_state_dual
+
+    !> q' = T(q) v of chain c (pure: the chain's own kinematics, inlined).
+    module procedure chain_rates
+        integer :: b, jq, jv
+        associate (g => self%chain_geom(c))
+            do b = 1, size(g%parent)
+                jq = g%iq(b)
+                jv = g%iv(b)
+                if (g%kinds(b) == chain_joint_spherical) then
+                    rate(jq + 1:jq + 4) = matmul(quat_rate_matrix(qc(jq + 1:jq + 4)), &
+                                                 vc(jv + 1:jv + 3))
+                else
+                    rate(jq + 1) = vc(jv + 1)
+                end if
+            end do
+        end associate
+    end procedure chain_rates
+
+    !> Real Jacobians of chain marker k: velocity space by the formulas,
+    !> position space (quaternion coordinates) by one dual pass.
+    module procedure chain_jacobian_real
+        type(marker_state_d) :: m
+        type(dual_t) :: p(rigid_body_nq)
+        integer :: c, nq, nv, n, l
+        c = self%markers(k)%chain
+        nq = self%chains(c)%nq
+        nv = self%chains(c)%nv
+        jx = 0.0_wp
+        ja = 0.0_wp
+        if (.not. position_space .or. nq == nv) then
+            associate (mk => self%markers(k), g => self%chain_geom(c))
+                call chain_marker_jacobian(g%parent, g%kinds, g%iq, g%iv, g%jpos, g%jrot, &
+                    g%axis, mk%link, mk%position, mk%axes, q(iq + 1:iq + nq), jx(:, 1:nv), &
+                    ja(:, 1:nv, :))
+            end associate
+            return
+        end if
+        p = 0.0_wp
+        call chain_state_dual(self, k, q, self%zero_v, seed_position, 1, iq, 0, m, p, n)
+        do l = 1, 3
+            jx(l, 1:nq) = m%x(l)%der(1:nq)
+            ja(l, 1:nq, 1) = m%a(l, 1)%der(1:nq)
+            ja(l, 1:nq, 2) = m%a(l, 2)%der(1:nq)
+            ja(l, 1:nq, 3) = m%a(l, 3)%der(1:nq)
+        end do
+    end procedure chain_jacobian_real
+
+    !> Driver values (s, s', s'') of joint k at t (zero for joints without s).
+    module procedure joint_driver
+        drv = driver_values(self%joints(k)%driver, t)
+    end procedure joint_driver
+
+    !> Dual driver values, with the time tangent in direction td (none if td = 0).
+    module procedure driver_dual
+        d = drv
+        if (td > 0) then
+            d(1)%der(td) = drv(2)
+            d(2)%der(td) = drv(3)
+        end if
+    end procedure driver_dual
+
+    !> out(row0 + rows, columns of marker k's body) += block (velocity or
+    !> position space).
+    module procedure add_columns
+        integer :: b, iq, iv
+        call marker_offsets(self, k, b, iq, iv)
+        if (b == 0) return
+        call out%add_range(row0, merge(iq, iv, position_space), block)
+    end procedure add_columns
+
+    !> The dual pose of a marker with frame m: tangent d of x is jx(:, d), of
+    !> axis k ja(:, d, k), in directions off + d (its motion is left unset).
+    module procedure seeded_frame
+        integer :: l, k, n
+        ! the pose only (the vector relations' values use nothing else)
+        n = size(jx, 2)
+        md%x = m%x
+        md%a = m%a
+        do l = 1, 3
+            md%x(l)%der(off + 1:off + n) = jx(l, :)
+            do k = 1, 3
+                md%a(l, k)%der(off + 1:off + n) = ja(l, :, k)
+            end do
+        end do
+    end procedure seeded_frame
+
+    !> The jet pose of a marker along its motion at zero accelerations: x, ẋ
+    !> and the convective acceleration, for the origin and the axes.
+    module procedure moving_frame
+        type(jet_t) :: x(3), a(3, 3)
+        integer :: l, k
+        do l = 1, 3
+            x(l) = jet_t(m%x(l), m%xd(l), m%gx(l))
+            do k = 1, 3
+                a(l, k) = jet_t(m%a(l, k), m%ad(l, k), m%ga(l, k))
+            end do
+        end do
+        call ground_marker_state_j(x, a, mj)
+    end procedure moving_frame
+end submodule flexmbs_mbs_system_markers

@@ -1,0 +1,381 @@
+!> Sparse forms and derivative blocks of flexmbs_mbs_system
+!> (the type and the procedures' interfaces are there).
+submodule (flexmbs_mbs_system) flexmbs_mbs_system_patterns
+    implicit none
+
+contains
+
+    ! ------------------------------------------------ sparse (CSC) forms
+
+    module procedure system_has_sparse
+        system_has_sparse = .true.
+    end procedure system_has_sparse
+
+    !> M: per body m I₃ (3 slots) and the full 3 × 3 inertia block, in the
+    !> triplet order mass_sparse fills.
+    module procedure system_mass_pattern
+        integer, allocatable :: rows(:), cols(:)
+        integer :: b, i, j, n, iv, f
+        integer(i8) :: p
+        n = 12 * size(self%rigid%bodies)
+        do f = 1, size(self%flex)
+            n = n + int(self%flex(f)%mass_matrix%nnz)
+        end do
+        do f = 1, size(self%chains)
+            n = n + self%chains(f)%nv**2
+        end do
+        allocate (rows(n), cols(n))
+        n = 0
+        do b = 1, size(self%rigid%bodies)
+            iv = rigid_body_nv * (b - 1)
+            do i = 1, 3
+                n = n + 1
+                rows(n) = iv + i
+                cols(n) = iv + i
+            end do
+            do j = 4, 6
+                do i = 4, 6
+                    n = n + 1
+                    rows(n) = iv + i
+                    cols(n) = iv + j
+                end do
+            end do
+        end do
+        ! chains: dense blocks M(q), column by column
+        do f = 1, size(self%chains)
+            do j = 1, self%chains(f)%nv
+                do i = 1, self%chains(f)%nv
+                    n = n + 1
+                    rows(n) = self%chain_v(f) + i
+                    cols(n) = self%chain_v(f) + j
+                end do
+            end do
+        end do
+        ! flexible bodies: their own mass patterns, column by column
+        do f = 1, size(self%flex)
+            associate (mm => self%flex(f)%mass_matrix)
+                do j = 1, mm%ncol
+                    do p = mm%colptr(j) + 1, mm%colptr(j + 1)
+                        n = n + 1
+                        rows(n) = self%flex_v(f) + int(mm%rowind(p)) + 1
+                        cols(n) = self%flex_v(f) + j
+                    end do
+                end do
+            end associate
+        end do
+        call pattern%build(self%nv, self%nv, rows, cols, status)
+        if (status%ok()) self%mass_csc = pattern
+    end procedure system_mass_pattern
+
+    module procedure system_mass_sparse
+        integer :: b, i, j, n, f
+        integer(i8) :: p
+        real(wp) :: mc(rigid_body_nq, rigid_body_nq)
+        n = 0
+        values = 0.0_wp
+        do b = 1, size(self%rigid%bodies)
+            do i = 1, 3
+                n = n + 1
+                values(self%mass_csc%triplet_map(n)) = self%rigid%bodies(b)%mass
+            end do
+            do j = 1, 3
+                do i = 1, 3
+                    n = n + 1
+                    values(self%mass_csc%triplet_map(n)) = self%rigid%bodies(b)%inertia(i, j)
+                end do
+            end do
+        end do
+        do f = 1, size(self%chains)
+            associate (iq => self%chain_q(f), nc => self%chains(f)%nv, nq => self%chains(f)%nq)
+                call self%chains(f)%mass(t, q(iq + 1:iq + nq), mc(1:nc, 1:nc), status)
+                do j = 1, nc
+                    do i = 1, nc
+                        n = n + 1
+                        values(self%mass_csc%triplet_map(n)) = mc(i, j)
+                    end do
+                end do
+            end associate
+        end do
+        do f = 1, size(self%flex)
+            associate (mm => self%flex(f)%mass_matrix)
+                do p = 1, mm%nnz
+                    n = n + 1
+                    values(self%mass_csc%triplet_map(n)) = mm%values(p)
+                end do
+            end associate
+        end do
+    end procedure system_mass_sparse
+
+    !> G: joint k's rows times the 6 velocity columns of each of its
+    !> markers' bodies (none for the ground), joint by joint.
+    module procedure system_constraint_jacobian_pattern
+        integer, allocatable :: rows(:), cols(:)
+        integer :: k, n, r, c, side, mk, b, iq, iv, nt
+        nt = 0
+        do k = 1, size(self%joints)
+            do side = 1, 2
+                mk = merge(self%joints(k)%marker_i, self%joints(k)%marker_j, side == 1)
+                nt = nt + self%joints(k)%joint%nrows * marker_columns(self, mk, .false.)
+            end do
+        end do
+        do k = 1, size(self%frames)
+            nt = nt + node_frame_rows * frame_columns(self%frames(k), .false.)
+        end do
+        allocate (rows(nt), cols(nt))
+        n = 0
+        do k = 1, size(self%joints)
+            do side = 1, 2
+                mk = merge(self%joints(k)%marker_i, self%joints(k)%marker_j, side == 1)
+                call marker_offsets(self, mk, b, iq, iv)
+                do c = 1, marker_columns(self, mk, .false.)
+                    do r = 1, self%joints(k)%joint%nrows
+                        n = n + 1
+                        rows(n) = self%joints(k)%row0 + r
+                        cols(n) = iv + c
+                    end do
+                end do
+            end do
+        end do
+        do k = 1, size(self%frames)
+            do c = 1, frame_columns(self%frames(k), .false.)
+                do r = 1, node_frame_rows
+                    n = n + 1
+                    rows(n) = self%frames(k)%row0 + r
+                    cols(n) = frame_column(self%frames(k), c, .false.)
+                end do
+            end do
+        end do
+        call pattern%build(self%nc, self%nv, rows, cols, status)
+        if (status%ok()) self%jacobian_csc = pattern
+    end procedure system_constraint_jacobian_pattern
+
+    module procedure system_constraint_jacobian_sparse
+        real(wp) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq), ct(max_rows)
+        integer :: k, n, r, c, ni, nj, nr
+        n = 0
+        values = 0.0_wp
+        do k = 1, size(self%joints)
+            nr = self%joints(k)%joint%nrows
+            call joint_first_derivatives(self, k, t, q, .false., ci, cj, ni, nj, ct)
+            do c = 1, ni
+                do r = 1, nr
+                    n = n + 1
+                    values(self%jacobian_csc%triplet_map(n)) = ci(r, c)
+                end do
+            end do
+            do c = 1, nj
+                do r = 1, nr
+                    n = n + 1
+                    values(self%jacobian_csc%triplet_map(n)) = cj(r, c)
+                end do
+            end do
+        end do
+        do k = 1, size(self%frames)
+            block
+                real(wp) :: fb(node_frame_rows, frame_columns(self%frames(k), .false.))
+                call frame_first_derivatives(self, k, q, .false., fb)
+                do c = 1, size(fb, 2)
+                    do r = 1, node_frame_rows
+                        n = n + 1
+                        values(self%jacobian_csc%triplet_map(n)) = fb(r, c)
+                    end do
+                end do
+            end block
+        end do
+    end procedure system_constraint_jacobian_sparse
+
+    ! ------------------------------------------------ sparse derivative blocks
+
+    module procedure system_has_sparse_derivatives
+        system_has_sparse_derivatives = .true.
+    end procedure system_has_sparse_derivatives
+
+    !> Patterns of the derivative blocks (mechanical_patterns_t): rigid
+    !> bodies' quaternion and gyroscopic blocks, the chains' full blocks, the
+    !> flexible bodies' tangent patterns, and per joint or node frame its rows
+    !> times the columns of its markers' bodies.
+    module procedure system_derivative_patterns
+        type(triplets_t) :: cq, rq, tk, tq, fq, fv
+        integer :: b, f, k, side, mk, iq, iv, nq, nv, i, other, oq, ov, bo
+        call self%mass_pattern(patterns%mass, status)
+        if (status%ok()) call self%constraint_jacobian_pattern(patterns%constraint_v, status)
+        if (.not. status%ok()) return
+        do b = 1, size(self%rigid%bodies)
+            iq = rigid_body_nq * (b - 1)
+            iv = rigid_body_nv * (b - 1)
+            do i = 1, 3
+                call tk%add(iq + i, iv + i)
+            end do
+            call tk%add_range(iq + 3, iv + 3, 4, 3)
+            call tq%add_range(iq + 3, iq + 3, 4, 4)
+            call fv%add_range(iv + 3, iv + 3, 3, 3)
+        end do
+        do f = 1, size(self%chains)
+            nq = self%chains(f)%nq
+            nv = self%chains(f)%nv
+            call tk%add_range(self%chain_q(f), self%chain_v(f), nq, nv)
+            call tq%add_range(self%chain_q(f), self%chain_q(f), nq, nq)
+            call fq%add_range(self%chain_v(f), self%chain_q(f), nv, nq)
+            call fv%add_range(self%chain_v(f), self%chain_v(f), nv, nv)
+        end do
+        do f = 1, size(self%flex)
+            do i = 1, self%flex(f)%nv
+                call tk%add(self%flex_q(f) + i, self%flex_v(f) + i)
+            end do
+            call fq%add_pattern(self%flex_v(f), self%flex_q(f), self%flex(f)%stiffness)
+            call fv%add_pattern(self%flex_v(f), self%flex_v(f), self%flex(f)%damping)
+        end do
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                do side = 1, 2
+                    mk = merge(jt%marker_i, jt%marker_j, side == 1)
+                    call marker_offsets(self, mk, b, iq, iv)
+                    if (marker_columns(self, mk, .true.) == 0) cycle
+                    call cq%add_range(jt%row0, iq, jt%joint%nrows, &
+                                      marker_columns(self, mk, .true.))
+                    do other = 1, 2
+                        call marker_offsets(self, merge(jt%marker_i, jt%marker_j, other == 1), &
+                                            bo, oq, ov)
+                        call rq%add_range(iv, oq, marker_columns(self, mk, .false.), &
+                            marker_columns(self, merge(jt%marker_i, jt%marker_j, other == 1), &
+                                           .true.))
+                    end do
+                end do
+            end associate
+        end do
+        do k = 1, size(self%frames)
+            associate (fr => self%frames(k))
+                do i = 1, frame_columns(fr, .true.)
+                    call cq%add_range(fr%row0, frame_column(fr, i, .true.) - 1, &
+                                      node_frame_rows, 1)
+                    do b = 1, frame_columns(fr, .false.)
+                        call rq%add(frame_column(fr, b, .false.), frame_column(fr, i, .true.))
+                    end do
+                end do
+            end associate
+        end do
+        call cq%build(self%nc, self%nq, patterns%constraint_q, status)
+        if (status%ok()) call rq%build(self%nv, self%nq, patterns%reaction_q, status)
+        if (status%ok()) call tk%build(self%nq, self%nv, patterns%kinematics, status)
+        if (status%ok()) call tq%build(self%nq, self%nq, patterns%kinematics_q, status)
+        if (status%ok()) call fq%build(self%nv, self%nq, patterns%force_q, status)
+        if (status%ok()) call fv%build(self%nv, self%nv, patterns%force_v, status)
+        if (.not. status%ok()) then
+            status%message = 'mbs system: derivative patterns: ' // status%message
+            return
+        end if
+        self%patterns = patterns
+    end procedure system_derivative_patterns
+
+    !> T: I₃ and L(p)ᵀ/2 per rigid body, the chains' columns T e_l, I for
+    !> flexible bodies.
+    module procedure system_kinematics_sparse
+        real(wp) :: e(rigid_body_nq), rate(rigid_body_nq), l(3, 4)
+        integer :: b, f, i, iq, iv
+        associate (acc => self%acc(1))
+            call acc%start_sparse(self%patterns%kinematics)
+            do b = 1, size(self%rigid%bodies)
+                iq = rigid_body_nq * (b - 1)
+                iv = rigid_body_nv * (b - 1)
+                do i = 1, 3
+                    call acc%add(iq + i, iv + i, 1.0_wp)
+                end do
+                l = quat_l(q(iq + 4:iq + 7))
+                call acc%add_range(iq + 3, iv + 3, 0.5_wp * transpose(l))
+            end do
+            do f = 1, size(self%chains)
+                associate (cq => self%chain_q(f), nq => self%chains(f)%nq, &
+                           nv => self%chains(f)%nv)
+                    do i = 1, nv
+                        e(1:nv) = 0.0_wp
+                        e(i) = 1.0_wp
+                        call chain_rates(self, f, q(cq + 1:cq + nq), e(1:nv), rate(1:nq))
+                        call acc%add_range(cq, self%chain_v(f) + i - 1, &
+                                           reshape(rate(1:nq), [nq, 1]))
+                    end do
+                end associate
+            end do
+            do f = 1, size(self%flex)
+                do i = 1, self%flex(f)%nv
+                    call acc%add(self%flex_q(f) + i, self%flex_v(f) + i, 1.0_wp)
+                end do
+            end do
+            call acc%get_values(values, 'mbs system: T', status)
+        end associate
+    end procedure system_kinematics_sparse
+
+    !> ∂(T w)/∂q: the quaternion blocks of the rigid bodies, the chains' blocks.
+    module procedure system_kinematics_derivative_sparse
+        real(wp) :: blk(rigid_body_nq, rigid_body_nq)
+        integer :: b, f, iq, iv
+        associate (acc => self%acc(1))
+            call acc%start_sparse(self%patterns%kinematics_q)
+            do b = 1, size(self%rigid%bodies)
+                iq = rigid_body_nq * (b - 1)
+                iv = rigid_body_nv * (b - 1)
+                call acc%add_range(iq + 3, iq + 3, quaternion_rate_derivative(w(iv + 4:iv + 6)))
+            end do
+            do f = 1, size(self%chains)
+                associate (cq => self%chain_q(f), cv => self%chain_v(f), &
+                           nq => self%chains(f)%nq, nv => self%chains(f)%nv)
+                    call self%chains(f)%kinematics_derivative(t, q(cq + 1:cq + nq), &
+                        w(cv + 1:cv + nv), blk(1:nq, 1:nq), status)
+                    call acc%add_range(cq, cq, blk(1:nq, 1:nq))
+                end associate
+            end do
+            call acc%get_values(values, 'mbs system: d(T w)/dq', status)
+        end associate
+    end procedure system_kinematics_derivative_sparse
+
+    module procedure system_mass_derivative_sparse
+        call self%acc(1)%start_sparse(self%patterns%force_q)
+        call mass_derivative_into(self, t, q, w, self%acc(1), status)
+        call self%acc(1)%get_values(values, 'mbs system: d(M w)/dq', status)
+    end procedure system_mass_derivative_sparse
+
+    !> ∂f/∂q, ∂f/∂v: gyroscopic blocks, the chains' blocks, and −∂k/∂q,
+    !> −∂k/∂v of the flexible bodies from their analytic tangents.
+    module procedure system_force_derivatives_sparse
+        real(wp) :: bq(rigid_body_nq, rigid_body_nq), bv(rigid_body_nq, rigid_body_nq)
+        type(status_t) :: local
+        integer :: b, iv
+        associate (aq => self%acc(1), av => self%acc(2))
+            call aq%start_sparse(self%patterns%force_q)
+            call av%start_sparse(self%patterns%force_v)
+            do b = 1, size(self%rigid%bodies)
+                iv = rigid_body_nv * (b - 1)
+                call av%add_range(iv + 3, iv + 3, gyroscopic_derivative( &
+                    self%rigid%bodies(b)%inertia, v(iv + 4:iv + 6)))
+            end do
+            do b = 1, size(self%chains)
+                associate (cq => self%chain_q(b), cv => self%chain_v(b), &
+                           nq => self%chains(b)%nq, nv => self%chains(b)%nv)
+                    call self%chains(b)%force_derivatives(t, q(cq + 1:cq + nq), &
+                        v(cv + 1:cv + nv), bq(1:nv, 1:nq), bv(1:nv, 1:nv), status)
+                    call aq%add_range(cv, cq, bq(1:nv, 1:nq))
+                    call av%add_range(cv, cv, bv(1:nv, 1:nv))
+                end associate
+            end do
+            do b = 1, size(self%flex)
+                associate (fq0 => self%flex_q(b), fv0 => self%flex_v(b), n => self%flex(b)%nv)
+                    call self%flex(b)%assemble_tangents(q(fq0 + 1:fq0 + n), v(fv0 + 1:fv0 + n), &
+                                                        local)
+                    if (.not. local%ok()) then
+                        status = local
+                        return
+                    end if
+                    call aq%add_csc(fv0, fq0, self%flex(b)%stiffness, -1.0_wp)
+                    call av%add_csc(fv0, fv0, self%flex(b)%damping, -1.0_wp)
+                end associate
+            end do
+            call aq%get_values(fq, 'mbs system: df/dq', status)
+            call av%get_values(fv, 'mbs system: df/dv', status)
+        end associate
+    end procedure system_force_derivatives_sparse
+
+    module procedure system_constraint_position_jacobian_sparse
+        call self%acc(1)%start_sparse(self%patterns%constraint_q)
+        call assemble_first_derivative(self, t, q, .true., self%acc(1))
+        call self%acc(1)%get_values(values, 'mbs system: g_q', status)
+    end procedure system_constraint_position_jacobian_sparse
+end submodule flexmbs_mbs_system_patterns

@@ -1,0 +1,195 @@
+!> Second derivatives by AD of flexmbs_mbs_system
+!> (the type and the procedures' interfaces are there).
+submodule (flexmbs_mbs_system) flexmbs_mbs_system_second_derivatives
+    implicit none
+
+contains
+
+    ! ------------------------------------------------ second derivatives (AD)
+
+    module procedure system_constraint_jacobian_derivatives
+        call self%acc(1)%start_dense(self%nc, self%nq)
+        call self%acc(2)%start_dense(self%nv, self%nq)
+        call jacobian_derivatives_into(self, t, q, w, lambda, self%acc(1), self%acc(2))
+        call self%acc(1)%get_dense(gwq)
+        call self%acc(2)%get_dense(gtlq)
+    end procedure system_constraint_jacobian_derivatives
+
+    module procedure system_constraint_jacobian_derivatives_sparse
+        call self%acc(1)%start_sparse(self%patterns%constraint_q)
+        call self%acc(2)%start_sparse(self%patterns%reaction_q)
+        call jacobian_derivatives_into(self, t, q, w, lambda, self%acc(1), self%acc(2))
+        call self%acc(1)%get_values(gwq, 'mbs system: d(G w)/dq', status)
+        call self%acc(2)%get_values(gtlq, 'mbs system: d(G^T lambda)/dq', status)
+    end procedure system_constraint_jacobian_derivatives_sparse
+
+    !> ∂(G w)/∂q (nc x nq) and ∂(Gᵀλ)/∂q (nv x nq) added into gwq, gtlq: AD of
+    !> the hand-coded G along the position unit vectors of the joint's two bodies.
+    module procedure jacobian_derivatives_into
+        type(marker_state_d) :: mid, mjd
+        type(dual_t) :: pi(rigid_body_nq), pj(rigid_body_nq), jxi(3, rigid_body_nq), &
+            jai(3, rigid_body_nq, 3), jxj(3, rigid_body_nq), jaj(3, rigid_body_nq, 3), &
+            cid(max_rows, rigid_body_nq), cjd(max_rows, rigid_body_nq), s
+        integer :: k, r0, nr, qi, qj, ni, nj, r, l, bi, bj, iqi, iqj, ivi, ivj
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                r0 = jt%row0
+                nr = jt%joint%nrows
+                call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed_position, 1, &
+                                       mid, pi, qi, pose_only=.true.)
+                call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed_position, &
+                                       1 + qi, mjd, pj, qj, pose_only=.true.)
+                call marker_jacobian_dual(self, jt%marker_i, pi, jxi, jai)
+                call marker_jacobian_dual(self, jt%marker_j, pj, jxj, jaj)
+                ni = marker_columns(self, jt%marker_i, .false.)
+                nj = marker_columns(self, jt%marker_j, .false.)
+                call joint_jacobian_d(jt%joint, mid, jxi(:, 1:ni), jai(:, 1:ni, :), mjd, &
+                                      jxj(:, 1:nj), jaj(:, 1:nj, :), &
+                                      driver_dual(joint_driver(self, k, t), 0), &
+                                      cid(1:nr, 1:ni), cjd(1:nr, 1:nj))
+                call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
+                call marker_offsets(self, jt%marker_j, bj, iqj, ivj)
+                do r = 1, nr
+                    s = dot_product(cid(r, 1:ni), w(ivi + 1:ivi + ni)) &
+                        + dot_product(cjd(r, 1:nj), w(ivj + 1:ivj + nj))
+                    call add_tangents(gwq, r0 + r, s, qi, iqi, qj, iqj)
+                end do
+                do l = 1, ni
+                    call add_tangents(gtlq, ivi + l, &
+                                      dot_product(cid(1:nr, l), lambda(r0 + 1:r0 + nr)), &
+                                      qi, iqi, qj, iqj)
+                end do
+                do l = 1, nj
+                    call add_tangents(gtlq, ivj + l, &
+                                      dot_product(cjd(1:nr, l), lambda(r0 + 1:r0 + nr)), &
+                                      qi, iqi, qj, iqj)
+                end do
+            end associate
+        end do
+        do k = 1, size(self%frames)
+            associate (fr => self%frames(k))
+                block
+                    real(wp) :: bq(node_frame_rows, frame_columns(fr, .true.)), &
+                        bl(frame_columns(fr, .false.), frame_columns(fr, .true.))
+                    integer :: c
+                    call frame_rate_q(fr, q, w, bq)
+                    call add_frame_columns(fr, .true., bq, fr%row0, gwq)
+                    call frame_gtl_q(fr, q, lambda(fr%row0 + 1:fr%row0 + node_frame_rows), bl)
+                    do l = 1, size(bl, 2)
+                        c = frame_column(fr, l, .true.)
+                        do r = 1, size(bl, 1)
+                            call gtlq%add(frame_column(fr, r, .false.), c, bl(r, l))
+                        end do
+                    end do
+                end block
+            end associate
+        end do
+    end procedure jacobian_derivatives_into
+
+    !> out(row, q columns of body i and j) += tangents of s (directions 1..qi
+    !> for body i at offset iqi, qi+1..qi+qj for body j at offset iqj).
+    module procedure add_tangents
+        integer :: l
+        do l = 1, qi
+            call out%add(row, iqi + l, s%der(l))
+        end do
+        do l = 1, qj
+            call out%add(row, iqj + l, s%der(qi + l))
+        end do
+    end procedure add_tangents
+
+    module procedure system_constraint_time_derivative_jacobian
+        call self%acc(1)%start_dense(self%nc, self%nq)
+        call time_derivative_jacobian_into(self, t, q, self%acc(1))
+        call self%acc(1)%get_dense(dq)
+    end procedure system_constraint_time_derivative_jacobian
+
+    module procedure system_constraint_time_derivative_jacobian_sparse
+        call self%acc(1)%start_sparse(self%patterns%constraint_q)
+        call time_derivative_jacobian_into(self, t, q, self%acc(1))
+        call self%acc(1)%get_values(values, 'mbs system: dg_I/dq', status)
+    end procedure system_constraint_time_derivative_jacobian_sparse
+
+    !> ∂c_t/∂q added into dq: AD of the hand-coded c_t.
+    module procedure time_derivative_jacobian_into
+        type(marker_state_d) :: mid, mjd
+        type(dual_t) :: pd(rigid_body_nq), ctd(max_rows)
+        integer :: k, nr, qi, qj, r, bi, bj, iqi, iqj, ivi, ivj
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                nr = jt%joint%nrows
+                call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed_position, 1, &
+                                       mid, pd, qi, pose_only=.true.)
+                call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed_position, &
+                                       1 + qi, mjd, pd, qj, pose_only=.true.)
+                call joint_rows_d(joint_part_time_derivative, jt%joint, mid, mjd, &
+                                  driver_dual(joint_driver(self, k, t), 0), ctd(1:nr))
+                call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
+                call marker_offsets(self, jt%marker_j, bj, iqj, ivj)
+                do r = 1, nr
+                    call add_tangents(dq, jt%row0 + r, ctd(r), qi, iqi, qj, iqj)
+                end do
+            end associate
+        end do
+    end procedure time_derivative_jacobian_into
+
+    module procedure system_constraint_curvature_derivatives
+        call self%acc(1)%start_dense(self%nc, self%nq)
+        call self%acc(2)%start_dense(self%nc, self%nv)
+        call curvature_derivatives_into(self, t, q, v, self%acc(1), self%acc(2))
+        call self%acc(1)%get_dense(gq)
+        call self%acc(2)%get_dense(gv)
+    end procedure system_constraint_curvature_derivatives
+
+    module procedure system_constraint_curvature_derivatives_sparse
+        call self%acc(1)%start_sparse(self%patterns%constraint_q)
+        call self%acc(2)%start_sparse(self%patterns%constraint_v)
+        call curvature_derivatives_into(self, t, q, v, self%acc(1), self%acc(2))
+        call self%acc(1)%get_values(gq, 'mbs system: dgamma/dq', status)
+        call self%acc(2)%get_values(gv, 'mbs system: dgamma/dv', status)
+    end procedure system_constraint_curvature_derivatives_sparse
+
+    !> ∂γ/∂q and ∂γ/∂v added into gq, gv: AD of the hand-coded γ, one pass
+    !> along the positions and one along the velocities of the joint's two bodies.
+    module procedure curvature_derivatives_into
+        type(marker_state_d) :: mid, mjd
+        type(dual_t) :: pd(rigid_body_nq), conv(max_rows), tt(max_rows), drvd(3)
+        integer :: k, nr, ni, nj, r, bi, bj, iqi, iqj, ivi, ivj, pass, seed
+        do k = 1, size(self%joints)
+            associate (jt => self%joints(k))
+                nr = jt%joint%nrows
+                drvd = driver_dual(joint_driver(self, k, t), 0)
+                call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
+                call marker_offsets(self, jt%marker_j, bj, iqj, ivj)
+                do pass = 1, 2
+                    seed = merge(seed_position, seed_velocity, pass == 1)
+                    call marker_state_dual(self, jt%marker_i, q, v, seed, 1, mid, pd, ni)
+                    call marker_state_dual(self, jt%marker_j, q, v, seed, 1 + ni, mjd, pd, nj)
+                    call joint_rows_d(joint_part_convective, jt%joint, mid, mjd, drvd, &
+                                      conv(1:nr))
+                    call joint_rows_d(joint_part_time_terms, jt%joint, mid, mjd, drvd, tt(1:nr))
+                    do r = 1, nr
+                        if (pass == 1) then
+                            call add_tangents(gq, jt%row0 + r, conv(r) + tt(r), ni, iqi, nj, &
+                                              iqj)
+                        else
+                            call add_tangents(gv, jt%row0 + r, conv(r) + tt(r), ni, ivi, nj, &
+                                              ivj)
+                        end if
+                    end do
+                end do
+            end associate
+        end do
+        do k = 1, size(self%frames)
+            associate (fr => self%frames(k))
+                block
+                    real(wp) :: bq(node_frame_rows, frame_columns(fr, .true.)), &
+                        bv(node_frame_rows, frame_columns(fr, .false.))
+                    call frame_curvature_qv(fr, q, v, bq, bv)
+                    call add_frame_columns(fr, .true., bq, fr%row0, gq)
+                    call add_frame_columns(fr, .false., bv, fr%row0, gv)
+                end block
+            end associate
+        end do
+    end procedure curvature_derivatives_into
+end submodule flexmbs_mbs_system_second_derivatives
