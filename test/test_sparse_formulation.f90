@@ -15,7 +15,7 @@ module test_sparse_formulation
     use flexmbs_linalg_factory, only: new_linear_solver
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
-    use flexmbs_mbs_formulation, only: formulation_t, formulation_index1
+    use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_io_namelist, only: scene_input_t, read_scene
     use flexmbs_io_scene, only: run_result_t, run_scene, build_problem, block_spec_t
     use testing, only: test_case_t, new_test, error_t, check
@@ -87,9 +87,8 @@ contains
                 if (allocated(error)) return
                 select type (ps)
                 type is (formulation_t)
-                    call check(error, ps%is_sparse() .eqv. .not. (ps%form == formulation_index1 &
-                        .and. .not. ps%accelerations), trim(scenes(s)) // ' ' // &
-                        trim(forms(k)) // ': sparse path taken where the layout allows')
+                    call check(error, ps%is_sparse(), trim(scenes(s)) // ' ' // &
+                        trim(forms(k)) // ': sparse path taken')
                     if (.not. ps%is_sparse()) cycle
                 end select
                 if (allocated(error)) return

@@ -58,6 +58,7 @@ module flexmbs_fe_flexible_body
         procedure :: forces => body_forces
         procedure :: constraint => body_constraint
         procedure :: constraint_jacobian => body_constraint_jacobian
+        procedure :: constraint_curvature => body_constraint_curvature
         procedure :: internal_forces => body_internal_forces
         procedure :: tangents => body_tangents
         procedure :: assemble_tangents => body_assemble_tangents
@@ -726,6 +727,14 @@ contains
         real(wp), intent(out) :: g(:)
         type(status_t), intent(inout) :: status
     end subroutine body_constraint
+
+    !> No constraints: γ is empty.
+    subroutine body_constraint_curvature(self, t, q, v, gamma, status)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: gamma(:)
+        type(status_t), intent(inout) :: status
+    end subroutine body_constraint_curvature
 
     subroutine body_constraint_jacobian(self, t, q, gmat, status)
         class(flexible_body_t), intent(inout) :: self

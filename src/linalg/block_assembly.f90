@@ -39,6 +39,7 @@ module flexmbs_linalg_block_assembly
         procedure :: zero => assembly_zero
         procedure :: scatter => assembly_scatter
         procedure :: scatter_diagonal => assembly_scatter_diagonal
+        procedure :: scatter_full => assembly_scatter_full
     end type block_assembly_t
 
     public :: product_pattern, product_values, transpose_pattern, transpose_values
@@ -188,6 +189,25 @@ contains
             end do
         end associate
     end subroutine assembly_scatter
+
+    !> Global values += w for block id registered with a full pattern of w's
+    !> shape (its slots in column-major order).
+    pure subroutine assembly_scatter_full(self, id, w)
+        class(block_assembly_t), intent(inout) :: self
+        integer, intent(in) :: id
+        real(wp), intent(in) :: w(:, :)
+        integer :: i, j
+        integer(i8) :: k
+        k = 0
+        associate (slot => self%blocks(id)%slot, v => self%matrix%values)
+            do j = 1, size(w, 2)
+                do i = 1, size(w, 1)
+                    k = k + 1
+                    v(slot(k)) = v(slot(k)) + w(i, j)
+                end do
+            end do
+        end associate
+    end subroutine assembly_scatter_full
 
     !> Global values += value on diagonal block id.
     pure subroutine assembly_scatter_diagonal(self, id, value)

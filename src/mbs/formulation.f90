@@ -25,8 +25,8 @@
 !> derivative blocks: the multibody systems): ∂F/∂y, the DAE mass matrix and
 !> [M Gᵀ; G 0] are CSC values on patterns built once
 !> (flexmbs_mbs_formulation_sparse), and F uses sparse products with G and M;
-!> no n x n or nc x nq array is allocated. Index 1 in the constant-mass
-!> layout stays dense (its rows need M⁻¹).
+!> no n x n array is allocated (index 1 in the constant-mass layout keeps
+!> nc dense rows: G M⁻¹ couples every coordinate).
 !>
 !> Dense Jacobians ∂F/∂y are analytic in the unknowns that enter F
 !> linearly (a, λ, μ and T's, G's and M's action on them); the derivatives in
@@ -123,9 +123,8 @@ contains
     !> layout y = (q, v, λ[, μ]) with DAE mass diag(I, M, 0), M evaluated at
     !> q0 (the caller asserts M does not depend on q); otherwise accelerations
     !> are unknowns. `sparse` asks for the sparse path, which is taken when
-    !> the mechanical problem provides sparse derivatives (has_sparse_derivatives)
-    !> and the formulation is not index 1 in the constant-mass layout; see
-    !> `is_sparse`. On bad arguments `status` says why and n = 0.
+    !> the mechanical problem provides sparse derivatives (has_sparse_derivatives);
+    !> On bad arguments `status` says why and n = 0.
     function new_formulation(mechanical, form, q0, constant_mass, baumgarte_zeta, &
                              baumgarte_omega, projection, status, sparse) result(self)
         class(mechanical_problem_t), target, intent(inout) :: mechanical
@@ -181,8 +180,7 @@ contains
         self%q_mass = q0
         nk = nv + nc
         if (present(sparse)) self%sparse = sparse .and. mechanical%has_sparse() .and. &
-            mechanical%has_sparse_derivatives() .and. &
-            .not. (form == formulation_index1 .and. .not. self%accelerations)
+            mechanical%has_sparse_derivatives()
         if (self%sparse) then
             call self%sp%init(mechanical, sparse_layout_t(form=form, &
                 accelerations=self%accelerations, ggl=form == formulation_ggl, n=self%n, &
@@ -288,7 +286,13 @@ contains
                 call mech%constraint(t, q, f(self%om + 1:self%om + nc), status)
             case (formulation_index1)
                 ! b = a, or M⁻¹(f - Gᵀλ) with the constant M
-                if (.not. self%accelerations) call solve_mass(self, t, self%b, status)
+                if (.not. self%accelerations) then
+                    if (self%sparse) then
+                        call self%sp%solve_mass(self%b, status)
+                    else
+                        call solve_mass(self, t, self%b, status)
+                    end if
+                end if
                 call mech%constraint_curvature(t, q, v, fc, status)
                 call g_times(self, self%b, self%c)
                 fc = fc + self%c

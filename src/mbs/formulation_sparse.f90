@@ -12,8 +12,10 @@
 !> pattern of g_q in q and of G in v. Blocks that share a pattern are summed
 !> before one scatter. No array of order n x n exists on this path.
 !>
-!> Not covered: index 1 in the constant-mass layout, whose constraint rows
-!> need G M⁻¹ (f_q, f_v, Gᵀ); the formulation keeps it dense.
+!> Index 1 in the constant-mass layout: its constraint rows hold
+!> G M⁻¹ (∂f/∂q − ∂(Gᵀλ)/∂q), G M⁻¹ ∂f/∂v and −G M⁻¹ Gᵀ, dense over the q, v
+!> and λ columns (nc rows, never n x n): Z = M⁻¹ Gᵀ by nc sparse solves with
+!> the constant M (KLU, factored once), then Zᵀ times the sparse blocks.
 module flexmbs_mbs_formulation_sparse
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t
@@ -21,6 +23,8 @@ module flexmbs_mbs_formulation_sparse
     use flexmbs_linalg_block_assembly, only: block_assembly_t, product_pattern, &
         product_values, transpose_pattern
     use flexmbs_linalg_saddle_point, only: saddle_point_t
+    use flexmbs_linalg_klu, only: klu_factor_t
+    use flexmbs_linalg_triplets, only: triplets_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t, mechanical_patterns_t
     implicit none
     private
@@ -54,6 +58,11 @@ module flexmbs_mbs_formulation_sparse
         ! GGL: T, ∂(Gᵀμ)/∂q, Gᵀ and the products T·∂(Gᵀμ)/∂q, T·Gᵀ
         type(csc_matrix_t) :: tmat, rmat, gtmat, trq, tgt
         integer(i8), allocatable :: gt_map(:)
+        ! index 1, constant mass: M's LU, Z = M⁻¹ Gᵀ and the dense row blocks
+        logical :: mass_rows = .false.
+        type(klu_factor_t) :: mlu
+        integer :: id_iq = 0, id_iv = 0, id_il = 0
+        real(wp), allocatable :: zmat(:, :), wq(:, :), wvv(:, :), wl(:, :), f(:)
     contains
         procedure :: init => sparse_init
         procedure :: jacobian => sparse_jacobian
@@ -64,6 +73,7 @@ module flexmbs_mbs_formulation_sparse
         procedure :: m_times => sparse_m_times
         procedure :: factor_kkt => sparse_factor_kkt
         procedure :: solve_kkt => sparse_solve_kkt
+        procedure :: solve_mass => sparse_solve_mass
     end type sparse_formulation_t
 
     ! formulation codes (flexmbs_mbs_formulation's values)
@@ -118,7 +128,18 @@ contains
                 if (lay%ggl) call j%add_block(p%constraint_q, om, oq, self%id_mq)
             case (index1)
                 call j%add_block(p%constraint_v, ol, ov, self%id_cv)
-                call j%add_block(p%constraint_v, ol, oa, self%id_ca)
+                if (lay%accelerations) then
+                    call j%add_block(p%constraint_v, ol, oa, self%id_ca)
+                else
+                    self%mass_rows = .true.
+                    call add_full_block(j, lay%nc, lay%nq, ol, oq, self%id_iq, status)
+                    call add_full_block(j, lay%nc, lay%nv, ol, ov, self%id_iv, status)
+                    call add_full_block(j, lay%nc, lay%nc, ol, ol, self%id_il, status)
+                    if (.not. status%ok()) return
+                    allocate (self%zmat(lay%nv, lay%nc), self%wq(lay%nc, lay%nq), &
+                              self%wvv(lay%nc, lay%nv), self%wl(lay%nc, lay%nc), &
+                              self%f(lay%nv))
+                end if
             end select
             call j%build(lay%n, lay%n, status)
             if (.not. status%ok()) return
@@ -228,12 +249,16 @@ contains
                                                                       self%gv, status)
                     call j%scatter(self%id_cq, self%cq)
                     call j%scatter(self%id_cv, self%gv)
-                    associate (a => y(lay%oa + 1:lay%oa + nv))
-                        call mech%constraint_jacobian_derivatives_sparse(t, q, a, lam, self%cq, &
-                                                                         self%rq, status)
-                    end associate
-                    call j%scatter(self%id_cq, self%cq)
-                    call j%scatter(self%id_ca, self%g)
+                    if (self%mass_rows) then
+                        call index1_mass_rows(self, mech, t, q, v, lam, status)
+                    else
+                        associate (a => y(lay%oa + 1:lay%oa + nv))
+                            call mech%constraint_jacobian_derivatives_sparse(t, q, a, lam, &
+                                self%cq, self%rq, status)
+                        end associate
+                        call j%scatter(self%id_cq, self%cq)
+                        call j%scatter(self%id_ca, self%g)
+                    end if
                     if (lay%baumgarte_omega > 0.0_wp) then
                         kz = 2.0_wp * lay%baumgarte_zeta * lay%baumgarte_omega
                         call velocity_constraint_q(self, mech, t, q, v, status)
@@ -247,6 +272,105 @@ contains
             end associate
         end associate
     end subroutine sparse_jacobian
+
+    !> Index 1, constant mass: the G M⁻¹ (f - Gᵀλ) part of the constraint rows
+    !> (module header), with self%fq, self%fv and self%g of this evaluation.
+    subroutine index1_mass_rows(self, mech, t, q, v, lam, status)
+        type(sparse_formulation_t), intent(inout) :: self
+        class(mechanical_problem_t), intent(inout) :: mech
+        real(wp), intent(in) :: t, q(:), v(:), lam(:)
+        type(status_t), intent(inout) :: status
+        integer :: k, j
+        integer(i8) :: p
+        associate (nc => self%lay%nc, gp => self%pat%constraint_v)
+            ! b = M⁻¹(f - Gᵀλ); ∂(G b)/∂q at fixed b, and ∂(Gᵀλ)/∂q
+            call mech%forces(t, q, v, self%f, status)
+            call self%gt_times(lam, self%wv)
+            self%wv = self%f - self%wv
+            call self%solve_mass(self%wv, status)
+            call mech%constraint_jacobian_derivatives_sparse(t, q, self%wv, lam, self%cq, &
+                                                             self%rq, status)
+            call self%jac%scatter(self%id_cq, self%cq)
+            ! Z = M⁻¹ Gᵀ, column k from row k of G
+            self%zmat = 0.0_wp
+            do j = 1, gp%ncol
+                do p = gp%colptr(j) + 1, gp%colptr(j + 1)
+                    self%zmat(j, gp%rowind(p) + 1) = self%g(p)
+                end do
+            end do
+            do k = 1, nc
+                call self%solve_mass(self%zmat(:, k), status)
+            end do
+            if (.not. status%ok()) return
+            call add_zt_times(self%zmat, self%pat%force_q, self%fq, 1.0_wp, .true., self%wq)
+            call add_zt_times(self%zmat, self%pat%reaction_q, self%rq, -1.0_wp, .false., &
+                              self%wq)
+            call add_zt_times(self%zmat, self%pat%force_v, self%fv, 1.0_wp, .true., self%wvv)
+            call add_zt_times(self%zmat, gp, self%g, -1.0_wp, .true., self%wl, transposed=.true.)
+            call self%jac%scatter_full(self%id_iq, self%wq)
+            call self%jac%scatter_full(self%id_iv, self%wvv)
+            call self%jac%scatter_full(self%id_il, self%wl)
+        end associate
+    end subroutine index1_mass_rows
+
+    !> w (+)= scale Zᵀ A for A a pattern with values (nv x ncol); with
+    !> `transposed`, w (+)= scale A Z (A nc x nv, as G Z).
+    pure subroutine add_zt_times(z, a, values, scale, fresh, w, transposed)
+        real(wp), intent(in) :: z(:, :), values(:), scale
+        type(csc_matrix_t), intent(in) :: a
+        logical, intent(in) :: fresh   !! overwrite w instead of adding
+        real(wp), intent(inout) :: w(:, :)
+        logical, intent(in), optional :: transposed
+        integer :: j, i
+        integer(i8) :: p
+        if (fresh) w = 0.0_wp
+        if (present(transposed)) then
+            ! w(k, :) += scale A(k, i) Z(i, :) for A's slots (k = row, i = column)
+            do i = 1, a%ncol
+                do p = a%colptr(i) + 1, a%colptr(i + 1)
+                    w(a%rowind(p) + 1, :) = w(a%rowind(p) + 1, :) + scale * values(p) * z(i, :)
+                end do
+            end do
+            return
+        end if
+        do j = 1, a%ncol
+            do p = a%colptr(j) + 1, a%colptr(j + 1)
+                w(:, j) = w(:, j) + scale * values(p) * z(a%rowind(p) + 1, :)
+            end do
+        end do
+    end subroutine add_zt_times
+
+    !> A full nrow x ncol block at (row0, col0): its slots in column-major order.
+    subroutine add_full_block(j, nrow, ncol, row0, col0, id, status)
+        type(block_assembly_t), intent(inout) :: j
+        integer, intent(in) :: nrow, ncol, row0, col0
+        integer, intent(out) :: id
+        type(status_t), intent(inout) :: status
+        type(triplets_t) :: t
+        type(csc_matrix_t) :: full
+        call t%add_range(0, 0, nrow, ncol)
+        call t%build(nrow, ncol, full, status)
+        call j%add_block(full, row0, col0, id)
+    end subroutine add_full_block
+
+    !> x ← M⁻¹ x with the constant M (KLU, analysed and factored at first use).
+    subroutine sparse_solve_mass(self, x, status)
+        class(sparse_formulation_t), intent(inout) :: self
+        real(wp), intent(inout) :: x(:)
+        type(status_t), intent(inout) :: status
+        type(status_t) :: local
+        if (.not. self%mlu%is_analysed()) then
+            call self%mlu%analyse(self%lay%nv, self%pat%mass%colptr, self%pat%mass%rowind, local)
+            if (local%ok()) call self%mlu%factor(self%m0, local)
+            if (.not. local%ok()) then
+                status = local
+                status%message = 'formulation: mass matrix: ' // status%message
+                return
+            end if
+        end if
+        call self%mlu%solve(x, local)
+        if (.not. local%ok()) status = local
+    end subroutine sparse_solve_mass
 
     !> self%cq = ∂(G v + g_I)/∂q (self%rq, self%cq2 overwritten).
     subroutine velocity_constraint_q(self, mech, t, q, v, status)
