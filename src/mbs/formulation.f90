@@ -383,7 +383,7 @@ contains
         class(formulation_t), intent(inout) :: self
         type(csc_matrix_t), intent(inout) :: pattern
         type(status_t), intent(inout) :: status
-        pattern = self%sp%jac%matrix
+        call self%sp%jacobian_pattern(pattern)
     end subroutine formulation_jacobian_pattern
 
     !> ∂F/∂y's values in its pattern (sparse path).

@@ -41,6 +41,7 @@ module flexmbs_mbs_formulation_sparse
 
     !> Patterns, maps and value workspaces of the sparse path.
     type, public :: sparse_formulation_t
+        private
         type(sparse_layout_t) :: lay
         type(mechanical_patterns_t) :: pat
         type(block_assembly_t) :: jac, mass
@@ -67,6 +68,7 @@ module flexmbs_mbs_formulation_sparse
         procedure :: init => sparse_init
         procedure :: jacobian => sparse_jacobian
         procedure :: mass_matrix => sparse_mass_matrix
+        procedure :: jacobian_pattern => sparse_jacobian_pattern
         procedure :: constraint_jacobian => sparse_constraint_jacobian
         procedure :: g_times => sparse_g_times
         procedure :: gt_times => sparse_gt_times
@@ -389,6 +391,13 @@ contains
         type(csc_matrix_t), intent(inout) :: m
         m = self%mass%matrix
     end subroutine sparse_mass_matrix
+
+    !> The pattern of ∂F/∂y (values zero).
+    subroutine sparse_jacobian_pattern(self, pattern)
+        class(sparse_formulation_t), intent(in) :: self
+        type(csc_matrix_t), intent(inout) :: pattern
+        pattern = self%jac%matrix
+    end subroutine sparse_jacobian_pattern
 
     !> G(t, q) into self%g (for g_times, gt_times and the KKT matrix).
     subroutine sparse_constraint_jacobian(self, mech, t, q, status)

@@ -271,7 +271,7 @@ contains
     !> flexible bodies.
     module procedure system_kinematics_sparse
         real(wp) :: e(rigid_body_nq), rate(rigid_body_nq), l(3, 4)
-        integer :: b, f, i, iq, iv
+        integer :: b, f, i, k, iq, iv
         associate (acc => self%acc(1))
             call acc%start_sparse(self%patterns%kinematics)
             do b = 1, size(self%rigid%bodies)
@@ -290,8 +290,9 @@ contains
                         e(1:nv) = 0.0_wp
                         e(i) = 1.0_wp
                         call chain_rates(self, f, q(cq + 1:cq + nq), e(1:nv), rate(1:nq))
-                        call acc%add_range(cq, self%chain_v(f) + i - 1, &
-                                           reshape(rate(1:nq), [nq, 1]))
+                        do k = 1, nq
+                            call acc%add(cq + k, self%chain_v(f) + i, rate(k))
+                        end do
                     end do
                 end associate
             end do
