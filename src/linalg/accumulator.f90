@@ -30,7 +30,6 @@ module flexmbs_linalg_accumulator
         procedure :: start_sparse => accumulator_start_sparse
         procedure :: add => accumulator_add
         procedure :: add_range => accumulator_add_range
-        procedure :: add_csc => accumulator_add_csc
         procedure :: get_dense => accumulator_get_dense
         procedure :: get_values => accumulator_get_values
         procedure :: is_sparse => accumulator_is_sparse
@@ -109,24 +108,6 @@ contains
             end do
         end do
     end subroutine accumulator_add_range
-
-    !> Entries (row0 + i, col0 + j) += scale * a(i, j) for a's pattern.
-    pure subroutine accumulator_add_csc(self, row0, col0, a, scale)
-        class(accumulator_t), intent(inout) :: self
-        integer, intent(in) :: row0, col0
-        type(csc_matrix_t), intent(in) :: a
-        real(wp), intent(in), optional :: scale
-        real(wp) :: s
-        integer :: j
-        integer(i8) :: p
-        s = 1.0_wp
-        if (present(scale)) s = scale
-        do j = 1, a%ncol
-            do p = a%colptr(j) + 1, a%colptr(j + 1)
-                call self%add(row0 + int(a%rowind(p)) + 1, col0 + j, s * a%values(p))
-            end do
-        end do
-    end subroutine accumulator_add_csc
 
     !> The dense result.
     pure subroutine accumulator_get_dense(self, out)

@@ -151,6 +151,12 @@ module flexmbs_mbs_system
         integer :: row0 = 0 !! rows row0+1 .. row0+joint%nrows of c
     end type assembled_joint_t
 
+    !> Where a flexible body's tangent entries go in the system's ∂f/∂q (q)
+    !> and ∂f/∂v (v) patterns, slot by slot of its own pattern.
+    type :: tangent_slots_t
+        integer(i8), allocatable :: q(:), v(:)
+    end type tangent_slots_t
+
     !> Rigid bodies, markers and joints as a mechanical problem (module header).
     type, extends(mechanical_problem_t), public :: mbs_system_t
         type(rigid_bodies_t) :: rigid
@@ -178,6 +184,8 @@ module flexmbs_mbs_system
         !> accumulators the derivative code adds into, dense or sparse
         type(mechanical_patterns_t) :: patterns
         type(accumulator_t) :: acc(2)
+        !> each flexible body's tangent slots in patterns%force_q and %force_v
+        type(tangent_slots_t), allocatable :: flex_slots(:)
     contains
         procedure :: kinematics => system_kinematics
         procedure :: has_sparse => system_has_sparse

@@ -197,6 +197,7 @@ contains
     module procedure system_derivative_patterns
         type(triplets_t) :: cq, rq, tk, tq, fq, fv
         integer :: b, f, k, side, mk, iq, iv, nq, nv, i, other, oq, ov, bo
+        integer(i8) :: p
         call self%mass_pattern(patterns%mass, status)
         if (status%ok()) call self%constraint_jacobian_pattern(patterns%constraint_v, status)
         if (.not. status%ok()) return
@@ -265,6 +266,22 @@ contains
             return
         end if
         self%patterns = patterns
+        ! the flexible bodies' tangents go in by slot, without a search per entry
+        if (allocated(self%flex_slots)) deallocate (self%flex_slots)
+        allocate (self%flex_slots(size(self%flex)))
+        do f = 1, size(self%flex)
+            associate (st => self%flex(f)%stiffness, sl => self%flex_slots(f))
+                allocate (sl%q(st%nnz), sl%v(st%nnz))
+                do i = 1, st%ncol
+                    do p = st%colptr(i) + 1, st%colptr(i + 1)
+                        sl%q(p) = patterns%force_q%find(self%flex_v(f) + int(st%rowind(p)) + 1, &
+                                                        self%flex_q(f) + i)
+                        sl%v(p) = patterns%force_v%find(self%flex_v(f) + int(st%rowind(p)) + 1, &
+                                                        self%flex_v(f) + i)
+                    end do
+                end do
+            end associate
+        end do
     end procedure system_derivative_patterns
 
     !> T: I₃ and L(p)ᵀ/2 per rigid body, the chains' columns T e_l, I for
@@ -340,6 +357,7 @@ contains
         real(wp) :: bq(rigid_body_nq, rigid_body_nq), bv(rigid_body_nq, rigid_body_nq)
         type(status_t) :: local
         integer :: b, iv
+        integer(i8) :: p
         associate (aq => self%acc(1), av => self%acc(2))
             call aq%start_sparse(self%patterns%force_q)
             call av%start_sparse(self%patterns%force_v)
@@ -365,13 +383,21 @@ contains
                         status = local
                         return
                     end if
-                    call aq%add_csc(fv0, fq0, self%flex(b)%stiffness, -1.0_wp)
-                    call av%add_csc(fv0, fv0, self%flex(b)%damping, -1.0_wp)
                 end associate
             end do
             call aq%get_values(fq, 'mbs system: df/dq', status)
             call av%get_values(fv, 'mbs system: df/dv', status)
         end associate
+        ! −∂k/∂q, −∂k/∂v of the flexible bodies by their slot maps
+        do b = 1, size(self%flex)
+            associate (sl => self%flex_slots(b), st => self%flex(b)%stiffness, &
+                       dm => self%flex(b)%damping)
+                do p = 1, st%nnz
+                    fq(sl%q(p)) = fq(sl%q(p)) - st%values(p)
+                    fv(sl%v(p)) = fv(sl%v(p)) - dm%values(p)
+                end do
+            end associate
+        end do
     end procedure system_force_derivatives_sparse
 
     module procedure system_constraint_position_jacobian_sparse
