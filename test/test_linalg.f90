@@ -9,6 +9,7 @@ module test_linalg
         transpose_pattern
     use flexmbs_linalg_accumulator, only: accumulator_t
     use flexmbs_core_threads, only: default_blas_threads, blas_threads
+    use flexmbs_linalg_saddle_point, only: saddle_point_t
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
     private
@@ -23,7 +24,8 @@ contains
                  new_test('classic_lu', test_classic_lu), &
                  new_test('block_assembly', test_block_assembly), &
                  new_test('accumulator_dense_sparse', test_accumulator), &
-                 new_test('blas_threads_default', test_blas_threads)]
+                 new_test('blas_threads_default', test_blas_threads), &
+                 new_test('saddle_point', test_saddle_point)]
     end function collect_linalg
 
     subroutine test_csc_duplicates(error)
@@ -262,4 +264,43 @@ contains
             call check(error, blas_threads() == before, 'the environment''s count stays')
         end if
     end subroutine test_blas_threads
+
+    !> [M Bᵀ; A 0] x = b by the sparse saddle-point module against the
+    !> dense matrix: M tridiagonal (4 x 4), A and B two constraint rows on
+    !> one pattern with different values; refactoring with new values.
+    subroutine test_saddle_point(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(saddle_point_t) :: kkt
+        type(csc_matrix_t) :: m, a
+        type(status_t) :: status
+        real(wp) :: k(6, 6), dm(4, 4), da(2, 4), db(2, 4), x(6), b(6), av(5), bv(5)
+        integer :: pass
+        call m%build(4, 4, [1, 2, 1, 2, 3, 2, 3, 4, 3, 4], [1, 1, 2, 2, 2, 3, 3, 3, 4, 4], status)
+        m%values = [4.0_wp, -1.0_wp, -1.0_wp, 4.0_wp, -1.0_wp, -1.0_wp, 4.0_wp, -1.0_wp, &
+                    -1.0_wp, 4.0_wp]
+        call a%build(2, 4, [1, 1, 2, 2, 1], [1, 2, 3, 4, 4], status)
+        call kkt%init(m, a, status)
+        call check(error, status%ok(), 'init: ' // status%text())
+        if (allocated(error)) return
+        do pass = 1, 2
+            av = [1.0_wp, 2.0_wp, -1.0_wp, 0.5_wp, 3.0_wp] * pass
+            bv = av + [0.1_wp, -0.2_wp, 0.3_wp, 0.0_wp, 0.1_wp]
+            a%values = av
+            call a%to_dense(da)
+            a%values = bv
+            call a%to_dense(db)
+            call m%to_dense(dm)
+            k = 0.0_wp
+            k(1:4, 1:4) = dm
+            k(1:4, 5:6) = transpose(db)
+            k(5:6, 1:4) = da
+            x = [1.0_wp, -2.0_wp, 0.5_wp, 3.0_wp, -1.0_wp, 2.0_wp]
+            b = matmul(k, x)
+            call kkt%assemble(m%values, av, bv)
+            call kkt%factor(status)
+            call kkt%solve(b, status)
+            call check(error, status%ok() .and. maxval(abs(b - x)) <= 1.0e-13_wp, &
+                       'sparse saddle-point solve, pass ' // char(48 + pass))
+        end do
+    end subroutine test_saddle_point
 end module test_linalg
