@@ -3,7 +3,8 @@
 #   make run     install what is missing, build (release), run the main example
 #   make test    install what is missing, build (debug, bounds checks), run every suite
 #   make bench   install what is missing, build (release), run the benchmarks
-#   make paper   the paper's studies on the five-body mechanism into results/
+#   make paper   the paper's studies on the five-body mechanism (coarse and fine coupler
+#                mesh, about 20 min) into results/
 #   make extremes  every solver at extreme tolerances, materials and times
 #   make install PREFIX=...   install library, modules and the classic faces
 #   OPENMP=1     (with any of them) thread the finite-element assembly
@@ -131,24 +132,35 @@ install: deps
 	$(FPM) install --no-prune --profile release --prefix $(PREFIX)
 	cd legacy && $(FPM) install --profile release --prefix $(PREFIX)
 
-# The paper's studies (inputs/paper/five_body_*.nml) into results/: the
-# references, then the sweeps in two processes; each sweep's log and table.
-PAPER_SWEEPS := five_body_table3 five_body_table2 five_body_figure6 five_body_table2_undamped
+# The paper's studies (inputs/paper/five_body_*.nml) into results/, on the
+# coarse and on the fine coupler mesh: the references (two at a time), then
+# the sweeps in two processes; each sweep's log and table.
+PAPER_SWEEPS := five_body_table3 five_body_table2 five_body_figure6 five_body_table2_undamped \
+                five_body_fine_table3 five_body_fine_table2 five_body_fine_figure6 \
+                five_body_fine_table2_undamped
+PAPER_REFERENCES := five_body_table3:reference five_body_table2_undamped:reference_undamped \
+                    five_body_fine_table3:reference_fine \
+                    five_body_fine_table2_undamped:reference_fine_undamped
 # x of the coupler's middle node (node 23 of its 3 x 5 x 3 grid) in y: after
 # 4 bodies x 7 coordinates and the chain's 2, its x is free coordinate 67
 MIDDLE_NODE_X := 97
+# The fine mesh (6 x 21 x 6 nodes) has no node at the coupler's centre: its
+# x there is the mean of the four nodes around it on the face y = 0.2 (the
+# hexahedra's interpolation at that face centre), nodes 315, 316, 441, 442.
+MIDDLE_FINE_X := 973 976 1351 1354
 paper:
 	@$(MAKE) --no-print-directory deps EXTRA_PACKAGES=gnuplot-nox
 	$(FPM) build --profile release
 	@mkdir -p results
 	@bin=$$($(FPM) run --profile release flexmbs --runner echo 2>/dev/null | tail -1); \
 	export OPENBLAS_NUM_THREADS=1; \
-	( $$bin reference inputs/paper/five_body_table3.nml --quiet > results/reference.txt 2>&1 & \
-	  $$bin reference inputs/paper/five_body_table2_undamped.nml --quiet \
-	      > results/reference_undamped.txt 2>&1 & wait ) ; \
-	cat results/reference.txt results/reference_undamped.txt; \
-	grep -q '^written' results/reference.txt && grep -q '^written' results/reference_undamped.txt \
-	    || { echo 'make paper: a reference failed' >&2; exit 1; }; \
+	echo $(PAPER_REFERENCES) | tr ' ' '\n' | xargs -P 2 -I{} sh -c \
+	    's={}; '"$$bin"' reference inputs/paper/$${s%%:*}.nml --quiet > results/$${s#*:}.txt 2>&1'; \
+	for r in $(PAPER_REFERENCES); do \
+	    cat results/$${r#*:}.txt; \
+	    grep -q '^written' results/$${r#*:}.txt \
+	        || { echo "make paper: the reference of $${r%%:*} failed" >&2; exit 1; }; \
+	done; \
 	for s in $(PAPER_SWEEPS); do \
 	    $$bin sweep inputs/paper/$$s.nml -j 2 --quiet > results/$$s.txt 2>&1 \
 	        || { cat results/$$s.txt; exit 1; }; \
@@ -157,6 +169,11 @@ paper:
 	$$bin columns results/five_body_reference.h5 $(MIDDLE_NODE_X) > results/figure5_damped.txt && \
 	$$bin columns results/five_body_undamped_reference.h5 $(MIDDLE_NODE_X) \
 	    > results/figure5_undamped.txt && \
+	for v in fine:five_body_fine fine_undamped:five_body_fine_undamped; do \
+	    $$bin columns results/$${v#*:}_reference.h5 $(MIDDLE_FINE_X) \
+	        | awk '/^#/ { print; next } { printf "%.15e %.15e\n", $$1, ($$2 + $$3 + $$4 + $$5) / 4 }' \
+	        > results/figure5_$${v%%:*}.txt || exit 1; \
+	done && \
 	gnuplot inputs/paper/plots.gp && \
 	bash inputs/paper/frames.sh $$bin results/five_body_reference.h5 results/five_body_frames.png && \
 	ls results/*.png

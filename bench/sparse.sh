@@ -3,7 +3,7 @@
 # figures, asserts nothing (docs/linear_algebra.md has a measured copy).
 #   1. the default five-body run (RADAU5 + GGL, TOL 1e-6, 1 s): dense LU
 #      against the sparse path, side by side, best CPU of 3;
-#   2. 3-D refinement of the five-body coupler (2x4x2 .. 8x16x8 hex8, 0.02 s):
+#   2. 3-D refinement of the five-body coupler (2x4x2 .. 8x32x8 hex8, 0.02 s):
 #      CPU per step against the order n of the iteration matrix, fitted
 #      exponent;
 #   3. a slender soft arm on a rigid link (rigid_flexible_pendulum.nml,
@@ -73,7 +73,7 @@ echo
 echo "== 2. 3-D refinement of the coupler (RADAU5 + GGL, TOL 1e-6, t_end 0.02 s, 'auto')"
 echo "  divisions      n_FE    CPU[s]  NST  CPU/step[s]"
 : > "$OUT/refine.txt"
-for d in "2, 4, 2" "3, 6, 3" "4, 8, 4" "6, 12, 6" "8, 16, 8"; do
+for d in "2, 4, 2" "3, 6, 3" "4, 8, 4" "6, 12, 6" "8, 16, 8" "8, 32, 8"; do
     set -- ${d//,/}
     nfe=$(( 3 * ($1 + 1) * ($2 + 1) * ($3 + 1) ))
     f="$OUT/refine_$1x$2x$3.nml"

@@ -4,7 +4,9 @@
 !> factorisations are small (the classic faces, small scenes, MUMPS's
 !> fronts): on them threads cost more than they gain. Measured on the
 !> five-body scene (RADAU5 + GGL, TOL 1e-6, dense LU of order 547, two
-!> cores): 11.5 s wall with OpenBLAS's two threads against 7.0 s with one.
+!> cores): one thread 4.9-5.2 s wall and as much CPU, two threads 4.1-5.0 s
+!> wall at 8.0-10.0 s CPU; on an earlier machine 11.5 s wall with two
+!> threads against 7.0 s with one. Studies run two processes at a time.
 !> So unless the user says otherwise — OPENBLAS_NUM_THREADS, GOTO_NUM_THREADS
 !> or OMP_NUM_THREADS set in the environment, which are then left alone —
 !> the solvers put OpenBLAS on one thread when they set up their linear
