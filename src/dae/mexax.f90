@@ -29,7 +29,6 @@ module flexmbs_dae_mexax
         reason_non_finite, reason_projection, reason_user_function, reason_det_f
     use flexmbs_core_text, only: real_text, int_text
     use flexmbs_core_timer, only: timer_t
-    use flexmbs_linalg_dense, only: dense_lu_factor, dense_lu_solve
     use flexmbs_linalg_csc, only: csc_matrix_t, pattern_matvec
     use flexmbs_linalg_klu, only: klu_ordering_auto
     use flexmbs_linalg_saddle_point, only: saddle_point_t
@@ -170,14 +169,14 @@ module flexmbs_dae_mexax
         real(wp) :: varpi = 1.0_wp
         real(wp) :: order_down = fac3, order_up = fac4 !! FAC3, FAC4 of the base
         real(wp) :: monitor_power = 1.0_wp         !! ϖ of the convergence monitor
-        integer, allocatable :: nj(:), ipiv(:)
+        integer, allocatable :: nj(:)
         real(wp), allocatable :: rtol(:), atol(:), wt(:), wst(:)
         real(wp), allocatable :: p0(:), v0(:), a0(:), lam0(:), f0(:), pdot0(:)
         type(block_t) :: m0, g0, mm, gm, gn
-        ! augmented matrix: dense (LAPACK) in kmat, or sparse (KLU) in kkt
+        ! augmented matrix [M Gᵀ; G 0]: dense (LAPACK, or the classic elimination
+        ! order) or sparse (KLU), flexmbs_linalg_saddle_point
         logical :: sparse = .false.
         logical :: classic_lu = .false. !! dense LU in the classic elimination order (options)
-        real(wp), allocatable :: kmat(:, :)
         type(csc_matrix_t) :: mpat, gpat
         type(saddle_point_t) :: kkt
         real(wp), allocatable :: p(:), pp(:), pn(:), v(:), vp(:), f(:), pdot(:), gt(:)
@@ -308,9 +307,8 @@ contains
         end if
 
         call setup_workspace(w, problem, self%base, km, options%linear_solver, status, &
-            options%sparse_ordering)
+            options%sparse_ordering, options%classic_lu)
         if (.not. status%ok()) return
-        w%classic_lu = options%classic_lu
         call options%tolerances(w%rtol, w%atol)
         allocate (yout(w%nq + w%nv + w%nc))
         w%p0 = q
@@ -733,15 +731,19 @@ contains
 
     !> Allocate the workspace for `km` columns and set up the linear solver
     !> of the augmented system ('auto' | 'dense' | 'klu').
-    subroutine setup_workspace(w, problem, base, km, linear_solver, status, ordering)
+    subroutine setup_workspace(w, problem, base, km, linear_solver, status, ordering, &
+                               classic_lu)
         type(workspace_t), intent(out) :: w
         class(mechanical_problem_t), intent(inout) :: problem
         integer, intent(in) :: base, km
         character(len=*), intent(in) :: linear_solver
         type(status_t), intent(out) :: status
         character(len=*), intent(in), optional :: ordering !! 'auto' | 'amd' | 'nd'
+        !> dense: the classic elimination order (options%classic_lu)
+        logical, intent(in), optional :: classic_lu
         integer :: j, nq, nv, nc
         call default_blas_threads()
+        if (present(classic_lu)) w%classic_lu = classic_lu
         nq = problem%nq
         nv = problem%nv
         nc = problem%nc
@@ -771,7 +773,7 @@ contains
         w%err = 0.0_wp
         w%hh = 0.0_wp
         w%work = 0.0_wp
-        allocate (w%rtol(w%ne), w%atol(w%ne), w%wt(w%ne), w%wst(nv), w%ipiv(w%na))
+        allocate (w%rtol(w%ne), w%atol(w%ne), w%wt(w%ne), w%wst(nv))
         allocate (w%p0(nq), w%v0(nv), w%a0(nv), w%lam0(nc), w%f0(nv), w%pdot0(nq))
         allocate (w%rhs(w%na))
         allocate (w%p(nq), w%pp(nq), w%pn(nq), w%v(nv), w%vp(nv), w%f(nv), w%pdot(nq), w%gt(nc))
@@ -802,7 +804,7 @@ contains
         else
             allocate (w%m0%dense(nv, nv), w%g0%dense(nc, nv), w%mm%dense(nv, nv), &
                 w%gm%dense(nc, nv), w%gn%dense(nc, nv))
-            allocate (w%kmat(w%na, w%na))
+            call w%kkt%init_dense(nv, nc, w%classic_lu)
         end if
     end subroutine setup_workspace
 
@@ -934,33 +936,23 @@ contains
         w%lam0 = w%rhs(nv + 1:)
     end subroutine consistent_acceleration
 
-    !> K = [mtop gtopᵀ; gbot 0] into w%kmat, or into the saddle-point matrix
-    !> (no allocation).
+    !> K = [mtop gtopᵀ; gbot 0] into the saddle-point matrix (no allocation).
     subroutine assemble(w, mtop, gtop, gbot)
         type(workspace_t), intent(inout) :: w
         type(block_t), intent(in) :: mtop, gtop, gbot
-        integer :: nv
-        nv = w%nv
         if (w%sparse) then
             call w%kkt%assemble(mtop%values, gbot%values, gtop%values)
-            return
+        else
+            call w%kkt%assemble(mtop%dense, gbot%dense, gtop%dense)
         end if
-        w%kmat(1:nv, 1:nv) = mtop%dense
-        w%kmat(1:nv, nv + 1:) = transpose(gtop%dense)
-        w%kmat(nv + 1:, 1:nv) = gbot%dense
-        w%kmat(nv + 1:, nv + 1:) = 0.0_wp
     end subroutine assemble
 
-    !> LU of the assembled K: LAPACK, or KLU reusing the last pivot order
-    !> while it stays good (klu_factor_t%refactor).
+    !> LU of the assembled K: LAPACK or the classic order, or KLU reusing the
+    !> last pivot order while it stays good (klu_factor_t%refactor).
     subroutine factor(w, status)
         type(workspace_t), intent(inout) :: w
         type(status_t), intent(out) :: status
-        if (w%sparse) then
-            call w%kkt%factor(status)
-        else
-            call dense_lu_factor(w%kmat, w%ipiv, status, w%classic_lu)
-        end if
+        call w%kkt%factor(status)
     end subroutine factor
 
     !> b ← K⁻¹ b with the factorisation of `factor`.
@@ -968,15 +960,11 @@ contains
         type(workspace_t), intent(inout) :: w
         real(wp), intent(inout) :: b(:)
         type(status_t) :: lst
-        if (w%sparse) then
-            ! fails only without a factorisation, which `factor` excluded
-            call w%kkt%solve(b, lst)
-        else
-            call dense_lu_solve(w%kmat, w%ipiv, b, w%classic_lu)
-        end if
+        ! fails only without a factorisation, which `factor` excluded
+        call w%kkt%solve(b, lst)
     end subroutine solve
 
-    !> Factor w%kmat and solve for w%rhs; ev_stop on a singular matrix.
+    !> Factor the augmented matrix and solve for w%rhs; ev_stop on a singular matrix.
     subroutine factor_solve(self, w, where, ev, status)
         class(mexax_t), intent(inout) :: self
         type(workspace_t), intent(inout) :: w

@@ -46,7 +46,7 @@ module flexmbs_linalg_klu
         integer(i8) :: nfactor = 0    !! fresh factorisations (new pivot order)
         integer(i8) :: nrefactor = 0  !! accepted refactorisations (old pivot order)
         real(wp) :: rcond = 0.0_wp    !! KLU's min |U_kk| / max |U_kk| of the latest
-        real(wp) :: rgrowth = 0.0_wp  !! KLU's reciprocal pivot growth of the latest
+        real(wp) :: rgrowth = 0.0_wp  !! KLU's reciprocal pivot growth of the latest fresh one
         logical :: factored = .false. !! a factorisation is alive
     end type klu_stats_t
 
@@ -389,7 +389,7 @@ contains
         call self%destroy()
     end subroutine klu_final
 
-    !> Fraction of the fresh rcond and rgrowth below which a refactorisation
+    !> Fraction of the fresh rcond below which a refactorisation
     !> is rejected in favour of a fresh one (a named constant in the shim).
     real(wp) function klu_refactor_degrade_ratio()
         klu_refactor_degrade_ratio = shim_degrade_ratio()

@@ -47,18 +47,22 @@ static const int64_t nd_min_order = 5000;
 static const double nd_min_fill_ratio = 10.0;
 
 /* klu_l_refactor keeps the pivot order of the last fresh factorisation. It is
- * accepted while KLU's pivot-ratio estimate rcond and its reciprocal pivot
- * growth rgrowth both stay above this fraction of their values at that fresh
- * factorisation; otherwise the matrix is factored afresh with new pivoting.
- * The LU backward error grows with the pivot growth, so 1e-2 lets a reused
- * pivot order cost at most about two digits beyond fresh pivoting, which the
- * simplified Newton iterations of the DAE solvers absorb. */
+ * accepted while KLU's pivot-ratio estimate rcond = min |u_ii| / max |u_ii|
+ * stays above this fraction of its value at that fresh factorisation;
+ * otherwise the matrix is factored afresh with new pivoting. A stale order
+ * shows as tiny or as grown diagonal pivots, both of which lower rcond; 1e-2
+ * lets a reused order cost at most about two digits beyond fresh pivoting,
+ * which the simplified Newton iterations of the DAE solvers absorb. KLU's
+ * reciprocal pivot growth rgrowth, O(nnz) a call (10 % of the five-body run
+ * when taken at every refactorisation), is measured at fresh factorisations
+ * only, for the statistics. */
 static const double refactor_degrade_ratio = 1.0e-2;
 
 typedef struct {
     klu_l_numeric *numeric;
-    double rcond_fresh, rgrowth_fresh; /* at the last fresh factorisation */
-    double rcond, rgrowth;             /* at the last (re)factorisation */
+    double rcond_fresh;                /* at the last fresh factorisation */
+    double rcond;                      /* at the last (re)factorisation */
+    double rgrowth;                    /* at the last fresh factorisation */
     int64_t nfactor, nrefactor;        /* fresh and reused-pivot counts */
 } numeric_part;
 
@@ -254,23 +258,24 @@ int64_t flexmbs_klu_factor_nonzeros(const void *handle, int part)
     return numeric == NULL ? -1 : (int64_t)(numeric->lnz + numeric->unz);
 }
 
-/* Record rcond and rgrowth of the current numeric factorisation. */
-static int measure(flexmbs_klu *h, int which, double *values)
+/* Record rcond, and with `growth` rgrowth, of the current numeric
+ * factorisation. */
+static int measure(flexmbs_klu *h, int which, double *values, int growth)
 {
     numeric_part *p = &h->part[which];
     SuiteSparse_long ok;
     if (which == PART_REAL) {
         ok = klu_l_rcond(h->symbolic, p->numeric, &h->common)
-             && klu_l_rgrowth(h->colptr, h->rowind, values, h->symbolic, p->numeric,
-                              &h->common);
+             && (!growth || klu_l_rgrowth(h->colptr, h->rowind, values, h->symbolic,
+                                          p->numeric, &h->common));
     } else {
         ok = klu_zl_rcond(h->symbolic, p->numeric, &h->common)
-             && klu_zl_rgrowth(h->colptr, h->rowind, values, h->symbolic, p->numeric,
-                               &h->common);
+             && (!growth || klu_zl_rgrowth(h->colptr, h->rowind, values, h->symbolic,
+                                           p->numeric, &h->common));
     }
     if (!ok) return code_of(&h->common);
     p->rcond = h->common.rcond;
-    p->rgrowth = h->common.rgrowth;
+    if (growth) p->rgrowth = h->common.rgrowth;
     return FLEXMBS_KLU_OK;
 }
 
@@ -300,13 +305,12 @@ static int fresh_factor(flexmbs_klu *h, int which, double *values)
         free_numeric(h, which);
         return code == FLEXMBS_KLU_OK ? FLEXMBS_KLU_INVALID : code;
     }
-    int code = measure(h, which, values);
+    int code = measure(h, which, values, 1);
     if (code != FLEXMBS_KLU_OK) {
         free_numeric(h, which);
         return code;
     }
     p->rcond_fresh = p->rcond;
-    p->rgrowth_fresh = p->rgrowth;
     p->nfactor++;
     return FLEXMBS_KLU_OK;
 }
@@ -336,9 +340,8 @@ static int refactor(flexmbs_klu *h, int which, double *values)
         free_numeric(h, which);
         return code == FLEXMBS_KLU_OK ? FLEXMBS_KLU_INVALID : code;
     }
-    if (measure(h, which, values) != FLEXMBS_KLU_OK
-        || !(p->rcond >= refactor_degrade_ratio * p->rcond_fresh)
-        || !(p->rgrowth >= refactor_degrade_ratio * p->rgrowth_fresh))
+    if (measure(h, which, values, 0) != FLEXMBS_KLU_OK
+        || !(p->rcond >= refactor_degrade_ratio * p->rcond_fresh))
         return fresh_factor(h, which, values);
     p->nrefactor++;
     return FLEXMBS_KLU_OK;
@@ -393,7 +396,8 @@ int flexmbs_klu_zsolve(void *handle, int64_t nrhs, double _Complex *b)
 }
 
 /* Statistics of one part (0 real, 1 complex): counts of fresh and reused
- * factorisations, rcond and rgrowth of the latest, whether one is alive. */
+ * factorisations, rcond of the latest and rgrowth of the latest fresh one,
+ * whether one is alive. */
 int flexmbs_klu_stats(const void *handle, int part, int64_t *nfactor, int64_t *nrefactor,
                       double *rcond, double *rgrowth, int *factored)
 {

@@ -1,10 +1,16 @@
-!> Sparse saddle-point systems
+!> Saddle-point systems
 !>
 !>     K [x; y] = [M  Bᵀ; A  0] [x; y] = [f; g],
 !>
-!> M (nv x nv), A and B (nc x nv) on fixed CSC patterns, A and B sharing
-!> one: the acceleration layout's [M Gᵀ; G 0], the coordinate projection
-!> and the consistent initial values of the formulations. K's pattern and
+!> M (nv x nv), A and B (nc x nv): the coordinate projection and the
+!> consistent initial values of the formulations, and MEXAX's augmented
+!> systems, dense or sparse.
+!>
+!> Dense (`init_dense`): K in an array, LAPACK's LU or, for the classic
+!> faces, the classic elimination order (flexmbs_linalg_dense).
+!>
+!> Sparse (`init`): M, A and B on fixed CSC patterns, A and B sharing
+!> one. K's pattern and
 !> the maps from the blocks into it are built once (`init`), KLU analyses it
 !> once (lazily: a copy made by assignment analyses again, see
 !> flexmbs_linalg_klu); `assemble` refills the values and `factor` factors
@@ -20,6 +26,7 @@ module flexmbs_linalg_saddle_point
     use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_linalg_block_assembly, only: block_assembly_t
     use flexmbs_linalg_klu, only: klu_factor_t, klu_ordering_auto
+    use flexmbs_linalg_dense, only: dense_lu_factor, dense_lu_solve
     implicit none
     private
 
@@ -27,13 +34,20 @@ module flexmbs_linalg_saddle_point
     type, public :: saddle_point_t
         private
         integer :: nv = 0, nc = 0
+        logical :: sparse = .true.
+        logical :: classic_order = .false.      !! dense: the classic elimination order
+        real(wp), allocatable :: kd(:, :)       !! dense K and its LU
+        integer, allocatable :: ipiv(:)
         type(block_assembly_t) :: k
         integer :: id_m = 0, id_bt = 0, id_a = 0
         type(klu_factor_t) :: lu
         integer :: ordering = klu_ordering_auto
     contains
         procedure :: init => saddle_init
-        procedure :: assemble => saddle_assemble
+        procedure :: init_dense => saddle_init_dense
+        procedure, private :: assemble_sparse => saddle_assemble
+        procedure, private :: assemble_dense => saddle_assemble_dense
+        generic :: assemble => assemble_sparse, assemble_dense
         procedure :: factor => saddle_factor
         procedure :: solve => saddle_solve
         procedure :: order => saddle_order
@@ -59,6 +73,38 @@ contains
         if (.not. status%ok()) status%message = 'saddle point: ' // status%message
     end subroutine saddle_init
 
+    !> A dense K of order nv + nc; `classic_order` selects the classic
+    !> elimination order instead of LAPACK's (the classic faces' counters).
+    subroutine saddle_init_dense(self, nv, nc, classic_order)
+        class(saddle_point_t), intent(inout) :: self
+        integer, intent(in) :: nv, nc
+        logical, intent(in), optional :: classic_order
+        call default_blas_threads()
+        self%sparse = .false.
+        self%nv = nv
+        self%nc = nc
+        if (present(classic_order)) self%classic_order = classic_order
+        if (allocated(self%kd)) deallocate (self%kd, self%ipiv)
+        allocate (self%kd(nv + nc, nv + nc), self%ipiv(nv + nc))
+    end subroutine saddle_init_dense
+
+    !> Dense K from M, A and B (B = A when absent).
+    pure subroutine saddle_assemble_dense(self, m, a, b)
+        class(saddle_point_t), intent(inout) :: self
+        real(wp), intent(in) :: m(:, :), a(:, :)
+        real(wp), intent(in), optional :: b(:, :)
+        associate (nv => self%nv, k => self%kd)
+            k(1:nv, 1:nv) = m
+            if (present(b)) then
+                k(1:nv, nv + 1:) = transpose(b)
+            else
+                k(1:nv, nv + 1:) = transpose(a)
+            end if
+            k(nv + 1:, 1:nv) = a
+            k(nv + 1:, nv + 1:) = 0.0_wp
+        end associate
+    end subroutine saddle_assemble_dense
+
     !> K's values from those of M, A and B (B = A when absent).
     pure subroutine saddle_assemble(self, m_values, a_values, b_values)
         class(saddle_point_t), intent(inout) :: self
@@ -79,6 +125,11 @@ contains
         class(saddle_point_t), intent(inout) :: self
         type(status_t), intent(inout) :: status
         type(status_t) :: local
+        if (.not. self%sparse) then
+            call dense_lu_factor(self%kd, self%ipiv, local, self%classic_order)
+            if (.not. local%ok()) status = local
+            return
+        end if
         if (.not. self%lu%is_analysed()) then
             call self%lu%analyse(self%nv + self%nc, self%k%matrix%colptr, &
                                  self%k%matrix%rowind, local, self%ordering)
@@ -100,6 +151,10 @@ contains
         real(wp), intent(inout) :: rhs(:)
         type(status_t), intent(inout) :: status
         type(status_t) :: local
+        if (.not. self%sparse) then
+            call dense_lu_solve(self%kd, self%ipiv, rhs, self%classic_order)
+            return
+        end if
         call self%lu%solve(rhs, local)
         if (.not. local%ok()) then
             status = local

@@ -52,6 +52,7 @@ module flexmbs_mbs_formulation
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_mbs_formulation_sparse, only: sparse_formulation_t, sparse_layout_t
+    use flexmbs_linalg_saddle_point, only: saddle_point_t
     implicit none
     private
 
@@ -89,8 +90,9 @@ module flexmbs_mbs_formulation
         real(wp), allocatable :: m(:, :), gmat(:, :), force(:), w(:), b(:), c(:), ct(:)
         real(wp), allocatable :: qq(:, :), vq(:, :), vv(:, :), cq(:, :), cq2(:, :), cv(:, :)
         real(wp), allocatable :: gtlq(:, :), minv_gt(:, :), tq(:), q0(:), mass_lu(:, :)
-        real(wp), allocatable :: kkt(:, :), kkt_rhs(:)
-        integer, allocatable :: mass_pivots(:), kkt_pivots(:)
+        real(wp), allocatable :: kkt_rhs(:)
+        integer, allocatable :: mass_pivots(:)
+        type(saddle_point_t) :: kkt          !! dense [M Gᵀ; G 0] (the sparse one is in sp)
         logical :: mass_factored = .false.
         logical :: sparse = .false.          !! the sparse path (module header)
         type(sparse_formulation_t) :: sp
@@ -200,8 +202,9 @@ contains
                   self%c(nc), self%ct(nc), self%qq(nq, nq), self%vq(nv, nq), self%vv(nv, nv), &
                   self%cq(nc, nq), self%cq2(nc, nq), self%cv(nc, nv), self%tq(nq), &
                   self%gtlq(nv, nq), self%minv_gt(nv, nc), &
-                  self%q0(nq), self%mass_lu(nv, nv), self%kkt(nk, nk), self%kkt_rhs(nk), &
-                  self%mass_pivots(nv), self%kkt_pivots(nk))
+                  self%q0(nq), self%mass_lu(nv, nv), self%kkt_rhs(nk), &
+                  self%mass_pivots(nv))
+        call self%kkt%init_dense(nv, nc)
     end function new_formulation
 
     !> Factor the constant M once (constant-mass layout, index 1 needs M⁻¹).
@@ -639,21 +642,16 @@ contains
         class(formulation_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:)
         type(status_t), intent(inout) :: status
-        integer :: info, nv, nc
+        type(status_t) :: local
         if (self%sparse) then
             call self%sp%factor_kkt(self%mechanical, t, q, status)
             return
         end if
-        nv = self%nv
-        nc = self%nc
         call self%mechanical%mass(t, q, self%m, status)
         call self%mechanical%constraint_jacobian(t, q, self%gmat, status)
-        self%kkt = 0.0_wp
-        self%kkt(1:nv, 1:nv) = self%m
-        self%kkt(1:nv, nv + 1:nv + nc) = transpose(self%gmat)
-        self%kkt(nv + 1:nv + nc, 1:nv) = self%gmat
-        call dgetrf(nv + nc, nv + nc, self%kkt, nv + nc, self%kkt_pivots, info)
-        if (info /= 0) call status%set(status_solver_failure, &
+        call self%kkt%assemble(self%m, self%gmat)
+        call self%kkt%factor(local)
+        if (.not. local%ok()) call status%set(status_solver_failure, &
             'formulation: projection matrix [M Gᵀ; G 0] is singular (redundant constraints?)', &
             reason_singular_matrix)
     end subroutine factor_kkt
@@ -661,14 +659,12 @@ contains
     !> self%kkt_rhs ← K⁻¹ self%kkt_rhs.
     subroutine solve_kkt(self)
         class(formulation_t), intent(inout) :: self
-        integer :: info, nk
         type(status_t) :: status
         if (self%sparse) then
             call self%sp%solve_kkt(self%kkt_rhs, status)
-            return
+        else
+            call self%kkt%solve(self%kkt_rhs, status)
         end if
-        nk = self%nv + self%nc
-        call dgetrs('N', nk, 1, self%kkt, nk, self%kkt_pivots, self%kkt_rhs, nk, info)
     end subroutine solve_kkt
 
     !> Simplified Newton for g(t, q) = 0 with K at the starting q̃ (§3.6 step 1).
