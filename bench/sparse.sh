@@ -9,7 +9,9 @@
 #   3. a slender soft arm on a rigid link (rigid_flexible_pendulum.nml,
 #      2 x 2 cross-section, 20 .. 320 elements along it, 0.02 s) with RADAU5,
 #      DDASSL and IDA: CPU per step and peak memory against n, exponents;
-#   4. where the time of the fine five-body run goes (perf, when installed).
+#   4. where the time of the fine five-body run goes (perf, when installed);
+#   5. KLU against MUMPS on the formulations' iteration matrices (the
+#      figures behind linear_solver = 'auto''s choice between them).
 # One BLAS thread throughout (ratios on a shared 2-core machine).
 set -u
 cd "$(dirname "$0")/.."
@@ -123,3 +125,17 @@ if command -v perf >/dev/null 2>&1; then
 else
     echo "  skipped: perf is not installed"
 fi
+
+echo
+echo "== 5. KLU against MUMPS on the formulations' iteration matrices (RADAU5, CPU)"
+for c in "coupler 4x8x4:five_body:s/divisions = 2, 4, 2/divisions = 4, 8, 4/; s/t_end   = 1.0/t_end = 0.02/" \
+         "coupler 6x12x6:five_body:s/divisions = 2, 4, 2/divisions = 6, 12, 6/; s/t_end   = 1.0/t_end = 0.02/" \
+         "cube 12x12x12:flexible_cantilever:s/divisions = 8, 1, 1/divisions = 12, 12, 12/; s/lengths   = 0.4, 0.05, 0.05/lengths = 0.4, 0.4, 0.4/; s/t_end   = 0.2/t_end = 0.005/"; do
+    label=${c%%:*}; rest=${c#*:}; scene=${rest%%:*}; edits=${rest#*:}
+    for ls in klu mumps; do
+        variant "$OUT/lu_${ls}.nml" "inputs/$scene.nml" radau5 $ls "$edits"
+        r=$(run "$OUT/lu_${ls}.nml"); eval "lu_$ls=${r%% *}"
+    done
+    awk -v l="$label" -v k="$lu_klu" -v m="$lu_mumps" 'BEGIN {
+        printf "  %-15s KLU %8s s  MUMPS %8s s  KLU/MUMPS %.2f\n", l, k, m, (m > 0 ? k / m : 0) }'
+done

@@ -536,7 +536,7 @@ contains
         call check_close(error, yp(1), -2.0_wp * 2.0_wp * 0.04_wp, 1.0e-5_wp, 'yp(t_end)')
     end subroutine test_outputs
 
-    !> KLU and dense give the same trajectory on the sparse GGL pendulum.
+    !> KLU, MUMPS and dense give the same trajectory on the sparse GGL pendulum.
     subroutine test_klu(error)
         type(error_t), allocatable, intent(out) :: error
         type(dae_stats_t) :: s1, s2
@@ -548,6 +548,10 @@ contains
         call check(error, status%ok(), 'dense run failed: ' // status%text())
         call check(error, abs(e1 - e2) <= 1.0e-6_wp * max(e1, 1.0e-12_wp) + 1.0e-12_wp &
             .or. (s1%nst == s2%nst .and. s1%nje == s2%nje), 'klu and dense differ')
+        call run_pendulum(pendulum_ggl, 1.0e-6_wp, e1, s1, status, 'mumps')
+        call check(error, status%ok(), 'mumps run failed: ' // status%text())
+        call check(error, abs(e1 - e2) <= 1.0e-6_wp * max(e1, 1.0e-12_wp) + 1.0e-12_wp &
+            .or. (s1%nst == s2%nst .and. s1%nje == s2%nje), 'mumps and dense differ')
     end subroutine test_klu
 
     !> pmax = 2 never uses order 3 and costs more steps than pmax = 5 on a

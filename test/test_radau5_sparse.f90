@@ -1,5 +1,5 @@
-!> RADAU5 with KLU: the sparse path gives the dense trajectory to round-off,
-!> on a problem of more than 2000 unknowns.
+!> RADAU5 with KLU and with MUMPS: the sparse path gives the dense
+!> trajectory to round-off, on a problem of more than 2000 unknowns.
 module test_radau5_sparse
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t
@@ -19,8 +19,8 @@ contains
 
     function collect_radau5_sparse() result(tests)
         type(test_case_t), allocatable :: tests(:)
-        tests = [new_test('klu_equals_dense_brusselator_2000', test_brusselator), &
-                 new_test('klu_equals_dense_pendulum_ggl', test_pendulum), &
+        tests = [new_test('klu_mumps_equal_dense_brusselator_2000', test_brusselator), &
+                 new_test('klu_mumps_equal_dense_pendulum_ggl', test_pendulum), &
                  new_test('nested_dissection_equals_amd_brusselator_2d', test_orderings)]
     end function collect_radau5_sparse
 
@@ -60,6 +60,9 @@ contains
         call run(problem, y0, 0.5_wp, 'klu', y_klu, s_klu, status)
         call check(error, status%ok(), 'klu run: ' // status%text())
         call compare(error, y_dense, y_klu, s_dense, s_klu)
+        call run(problem, y0, 0.5_wp, 'mumps', y_klu, s_klu, status)
+        call check(error, status%ok(), 'mumps run: ' // status%text())
+        call compare(error, y_dense, y_klu, s_dense, s_klu)
     end subroutine test_brusselator
 
     !> Sparse Jacobian and mass (CSC) through KLU versus dense LU.
@@ -75,6 +78,9 @@ contains
         call check(error, status%ok(), 'dense run: ' // status%text())
         call run(problem, y0, 3.0_wp, 'klu', y_klu, s_klu, status)
         call check(error, status%ok(), 'klu run: ' // status%text())
+        call compare(error, y_dense, y_klu, s_dense, s_klu)
+        call run(problem, y0, 3.0_wp, 'mumps', y_klu, s_klu, status)
+        call check(error, status%ok(), 'mumps run: ' // status%text())
         call compare(error, y_dense, y_klu, s_dense, s_klu)
     end subroutine test_pendulum
 
@@ -109,6 +115,6 @@ contains
             trim(msg))
         call check(error, s_dense%nst == s_klu%nst .and. s_dense%nac == s_klu%nac .and. &
             s_dense%nfe == s_klu%nfe .and. s_dense%nje == s_klu%nje .and. &
-            s_dense%ndec == s_klu%ndec, 'counters differ between dense and KLU')
+            s_dense%ndec == s_klu%ndec, 'counters differ between dense and sparse')
     end subroutine compare
 end module test_radau5_sparse
