@@ -102,6 +102,44 @@ bad unknown-group "unknown_group.nml: &solvers: unknown group" unknown_group.nml
 printf '%s\n&solver rtol = -1 /\n' "$sim" > derived.nml
 bad derived-name-not-created "derived.nml: &solver: rtol = -1: must be positive" derived.nml
 
+# an output that is an input of the run, by any spelling: refused with
+# exit 2 before anything is written, and the input left as it was
+# untouched NAME PATTERN INPUT ARGS...: exit 2, the message, INPUT unchanged.
+untouched() {
+    local name=$1 pattern=$2 input=$3
+    shift 3
+    local before
+    before=$(md5sum < "$input")
+    check "$name" 2 "$pattern" "$@"
+    if [ -z "$problem" ] && [ "$(md5sum < "$input")" != "$before" ]; then
+        problem="$input was changed"
+    fi
+    if [ -n "$problem" ]; then fail "$name" "$problem"; else pass "$name"; fi
+}
+mkdir -p in sub
+sed -e "s#^&output#\&output file = './in/clobber.nml',#" "$root/inputs/van_der_pol.nml" \
+    > in/clobber.nml
+untouched output-is-scene-dot-spelling "would overwrite the input file" in/clobber.nml \
+    run in/clobber.nml --quiet
+sed -e "s#^&output#\&output file = 'sub/../in/clobber2.nml',#" "$root/inputs/van_der_pol.nml" \
+    > in/clobber2.nml
+untouched output-is-scene-relative-spelling "would overwrite the input file" in/clobber2.nml \
+    run "$work/in/clobber2.nml" --quiet
+cp "$root/inputs/van_der_pol.nml" in/x.h5
+cd in || exit 1
+check output-default-is-scene 2 "would overwrite the input file" run ./x.h5 --quiet
+cd "$work" || exit 1
+if [ -n "$problem" ]; then fail output-default-is-scene "$problem"
+elif ! cmp -s in/x.h5 "$root/inputs/van_der_pol.nml"; then
+    fail output-default-is-scene "in/x.h5 (the scene) was changed"
+else pass output-default-is-scene; fi
+cp "$root/inputs/meshes/bar_hex8.mesh" in/bar.mesh
+printf '%s\n' "&simulation problem = 'flexible_body', t_end = 0.01 /" \
+    "&flexible_body mesh_file = 'in/bar.mesh', fixed = 'clamp' /" \
+    "&material youngs_modulus = 7e5, density = 920 /" \
+    "&output file = './in/../in/bar.mesh' /" > mesh_clobber.nml
+untouched output-is-mesh-file "is the mesh file" in/bar.mesh run mesh_clobber.nml --quiet
+
 expect help 0 "usage:" --help
 expect version 0 "flexmbs 0." --version
 expect no-arguments 2 "usage:"

@@ -14,7 +14,7 @@ module flexmbs_io_namelist
     use, intrinsic :: ieee_exceptions, only: ieee_status_type, ieee_get_status, ieee_set_status
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
-    use flexmbs_core_files, only: read_text_file
+    use flexmbs_core_files, only: read_text_file, same_file
     use flexmbs_core_text, only: lower
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_linalg_linear_solver, only: linear_solver_names, linear_solver_names_text
@@ -2261,7 +2261,9 @@ contains
         else if (lower(scene%output_file) == 'none') then
             scene%output_file = ''
         end if
-        if (len(scene%output_file) == 0 .or. scene%output_file /= path) return
+        if (len(scene%output_file) == 0) return
+        ! the same file by any spelling (./s.nml, ../in/s.nml, a link)
+        if (scene%output_file /= path .and. .not. same_file(scene%output_file, path)) return
         do i = 1, size(entries)
             if (entries(i)%group == 'output' .and. entries(i)%name == 'file') then
                 call fail(status, path, entries(i), 'would overwrite the input file')

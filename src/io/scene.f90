@@ -6,6 +6,7 @@
 module flexmbs_io_scene
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_files, only: same_file
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_options, only: dae_options_t
@@ -373,6 +374,9 @@ contains
             return
         end if
 
+        ! no output may be one of the run's inputs; checked before any file is created
+        call check_outputs(scene, status)
+        if (.not. status%ok()) return
         ! ParaView output is checked before any file is created
         if (len_trim(scene%vtk) > 0) then
             call setup_vtk()
@@ -543,6 +547,31 @@ contains
             end select
         end subroutine record_energy
     end subroutine run_scene
+
+    !> No output of the run (the HDF5 file, the ParaView collection) may be
+    !> one of its inputs (the scene file, a mesh file), however the paths are
+    !> spelled: the input would be overwritten.
+    subroutine check_outputs(scene, status)
+        type(scene_input_t), intent(in) :: scene
+        type(status_t), intent(inout) :: status
+        if (len(scene%output_file) > 0) call against_inputs('file', scene%output_file)
+        if (len_trim(scene%vtk) > 0) call against_inputs('vtk', trim(scene%vtk) // '.pvd')
+    contains
+        subroutine against_inputs(name, output)
+            character(len=*), intent(in) :: name, output
+            if (.not. status%ok()) return
+            if (same_file(output, scene%path)) then
+                call status%set(status_bad_input, scene%path // ': &output: ' // name // &
+                    ': ''' // output // ''' is the scene file itself: refused, it would be &
+                    &overwritten')
+            else if (len_trim(scene%body%mesh_file) > 0) then
+                if (same_file(output, trim(scene%body%mesh_file))) &
+                    call status%set(status_bad_input, scene%path // ': &output: ' // name // &
+                        ': ''' // output // ''' is the mesh file ''' // &
+                        trim(scene%body%mesh_file) // ''': refused, it would be overwritten')
+            end if
+        end subroutine against_inputs
+    end subroutine check_outputs
 
     subroutine delete_file(path)
         character(len=*), intent(in) :: path

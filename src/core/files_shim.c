@@ -1,0 +1,12 @@
+/* File identity for flexmbs_core_files: two paths name the same file when
+ * they resolve to the same device and inode, however they are spelled
+ * (./s.nml, ../in/s.nml, a link). */
+#include <sys/stat.h>
+
+/* 1 when both paths exist and are the same file, 0 otherwise. */
+int flexmbs_same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    if (stat(a, &sa) != 0 || stat(b, &sb) != 0) return 0;
+    return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
