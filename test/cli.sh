@@ -260,6 +260,16 @@ expect columns 0 "1.000000000000000E+000" columns study_reference.h5 1 2
 expect columns-range 2 "component 999 outside 1 .. " columns study_reference.h5 999
 printf "&study scene = 'x.nml', solvers = 'rk4' /\n" > bad_study.nml
 expect study-bad 2 "bad_study.nml: &study: solvers: 'rk4': must be one of" sweep bad_study.nml
+# a study's outputs: never one of its inputs, and their folder checked
+# before the reference is computed (it used to be refused only when written)
+cp "$root/inputs/four_bar.nml" own_scene.nml
+printf "&study scene = 'own_scene.nml', reference_file = './own_scene.nml' /\n" > clobber_study.nml
+untouched study-reference-is-scene "is an input of the study" own_scene.nml \
+    reference clobber_study.nml --quiet
+printf "&study scene = '%s/inputs/four_bar.nml', reference_file = 'nodir/r.h5' /\n" "$root" \
+    > nodir_study.nml
+expect study-reference-no-folder 2 "the folder 'nodir' does not exist" reference nodir_study.nml \
+    --quiet
 printf "&study scene = '%s/inputs/four_bar.nml', reference_file = 'none.h5' /\n" "$root" \
     > no_reference.nml
 expect study-no-reference 2 "no reference file (make it with 'flexmbs reference' first)" \

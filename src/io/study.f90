@@ -23,6 +23,7 @@ module flexmbs_io_study
     use flexmbs_core_status, only: status_t, status_bad_input, status_io_error, &
         status_solver_failure
     use flexmbs_core_text, only: int_text, real_text
+    use flexmbs_core_files, only: same_file
     use flexmbs_dae_error_measure, only: paper_error
     use flexmbs_io_namelist, only: study_input_t, scene_input_t, read_scene
     use flexmbs_io_scene, only: run_result_t, run_scene
@@ -99,6 +100,41 @@ contains
         end if
     end subroutine read_study_scene
 
+    !> An output of a study (`name` = `output`: its reference file or its table)
+    !> must not be one of its inputs — the study file, the scene file, the
+    !> scene's mesh file — however spelled, and its folder must exist:
+    !> checked before any run, so that no reference is computed only to be
+    !> refused when it is written, and no input is overwritten.
+    subroutine check_study_output(study, base, name, output, status)
+        type(study_input_t), intent(in) :: study
+        type(scene_input_t), intent(in) :: base
+        character(len=*), intent(in) :: name, output
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: folder
+        logical :: exists
+        integer :: slash
+        if (same_file(output, study%path) .or. same_file(output, study%scene)) then
+            call status%set(status_bad_input, study%path // ': &study: ' // name // ' = ''' // &
+                output // ''': is an input of the study (the study or its scene file): &
+                &refused, it would be overwritten')
+            return
+        end if
+        if (len_trim(base%body%mesh_file) > 0) then
+            if (same_file(output, trim(base%body%mesh_file))) then
+                call status%set(status_bad_input, study%path // ': &study: ' // name // &
+                    ' = ''' // output // ''': is the scene''s mesh file: refused, it would &
+                    &be overwritten')
+                return
+            end if
+        end if
+        slash = index(output, '/', back=.true.)
+        if (slash <= 1) return
+        folder = output(1:slash - 1)
+        inquire (file=folder // '/.', exist=exists)
+        if (.not. exists) call status%set(status_bad_input, study%path // ': &study: ' // &
+            name // ' = ''' // output // ''': the folder ''' // folder // ''' does not exist')
+    end subroutine check_study_output
+
     !> The reference of a study (module header); `log` gets one line per
     !> run. Nothing is written unless both runs succeed.
     subroutine make_reference(study, version, quiet, log, status)
@@ -120,6 +156,8 @@ contains
         character, parameter :: nl = new_line('a')
 
         call read_study_scene(study, base, status)
+        if (.not. status%ok()) return
+        call check_study_output(study, base, 'reference_file', study%reference_file, status)
         if (.not. status%ok()) return
         call one_run('reference', trim(study%reference_solver), study%reference_tolerance, &
                      ref, rec)
@@ -283,6 +321,9 @@ contains
         integer :: k, njobs
 
         call prepare_sweep(study, base, t_ref, y_ref, points, status)
+        if (.not. status%ok()) return
+        if (len(study%table) > 0) call check_study_output(study, base, 'table', study%table, &
+                                                          status)
         if (.not. status%ok()) return
         njobs = 1
         if (present(jobs)) njobs = jobs
