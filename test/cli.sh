@@ -140,6 +140,17 @@ printf '%s\n' "&simulation problem = 'flexible_body', t_end = 0.01 /" \
     "&output file = './in/../in/bar.mesh' /" > mesh_clobber.nml
 untouched output-is-mesh-file "is the mesh file" in/bar.mesh run mesh_clobber.nml --quiet
 
+# inertia tensors a body can have: positive definite, principal moments
+# satisfying the triangle inequalities (a chain link's was not checked)
+sed -e "s/inertia_products = 0.003, 0.002, -0.001/inertia_products = 1.0, 1.0, 1.0/" \
+    "$root/inputs/double_pendulum_chain.nml" > chain_inertia.nml
+bad chain-inertia-not-definite \
+    "chain_inertia.nml: &rigid_chain 'upper': inertia, inertia_products: the inertia tensor is not positive definite" \
+    chain_inertia.nml
+sed -e "0,/inertia = [0-9., ]*/s//inertia = 0.001, 0.001, 0.01, /" "$root/inputs/four_bar.nml" \
+    > triangle.nml
+bad rigid-inertia-triangle "violate the triangle inequality J1 + J2 >= J3" triangle.nml
+
 expect help 0 "usage:" --help
 expect version 0 "flexmbs 0." --version
 expect no-arguments 2 "usage:"

@@ -7,6 +7,8 @@
 module flexmbs_io_chain_input
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_text, only: int_text
+    use flexmbs_mbs_inertia, only: inertia_tensor, inertia_defect
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, new_rigid_chain, chain_body_t, &
         chain_joint_revolute, chain_joint_prismatic, chain_joint_spherical
     use flexmbs_mbs_rotation, only: quat_from_axis_angle
@@ -25,6 +27,7 @@ contains
         real(wp), allocatable, intent(out) :: q0(:), v0(:)
         type(status_t), intent(out) :: status
         type(chain_body_t), allocatable :: bodies(:)
+        character(len=:), allocatable :: defect
         integer :: i, j
         allocate (bodies(size(scene%chain)), q0(0), v0(0))
         do i = 1, size(bodies)
@@ -42,10 +45,14 @@ contains
                 bodies(i)%axis = c%joint_axis / norm2(c%joint_axis)
                 bodies(i)%centre = c%centre
                 bodies(i)%mass = c%mass
-                bodies(i)%inertia = reshape([c%inertia(1), c%inertia_products(1), &
-                    c%inertia_products(3), c%inertia_products(1), c%inertia(2), &
-                    c%inertia_products(2), c%inertia_products(3), c%inertia_products(2), &
-                    c%inertia(3)], [3, 3])
+                bodies(i)%inertia = inertia_tensor(c%inertia, c%inertia_products)
+                defect = inertia_defect(bodies(i)%inertia)
+                if (len(defect) > 0) then
+                    call status%set(status_bad_input, scene%path // ': &rigid_chain ''' // &
+                        trim(c%name) // ''': inertia, inertia_products: ' // defect // &
+                        ' (line ' // int_text(c%line) // ')')
+                    return
+                end if
                 if (bodies(i)%joint == chain_joint_spherical) then
                     q0 = [q0, quat_from_axis_angle(c%rotation_axis / norm2(c%rotation_axis), &
                                                    c%rotation_angle)]

@@ -17,6 +17,7 @@ module flexmbs_io_multibody_input
     use flexmbs_linalg_lapack, only: dgesvd
     use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle, cross
     use flexmbs_mbs_rigid_body, only: rigid_body_t
+    use flexmbs_mbs_inertia, only: inertia_tensor, inertia_defect
     use flexmbs_mbs_joint, only: joint_spherical, joint_revolute, joint_cylindrical, &
         joint_prismatic, joint_universal, joint_fixed, joint_primitive
     use flexmbs_mbs_primitive_kinds, only: primitive_angle_driver, &
@@ -52,7 +53,7 @@ contains
         type(node_frame_t), allocatable :: frames(:)
         real(wp), allocatable :: qf(:), vf(:), qc(:), vc(:)
         integer, allocatable :: nodes(:), frame_of(:)
-        character(len=:), allocatable :: labels(:), frame_labels(:)
+        character(len=:), allocatable :: labels(:), frame_labels(:), defect
         real(wp) :: p(4), r(3, 3), anchor(3)
         integer :: i, nb, k, n, b, mi
         ! node-set markers that a joint other than 'attach' or a driver uses
@@ -73,14 +74,12 @@ contains
         do i = 1, size(scene%rigid_bodies)
             associate (b => scene%rigid_bodies(i))
                 bodies(i)%mass = b%mass
-                bodies(i)%inertia = reshape([b%inertia(1), b%inertia_products(1), &
-                    b%inertia_products(3), b%inertia_products(1), b%inertia(2), &
-                    b%inertia_products(2), b%inertia_products(3), b%inertia_products(2), &
-                    b%inertia(3)], [3, 3])
-                if (.not. positive_definite(bodies(i)%inertia)) then
+                bodies(i)%inertia = inertia_tensor(b%inertia, b%inertia_products)
+                defect = inertia_defect(bodies(i)%inertia)
+                if (len(defect) > 0) then
                     call status%set(status_bad_input, scene%path // ': &rigid_body ''' // &
-                        trim(b%name) // ''': inertia, inertia_products: the inertia tensor &
-                        &is not positive definite (line ' // int_text(b%line) // ')')
+                        trim(b%name) // ''': inertia, inertia_products: ' // defect // &
+                        ' (line ' // int_text(b%line) // ')')
                     return
                 end if
                 p = quat_from_axis_angle(b%rotation_axis / norm2(b%rotation_axis), &
@@ -352,14 +351,4 @@ contains
         case default; driver_kind = primitive_distance
         end select
     end function driver_kind
-
-    !> Sylvester's criterion on a symmetric 3 × 3 matrix.
-    pure logical function positive_definite(j)
-        real(wp), intent(in) :: j(3, 3)
-        positive_definite = j(1, 1) > 0.0_wp .and. &
-            j(1, 1) * j(2, 2) - j(1, 2) * j(2, 1) > 0.0_wp .and. &
-            j(1, 1) * (j(2, 2) * j(3, 3) - j(2, 3) * j(3, 2)) &
-            - j(1, 2) * (j(2, 1) * j(3, 3) - j(2, 3) * j(3, 1)) &
-            + j(1, 3) * (j(2, 1) * j(3, 2) - j(2, 2) * j(3, 1)) > 0.0_wp
-    end function positive_definite
 end module flexmbs_io_multibody_input

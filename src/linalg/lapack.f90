@@ -3,7 +3,7 @@ module flexmbs_linalg_lapack
     use flexmbs_core_kinds, only: wp
     implicit none
     private
-    public :: dgetrf, dgetrs, zgetrf, zgetrs, dgbtrf, dgbtrs, zgbtrf, zgbtrs, dgesvd
+    public :: dgetrf, dgetrs, zgetrf, zgetrs, dgbtrf, dgbtrs, zgbtrf, zgbtrs, dgesvd, dsyev
 
     interface
         subroutine dgetrf(m, n, a, lda, ipiv, info)
@@ -70,5 +70,13 @@ module flexmbs_linalg_lapack
             real(wp), intent(out) :: s(*), u(ldu, *), vt(ldvt, *), work(*)
             integer, intent(out) :: info
         end subroutine dgesvd
+        subroutine dsyev(jobz, uplo, n, a, lda, w, work, lwork, info)
+            import :: wp
+            character, intent(in) :: jobz, uplo
+            integer, intent(in) :: n, lda, lwork
+            real(wp), intent(inout) :: a(lda, *)
+            real(wp), intent(out) :: w(*), work(*)
+            integer, intent(out) :: info
+        end subroutine dsyev
     end interface
 end module flexmbs_linalg_lapack
