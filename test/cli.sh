@@ -151,6 +151,15 @@ sed -e "0,/inertia = [0-9., ]*/s//inertia = 0.001, 0.001, 0.01, /" "$root/inputs
     > triangle.nml
 bad rigid-inertia-triangle "violate the triangle inequality J1 + J2 >= J3" triangle.nml
 
+# sizes that cannot fit: counted in 64 bits and against the machine's
+# memory before anything is allocated (2000^3 used to overflow and crash)
+sed -e "s/divisions = 8, 1, 1/divisions = 2000, 2000, 2000/" \
+    "$root/inputs/flexible_cantilever.nml" > huge_mesh.nml
+bad huge-mesh-count "divisions = 2000, 2000, 2000: 8.012006E+09 nodes" huge_mesh.nml
+sed -e "s/divisions = 8, 1, 1/divisions = 400, 400, 400/" \
+    "$root/inputs/flexible_cantilever.nml" > big_mesh.nml
+bad big-mesh-memory "divisions = 400, 400, 400: 6.448120E+07 nodes, needs at least ~" big_mesh.nml
+
 expect help 0 "usage:" --help
 expect version 0 "flexmbs 0." --version
 expect no-arguments 2 "usage:"

@@ -10,3 +10,13 @@ int flexmbs_same_file(const char *a, const char *b)
     if (stat(a, &sa) != 0 || stat(b, &sb) != 0) return 0;
     return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
+
+#include <unistd.h>
+
+/* The machine's physical memory in bytes, or -1 when unknown. */
+long long flexmbs_physical_memory(void)
+{
+    long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || size <= 0) return -1;
+    return (long long)pages * (long long)size;
+}

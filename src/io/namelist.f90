@@ -12,10 +12,11 @@
 module flexmbs_io_namelist
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use, intrinsic :: ieee_exceptions, only: ieee_status_type, ieee_get_status, ieee_set_status
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_files, only: read_text_file, same_file
-    use flexmbs_core_text, only: lower
+    use flexmbs_core_text, only: lower, int_text, real_text
+    use flexmbs_core_resources, only: physical_memory, bytes_text
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_linalg_linear_solver, only: linear_solver_names, linear_solver_names_text
     implicit none
@@ -2147,6 +2148,9 @@ contains
                 call bad(fb, 'lengths', 1, 'must be positive')
             else if (len_trim(b%mesh_file) == 0 .and. any(b%divisions < 1)) then
                 call bad(fb, 'divisions', 1, 'must be at least 1 in every direction')
+            else if (len_trim(b%mesh_file) == 0 .and. len(box_size_problem(b%divisions, &
+                     b%element)) > 0) then
+                call bad(fb, 'divisions', 1, box_size_problem(b%divisions, b%element))
             else if (has_entry(entries, fb, 'fixed') .and. &
                      any(b%fixed(1:count_values(fb, 'fixed')) == '')) then
                 call bad(fb, 'fixed', 1, 'node-set names must not be empty')
@@ -2461,4 +2465,35 @@ contains
             ext = ''
         end if
     end function extension
+
+    !> Why a box mesh of `divisions` elements of type `element` cannot be
+    !> made here, or '': its node and element counts must fit the default
+    !> integers that number them, and a lower estimate of the memory the run
+    !> needs (the tangent pattern: per node 3 rows of 81 (hex8) or 375
+    !> (hex27) entries of about 40 bytes each, values, damping, index and
+    !> maps) must fit the machine. Counted in 64 bits: 2000³ elements
+    !> overflow a default integer.
+    function box_size_problem(divisions, element) result(why)
+        integer, intent(in) :: divisions(3)
+        character(len=*), intent(in) :: element
+        character(len=:), allocatable :: why
+        integer(i8) :: nodes, elements, p, machine
+        real(wp) :: bytes, per_node
+        why = ''
+        p = merge(1_i8, 2_i8, element == 'hex8')
+        per_node = merge(3.0_wp * 81.0_wp, 3.0_wp * 375.0_wp, element == 'hex8') * 40.0_wp
+        nodes = product(p * int(divisions, i8) + 1_i8)
+        elements = product(int(divisions, i8))
+        bytes = real(nodes, wp) * per_node
+        if (3_i8 * nodes > int(huge(1), i8) .or. elements > int(huge(1), i8)) then
+            why = real_text(real(nodes, wp)) // ' nodes (' // real_text(3.0_wp * real(nodes, &
+                wp)) // ' coordinates) and ' // real_text(real(elements, wp)) // &
+                ' elements: more than the ' // int_text(huge(1)) // ' a mesh can number'
+            return
+        end if
+        machine = physical_memory()
+        if (machine > 0 .and. bytes > real(machine, wp)) why = real_text(real(nodes, wp)) // &
+            ' nodes, needs at least ~' // bytes_text(bytes) // '; this machine has ' // &
+            bytes_text(real(machine, wp))
+    end function box_size_problem
 end module flexmbs_io_namelist
