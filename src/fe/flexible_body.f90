@@ -691,7 +691,7 @@ contains
         real(wp), intent(out) :: fq(:, :), fv(:, :)
         type(status_t), intent(inout) :: status
         type(status_t) :: local
-        call assemble(self, q, v, self%force_work, local, .true.)
+        call self%assemble_tangents(q, v, local)
         if (.not. local%ok()) then
             status = local
             return
@@ -815,13 +815,13 @@ contains
         type(status_t), intent(inout) :: status
         integer :: empty(0), i
         integer, allocatable :: diag(:)
-        patterns%mass = self%mass_matrix
+        call self%mass_pattern(patterns%mass, status)
         patterns%force_q = self%stiffness
         patterns%force_v = self%damping
         diag = [(i, i = 1, self%nv)]
         call patterns%kinematics%build(self%nq, self%nv, diag, diag, status)
         if (status%ok()) call patterns%kinematics_q%build(self%nq, self%nq, empty, empty, status)
-        if (status%ok()) call patterns%constraint_v%build(0, self%nv, empty, empty, status)
+        if (status%ok()) call self%constraint_jacobian_pattern(patterns%constraint_v, status)
         if (status%ok()) call patterns%constraint_q%build(0, self%nq, empty, empty, status)
         if (status%ok()) call patterns%reaction_q%build(self%nv, self%nq, empty, empty, status)
     end subroutine body_derivative_patterns
@@ -841,7 +841,7 @@ contains
         real(wp), intent(out) :: fq(:), fv(:)
         type(status_t), intent(inout) :: status
         type(status_t) :: local
-        call assemble(self, q, v, self%force_work, local, .true.)
+        call self%assemble_tangents(q, v, local)
         if (.not. local%ok()) then
             status = local
             return

@@ -53,17 +53,13 @@ contains
         self%misses = 0
     end subroutine accumulator_start_dense
 
-    !> Zero a sparse target on `pattern` (copied on first use; later calls
-    !> must pass the same pattern).
+    !> Zero a sparse target on `pattern`, copied on first use: an
+    !> accumulator serves one pattern (use one accumulator per block).
     subroutine accumulator_start_sparse(self, pattern)
         class(accumulator_t), intent(inout) :: self
         type(csc_matrix_t), intent(in) :: pattern
         self%sparse = .true.
-        if (.not. self%csc%is_built() .or. self%csc%nnz /= pattern%nnz .or. &
-            self%csc%nrow /= pattern%nrow .or. self%csc%ncol /= pattern%ncol) then
-            self%csc = pattern
-            if (.not. allocated(self%csc%values)) allocate (self%csc%values(pattern%nnz))
-        end if
+        if (.not. self%csc%is_built()) self%csc = pattern
         self%nrow = pattern%nrow
         self%ncol = pattern%ncol
         self%csc%values = 0.0_wp

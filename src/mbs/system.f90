@@ -88,6 +88,12 @@ module flexmbs_mbs_system
     !> chain angles) as well: slower, verifies the markers' Jacobians too.
     integer, parameter, public :: constraint_derivatives_ad_full = 3
 
+    ! The derivative blocks' accumulators (mbs_system_t%acc): g_q and the
+    ! other nc x nq blocks, G and ∂γ/∂v, ∂(Gᵀλ)/∂q, ∂f/∂q and ∂(M w)/∂q,
+    ! ∂f/∂v, T, ∂(T w)/∂q.
+    integer, parameter :: block_cq = 1, block_cv = 2, block_rq = 3, block_fq = 4, &
+        block_fv = 5, block_kin = 6, block_kinq = 7
+
     ! marker_offsets reports a chain marker's body as -(chain_body_flag + chain).
     integer, parameter :: chain_body_flag = 1000
     ! The most rows of a joint (fixed: spherical + 3 dot-1).
@@ -180,10 +186,12 @@ module flexmbs_mbs_system
         real(wp), allocatable :: zero_v(:) !! v = 0 for position-only evaluations
         !> copies of the CSC patterns handed out (their triplet maps place values)
         type(csc_matrix_t) :: mass_csc, jacobian_csc
-        !> the derivative blocks' patterns (derivative_patterns) and two
-        !> accumulators the derivative code adds into, dense or sparse
+        !> the derivative blocks' patterns (derivative_patterns) and one
+        !> accumulator per block (block_*), dense or sparse, which the
+        !> derivative code adds into: each keeps its shape and pattern, so
+        !> no evaluation allocates
         type(mechanical_patterns_t) :: patterns
-        type(accumulator_t) :: acc(2)
+        type(accumulator_t) :: acc(7)
         !> each flexible body's tangent slots in patterns%force_q and %force_v
         type(tangent_slots_t), allocatable :: flex_slots(:)
     contains

@@ -56,9 +56,9 @@ contains
     end procedure system_mass
 
     module procedure system_mass_derivative
-        call self%acc(1)%start_dense(self%nv, self%nq)
-        call mass_derivative_into(self, t, q, w, self%acc(1), status)
-        call self%acc(1)%get_dense(dq)
+        call self%acc(block_fq)%start_dense(self%nv, self%nq)
+        call mass_derivative_into(self, t, q, w, self%acc(block_fq), status)
+        call self%acc(block_fq)%get_dense(dq)
     end procedure system_mass_derivative
 
     !> ∂(M w)/∂q added into dq: zero for rigid and flexible bodies (constant

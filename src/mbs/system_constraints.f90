@@ -80,16 +80,16 @@ contains
 
     !> G = c_q T, nc x nv.
     module procedure system_constraint_jacobian
-        call self%acc(1)%start_dense(self%nc, self%nv)
-        call assemble_first_derivative(self, t, q, .false., self%acc(1))
-        call self%acc(1)%get_dense(gmat)
+        call self%acc(block_cv)%start_dense(self%nc, self%nv)
+        call assemble_first_derivative(self, t, q, .false., self%acc(block_cv))
+        call self%acc(block_cv)%get_dense(gmat)
     end procedure system_constraint_jacobian
 
     !> c_q, nc x nq.
     module procedure system_constraint_position_jacobian
-        call self%acc(1)%start_dense(self%nc, self%nq)
-        call assemble_first_derivative(self, t, q, .true., self%acc(1))
-        call self%acc(1)%get_dense(gq)
+        call self%acc(block_cq)%start_dense(self%nc, self%nq)
+        call assemble_first_derivative(self, t, q, .true., self%acc(block_cq))
+        call self%acc(block_cq)%get_dense(gq)
     end procedure system_constraint_position_jacobian
 
     !> G (velocity space) or c_q (position space) added into out.

@@ -289,7 +289,7 @@ contains
     module procedure system_kinematics_sparse
         real(wp) :: e(rigid_body_nq), rate(rigid_body_nq), l(3, 4)
         integer :: b, f, i, k, iq, iv
-        associate (acc => self%acc(1))
+        associate (acc => self%acc(block_kin))
             call acc%start_sparse(self%patterns%kinematics)
             do b = 1, size(self%rigid%bodies)
                 iq = rigid_body_nq * (b - 1)
@@ -326,7 +326,7 @@ contains
     module procedure system_kinematics_derivative_sparse
         real(wp) :: blk(rigid_body_nq, rigid_body_nq)
         integer :: b, f, iq, iv
-        associate (acc => self%acc(1))
+        associate (acc => self%acc(block_kinq))
             call acc%start_sparse(self%patterns%kinematics_q)
             do b = 1, size(self%rigid%bodies)
                 iq = rigid_body_nq * (b - 1)
@@ -346,9 +346,9 @@ contains
     end procedure system_kinematics_derivative_sparse
 
     module procedure system_mass_derivative_sparse
-        call self%acc(1)%start_sparse(self%patterns%force_q)
-        call mass_derivative_into(self, t, q, w, self%acc(1), status)
-        call self%acc(1)%get_values(values, 'mbs system: d(M w)/dq', status)
+        call self%acc(block_fq)%start_sparse(self%patterns%force_q)
+        call mass_derivative_into(self, t, q, w, self%acc(block_fq), status)
+        call self%acc(block_fq)%get_values(values, 'mbs system: d(M w)/dq', status)
     end procedure system_mass_derivative_sparse
 
     !> ∂f/∂q, ∂f/∂v: gyroscopic blocks, the chains' blocks, and −∂k/∂q,
@@ -358,7 +358,7 @@ contains
         type(status_t) :: local
         integer :: b, iv
         integer(i8) :: p
-        associate (aq => self%acc(1), av => self%acc(2))
+        associate (aq => self%acc(block_fq), av => self%acc(block_fv))
             call aq%start_sparse(self%patterns%force_q)
             call av%start_sparse(self%patterns%force_v)
             do b = 1, size(self%rigid%bodies)
@@ -401,8 +401,8 @@ contains
     end procedure system_force_derivatives_sparse
 
     module procedure system_constraint_position_jacobian_sparse
-        call self%acc(1)%start_sparse(self%patterns%constraint_q)
-        call assemble_first_derivative(self, t, q, .true., self%acc(1))
-        call self%acc(1)%get_values(values, 'mbs system: g_q', status)
+        call self%acc(block_cq)%start_sparse(self%patterns%constraint_q)
+        call assemble_first_derivative(self, t, q, .true., self%acc(block_cq))
+        call self%acc(block_cq)%get_values(values, 'mbs system: g_q', status)
     end procedure system_constraint_position_jacobian_sparse
 end submodule flexmbs_mbs_system_patterns

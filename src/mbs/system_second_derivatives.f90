@@ -8,19 +8,19 @@ contains
     ! ------------------------------------------------ second derivatives (AD)
 
     module procedure system_constraint_jacobian_derivatives
-        call self%acc(1)%start_dense(self%nc, self%nq)
-        call self%acc(2)%start_dense(self%nv, self%nq)
-        call jacobian_derivatives_into(self, t, q, w, lambda, self%acc(1), self%acc(2))
-        call self%acc(1)%get_dense(gwq)
-        call self%acc(2)%get_dense(gtlq)
+        call self%acc(block_cq)%start_dense(self%nc, self%nq)
+        call self%acc(block_rq)%start_dense(self%nv, self%nq)
+        call jacobian_derivatives_into(self, t, q, w, lambda, self%acc(block_cq), self%acc(block_rq))
+        call self%acc(block_cq)%get_dense(gwq)
+        call self%acc(block_rq)%get_dense(gtlq)
     end procedure system_constraint_jacobian_derivatives
 
     module procedure system_constraint_jacobian_derivatives_sparse
-        call self%acc(1)%start_sparse(self%patterns%constraint_q)
-        call self%acc(2)%start_sparse(self%patterns%reaction_q)
-        call jacobian_derivatives_into(self, t, q, w, lambda, self%acc(1), self%acc(2))
-        call self%acc(1)%get_values(gwq, 'mbs system: d(G w)/dq', status)
-        call self%acc(2)%get_values(gtlq, 'mbs system: d(G^T lambda)/dq', status)
+        call self%acc(block_cq)%start_sparse(self%patterns%constraint_q)
+        call self%acc(block_rq)%start_sparse(self%patterns%reaction_q)
+        call jacobian_derivatives_into(self, t, q, w, lambda, self%acc(block_cq), self%acc(block_rq))
+        call self%acc(block_cq)%get_values(gwq, 'mbs system: d(G w)/dq', status)
+        call self%acc(block_rq)%get_values(gtlq, 'mbs system: d(G^T lambda)/dq', status)
     end procedure system_constraint_jacobian_derivatives_sparse
 
     !> ∂(G w)/∂q (nc x nq) and ∂(Gᵀλ)/∂q (nv x nq) added into gwq, gtlq: AD of
@@ -99,15 +99,15 @@ contains
     end procedure add_tangents
 
     module procedure system_constraint_time_derivative_jacobian
-        call self%acc(1)%start_dense(self%nc, self%nq)
-        call time_derivative_jacobian_into(self, t, q, self%acc(1))
-        call self%acc(1)%get_dense(dq)
+        call self%acc(block_cq)%start_dense(self%nc, self%nq)
+        call time_derivative_jacobian_into(self, t, q, self%acc(block_cq))
+        call self%acc(block_cq)%get_dense(dq)
     end procedure system_constraint_time_derivative_jacobian
 
     module procedure system_constraint_time_derivative_jacobian_sparse
-        call self%acc(1)%start_sparse(self%patterns%constraint_q)
-        call time_derivative_jacobian_into(self, t, q, self%acc(1))
-        call self%acc(1)%get_values(values, 'mbs system: dg_I/dq', status)
+        call self%acc(block_cq)%start_sparse(self%patterns%constraint_q)
+        call time_derivative_jacobian_into(self, t, q, self%acc(block_cq))
+        call self%acc(block_cq)%get_values(values, 'mbs system: dg_I/dq', status)
     end procedure system_constraint_time_derivative_jacobian_sparse
 
     !> ∂c_t/∂q added into dq: AD of the hand-coded c_t.
@@ -134,19 +134,19 @@ contains
     end procedure time_derivative_jacobian_into
 
     module procedure system_constraint_curvature_derivatives
-        call self%acc(1)%start_dense(self%nc, self%nq)
-        call self%acc(2)%start_dense(self%nc, self%nv)
-        call curvature_derivatives_into(self, t, q, v, self%acc(1), self%acc(2))
-        call self%acc(1)%get_dense(gq)
-        call self%acc(2)%get_dense(gv)
+        call self%acc(block_cq)%start_dense(self%nc, self%nq)
+        call self%acc(block_cv)%start_dense(self%nc, self%nv)
+        call curvature_derivatives_into(self, t, q, v, self%acc(block_cq), self%acc(block_cv))
+        call self%acc(block_cq)%get_dense(gq)
+        call self%acc(block_cv)%get_dense(gv)
     end procedure system_constraint_curvature_derivatives
 
     module procedure system_constraint_curvature_derivatives_sparse
-        call self%acc(1)%start_sparse(self%patterns%constraint_q)
-        call self%acc(2)%start_sparse(self%patterns%constraint_v)
-        call curvature_derivatives_into(self, t, q, v, self%acc(1), self%acc(2))
-        call self%acc(1)%get_values(gq, 'mbs system: dgamma/dq', status)
-        call self%acc(2)%get_values(gv, 'mbs system: dgamma/dv', status)
+        call self%acc(block_cq)%start_sparse(self%patterns%constraint_q)
+        call self%acc(block_cv)%start_sparse(self%patterns%constraint_v)
+        call curvature_derivatives_into(self, t, q, v, self%acc(block_cq), self%acc(block_cv))
+        call self%acc(block_cq)%get_values(gq, 'mbs system: dgamma/dq', status)
+        call self%acc(block_cv)%get_values(gv, 'mbs system: dgamma/dv', status)
     end procedure system_constraint_curvature_derivatives_sparse
 
     !> ∂γ/∂q and ∂γ/∂v added into gq, gv: AD of the hand-coded γ, one pass
