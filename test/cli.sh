@@ -160,6 +160,12 @@ sed -e "s/divisions = 8, 1, 1/divisions = 400, 400, 400/" \
     "$root/inputs/flexible_cantilever.nml" > big_mesh.nml
 bad big-mesh-memory "divisions = 400, 400, 400: 6.448120E+07 nodes, needs at least ~" big_mesh.nml
 
+# user documentation names only files the repository ships
+if grep -nE '\.\./shared|shared/docs|(ALGORITHMS|PAPER|DESIGN|STYLE)\.md' \
+        "$root/README.md" "$root"/docs/*.md > outside.txt; then
+    fail docs-self-contained "README/docs point outside the repository: $(head -3 outside.txt)"
+else pass docs-self-contained; fi
+
 expect help 0 "usage:" --help
 expect version 0 "flexmbs 0." --version
 expect no-arguments 2 "usage:"
