@@ -11,6 +11,7 @@ program flexmbs_tests
     use test_radau5_dae, only: collect_radau5_dae
     use test_radau5_sparse, only: collect_radau5_sparse
     use test_io, only: collect_io
+    use test_scene_input, only: collect_scene_input
     use test_bdf_stability, only: collect_bdf_stability
     use test_reference, only: collect_reference
     use test_ida, only: collect_ida
@@ -58,6 +59,7 @@ program flexmbs_tests
     call run_suite('radau5_dae', collect_radau5_dae(), filter, npassed, nfailed)
     call run_suite('radau5_sparse', collect_radau5_sparse(), filter, npassed, nfailed)
     call run_suite('io', collect_io(), filter, npassed, nfailed)
+    call run_suite('scene_input', collect_scene_input(), filter, npassed, nfailed)
     call run_suite('bdf_stability', collect_bdf_stability(), filter, npassed, nfailed)
     call run_suite('reference', collect_reference(), filter, npassed, nfailed)
     call run_suite('ida', collect_ida(), filter, npassed, nfailed)

@@ -102,7 +102,9 @@ contains
         call check(error, scene%controller == 'classical', 'controller lower-cased')
         call check_close(error, scene%thet, -1.0_wp, 0.0_wp, 'thet')
         call check(error, scene%zero_start, 'zero_start')
-        call check(error, scene%output_file == 'out/run.h5', 'file')
+        ! relative to the scene's folder
+        call check(error, scene%output_file == path(1:index(path, '/', back=.true.)) // &
+                   'out/run.h5', 'file: ' // scene%output_file)
         call check(error, scene%n_output == 5, 'n_output')
         call check(error, scene%every_step, 'every_step')
         call check(error, scene%nit == 7, 'nit default')
@@ -218,9 +220,10 @@ contains
         type(status_t) :: status
         status = parse_status(vdp_sim() // '! the solver' // nl // '&solvers rtol = 1e-4 /')
         call check(error, status%code == status_bad_input, 'code')
-        call expect(error, status, 'in.nml: &solvers: unknown group (expected &simulation, ' // &
-                    '&solver, &output, &flexible_body, &material, &multibody, &rigid_body, ' // &
-                    '&marker, &joint, &driver or &rigid_chain) (line 3)')
+        call expect(error, status, 'in.nml: &solvers: unknown group (did you mean ''solver''?) ' &
+                    // '(known: &simulation, &solver, &output, &flexible_body, &material, ' // &
+                    '&multibody, &rigid_body, &marker, &joint, &driver, &rigid_chain; &study in ' &
+                    // 'study files) (line 3)')
     end subroutine test_unknown_group
 
     subroutine test_other_bad_text(error)
@@ -241,7 +244,8 @@ contains
         status = parse_status(vdp_sim() // '&solver name = ''radau5 /')
         call expect(error, status, 'unterminated string')
         status = parse_status(vdp_sim() // '&solver name = ''dassl'' /')
-        call expect(error, status, 'name = ''dassl'': must be ''radau5''')
+        call expect(error, status, 'name = ''dassl'': must be one of ''radau5'', ''ddassl'', ' // &
+                    '''ida'' or ''mexax'' (did you mean ''ddassl''?)')
         status = parse_status('&simulation problem = ''duffing'', t_end = 1 /')
         call expect(error, status, 'problem = ''duffing'': must be one of ''van_der_pol''')
         status = parse_status(vdp_sim() // '&solver sparse_ordering = ''metis'' /')

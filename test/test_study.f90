@@ -42,14 +42,14 @@ contains
         type(status_t) :: status
         call expect(error, '&study solvers = ''radau5'' /', 'scene: required')
         call expect(error, '&study scene = ''a.nml'', solvers = ''rk4'' /', &
-                    "dir/s.nml: &study: solvers: 'rk4': must be one of")
+                    "dir/s.nml: &study: solvers = 'rk4': must be one of")
         call expect(error, '&study scene = ''a.nml'', table = ''t.txt'' /', &
                     'the name must end in .md, .csv or .tex')
         call expect(error, '&study scene = ''a.nml'', tolerances = 1e-4, 2.0 /', &
-                    'tolerances: each must lie in (0, 1)')
-        call expect(error, '&study scene = ''a.nml'', pmax = 2, 7 /', 'pmax: each must be 1 .. 5')
+                    'tolerances = 1e-4, 2.0: must be less than 1')
+        call expect(error, '&study scene = ''a.nml'', pmax = 2, 7 /', 'pmax = 2, 7: must lie in 1..5')
         call expect(error, '&study scene = ''a.nml'', stabilisations = ''baumgarte'' /', &
-                    "stabilisations: 'baumgarte': must be one of")
+                    "stabilisations = 'baumgarte': must be 'none', 'ggl' or 'projection'")
         call expect(error, '&simulation t_end = 1 /' // nl // '&study scene = ''a.nml'' /', &
                     '&simulation: a study file holds only &study')
         call expect(error, '&study scene = ''a.nml'', tolerance = 1e-4 /', 'tolerance')

@@ -1,0 +1,152 @@
+!> Checks of `&flexible_body` and `&material` beyond the schema's ranges:
+!> presence, combinations, the size of a box mesh, unique names and
+!> element sets. Node- and element-set names are checked against the mesh
+!> when the body is built.
+module flexmbs_io_body_checks
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_text, only: int_text, real_text
+    use flexmbs_core_resources, only: physical_memory, bytes_text
+    use flexmbs_io_input_errors, only: input_errors_t, at_line
+    use flexmbs_io_scene_lexer, only: entry_t, has_entry, entry_index
+    use flexmbs_io_scene_values, only: value_error, required_error
+    use flexmbs_io_scene_input, only: scene_input_t
+    implicit none
+    private
+
+    public :: check_body, box_size_problem
+
+contains
+
+    subroutine check_body(scene, entries, errors)
+        type(scene_input_t), intent(in) :: scene
+        type(entry_t), intent(in) :: entries(:)
+        type(input_errors_t), intent(inout) :: errors
+        character(len=*), parameter :: fb = 'flexible_body', mat = 'material'
+        character(len=:), allocatable :: why
+        logical :: meshed
+        integer :: i, k
+
+        if (scene%problem /= 'flexible_body' .and. &
+            .not. (scene%problem == 'multibody' .and. scene%has_body)) then
+            if (scene%has_body) then
+                call errors%add('&flexible_body: given, but problem = ''' // &
+                    trim(scene%problem) // ''' (a scene builds only what it declares)', &
+                    scene%body%line)
+            else if (size(scene%materials) > 0) then
+                call errors%add('&material: given without &flexible_body', &
+                                scene%materials(1)%line)
+            end if
+            return
+        end if
+        if (.not. scene%has_body) then
+            call errors%add('&simulation: problem = ''flexible_body'': needs a &flexible_body &
+                &group', 0)
+            return
+        end if
+        associate (b => scene%body)
+            meshed = len_trim(b%mesh_file) > 0
+            if (meshed) then
+                if (has_entry(entries, fb, 'divisions')) call value_error(errors, entries, fb, &
+                    'divisions', 'not used with mesh_file (the file gives the mesh)')
+                if (has_entry(entries, fb, 'lengths')) call value_error(errors, entries, fb, &
+                    'lengths', 'not used with mesh_file (the file gives the mesh)')
+                if (has_entry(entries, fb, 'origin')) call value_error(errors, entries, fb, &
+                    'origin', 'not used with mesh_file (the file gives the mesh)')
+            else
+                if (.not. has_entry(entries, fb, 'lengths')) call errors%add('&flexible_body: &
+                    &lengths: required (the box edge lengths in m), or mesh_file', b%line)
+                k = entry_index(entries, fb, 'divisions')
+                why = ''
+                if (k > 0) then
+                    if (.not. entries(k)%bad) why = box_size_problem(b%divisions, b%element)
+                end if
+                if (len(why) > 0) call value_error(errors, entries, fb, 'divisions', why)
+            end if
+            k = entry_index(entries, fb, 'fixed')
+            if (k > 0) then
+                if (.not. entries(k)%bad .and. any(b%fixed(1:min(size(b%fixed), &
+                    size(entries(k)%items))) == '')) call value_error(errors, entries, fb, &
+                    'fixed', 'node-set names must not be empty')
+            end if
+            if (has_entry(entries, fb, 'load') .and. len_trim(b%load_set) == 0) &
+                call value_error(errors, entries, fb, 'load', 'needs load_set (the node set &
+                &that carries it)')
+            if (has_entry(entries, fb, 'load_set') .and. .not. has_entry(entries, fb, 'load')) &
+                call value_error(errors, entries, fb, 'load_set', 'needs load = fx, fy, fz &
+                &(the total force in N)')
+            if (size(scene%materials) == 0) call errors%add('&flexible_body: needs a &material &
+                &group (youngs_modulus, density, ...)', b%line)
+        end associate
+        do i = 1, size(scene%materials)
+            associate (m => scene%materials(i))
+                if (.not. has_entry(entries, mat, 'youngs_modulus', i)) call required_error( &
+                    errors, mat, 'youngs_modulus', 'Young''s modulus E in Pa', m%name, m%line)
+                if (.not. has_entry(entries, mat, 'density', i)) call required_error(errors, &
+                    mat, 'density', 'the mass density in kg/m^3', m%name, m%line)
+                if (has_entry(entries, mat, 'elements', i) .and. len_trim(m%elements) == 0) &
+                    call value_error(errors, entries, mat, 'elements', 'must name an element &
+                    &set (leave it out for the elements no other material names)', i)
+                call check_unique(i)
+            end associate
+        end do
+
+    contains
+
+        !> Material i's name and element set differ from the earlier ones'.
+        subroutine check_unique(i)
+            integer, intent(in) :: i
+            integer :: j
+            associate (m => scene%materials(i))
+                do j = 1, i - 1
+                    if (scene%materials(j)%name == m%name) then
+                        call value_error(errors, entries, mat, 'name', 'also the name of the &
+                            &&material' // at_line(scene%materials(j)%line), i)
+                    else if (scene%materials(j)%elements == m%elements .and. &
+                             len_trim(m%elements) > 0) then
+                        call value_error(errors, entries, mat, 'elements', 'the same set as &
+                            &&material ''' // trim(scene%materials(j)%name) // '''' // &
+                            at_line(scene%materials(j)%line), i)
+                    else if (scene%materials(j)%elements == m%elements) then
+                        call errors%add('&material ''' // trim(m%name) // ''': elements: not &
+                            &given here nor in &material ''' // trim(scene%materials(j)%name) &
+                            // ''': only one material may cover the elements no other names', &
+                            m%line)
+                    end if
+                end do
+            end associate
+        end subroutine check_unique
+    end subroutine check_body
+
+
+    !> Why a box mesh of `divisions` elements of type `element` cannot be
+    !> made here, or '': its node and element counts must fit the default
+    !> integers that number them, and a lower estimate of the memory the run
+    !> needs (the tangent pattern: per node 3 rows of 81 (hex8) or 375
+    !> (hex27) entries of about 40 bytes each, values, damping, index and
+    !> maps) must fit the machine. Counted in 64 bits: 2000³ elements
+    !> overflow a default integer.
+    function box_size_problem(divisions, element) result(why)
+        integer, intent(in) :: divisions(3)
+        character(len=*), intent(in) :: element
+        character(len=:), allocatable :: why
+        integer(i8) :: nodes, elements, p, machine
+        real(wp) :: bytes, per_node
+        why = ''
+        if (any(divisions < 1)) return
+        p = merge(1_i8, 2_i8, element == 'hex8')
+        per_node = merge(3.0_wp * 81.0_wp, 3.0_wp * 375.0_wp, element == 'hex8') * 40.0_wp
+        nodes = product(p * int(divisions, i8) + 1_i8)
+        elements = product(int(divisions, i8))
+        bytes = real(nodes, wp) * per_node
+        if (3_i8 * nodes > int(huge(1), i8) .or. elements > int(huge(1), i8)) then
+            why = real_text(real(nodes, wp)) // ' nodes (' // real_text(3.0_wp * real(nodes, &
+                wp)) // ' coordinates) and ' // real_text(real(elements, wp)) // &
+                ' elements: more than the ' // int_text(huge(1)) // ' a mesh can number'
+            return
+        end if
+        machine = physical_memory()
+        if (machine > 0 .and. bytes > real(machine, wp)) why = real_text(real(nodes, wp)) // &
+            ' nodes, needs at least ~' // bytes_text(bytes) // '; this machine has ' // &
+            bytes_text(real(machine, wp))
+    end function box_size_problem
+end module flexmbs_io_body_checks

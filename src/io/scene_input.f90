@@ -1,0 +1,190 @@
+!> What a scene file says, typed: one derived type per group, filled by
+!> flexmbs_io_scene_reader with the file's values and the schema's
+!> defaults (flexmbs_io_scene_schema) for the rest.
+module flexmbs_io_scene_input
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_io_scene_schema, only: len_title, len_name, len_path, max_fixed_sets
+    implicit none
+    private
+
+    !> One `&material`: the paper's neo-Hookean law with damping, on an
+    !> element set of the body's mesh.
+    type, public :: material_input_t
+        character(len=len_name) :: name !! for messages ('' = 'material N')
+        real(wp) :: youngs_modulus !! E [Pa], required, > 0
+        real(wp) :: poisson_ratio !! ν, in (−1, 0.5)
+        real(wp) :: density !! ρ [kg/m³], required, > 0
+        real(wp) :: viscosity !! η [Pa·s], ≥ 0 (0: undamped)
+        !> element set it covers; '' = every element no other material names
+        character(len=len_name) :: elements
+        integer :: line = 0                      !! where the group starts
+    end type material_input_t
+
+    !> The `&flexible_body` group: mesh, supports, loads, initial velocity.
+    type, public :: body_input_t
+        character(len=len_name) :: name
+        character(len=len_name) :: element !! 'hex8' | 'hex27'
+        character(len=len_path) :: mesh_file !! '' = a box mesh
+        integer :: divisions(3) !! box: elements per direction
+        real(wp) :: lengths(3) !! box: edge lengths [m], required
+        real(wp) :: origin(3) !! box: lower corner [m]
+        character(len=len_name) :: fixed(max_fixed_sets) !! node sets held at X
+        character(len=len_name) :: load_set !! node set carrying `load`
+        real(wp) :: load(3) !! total force on load_set [N]
+        real(wp) :: gravity(3) !! [m/s²]
+        real(wp) :: initial_velocity(3) !! [m/s], rigid field
+        real(wp) :: initial_angular_velocity(3) !! [rad/s] about the centroid
+        character(len=len_name) :: formulation
+        integer :: line = 0                               !! where the group starts
+    end type body_input_t
+
+    !> The `&multibody` group: how rigid bodies and joints are integrated.
+    type, public :: multibody_input_t
+        character(len=len_name) :: formulation
+        real(wp) :: gravity(3) !! [m/s²]
+        character(len=len_name) :: constraint_derivatives
+        logical :: projection !! coordinate projection after each step
+        !> largest move of a body by the consistent initial assembly [m]
+        real(wp) :: assembly_tolerance
+        integer :: line = 0
+    end type multibody_input_t
+
+    !> One `&rigid_body`: mass, inertia about the centre of mass (body
+    !> frame), initial pose and velocities (world).
+    type, public :: rigid_body_input_t
+        character(len=len_name) :: name
+        real(wp) :: mass !! [kg], required
+        real(wp) :: inertia(3) !! Jxx, Jyy, Jzz [kg m²], required
+        real(wp) :: inertia_products(3) !! Jxy, Jyz, Jxz
+        real(wp) :: position(3) !! centre of mass [m]
+        real(wp) :: rotation_axis(3)
+        real(wp) :: rotation_angle !! [rad]
+        real(wp) :: velocity(3) !! [m/s]
+        real(wp) :: angular_velocity(3) !! [rad/s], world frame
+        integer :: line = 0
+    end type rigid_body_input_t
+
+    !> One `&marker`: a frame on a rigid body or the ground.
+    type, public :: marker_input_t
+        character(len=len_name) :: name
+        character(len=len_name) :: body
+        real(wp) :: position(3) !! in the body's frame [m]
+        real(wp) :: z_axis(3)
+        real(wp) :: x_axis(3) !! 0: any normal to z
+        character(len=len_name) :: node_set !! on the flexible body: its nodes
+        logical :: position_given = .false.         !! (node-set markers default to the centroid)
+        integer :: line = 0
+    end type marker_input_t
+
+    !> One `&joint` between two markers.
+    type, public :: joint_input_t
+        character(len=len_name) :: name
+        character(len=len_name) :: type
+        character(len=len_name) :: marker_i, marker_j
+        integer :: line = 0
+    end type joint_input_t
+
+
+    !> One `&driver`: an angle, translation or distance following s(t).
+    type, public :: driver_input_t
+        character(len=len_name) :: name
+        character(len=len_name) :: type !! 'angle' | 'translation' | 'distance'
+        character(len=len_name) :: marker_i, marker_j
+        integer :: axis_i, axis_j
+        real(wp) :: coefficients(4) !! s = c0 + c1 t + c2 t² + c3 t³
+        real(wp) :: amplitude !! + a sin(ω t + φ)
+        real(wp) :: frequency !! ω [rad/s]
+        real(wp) :: phase !! φ [rad]
+        integer :: line = 0
+    end type driver_input_t
+
+    !> One `&rigid_chain` group: a body of a loop-free chain in relative
+    !> coordinates and the joint to its parent (flexmbs_mbs_rigid_chain).
+    type, public :: chain_body_input_t
+        character(len=len_name) :: name
+        character(len=len_name) :: parent !! 'ground' or an earlier body
+        character(len=len_name) :: joint !! 'revolute' | 'prismatic'
+        real(wp) :: joint_position(3) !! in the parent's frame [m]
+        real(wp) :: joint_axis(3) !! parent's frame
+        real(wp) :: centre(3) !! centre of mass, own frame [m]
+        real(wp) :: mass !! [kg], required
+        real(wp) :: inertia(3) !! about the centre of mass, required
+        real(wp) :: inertia_products(3)
+        real(wp) :: coordinate !! initial q [rad or m]
+        real(wp) :: rate !! initial q' [rad/s or m/s]
+        !> spherical: initial relative rotation and angular velocity (own frame)
+        real(wp) :: rotation_axis(3)
+        real(wp) :: rotation_angle
+        real(wp) :: angular_rate(3)
+        integer :: line = 0
+    end type chain_body_input_t
+
+    !> Everything a scene file says, with defaults for what it leaves out.
+    type, public :: scene_input_t
+        character(len=:), allocatable :: path !! the file read
+        character(len=:), allocatable :: text !! its full text (stored in the HDF5 file)
+        ! &simulation
+        character(len=len_title) :: title
+        character(len=len_name) :: problem
+        real(wp) :: t_start !! s
+        real(wp) :: t_end !! s, required, > t_start
+        real(wp) :: vdp_eps
+        real(wp) :: vdp_y1
+        real(wp) :: vdp_y2
+        character(len=len_name) :: pendulum_formulation
+        real(wp) :: pendulum_length !! m
+        real(wp) :: pendulum_mass !! kg
+        real(wp) :: pendulum_angle !! rad from the downward vertical, at rest
+        logical :: pendulum_projection !! project onto both constraints
+        real(wp) :: gravity !! m/s²
+        integer :: npoints !! grid points per direction (Brusselator)
+        ! &solver
+        character(len=len_name) :: solver_name
+        real(wp) :: rtol
+        real(wp) :: atol
+        real(wp) :: h0 !! s, 0 = automatic
+        real(wp) :: hmax !! s, 0 = |t_end - t_start|
+        integer :: max_steps
+        character(len=len_name) :: linear_solver
+        character(len=len_name) :: sparse_ordering !! KLU: 'auto' | 'amd' | 'nd'
+        character(len=len_name) :: jacobian
+        integer :: nit
+        real(wp) :: thet
+        real(wp) :: fnewt !! 0 = the solver's default
+        real(wp) :: quot1
+        real(wp) :: quot2
+        real(wp) :: safe
+        real(wp) :: fac_min
+        real(wp) :: fac_max
+        character(len=len_name) :: controller
+        logical :: zero_start
+        integer :: pmax
+        logical :: initial_derivative !! DDASSL: y' by DDAINI
+        logical :: exclude_index23 !! DDASSL: index-2/3 out of the error test
+        logical :: netlib !! DDASSL: later netlib revision
+        integer :: max_extrapolation !! MEXAX: extrapolation columns (KDMAX), 2..12
+        character(len=len_name) :: mexax_base !! MEXAX: 'midpoint' | 'euler'
+        ! &output
+        !> HDF5 file; '' = none. Derived from the input name when not given.
+        character(len=:), allocatable :: output_file
+        integer :: n_output
+        logical :: every_step
+        character(len=len_path) :: table
+        logical :: progress
+        !> ParaView files PREFIX_NNNN.vtu and PREFIX.pvd ('' = none)
+        character(len=len_path) :: vtk
+        ! &flexible_body and &material
+        logical :: has_body = .false.                 !! a &flexible_body group was given
+        type(body_input_t) :: body
+        type(material_input_t), allocatable :: materials(:) !! in the order given
+        ! &multibody, &rigid_body, &marker, &joint, &driver
+        logical :: has_multibody = .false.
+        type(multibody_input_t) :: multibody
+        type(rigid_body_input_t), allocatable :: rigid_bodies(:)
+        type(marker_input_t), allocatable :: markers(:)
+        type(joint_input_t), allocatable :: joints(:)
+        type(driver_input_t), allocatable :: drivers(:)
+        ! &rigid_chain
+        type(chain_body_input_t), allocatable :: chain(:)
+    end type scene_input_t
+end module flexmbs_io_scene_input

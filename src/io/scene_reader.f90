@@ -1,0 +1,257 @@
+!> Filling scene_input_t from checked entries: every variable from its
+!> entry or, when not given (or given wrongly, already reported), from the
+!> schema's default. Names of repeated groups default to 'body N' etc.;
+!> choices are lower-cased (they compare case-insensitively).
+module flexmbs_io_scene_reader
+    use flexmbs_core_text, only: lower, int_text
+    use flexmbs_io_scene_schema, only: find_group
+    use flexmbs_io_scene_lexer, only: entry_t, span_t, has_entry
+    use flexmbs_io_scene_values, only: get
+    use flexmbs_io_scene_input, only: scene_input_t
+    implicit none
+    private
+
+    public :: read_entries
+
+contains
+
+    !> The scene's values; `spans` give the groups present and their lines.
+    subroutine read_entries(entries, spans, scene)
+        type(entry_t), intent(in) :: entries(:)
+        type(span_t), intent(in) :: spans(:)
+        type(scene_input_t), intent(inout) :: scene
+        integer :: i
+
+        call read_simulation(entries, scene)
+        call read_solver(entries, scene)
+        call read_output(entries, scene)
+        scene%has_body = any(spans%group == find_group('flexible_body'))
+        scene%has_multibody = any(spans%group == find_group('multibody'))
+        allocate (scene%materials(count(spans%group == find_group('material'))), &
+                  scene%rigid_bodies(count(spans%group == find_group('rigid_body'))), &
+                  scene%markers(count(spans%group == find_group('marker'))), &
+                  scene%joints(count(spans%group == find_group('joint'))), &
+                  scene%drivers(count(spans%group == find_group('driver'))), &
+                  scene%chain(count(spans%group == find_group('rigid_chain'))))
+        call read_body(entries, scene)
+        call read_multibody(entries, scene)
+        do i = 1, size(spans)
+            call set_line(scene, spans(i))
+        end do
+        if (scene%has_body .and. .not. has_entry(entries, 'simulation', 'problem')) &
+            scene%problem = 'flexible_body'
+        if (size(scene%rigid_bodies) > 0 .and. &
+            .not. has_entry(entries, 'simulation', 'problem')) scene%problem = 'multibody'
+    end subroutine read_entries
+
+    subroutine set_line(scene, span)
+        type(scene_input_t), intent(inout) :: scene
+        type(span_t), intent(in) :: span
+        if (span%group == find_group('flexible_body')) scene%body%line = span%line
+        if (span%group == find_group('multibody')) scene%multibody%line = span%line
+        if (span%group == find_group('material')) scene%materials(span%instance)%line = span%line
+        if (span%group == find_group('rigid_body')) &
+            scene%rigid_bodies(span%instance)%line = span%line
+        if (span%group == find_group('marker')) scene%markers(span%instance)%line = span%line
+        if (span%group == find_group('joint')) scene%joints(span%instance)%line = span%line
+        if (span%group == find_group('driver')) scene%drivers(span%instance)%line = span%line
+        if (span%group == find_group('rigid_chain')) scene%chain(span%instance)%line = span%line
+    end subroutine set_line
+
+    subroutine read_simulation(e, scene)
+        type(entry_t), intent(in) :: e(:)
+        type(scene_input_t), intent(inout) :: scene
+        character(len=*), parameter :: g = 'simulation'
+        call get(e, g, 'title', scene%title)
+        call get(e, g, 'problem', scene%problem)
+        scene%problem = lower(scene%problem)
+        call get(e, g, 't_start', scene%t_start)
+        call get(e, g, 't_end', scene%t_end)
+        call get(e, g, 'vdp_eps', scene%vdp_eps)
+        call get(e, g, 'vdp_y1', scene%vdp_y1)
+        call get(e, g, 'vdp_y2', scene%vdp_y2)
+        call get(e, g, 'pendulum_formulation', scene%pendulum_formulation)
+        scene%pendulum_formulation = lower(scene%pendulum_formulation)
+        call get(e, g, 'pendulum_length', scene%pendulum_length)
+        call get(e, g, 'pendulum_mass', scene%pendulum_mass)
+        call get(e, g, 'pendulum_angle', scene%pendulum_angle)
+        call get(e, g, 'pendulum_projection', scene%pendulum_projection)
+        call get(e, g, 'gravity', scene%gravity)
+        call get(e, g, 'npoints', scene%npoints)
+    end subroutine read_simulation
+
+    subroutine read_solver(e, scene)
+        type(entry_t), intent(in) :: e(:)
+        type(scene_input_t), intent(inout) :: scene
+        character(len=*), parameter :: g = 'solver'
+        call get(e, g, 'name', scene%solver_name)
+        scene%solver_name = lower(scene%solver_name)
+        call get(e, g, 'rtol', scene%rtol)
+        call get(e, g, 'atol', scene%atol)
+        call get(e, g, 'h0', scene%h0)
+        call get(e, g, 'hmax', scene%hmax)
+        call get(e, g, 'max_steps', scene%max_steps)
+        call get(e, g, 'linear_solver', scene%linear_solver)
+        scene%linear_solver = lower(scene%linear_solver)
+        call get(e, g, 'sparse_ordering', scene%sparse_ordering)
+        scene%sparse_ordering = lower(scene%sparse_ordering)
+        call get(e, g, 'jacobian', scene%jacobian)
+        scene%jacobian = lower(scene%jacobian)
+        call get(e, g, 'nit', scene%nit)
+        call get(e, g, 'thet', scene%thet)
+        call get(e, g, 'fnewt', scene%fnewt)
+        call get(e, g, 'quot1', scene%quot1)
+        call get(e, g, 'quot2', scene%quot2)
+        call get(e, g, 'safe', scene%safe)
+        call get(e, g, 'fac_min', scene%fac_min)
+        call get(e, g, 'fac_max', scene%fac_max)
+        call get(e, g, 'controller', scene%controller)
+        scene%controller = lower(scene%controller)
+        call get(e, g, 'zero_start', scene%zero_start)
+        call get(e, g, 'pmax', scene%pmax)
+        call get(e, g, 'initial_derivative', scene%initial_derivative)
+        call get(e, g, 'exclude_index23', scene%exclude_index23)
+        call get(e, g, 'netlib', scene%netlib)
+        call get(e, g, 'max_extrapolation', scene%max_extrapolation)
+        call get(e, g, 'mexax_base', scene%mexax_base)
+        scene%mexax_base = lower(scene%mexax_base)
+    end subroutine read_solver
+
+    !> `file` stays as written; resolving it is the checks' business.
+    subroutine read_output(e, scene)
+        type(entry_t), intent(in) :: e(:)
+        type(scene_input_t), intent(inout) :: scene
+        character(len=*), parameter :: g = 'output'
+        character(len=512) :: file
+        call get(e, g, 'file', file)
+        scene%output_file = trim(file)
+        call get(e, g, 'n_output', scene%n_output)
+        call get(e, g, 'every_step', scene%every_step)
+        call get(e, g, 'table', scene%table)
+        call get(e, g, 'progress', scene%progress)
+        call get(e, g, 'vtk', scene%vtk)
+    end subroutine read_output
+
+    subroutine read_body(e, scene)
+        type(entry_t), intent(in) :: e(:)
+        type(scene_input_t), intent(inout) :: scene
+        character(len=*), parameter :: g = 'flexible_body'
+        integer :: i
+        associate (b => scene%body)
+            call get(e, g, 'name', b%name)
+            call get(e, g, 'element', b%element)
+            b%element = lower(b%element)
+            call get(e, g, 'mesh_file', b%mesh_file)
+            call get(e, g, 'divisions', b%divisions)
+            call get(e, g, 'lengths', b%lengths)
+            call get(e, g, 'origin', b%origin)
+            call get(e, g, 'fixed', b%fixed)
+            call get(e, g, 'load_set', b%load_set)
+            call get(e, g, 'load', b%load)
+            call get(e, g, 'gravity', b%gravity)
+            call get(e, g, 'initial_velocity', b%initial_velocity)
+            call get(e, g, 'initial_angular_velocity', b%initial_angular_velocity)
+            call get(e, g, 'formulation', b%formulation)
+            b%formulation = lower(b%formulation)
+        end associate
+        do i = 1, size(scene%materials)
+            associate (m => scene%materials(i))
+                call get(e, 'material', 'name', m%name, i)
+                if (len_trim(m%name) == 0) m%name = 'material ' // int_text(i)
+                call get(e, 'material', 'youngs_modulus', m%youngs_modulus, i)
+                call get(e, 'material', 'poisson_ratio', m%poisson_ratio, i)
+                call get(e, 'material', 'density', m%density, i)
+                call get(e, 'material', 'viscosity', m%viscosity, i)
+                call get(e, 'material', 'elements', m%elements, i)
+            end associate
+        end do
+    end subroutine read_body
+
+    subroutine read_multibody(e, scene)
+        type(entry_t), intent(in) :: e(:)
+        type(scene_input_t), intent(inout) :: scene
+        integer :: i
+        associate (mb => scene%multibody)
+            call get(e, 'multibody', 'formulation', mb%formulation)
+            mb%formulation = lower(mb%formulation)
+            call get(e, 'multibody', 'gravity', mb%gravity)
+            call get(e, 'multibody', 'constraint_derivatives', mb%constraint_derivatives)
+            mb%constraint_derivatives = lower(mb%constraint_derivatives)
+            call get(e, 'multibody', 'projection', mb%projection)
+            call get(e, 'multibody', 'assembly_tolerance', mb%assembly_tolerance)
+        end associate
+        do i = 1, size(scene%rigid_bodies)
+            associate (b => scene%rigid_bodies(i))
+                call get(e, 'rigid_body', 'name', b%name, i)
+                if (len_trim(b%name) == 0) b%name = 'body ' // int_text(i)
+                call get(e, 'rigid_body', 'mass', b%mass, i)
+                call get(e, 'rigid_body', 'inertia', b%inertia, i)
+                call get(e, 'rigid_body', 'inertia_products', b%inertia_products, i)
+                call get(e, 'rigid_body', 'position', b%position, i)
+                call get(e, 'rigid_body', 'rotation_axis', b%rotation_axis, i)
+                call get(e, 'rigid_body', 'rotation_angle', b%rotation_angle, i)
+                call get(e, 'rigid_body', 'velocity', b%velocity, i)
+                call get(e, 'rigid_body', 'angular_velocity', b%angular_velocity, i)
+            end associate
+        end do
+        do i = 1, size(scene%markers)
+            associate (m => scene%markers(i))
+                call get(e, 'marker', 'name', m%name, i)
+                if (len_trim(m%name) == 0) m%name = 'marker ' // int_text(i)
+                call get(e, 'marker', 'body', m%body, i)
+                call get(e, 'marker', 'position', m%position, i)
+                m%position_given = has_entry(e, 'marker', 'position', i)
+                call get(e, 'marker', 'z_axis', m%z_axis, i)
+                call get(e, 'marker', 'x_axis', m%x_axis, i)
+                call get(e, 'marker', 'node_set', m%node_set, i)
+            end associate
+        end do
+        do i = 1, size(scene%joints)
+            associate (j => scene%joints(i))
+                call get(e, 'joint', 'name', j%name, i)
+                if (len_trim(j%name) == 0) j%name = 'joint ' // int_text(i)
+                call get(e, 'joint', 'type', j%type, i)
+                j%type = lower(j%type)
+                call get(e, 'joint', 'marker_i', j%marker_i, i)
+                call get(e, 'joint', 'marker_j', j%marker_j, i)
+            end associate
+        end do
+        do i = 1, size(scene%drivers)
+            associate (d => scene%drivers(i))
+                call get(e, 'driver', 'name', d%name, i)
+                if (len_trim(d%name) == 0) d%name = 'driver ' // int_text(i)
+                call get(e, 'driver', 'type', d%type, i)
+                d%type = lower(d%type)
+                call get(e, 'driver', 'marker_i', d%marker_i, i)
+                call get(e, 'driver', 'marker_j', d%marker_j, i)
+                call get(e, 'driver', 'axis_i', d%axis_i, i)
+                call get(e, 'driver', 'axis_j', d%axis_j, i)
+                call get(e, 'driver', 'coefficients', d%coefficients, i)
+                call get(e, 'driver', 'amplitude', d%amplitude, i)
+                call get(e, 'driver', 'frequency', d%frequency, i)
+                call get(e, 'driver', 'phase', d%phase, i)
+            end associate
+        end do
+        do i = 1, size(scene%chain)
+            associate (c => scene%chain(i))
+                call get(e, 'rigid_chain', 'name', c%name, i)
+                if (len_trim(c%name) == 0) c%name = 'link ' // int_text(i)
+                call get(e, 'rigid_chain', 'parent', c%parent, i)
+                call get(e, 'rigid_chain', 'joint', c%joint, i)
+                c%joint = lower(c%joint)
+                call get(e, 'rigid_chain', 'joint_position', c%joint_position, i)
+                call get(e, 'rigid_chain', 'joint_axis', c%joint_axis, i)
+                call get(e, 'rigid_chain', 'centre', c%centre, i)
+                call get(e, 'rigid_chain', 'mass', c%mass, i)
+                call get(e, 'rigid_chain', 'inertia', c%inertia, i)
+                call get(e, 'rigid_chain', 'inertia_products', c%inertia_products, i)
+                call get(e, 'rigid_chain', 'coordinate', c%coordinate, i)
+                call get(e, 'rigid_chain', 'rate', c%rate, i)
+                call get(e, 'rigid_chain', 'rotation_axis', c%rotation_axis, i)
+                call get(e, 'rigid_chain', 'rotation_angle', c%rotation_angle, i)
+                call get(e, 'rigid_chain', 'angular_rate', c%angular_rate, i)
+            end associate
+        end do
+    end subroutine read_multibody
+
+end module flexmbs_io_scene_reader
