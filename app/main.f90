@@ -237,6 +237,8 @@ contains
         end do
         if (n > max_printed) write (output_unit, '(a,i0,a)') '... (', n, &
             ' components; all of them are in the HDF5 file)'
+        if (allocated(result%assembly)) write (output_unit, '(a)') &
+            'initial assembly moved: ' // result%assembly
         if (result%has_drift .and. result%constraints > 0) then
             write (output_unit, '(a,2es11.3)') 'constraint drift at t_end: |g|, |G v + g_I|', &
                 result%drift_end

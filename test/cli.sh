@@ -320,5 +320,17 @@ else fail vtk-chain-links "$(head -c 300 out/chain_bodies_0001.vtu 2>/dev/null)"
 sed -e "s#^&output#\&output vtk = 'vdp',#" "$root/inputs/van_der_pol.nml" > vdp_vtk.nml
 bad vtk-no-bodies "&output: vtk: problem = 'van_der_pol' has no bodies to draw" vdp_vtk.nml
 
+# a rigid body placed off its joints: the initial assembly would move it
+# silently; beyond &multibody assembly_tolerance (1 mm) it is bad input
+sed -e "s/position = 0.371536305571885, /position = 0.401536305571885, /" \
+    -e "s/t_end *= *[0-9.]*/t_end = 0.01/" "$root/inputs/four_bar.nml" > off_joint.nml
+bad assembly-moves-body "the initial assembly moves rigid body 'rocker' by" off_joint.nml
+expect assembly-names-joint 2 "most violated at the given positions: &joint 'rocker" \
+    run off_joint.nml --quiet
+sed -e "s/^&multibody/\&multibody assembly_tolerance = 0.1,/" off_joint.nml > off_joint_ok.nml
+expect assembly-within-tolerance 0 "initial assembly moved: rigid body 'crank'" \
+    run off_joint_ok.nml --quiet
+expect assembly-reported 0 "rigid body 'rocker' 3.000000E-02 m" run off_joint_ok.nml --quiet
+
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

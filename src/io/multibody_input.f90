@@ -40,11 +40,13 @@ module flexmbs_io_multibody_input
 contains
 
     !> The system of the scene, q0 = (r, p) per body and v0 = (ṙ, ω′) per body.
-    subroutine build_multibody(scene, sys, q0, v0, status)
+    subroutine build_multibody(scene, sys, q0, v0, status, joint_labels)
         type(scene_input_t), intent(in) :: scene
         type(mbs_system_t), intent(out) :: sys
         real(wp), allocatable, intent(out) :: q0(:), v0(:)
         type(status_t), intent(out) :: status
+        !> per system joint, what the scene calls it ('&joint ''J''', ...)
+        character(len=:), allocatable, intent(out), optional :: joint_labels(:)
         type(rigid_body_t), allocatable :: bodies(:)
         type(marker_t), allocatable :: markers(:)
         type(mbs_joint_t), allocatable :: joints(:)
@@ -218,6 +220,7 @@ contains
             return
         end if
         call check_rank(scene, sys, q0, [character(len=80) :: labels, frame_labels], status)
+        if (present(joint_labels)) joint_labels = [character(len=80) :: labels, frame_labels]
 
     contains
 

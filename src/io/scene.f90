@@ -31,6 +31,7 @@ module flexmbs_io_scene
         formulation_index2, formulation_index3, formulation_ggl
     use flexmbs_io_namelist, only: scene_input_t, scene_dae_options, controller_code
     use flexmbs_io_multibody_input, only: build_multibody
+    use flexmbs_io_assembly_check, only: check_assembly
     use flexmbs_io_monitor_sink, only: monitor_sink_t
     use flexmbs_io_chain_input, only: build_rigid_chain
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
@@ -66,6 +67,8 @@ module flexmbs_io_scene
         logical :: has_drift = .false.
         real(wp) :: drift_end(2) = 0.0_wp
         integer :: constraints = 0
+        !> a multibody scene: how far the initial assembly moved each body
+        character(len=:), allocatable :: assembly
         !> the positions in y (block 'q'), all of y when there is none
         integer :: q_first = 0, q_last = 0
     end type run_result_t
@@ -81,13 +84,16 @@ contains
     !> its mechanical problem in `mechanical`, which the formulation in
     !> `problem` points to: it must stay in place while `problem` is used.
     !> Its y = (q, v, λ) is the layout MEXAX integrates.
-    subroutine build_problem(scene, problem, y0, blocks, status, mechanical)
+    subroutine build_problem(scene, problem, y0, blocks, status, mechanical, assembly)
         type(scene_input_t), intent(in) :: scene
         class(dae_problem_t), allocatable, intent(out) :: problem
         real(wp), allocatable, intent(out) :: y0(:)
         type(block_spec_t), allocatable, intent(out) :: blocks(:)
         type(status_t), intent(out) :: status
         class(mechanical_problem_t), allocatable, target, intent(inout), optional :: mechanical
+        !> a multibody scene: how far the initial assembly moved each body
+        character(len=:), allocatable, intent(out), optional :: assembly
+        character(len=:), allocatable :: labels(:), moves
         type(robertson_t) :: robertson
         type(pendulum_t) :: pendulum
         type(reaction_diffusion_t) :: bruss
@@ -165,7 +171,7 @@ contains
             massless = .false.
             select type (sys => mechanical)
             type is (mbs_system_t)
-                call build_multibody(scene, sys, q0, v0, status)
+                call build_multibody(scene, sys, q0, v0, status, labels)
                 massless = size(sys%frames) > 0
             end select
             if (.not. status%ok()) return
@@ -194,6 +200,13 @@ contains
                     &velocities): ' // status%text())
                 return
             end if
+            select type (sys => mechanical)
+            type is (mbs_system_t)
+                call check_assembly(scene, sys, labels, scene%t_start, q0, &
+                    y0(formulation%oq + 1:formulation%oq + formulation%nq), moves, status)
+                if (present(assembly)) assembly = moves
+            end select
+            if (.not. status%ok()) return
             blocks = [block_spec_t('q', formulation%oq + 1, formulation%oq + formulation%nq), &
                       block_spec_t('v', formulation%ov + 1, formulation%ov + formulation%nv)]
             if (formulation%nc > 0) blocks = [blocks, block_spec_t('lambda', &
@@ -348,7 +361,7 @@ contains
         character(len=:), allocatable :: outcome
         real(wp), allocatable :: y_start(:)
 
-        call build_problem(scene, problem, result%y, blocks, status, mechanical)
+        call build_problem(scene, problem, result%y, blocks, status, mechanical, result%assembly)
         if (.not. status%ok()) return
         result%q_first = 1
         result%q_last = size(result%y)
@@ -397,6 +410,9 @@ contains
             call h5%write_text('problem', trim(scene%problem), status)
             if (status%ok()) call h5%write_text('title', trim(scene%title), status)
             if (status%ok()) call h5%write_text('input_file', scene%path, status)
+            if (status%ok() .and. allocated(result%assembly)) call h5%write_text('assembly', &
+                'moves of the initial assembly from the given positions: ' // &
+                result%assembly, status)
             if (.not. status%ok()) return
             call sinks%attach(h5)
         end if
