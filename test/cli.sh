@@ -332,5 +332,27 @@ expect assembly-within-tolerance 0 "initial assembly moved: rigid body 'crank'" 
     run off_joint_ok.nml --quiet
 expect assembly-reported 0 "rigid body 'rocker' 3.000000E-02 m" run off_joint_ok.nml --quiet
 
+# inputs that are not regular files are refused at once (a FIFO used to
+# block for ever); a mesh declaring more nodes than it holds is refused
+# before anything is allocated (2e9 nodes died in an allocation)
+mkfifo fifo.nml
+check fifo-input 2 "fifo.nml: not a regular file" run fifo.nml --quiet
+if [ -n "$problem" ]; then fail fifo-input "$problem"; else pass fifo-input; fi
+mkdir -p folder.nml
+expect folder-input 2 "folder.nml: is a folder, not a file" run folder.nml --quiet
+printf '%s\n' "flexmbs-mesh 1" "nodes 2000000000" "1 0 0 0" > in/huge.mesh
+printf '%s\n' "&simulation problem = 'flexible_body', t_end = 0.01 /" \
+    "&flexible_body mesh_file = 'in/huge.mesh' /" \
+    "&material youngs_modulus = 7e5, density = 920 /" > huge_mesh.nml
+bad mesh-count-beyond-file "2000000000 nodes declared, but the file holds only" huge_mesh.nml
+
+# dense matrices beyond the machine's memory: refused before they are
+# allocated (they died in an allocation)
+printf '%s\n' "&simulation problem = 'flexible_body', t_end = 0.01 /" \
+    "&flexible_body lengths = 1, 1, 1, divisions = 30, 30, 30 /" \
+    "&material youngs_modulus = 7e5, density = 920 /" \
+    "&solver linear_solver = 'dense' /" > dense_big.nml
+bad dense-beyond-memory "&solver: linear_solver = 'dense': " dense_big.nml
+
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

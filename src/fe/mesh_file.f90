@@ -72,6 +72,8 @@ contains
             call fail('node count must be positive')
             return
         end if
+        ! counts beyond what the text can hold are refused before allocating
+        if (.not. fits(nnode, 4, 'nodes')) return
         allocate (work%x(3, nnode))
         do i = 1, nnode
             call next_int(id, 'node id')
@@ -106,6 +108,7 @@ contains
             call fail('element count must be positive')
             return
         end if
+        if (.not. fits(nelem, work%nnode_element + 1, 'elements')) return
         allocate (work%connectivity(work%nnode_element, nelem))
         allocate (work%node_sets(0), work%element_sets(0))
         do i = 1, nelem
@@ -175,6 +178,7 @@ contains
                 return
             end if
             set%name = name
+            if (.not. fits(nset, 1, 'set members')) return
             allocate (set%nodes(nset))
             do j = 1, nset
                 call next_int(set%nodes(j), 'node id of set ''' // name // '''')
@@ -198,6 +202,7 @@ contains
                 return
             end if
             set%name = name
+            if (.not. fits(nset, 1, 'set members')) return
             allocate (set%elements(nset))
             do j = 1, nset
                 call next_int(set%elements(j), 'element id of set ''' // name // '''')
@@ -210,6 +215,18 @@ contains
             end do
             work%element_sets = [work%element_sets, set]
         end subroutine read_element_set
+
+        !> Whether `count` items of `per_item` values each fit in the values
+        !> the file has left; bad input (before any allocation) if not, so
+        !> that a declared count of 2e9 cannot exhaust the memory.
+        logical function fits(count, per_item, what)
+            integer, intent(in) :: count, per_item
+            character(len=*), intent(in) :: what
+            fits = count <= (tok%n - pos) / per_item
+            if (.not. fits) call fail(int_text(count) // ' ' // what // ' declared, but the &
+                &file holds only ' // int_text(tok%n - pos) // ' more values (' // &
+                int_text(per_item) // ' per item)')
+        end function fits
 
         !> Bad input at the current token's line (the last line at the end).
         subroutine fail(reason)

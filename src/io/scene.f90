@@ -4,9 +4,11 @@
 !> Everything that can be checked is checked before any output file is
 !> created, so bad input never leaves a half-written file behind.
 module flexmbs_io_scene
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_files, only: same_file
+    use flexmbs_core_text, only: real_text
+    use flexmbs_core_resources, only: physical_memory, bytes_text
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_options, only: dae_options_t
@@ -152,6 +154,8 @@ contains
                 call build_flexible_body(scene, body, q0, v0, status)
             end select
             if (.not. status%ok()) return
+            call check_dense_size(scene, mechanical, status)
+            if (.not. status%ok()) return
             ! M is constant in absolute nodal coordinates: y = (q, v[, λ]).
             formulation = new_formulation(mechanical, &
                 mechanical_formulation(scene%body%formulation), q0, constant_mass=.true., &
@@ -174,6 +178,8 @@ contains
                 call build_multibody(scene, sys, q0, v0, status, labels)
                 massless = size(sys%frames) > 0
             end select
+            if (.not. status%ok()) return
+            call check_dense_size(scene, mechanical, status)
             if (.not. status%ok()) return
             ! Rigid and flexible bodies have a constant M (body-fixed ω'):
             ! y = (q, v, λ[, μ]); a chain's M(q) and the zero M of node frames
@@ -254,6 +260,26 @@ contains
                 trim(scene%problem) // ''': not available in this build')
         end select
     end subroutine build_problem
+
+    !> With linear_solver = 'dense' the formulation and the solvers hold a
+    !> few n x n matrices (the Jacobian, the mass matrix, the iteration
+    !> matrix and its factors: counted as 6); beyond the machine's memory
+    !> that is bad input, named before anything is allocated.
+    subroutine check_dense_size(scene, mechanical, status)
+        type(scene_input_t), intent(in) :: scene
+        class(mechanical_problem_t), intent(in) :: mechanical
+        type(status_t), intent(inout) :: status
+        real(wp) :: n, bytes
+        integer(i8) :: machine
+        if (scene%linear_solver /= 'dense') return
+        n = real(mechanical%nq, wp) + real(mechanical%nv, wp) + 2.0_wp * real(mechanical%nc, wp)
+        bytes = 6.0_wp * 8.0_wp * n**2
+        machine = physical_memory()
+        if (machine > 0 .and. bytes > real(machine, wp)) call status%set(status_bad_input, &
+            scene%path // ': &solver: linear_solver = ''dense'': ' // real_text(n) // &
+            ' unknowns need ~' // bytes_text(bytes) // ' of dense matrices; this machine has ' &
+            // bytes_text(real(machine, wp)) // ' (''auto'', ''klu'' or ''mumps'' are sparse)')
+    end subroutine check_dense_size
 
     pure integer function formulation_code(name)
         character(len=*), intent(in) :: name
