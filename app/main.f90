@@ -8,13 +8,17 @@
 !>   flexmbs --help | --version
 !>
 !> Exit codes: 0 success, 2 bad input (nothing written), 3 solver failure
-!> (outputs kept), 4 I/O error. Only this program decides exit codes.
+!> (outputs kept), 4 I/O error, 130 / 143 stopped by SIGINT / SIGTERM
+!> (outputs flushed and closed). Only this program decides exit codes.
 program flexmbs_main
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_text, only: int_text
     use flexmbs_core_status, only: status_t, status_ok, status_bad_input, &
-        status_solver_failure, status_io_error, status_interrupted, reason_name, reason_none
+        status_solver_failure, status_io_error, status_interrupted, status_signal, &
+        reason_name, reason_none
+    use flexmbs_core_signals, only: install_signals, caught_signal
+    use flexmbs_core_version, only: version
     use flexmbs_io_namelist, only: scene_input_t, read_scene
     use flexmbs_io_scene, only: run_result_t, run_scene
     use flexmbs_io_namelist, only: study_input_t, read_study
@@ -23,8 +27,10 @@ program flexmbs_main
     use flexmbs_io_table, only: layout_text, table_markdown, stats_row_t
     implicit none
 
-    character(len=*), parameter :: version = '0.1.0'
     integer, parameter :: exit_ok = 0, exit_bad_input = 2, exit_solver = 3, exit_io = 4
+    !> A run stopped by a signal exits with this plus the signal's number
+    !> (the shell's convention: 130 for SIGINT, 143 for SIGTERM).
+    integer, parameter :: exit_signal_base = 128
     !> Largest state printed whole; larger ones are summarised.
     integer, parameter :: max_printed = 12
 
@@ -81,6 +87,10 @@ program flexmbs_main
                 file = arg
             end if
         end do
+        ! SIGINT and SIGTERM stop a run after its current step (core/signals);
+        ! a parallel sweep's point catches them although its shell ignores them
+        if (.not. install_signals(even_if_ignored=point > 0)) write (error_unit, '(a)') &
+            'flexmbs: warning: SIGINT and SIGTERM cannot be caught: they end the run at once'
         select case (command)
         case ('run')
             if (len(file) == 0) call fail_usage('run needs a scene file')
@@ -121,12 +131,17 @@ contains
             if (len_trim(scene%title) > 0) write (output_unit, '(a)') trim(scene%title)
             call report(result, scene)
             call finish(exit_ok)
-        case (status_solver_failure, status_interrupted)
-            write (error_unit, '(a)') 'flexmbs: ' // failure_text(status)
+        case (status_solver_failure, status_interrupted, status_signal)
+            if (status%code == status_signal) then
+                write (error_unit, '(a)') 'flexmbs: ' // status%text()
+            else
+                write (error_unit, '(a)') 'flexmbs: ' // failure_text(status)
+            end if
             write (error_unit, '(a,es23.15)') 'flexmbs: time reached t =', result%t
             write (error_unit, '(a)') 'flexmbs: statistics so far: ' // result%stats%summary()
             if (result%hdf5_written) write (error_unit, '(a)') &
                 'flexmbs: trajectory up to there kept in ' // scene%output_file
+            if (status%code == status_signal) call finish(signal_exit(status))
             call finish(exit_solver)
         case default
             call stop_on(status)
@@ -269,10 +284,24 @@ contains
             call finish(exit_bad_input)
         case (status_io_error)
             call finish(exit_io)
+        case (status_signal)
+            call finish(signal_exit(status))
         case default
             call finish(exit_solver)
         end select
     end subroutine stop_on
+
+    !> 128 + the number of the signal that stopped the run (the status's
+    !> reason; a sweep's processes may have caught it instead of this one).
+    integer function signal_exit(status)
+        type(status_t), intent(in) :: status
+        signal_exit = exit_solver
+        if (status%reason > 0) then
+            signal_exit = exit_signal_base + status%reason
+        else if (caught_signal() > 0) then
+            signal_exit = exit_signal_base + caught_signal()
+        end if
+    end function signal_exit
 
     subroutine fail_usage(message)
         character(len=*), intent(in) :: message
@@ -308,7 +337,9 @@ contains
             '--quiet turns the progress display on standard error off.', &
             '', &
             'exit codes: 0 success, 2 bad input (no output written),', &
-            '            3 solver failure (outputs kept), 4 I/O error'
+            '            3 solver failure (outputs kept), 4 I/O error,', &
+            '            130 / 143 stopped by SIGINT / SIGTERM after the current step', &
+            '            (outputs flushed and closed; a second signal ends it at once)'
     end subroutine usage
 
     function argument(i) result(value)

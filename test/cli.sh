@@ -9,21 +9,7 @@
 # Without an argument the debug build is used (built if needed). The last
 # line is `N passed, M failed`; the exit status is non-zero on failures.
 set -u
-root=$(cd "$(dirname "$0")/.." && pwd)
-if [ $# -ge 1 ]; then
-    exe=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
-else
-    # the Makefile's flags: other flags would make fpm rebuild everything
-    export FPM_FFLAGS=${FPM_FFLAGS:-"-I/usr/include/hdf5/serial -I/usr/include/sundials/fortran -I/usr/include -I/usr/include/mumps_seq"}
-    export FPM_CFLAGS=${FPM_CFLAGS:-"-I/usr/include/suitesparse"}
-    exe=$(cd "$root" && ${FPM:-fpm} run --profile debug --runner echo flexmbs 2>/dev/null | tail -n 1)
-    [ -n "$exe" ] && exe="$root/$exe"
-fi
-if [ -z "$exe" ] || [ ! -x "$exe" ]; then
-    echo "FAIL cli: no executable (got '$exe')"
-    echo "0 passed, 1 failed"
-    exit 1
-fi
+. "$(dirname "$0")/executable.sh" cli "$@"
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/flexmbs-cli.XXXXXX")
 trap 'rm -rf "$work"' EXIT

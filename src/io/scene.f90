@@ -5,7 +5,9 @@
 !> created, so bad input never leaves a half-written file behind.
 module flexmbs_io_scene
     use flexmbs_core_kinds, only: wp
-    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_status, only: status_t, status_bad_input, status_interrupted, status_signal
+    use flexmbs_core_signals, only: signal_pending, caught_signal, signal_name
+    use flexmbs_core_text, only: real_text
     use flexmbs_core_files, only: same_file
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
@@ -39,6 +41,7 @@ module flexmbs_io_scene
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_progress, only: progress_t, new_progress
     use flexmbs_io_multi_sink, only: multi_sink_t
+    use flexmbs_io_signal_sink, only: signal_sink_t
     use flexmbs_io_table, only: new_stats_row, write_table
     use flexmbs_io_vtk_sink, only: vtk_sink_t
     implicit none
@@ -323,8 +326,9 @@ contains
 
     !> Run a validated scene: build, check, create the outputs, integrate,
     !> store the statistics. `status` is ok, bad_input (before any file is
-    !> created), solver_failure (outputs kept, `result` says how far it
-    !> got) or io_error.
+    !> created), solver_failure or signal (SIGINT/SIGTERM, checked after
+    !> every accepted step: outputs kept, `result` says how far it got) or
+    !> io_error.
     subroutine run_scene(scene, quiet, result, status, record)
         type(scene_input_t), intent(in) :: scene
         logical, intent(in) :: quiet             !! no progress display
@@ -342,6 +346,7 @@ contains
         class(linear_solver_t), allocatable :: linear_solver
         type(hdf5_sink_t), target :: h5
         type(progress_t), target :: progress
+        type(signal_sink_t), target :: signals
         type(multi_sink_t) :: sinks
         type(status_t) :: io_status
         integer :: i
@@ -411,6 +416,7 @@ contains
             call progress%watch(solver%native%nstep, solver%native%naccpt)
         end select
         call sinks%attach(progress)
+        call sinks%attach(signals)
         if (present(record)) call sinks%attach(record)
         if (len_trim(scene%vtk) > 0) call sinks%attach(vtk)
         ! drift and energy of formulated mechanical scenes, at the output times
@@ -435,6 +441,9 @@ contains
             call solver%integrate(problem, result%t, result%y, scene%t_end, options, &
                                   result%stats, status, sinks)
         end select
+        if (status%code == status_interrupted .and. signal_pending()) call status%set( &
+            status_signal, 'stopped by ' // signal_name(caught_signal()) // ' at t = ' // &
+            real_text(result%t), caught_signal())
         if (status%ok()) call record_energy(result%y, result%energy_end)
         result%has_energy = result%has_energy .and. status%ok()
 

@@ -21,7 +21,8 @@ module flexmbs_io_study
     use hdf5
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input, status_io_error, &
-        status_solver_failure
+        status_solver_failure, status_signal
+    use flexmbs_core_signals, only: signal_pending, caught_signal, signal_name, signal_number
     use flexmbs_core_text, only: int_text, real_text
     use flexmbs_core_files, only: same_file
     use flexmbs_dae_error_measure, only: paper_error
@@ -330,10 +331,19 @@ contains
         allocate (runs(size(points)))
         if (njobs > 1 .and. present(exe)) then
             call run_in_processes(study, exe, njobs, runs, status)
-            if (.not. status%ok()) return
+            if (.not. status%ok()) then
+                deallocate (runs) ! none complete: what there is stays in the points' files
+                return
+            end if
         else
             do k = 1, size(points)
                 runs(k) = point_run(base, points(k), t_ref, y_ref, quiet)
+                if (signal_pending()) then
+                    ! the runs so far, the interrupted one last; no table
+                    runs = runs(1:k)
+                    call stopped(int_text(k) // ' of ' // int_text(size(points)) // ' runs')
+                    return
+                end if
             end do
         end if
         if (study%cpu_reference <= size(runs)) then
@@ -343,6 +353,15 @@ contains
         rows = runs%row
         if (len(study%table) > 0) call write_table(study%table, rows, status, &
                                                    trim(study%layout))
+
+    contains
+
+        subroutine stopped(done)
+            character(len=*), intent(in) :: done
+            call status%set(status_signal, study%path // ': stopped by ' // &
+                signal_name(caught_signal()) // ' after ' // done // '; no table written', &
+                caught_signal())
+        end subroutine stopped
     end subroutine run_sweep
 
     !> What every sweep starts from: the study's scene with the sweep's step
@@ -379,6 +398,8 @@ contains
             return
         end if
         line = record_line(point_run(base, points(k), t_ref, y_ref, .true.))
+        if (signal_pending()) call status%set(status_signal, study%path // ': point ' // &
+            int_text(k) // ': stopped by ' // signal_name(caught_signal()), caught_signal())
     end subroutine run_sweep_point
 
     !> The points in processes: each writes its record to a file of a
@@ -390,14 +411,28 @@ contains
         type(sweep_run_t), intent(inout) :: runs(:)
         type(status_t), intent(inout) :: status
         character(len=:), allocatable :: dir, command, text
-        integer :: k, stat, unit, ios
+        integer :: k, stat, unit, ios, signo
         character(len=4096) :: buffer
         dir = study%reference_file // '.sweep'
-        command = 'rm -rf "' // dir // '" && mkdir -p "' // dir // '" && seq 1 ' // &
-            int_text(size(runs)) // ' | xargs -P ' // int_text(jobs) // &
-            ' -I{} sh -c ''"$0" sweep "$1" --point {} > "$2/{}.txt" 2>&1'' "' // exe // &
-            '" "' // study%path // '" "' // dir // '"'
+        ! SIGINT (Ctrl-C: the whole process group) and SIGTERM stop the running
+        ! points after their step (they catch the signals that the shell and
+        ! xargs ignore, so that these wait for them); a point so stopped
+        ! leaves the file 'stopped', and no later point starts.
+        command = 'rm -rf "' // dir // '" && mkdir -p "' // dir // '" && trap '''' INT TERM' // &
+            ' && seq 1 ' // int_text(size(runs)) // ' | xargs -P ' // int_text(jobs) // &
+            ' -I{} sh -c ''[ -e "$2/stopped" ] && exit 0; "$0" sweep "$1" --point {} > ' // &
+            '"$2/{}.txt" 2>&1; rc=$?; [ $rc -gt 128 ] && : > "$2/stopped"; exit $rc'' "' // &
+            exe // '" "' // study%path // '" "' // dir // '"'
         call execute_command_line(command, exitstat=stat)
+        ! This process ignores SIGINT until the command returns (system(3)):
+        ! the points say whether they were stopped.
+        signo = caught_signal()
+        if (signo == 0) signo = points_signal()
+        if (signo > 0) then
+            call status%set(status_signal, study%path // ': stopped by ' // &
+                signal_name(signo) // ': the sweep''s processes ended; no table written', signo)
+            return
+        end if
         if (stat /= 0) then
             call status%set(status_io_error, study%path // ': the sweep processes failed ' // &
                 '(exit ' // int_text(stat) // '): ' // command)
@@ -424,6 +459,30 @@ contains
             if (.not. status%ok()) return
         end do
         call execute_command_line('rm -rf "' // dir // '"')
+
+    contains
+
+        !> The signal that a point reports it was stopped by ('... stopped by
+        !> SIGINT' in its file), 0 when none was.
+        integer function points_signal() result(signo)
+            integer :: j, at, unit, ios
+            signo = 0
+            do j = 1, size(runs)
+                open (newunit=unit, file=dir // '/' // int_text(j) // '.txt', action='read', &
+                      iostat=ios)
+                if (ios /= 0) cycle
+                do
+                    read (unit, '(a)', iostat=ios) buffer
+                    if (ios /= 0) exit
+                    at = index(buffer, ': stopped by ')
+                    if (at == 0) cycle
+                    signo = signal_number(trim(buffer(at + 13:)))
+                    if (signo > 0) exit
+                end do
+                close (unit)
+                if (signo > 0) return
+            end do
+        end function points_signal
     end subroutine run_in_processes
 
     !> One point of the grid against the reference.
