@@ -1,8 +1,8 @@
 !> The flexmbs command line.
 !>
-!>   flexmbs run FILE.nml [--quiet]          run a scene
-!>   flexmbs reference STUDY.nml [--quiet]   a study's reference solution
-!>   flexmbs sweep STUDY.nml [-j N] [--quiet]  a study's grid of runs against it
+!>   flexmbs run FILE.nml [--quiet] [--force]          run a scene
+!>   flexmbs reference STUDY.nml [--quiet] [--force]   a study's reference solution
+!>   flexmbs sweep STUDY.nml [-j N] [--quiet] [--force]  a study's grid of runs against it
 !>   (sweep --point K runs point K alone and prints its record: the child of -j)
 !>   flexmbs columns FILE.h5 K [K ...]           t and y(K) of a trajectory as text
 !>   flexmbs --help | --version
@@ -35,7 +35,7 @@ program flexmbs_main
     integer, parameter :: max_printed = 12
 
     character(len=:), allocatable :: command, file, arg, value
-    logical :: quiet
+    logical :: quiet, force
     integer :: i, nargs, jobs, point, ios
 
     nargs = command_argument_count()
@@ -53,6 +53,7 @@ program flexmbs_main
         call finish(exit_ok)
     case ('run', 'reference', 'sweep')
         quiet = .false.
+        force = .false.
         file = ''
         jobs = 1
         point = 0
@@ -62,6 +63,8 @@ program flexmbs_main
             arg = argument(i)
             if (arg == '--quiet' .or. arg == '-q') then
                 quiet = .true.
+            else if (arg == '--force') then
+                force = .true.
             else if (command == 'sweep' .and. (arg == '-j' .or. arg == '--point')) then
                 if (i == nargs) call fail_usage(arg // ' needs a number')
                 i = i + 1
@@ -94,16 +97,16 @@ program flexmbs_main
         select case (command)
         case ('run')
             if (len(file) == 0) call fail_usage('run needs a scene file')
-            call run(file, quiet)
+            call run(file, quiet, force)
         case ('reference')
             if (len(file) == 0) call fail_usage('reference needs a study file')
-            call reference(file, quiet)
+            call reference(file, quiet, force)
         case ('sweep')
             if (len(file) == 0) call fail_usage('sweep needs a study file')
             if (point > 0) then
                 call sweep_point(file, point)
             else
-                call sweep(file, quiet, jobs)
+                call sweep(file, quiet, jobs, force)
             end if
         end select
     case ('columns')
@@ -114,16 +117,16 @@ program flexmbs_main
 
 contains
 
-    subroutine run(path, quiet)
+    subroutine run(path, quiet, force)
         character(len=*), intent(in) :: path
-        logical, intent(in) :: quiet
+        logical, intent(in) :: quiet, force
         type(scene_input_t) :: scene
         type(run_result_t) :: result
         type(status_t) :: status
 
         call read_scene(path, scene, status)
         if (.not. status%ok()) call stop_on(status)
-        call run_scene(scene, quiet, result, status)
+        call run_scene(scene, quiet, result, status, force=force)
         select case (status%code)
         case (status_ok)
             if (allocated(result%stats%warning)) &
@@ -149,15 +152,15 @@ contains
     end subroutine run
 
     !> The reference solution of a study, cross-checked.
-    subroutine reference(path, quiet)
+    subroutine reference(path, quiet, force)
         character(len=*), intent(in) :: path
-        logical, intent(in) :: quiet
+        logical, intent(in) :: quiet, force
         type(study_input_t) :: study
         type(status_t) :: status
         character(len=:), allocatable :: log
         call read_study(path, study, status)
         if (.not. status%ok()) call stop_on(status)
-        call make_reference(study, version, quiet, log, status)
+        call make_reference(study, version, quiet, log, status, force)
         if (.not. status%ok()) call stop_on(status)
         write (output_unit, '(a)', advance='no') log
         call finish(exit_ok)
@@ -165,9 +168,9 @@ contains
 
     !> A study's grid of runs against its reference: a line per run, then
     !> the table (also written to the study's table file, if named).
-    subroutine sweep(path, quiet, jobs)
+    subroutine sweep(path, quiet, jobs, force)
         character(len=*), intent(in) :: path
-        logical, intent(in) :: quiet
+        logical, intent(in) :: quiet, force
         integer, intent(in) :: jobs
         type(study_input_t) :: study
         type(status_t) :: status
@@ -176,7 +179,7 @@ contains
         integer :: k
         call read_study(path, study, status)
         if (.not. status%ok()) call stop_on(status)
-        call run_sweep(study, quiet, runs, status, jobs, argument(0))
+        call run_sweep(study, quiet, runs, status, jobs, argument(0), force)
         if (allocated(runs)) then
             do k = 1, size(runs)
                 write (output_unit, '(a)') runs(k)%summary
@@ -316,10 +319,12 @@ contains
             ' - flexible multibody dynamics and stiff DAE solvers', &
             '', &
             'usage:', &
-            '  flexmbs run FILE.nml [--quiet]          run the scene described by FILE.nml', &
-            '  flexmbs reference STUDY.nml [--quiet]   integrate the study''s scene at tight', &
+            '  flexmbs run FILE.nml [--quiet] [--force]', &
+            '                                          run the scene described by FILE.nml', &
+            '  flexmbs reference STUDY.nml [--quiet] [--force]', &
+            '                                          integrate the study''s scene at tight', &
             '                                          tolerance, cross-check, keep in HDF5', &
-            '  flexmbs sweep STUDY.nml [-j N] [--quiet]', &
+            '  flexmbs sweep STUDY.nml [-j N] [--quiet] [--force]', &
             '                                          run the study''s grid of solvers and', &
             '                                          tolerances, ERR against the reference;', &
             '                                          -j N: N processes at a time', &
@@ -335,6 +340,10 @@ contains
             '(see README.md for every variable, its type, unit and default).', &
             'STUDY.nml holds one &study group naming a scene file and the grid.', &
             '--quiet turns the progress display on standard error off.', &
+            'An output never replaces an input, and two outputs of a run are never one', &
+            'file. A file already at an output''s path is replaced only when it is', &
+            'flexmbs''s own of that kind (an HDF5 result, a ParaView file, a table);', &
+            '--force replaces anything else too.', &
             '', &
             'exit codes: 0 success, 2 bad input (no output written),', &
             '            3 solver failure (outputs kept), 4 I/O error,', &

@@ -8,7 +8,6 @@ module flexmbs_io_scene
     use flexmbs_core_status, only: status_t, status_bad_input, status_interrupted, status_signal
     use flexmbs_core_signals, only: signal_pending, caught_signal, signal_name
     use flexmbs_core_text, only: real_text
-    use flexmbs_core_files, only: same_file
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_options, only: dae_options_t
@@ -44,6 +43,8 @@ module flexmbs_io_scene
     use flexmbs_io_signal_sink, only: signal_sink_t
     use flexmbs_io_table, only: new_stats_row, write_table
     use flexmbs_io_vtk_sink, only: vtk_sink_t
+    use flexmbs_io_output_files, only: named_path_t, named_path, check_output_paths, &
+        output_hdf5, output_vtk, output_table
     implicit none
     private
 
@@ -329,13 +330,15 @@ contains
     !> created), solver_failure or signal (SIGINT/SIGTERM, checked after
     !> every accepted step: outputs kept, `result` says how far it got) or
     !> io_error.
-    subroutine run_scene(scene, quiet, result, status, record)
+    subroutine run_scene(scene, quiet, result, status, record, force)
         type(scene_input_t), intent(in) :: scene
         logical, intent(in) :: quiet             !! no progress display
         type(run_result_t), intent(out) :: result
         type(status_t), intent(out) :: status
         !> also given the solution at every output time
         class(sink_t), intent(inout), target, optional :: record
+        !> replace existing files that are not flexmbs's own (io/output_files)
+        logical, intent(in), optional :: force
         class(dae_problem_t), allocatable, target :: problem
         type(monitor_sink_t), target :: monitor
         type(vtk_sink_t), target :: vtk
@@ -379,14 +382,14 @@ contains
             return
         end if
 
-        ! no output may be one of the run's inputs; checked before any file is created
-        call check_outputs(scene, status)
-        if (.not. status%ok()) return
         ! ParaView output is checked before any file is created
         if (len_trim(scene%vtk) > 0) then
             call setup_vtk()
             if (.not. status%ok()) return
         end if
+        ! which files the run may write; checked before any file is created
+        call check_outputs(scene, vtk, size(options%output_times), force_given(), status)
+        if (.not. status%ok()) return
         if (len(scene%output_file) > 0) then
             call h5%create(scene%output_file, problem%n, status, input_text=scene%text, &
                            every_step=scene%every_step)
@@ -539,6 +542,11 @@ contains
                 lambda=result%y(nq + nv + 1:nq + nv + nc))
         end subroutine integrate_mechanical
 
+        logical function force_given()
+            force_given = .false.
+            if (present(force)) force_given = force
+        end function force_given
+
         !> Energies of a flexible body at y = (q, v, ...).
         subroutine record_energy(y, energies)
             real(wp), intent(in) :: y(:)
@@ -557,29 +565,42 @@ contains
         end subroutine record_energy
     end subroutine run_scene
 
-    !> No output of the run (the HDF5 file, the ParaView collection) may be
-    !> one of its inputs (the scene file, a mesh file), however the paths are
-    !> spelled: the input would be overwritten.
-    subroutine check_outputs(scene, status)
+    !> The run's outputs (the HDF5 file, the table, the ParaView collection
+    !> and the pieces of its `records` records) against its inputs (the
+    !> scene file, a mesh file) and each other, and what they would replace
+    !> (io/output_files).
+    subroutine check_outputs(scene, vtk, records, force, status)
         type(scene_input_t), intent(in) :: scene
+        type(vtk_sink_t), intent(in) :: vtk
+        integer, intent(in) :: records
+        logical, intent(in) :: force
         type(status_t), intent(inout) :: status
-        if (len(scene%output_file) > 0) call against_inputs('file', scene%output_file)
-        if (len_trim(scene%vtk) > 0) call against_inputs('vtk', trim(scene%vtk) // '.pvd')
+        type(named_path_t), allocatable :: outputs(:), inputs(:)
+        character(len=:), allocatable :: pieces(:)
+        integer :: n, k
+        allocate (inputs(merge(2, 1, len_trim(scene%body%mesh_file) > 0)))
+        inputs(1) = named_path(scene%path, 'the scene file itself')
+        if (size(inputs) > 1) inputs(2) = named_path(trim(scene%body%mesh_file), &
+            'the mesh file ''' // trim(scene%body%mesh_file) // '''')
+        allocate (character(len=0) :: pieces(0))
+        if (len_trim(scene%vtk) > 0) pieces = vtk%pieces(records)
+        allocate (outputs(3 + size(pieces)))
+        n = 0
+        if (len(scene%output_file) > 0) call add(scene%output_file, 'file', output_hdf5)
+        if (len_trim(scene%table) > 0) call add(trim(scene%table), 'table', output_table)
+        if (len_trim(scene%vtk) > 0) call add(trim(scene%vtk) // '.pvd', 'vtk', output_vtk)
+        do k = 1, size(pieces)
+            call add(trim(pieces(k)), 'vtk', output_vtk)
+            outputs(n)%series = .true.
+        end do
+        call check_output_paths(scene%path // ': ', outputs(1:n), inputs, force, status)
     contains
-        subroutine against_inputs(name, output)
-            character(len=*), intent(in) :: name, output
-            if (.not. status%ok()) return
-            if (same_file(output, scene%path)) then
-                call status%set(status_bad_input, scene%path // ': &output: ' // name // &
-                    ': ''' // output // ''' is the scene file itself: refused, it would be &
-                    &overwritten')
-            else if (len_trim(scene%body%mesh_file) > 0) then
-                if (same_file(output, trim(scene%body%mesh_file))) &
-                    call status%set(status_bad_input, scene%path // ': &output: ' // name // &
-                        ': ''' // output // ''' is the mesh file ''' // &
-                        trim(scene%body%mesh_file) // ''': refused, it would be overwritten')
-            end if
-        end subroutine against_inputs
+        subroutine add(path, name, kind)
+            character(len=*), intent(in) :: path, name
+            integer, intent(in) :: kind
+            n = n + 1
+            outputs(n) = named_path(path, '&output: ' // name, kind)
+        end subroutine add
     end subroutine check_outputs
 
     subroutine delete_file(path)
