@@ -1,20 +1,24 @@
 !> The flexmbs command line.
 !>
-!>   flexmbs run FILE.nml [--quiet]          run a scene
-!>   flexmbs reference STUDY.nml [--quiet]   a study's reference solution
-!>   flexmbs sweep STUDY.nml [-j N] [--quiet]  a study's grid of runs against it
+!>   flexmbs run FILE.nml [--quiet] [--force]          run a scene
+!>   flexmbs reference STUDY.nml [--quiet] [--force]   a study's reference solution
+!>   flexmbs sweep STUDY.nml [-j N] [--quiet] [--force]  a study's grid of runs against it
 !>   (sweep --point K runs point K alone and prints its record: the child of -j)
 !>   flexmbs columns FILE.h5 K [K ...]           t and y(K) of a trajectory as text
 !>   flexmbs --help | --version
 !>
 !> Exit codes: 0 success, 2 bad input (nothing written), 3 solver failure
-!> (outputs kept), 4 I/O error. Only this program decides exit codes.
+!> (outputs kept), 4 I/O error, 130 / 143 stopped by SIGINT / SIGTERM
+!> (outputs flushed and closed). Only this program decides exit codes.
 program flexmbs_main
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_text, only: int_text
     use flexmbs_core_status, only: status_t, status_ok, status_bad_input, &
-        status_solver_failure, status_io_error, status_interrupted, reason_name, reason_none
+        status_solver_failure, status_io_error, status_interrupted, status_signal, &
+        reason_name, reason_none
+    use flexmbs_core_signals, only: install_signals, caught_signal
+    use flexmbs_core_version, only: version
     use flexmbs_io_namelist, only: scene_input_t, read_scene
     use flexmbs_io_scene, only: run_result_t, run_scene
     use flexmbs_io_namelist, only: study_input_t, read_study
@@ -23,13 +27,15 @@ program flexmbs_main
     use flexmbs_io_table, only: layout_text, table_markdown, stats_row_t
     implicit none
 
-    character(len=*), parameter :: version = '0.1.0'
     integer, parameter :: exit_ok = 0, exit_bad_input = 2, exit_solver = 3, exit_io = 4
+    !> A run stopped by a signal exits with this plus the signal's number
+    !> (the shell's convention: 130 for SIGINT, 143 for SIGTERM).
+    integer, parameter :: exit_signal_base = 128
     !> Largest state printed whole; larger ones are summarised.
     integer, parameter :: max_printed = 12
 
     character(len=:), allocatable :: command, file, arg, value
-    logical :: quiet
+    logical :: quiet, force
     integer :: i, nargs, jobs, point, ios
 
     nargs = command_argument_count()
@@ -47,6 +53,7 @@ program flexmbs_main
         call finish(exit_ok)
     case ('run', 'reference', 'sweep')
         quiet = .false.
+        force = .false.
         file = ''
         jobs = 1
         point = 0
@@ -56,6 +63,8 @@ program flexmbs_main
             arg = argument(i)
             if (arg == '--quiet' .or. arg == '-q') then
                 quiet = .true.
+            else if (arg == '--force') then
+                force = .true.
             else if (command == 'sweep' .and. (arg == '-j' .or. arg == '--point')) then
                 if (i == nargs) call fail_usage(arg // ' needs a number')
                 i = i + 1
@@ -81,19 +90,23 @@ program flexmbs_main
                 file = arg
             end if
         end do
+        ! SIGINT and SIGTERM stop a run after its current step (core/signals);
+        ! a parallel sweep's point catches them although its shell ignores them
+        if (.not. install_signals(even_if_ignored=point > 0)) write (error_unit, '(a)') &
+            'flexmbs: warning: SIGINT and SIGTERM cannot be caught: they end the run at once'
         select case (command)
         case ('run')
             if (len(file) == 0) call fail_usage('run needs a scene file')
-            call run(file, quiet)
+            call run(file, quiet, force)
         case ('reference')
             if (len(file) == 0) call fail_usage('reference needs a study file')
-            call reference(file, quiet)
+            call reference(file, quiet, force)
         case ('sweep')
             if (len(file) == 0) call fail_usage('sweep needs a study file')
             if (point > 0) then
                 call sweep_point(file, point)
             else
-                call sweep(file, quiet, jobs)
+                call sweep(file, quiet, jobs, force)
             end if
         end select
     case ('columns')
@@ -104,16 +117,16 @@ program flexmbs_main
 
 contains
 
-    subroutine run(path, quiet)
+    subroutine run(path, quiet, force)
         character(len=*), intent(in) :: path
-        logical, intent(in) :: quiet
+        logical, intent(in) :: quiet, force
         type(scene_input_t) :: scene
         type(run_result_t) :: result
         type(status_t) :: status
 
         call read_scene(path, scene, status)
         if (.not. status%ok()) call stop_on(status)
-        call run_scene(scene, quiet, result, status)
+        call run_scene(scene, quiet, result, status, force=force)
         select case (status%code)
         case (status_ok)
             if (allocated(result%stats%warning)) &
@@ -121,12 +134,17 @@ contains
             if (len_trim(scene%title) > 0) write (output_unit, '(a)') trim(scene%title)
             call report(result, scene)
             call finish(exit_ok)
-        case (status_solver_failure, status_interrupted)
-            write (error_unit, '(a)') 'flexmbs: ' // failure_text(status)
+        case (status_solver_failure, status_interrupted, status_signal)
+            if (status%code == status_signal) then
+                write (error_unit, '(a)') 'flexmbs: ' // status%text()
+            else
+                write (error_unit, '(a)') 'flexmbs: ' // failure_text(status)
+            end if
             write (error_unit, '(a,es23.15)') 'flexmbs: time reached t =', result%t
             write (error_unit, '(a)') 'flexmbs: statistics so far: ' // result%stats%summary()
             if (result%hdf5_written) write (error_unit, '(a)') &
                 'flexmbs: trajectory up to there kept in ' // scene%output_file
+            if (status%code == status_signal) call finish(signal_exit(status))
             call finish(exit_solver)
         case default
             call stop_on(status)
@@ -134,15 +152,15 @@ contains
     end subroutine run
 
     !> The reference solution of a study, cross-checked.
-    subroutine reference(path, quiet)
+    subroutine reference(path, quiet, force)
         character(len=*), intent(in) :: path
-        logical, intent(in) :: quiet
+        logical, intent(in) :: quiet, force
         type(study_input_t) :: study
         type(status_t) :: status
         character(len=:), allocatable :: log
         call read_study(path, study, status)
         if (.not. status%ok()) call stop_on(status)
-        call make_reference(study, version, quiet, log, status)
+        call make_reference(study, version, quiet, log, status, force)
         if (.not. status%ok()) call stop_on(status)
         write (output_unit, '(a)', advance='no') log
         call finish(exit_ok)
@@ -150,9 +168,9 @@ contains
 
     !> A study's grid of runs against its reference: a line per run, then
     !> the table (also written to the study's table file, if named).
-    subroutine sweep(path, quiet, jobs)
+    subroutine sweep(path, quiet, jobs, force)
         character(len=*), intent(in) :: path
-        logical, intent(in) :: quiet
+        logical, intent(in) :: quiet, force
         integer, intent(in) :: jobs
         type(study_input_t) :: study
         type(status_t) :: status
@@ -161,7 +179,7 @@ contains
         integer :: k
         call read_study(path, study, status)
         if (.not. status%ok()) call stop_on(status)
-        call run_sweep(study, quiet, runs, status, jobs, argument(0))
+        call run_sweep(study, quiet, runs, status, jobs, argument(0), force)
         if (allocated(runs)) then
             do k = 1, size(runs)
                 write (output_unit, '(a)') runs(k)%summary
@@ -271,10 +289,24 @@ contains
             call finish(exit_bad_input)
         case (status_io_error)
             call finish(exit_io)
+        case (status_signal)
+            call finish(signal_exit(status))
         case default
             call finish(exit_solver)
         end select
     end subroutine stop_on
+
+    !> 128 + the number of the signal that stopped the run (the status's
+    !> reason; a sweep's processes may have caught it instead of this one).
+    integer function signal_exit(status)
+        type(status_t), intent(in) :: status
+        signal_exit = exit_solver
+        if (status%reason > 0) then
+            signal_exit = exit_signal_base + status%reason
+        else if (caught_signal() > 0) then
+            signal_exit = exit_signal_base + caught_signal()
+        end if
+    end function signal_exit
 
     subroutine fail_usage(message)
         character(len=*), intent(in) :: message
@@ -289,10 +321,12 @@ contains
             ' - flexible multibody dynamics and stiff DAE solvers', &
             '', &
             'usage:', &
-            '  flexmbs run FILE.nml [--quiet]          run the scene described by FILE.nml', &
-            '  flexmbs reference STUDY.nml [--quiet]   integrate the study''s scene at tight', &
+            '  flexmbs run FILE.nml [--quiet] [--force]', &
+            '                                          run the scene described by FILE.nml', &
+            '  flexmbs reference STUDY.nml [--quiet] [--force]', &
+            '                                          integrate the study''s scene at tight', &
             '                                          tolerance, cross-check, keep in HDF5', &
-            '  flexmbs sweep STUDY.nml [-j N] [--quiet]', &
+            '  flexmbs sweep STUDY.nml [-j N] [--quiet] [--force]', &
             '                                          run the study''s grid of solvers and', &
             '                                          tolerances, ERR against the reference;', &
             '                                          -j N: N processes at a time', &
@@ -308,9 +342,15 @@ contains
             '(see README.md for every variable, its type, unit and default).', &
             'STUDY.nml holds one &study group naming a scene file and the grid.', &
             '--quiet turns the progress display on standard error off.', &
+            'An output never replaces an input, and two outputs of a run are never one', &
+            'file. A file already at an output''s path is replaced only when it is', &
+            'flexmbs''s own of that kind (an HDF5 result, a ParaView file, a table);', &
+            '--force replaces anything else too.', &
             '', &
             'exit codes: 0 success, 2 bad input (no output written),', &
-            '            3 solver failure (outputs kept), 4 I/O error'
+            '            3 solver failure (outputs kept), 4 I/O error,', &
+            '            130 / 143 stopped by SIGINT / SIGTERM after the current step', &
+            '            (outputs flushed and closed; a second signal ends it at once)'
     end subroutine usage
 
     function argument(i) result(value)

@@ -9,21 +9,7 @@
 # Without an argument the debug build is used (built if needed). The last
 # line is `N passed, M failed`; the exit status is non-zero on failures.
 set -u
-root=$(cd "$(dirname "$0")/.." && pwd)
-if [ $# -ge 1 ]; then
-    exe=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
-else
-    # the Makefile's flags: other flags would make fpm rebuild everything
-    export FPM_FFLAGS=${FPM_FFLAGS:-"-I/usr/include/hdf5/serial -I/usr/include/sundials/fortran -I/usr/include -I/usr/include/mumps_seq"}
-    export FPM_CFLAGS=${FPM_CFLAGS:-"-I/usr/include/suitesparse"}
-    exe=$(cd "$root" && ${FPM:-fpm} run --profile debug --runner echo flexmbs 2>/dev/null | tail -n 1)
-    [ -n "$exe" ] && exe="$root/$exe"
-fi
-if [ -z "$exe" ] || [ ! -x "$exe" ]; then
-    echo "FAIL cli: no executable (got '$exe')"
-    echo "0 passed, 1 failed"
-    exit 1
-fi
+. "$(dirname "$0")/executable.sh" cli "$@"
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/flexmbs-cli.XXXXXX")
 trap 'rm -rf "$work"' EXIT
@@ -168,6 +154,9 @@ else pass docs-self-contained; fi
 
 expect help 0 "usage:" --help
 expect version 0 "flexmbs 0." --version
+# the version its files carry (core/version) is fpm.toml's
+expect version-is-fpm-toml 0 "flexmbs $(sed -n 's/^version = "\(.*\)"/\1/p' "$root/fpm.toml")" \
+    --version
 expect no-arguments 2 "usage:"
 expect unknown-command 2 "unknown command 'fly'" fly
 expect unknown-option 2 "unknown option '--loud'" run x.nml --loud
@@ -353,6 +342,50 @@ printf '%s\n' "&simulation problem = 'flexible_body', t_end = 0.01 /" \
     "&material youngs_modulus = 7e5, density = 920 /" \
     "&solver linear_solver = 'dense' /" > dense_big.nml
 bad dense-beyond-memory "&solver: linear_solver = 'dense': " dense_big.nml
+
+# Replacing files: a file at an output's path is replaced only when it is
+# flexmbs's own result of that kind; anything else needs --force (and is
+# left as it was without); two outputs of one run are never one file
+py=/usr/bin/python3
+[ -x "$py" ] || py=python3
+printf '%s\n&solver rtol = 1e-4, atol = 1e-4, h0 = 1e-6 /\n%s\n' "$sim" \
+    "&output file = 'out/keep.h5', table = 'out/keep.md' /" > replace.nml
+echo "precious notes" > out/keep.h5
+untouched foreign-output-refused \
+    "replace.nml: &output: file: 'out/keep.h5' exists and is not an HDF5 file: refused; --force replaces it" \
+    out/keep.h5 run replace.nml --quiet
+"$py" -c "import h5py; h5py.File('out/keep.h5', 'w')['x'] = [1.0]" 2>&1
+untouched foreign-hdf5-refused "'out/keep.h5' exists and is an HDF5 file not written by flexmbs" \
+    out/keep.h5 run replace.nml --quiet
+expect foreign-output-forced 0 "radau5: NST=" run replace.nml --quiet --force
+expect flexmbs-result-replaced 0 "radau5: NST=" run replace.nml --quiet
+echo "| my | own | table |" > out/keep.md
+untouched foreign-table-refused "&output: table: 'out/keep.md' exists and is not a table written by flexmbs" \
+    out/keep.md run replace.nml --quiet
+rm -f out/keep.md
+printf '%s\n&output file = %s, table = %s /\n' "$sim" "'out/same.md'" "'./out/../out/same.md'" \
+    > same.nml
+bad two-outputs-one-file "&output: file: 'out/same.md' and &output: table: './out/../out/same.md' are the same file" \
+    same.nml
+sed -e "s#file = 'none'#file = 'out/vis_0001.vtu'#" vis.nml > vis_same.nml
+rm -f out/vis_0001.vtu
+bad hdf5-is-a-vtk-piece "&output: file: 'out/vis_0001.vtu' and &output: vtk: 'out/vis_0001.vtu' are the same file" \
+    vis_same.nml
+expect vtk-rerun 0 "radau5: NST=" run vis.nml --quiet
+echo "<VTKFile/>" > out/vis_0001.vtu
+untouched vtk-foreign-piece "&output: vtk: 'out/vis_0001.vtu' exists and is not a ParaView file written by flexmbs" \
+    out/vis_0001.vtu run vis.nml --quiet
+echo "notes" > study_reference.h5
+untouched study-reference-foreign "&study: reference_file: 'study_reference.h5' exists and is not an HDF5 file" \
+    study_reference.h5 reference study.nml --quiet
+expect study-reference-forced 0 "written: study_reference.h5" reference study.nml --quiet --force
+# (a table's name ends in .md, .csv or .tex; a reference's may too)
+sed -e "s#^ *pmax.*#&, reference_file = 'ref.md', table = './ref.md'#" \
+    -e "s/tolerances .*/tolerances = 1e-3/" -e "s/check_solver .*/check_solver = 'none'/" \
+    study.nml > table_is_reference.nml
+"$exe" reference table_is_reference.nml --quiet > /dev/null 2>&1
+untouched study-table-is-reference "&study: table: './ref.md' is an input of the sweep (the reference file)" \
+    ref.md sweep table_is_reference.nml --quiet
 
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

@@ -206,10 +206,13 @@ contains
         call check(error, status%ok() .and. mesh%element_count() == 1, 'malformed: the good ' &
                    // 'file fails: ' // status%text())
         call expect('version', 'flexmbs-mesh 2' // nl, ':1: format version 2')
+        ! a count the rest of the file cannot hold: refused before allocating
         call expect('truncated', head(1:index(head, '8 0 1 1') - 1), &
-                    ':9: file ends where a node id is expected')
-        call expect('number', head(1:index(head, '2 1 0 0') - 1) // '2 1 x0 0' // nl, &
-                    ':4: ''x0'' is not a number')
+                    ':2: 8 nodes declared, but the file holds only 28 more values')
+        call expect('truncated_set', head // good_element // 'node_set base 4' // nl // &
+                    '1 2 3' // nl, ':13: 4 set members declared, but the file holds only 3 more')
+        call expect('number', head(1:index(head, '2 1 0 0') - 1) // '2 1 x0 0' // &
+                    head(index(head, '2 1 0 0') + 7:), ':4: ''x0'' is not a number')
         call expect('range', head // 'elements hex8 1' // nl // '1 1 2 3 4 5 6 7 9' // nl, &
                     ':12: element 1 names node 9, outside 1..8')
         call expect('keyword', head // good_element // 'faces base 1' // nl // '1' // nl, &

@@ -11,6 +11,9 @@ module test_io
     use flexmbs_io_table, only: stats_row_t, new_stats_row, table_text, table_format, &
         write_table, table_markdown, table_csv, table_latex
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
+    use flexmbs_io_output_files, only: named_path_t, named_path, check_output_paths, &
+        output_hdf5, output_table
+    use flexmbs_core_version, only: version
     use flexmbs_io_progress, only: progress_t, new_progress
     use flexmbs_io_scene, only: run_result_t, run_scene, build_problem, block_spec_t
     use flexmbs_dae_problem, only: dae_problem_t
@@ -50,6 +53,7 @@ contains
                  new_test('hdf5_every_step', test_hdf5_every_step), &
                  new_test('hdf5_unwritable_path', test_hdf5_unwritable), &
                  new_test('progress_line', test_progress), &
+                 new_test('output_files_replace', test_output_files), &
                  new_test('run_scene_van_der_pol', test_run_scene), &
                  new_test('run_scene_pendulum_blocks', test_run_pendulum), &
                  new_test('run_scene_bad_linear_solver_no_file', test_run_bad_solver), &
@@ -305,11 +309,65 @@ contains
         path = scratch('table.csv')
         call write_table(path, rows, status)
         call check(error, status%ok(), 'write_table: ' // status%text())
-        call check(error, read_text(path) == table_text(rows, table_csv), 'file content')
+        ! the comment that marks flexmbs's tables, then the table
+        call check(error, read_text(path) == '# written by flexmbs ' // version // nl // &
+                   table_text(rows, table_csv), 'file content: ' // read_text(path))
         call delete(path)
         call write_table(scratch('table.txt'), rows, status)
         call check(error, status%code == status_bad_input, 'write_table unknown format')
     end subroutine test_table_formats
+
+    !> Which files a run may replace: flexmbs's own HDF5 result and table,
+    !> not a file of anyone else unless forced; never an input; never two
+    !> outputs in one file, however spelled.
+    subroutine test_output_files(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(named_path_t) :: outputs(2), inputs(1)
+        type(hdf5_sink_t) :: sink
+        type(status_t) :: status
+        character(len=:), allocatable :: h5, md, input
+        h5 = scratch('replace.h5')
+        md = scratch('replace.md')
+        input = scratch('replace.nml')
+        call write_text(input, '&simulation /')
+        call write_text(h5, 'notes')
+        call write_text(md, '| a | b |')
+        inputs(1) = named_path(input, 'the scene file itself')
+        outputs(1) = named_path(h5, '&output: file', output_hdf5)
+        outputs(2) = named_path(md, '&output: table', output_table)
+        call check_output_paths('s.nml: ', outputs, inputs, .false., status)
+        call check(error, status%code == status_bad_input .and. index(status%text(), &
+            'exists and is not an HDF5 file: refused; --force replaces it') > 0, &
+            'foreign file: ' // status%text())
+        call status%clear()
+        call check_output_paths('s.nml: ', outputs, inputs, .true., status)
+        call check(error, status%ok(), 'forced: ' // status%text())
+        ! flexmbs's own: replaced without force
+        call sink%create(h5, 1, status)
+        call sink%close(status)
+        call write_table(md, [new_stats_row('radau5', 1.0e-4_wp, '-', dae_stats_t())], status)
+        call check_output_paths('s.nml: ', outputs, inputs, .false., status)
+        call check(error, status%ok(), 'own files: ' // status%text())
+        ! never an input, even forced
+        outputs(2) = named_path(input, '&output: table', output_table)
+        call check_output_paths('s.nml: ', outputs, inputs, .true., status)
+        call check(error, index(status%text(), 'is the scene file itself: refused') > 0, &
+            'input: ' // status%text())
+        ! one file under two names, existing or not
+        call status%clear()
+        outputs(2) = named_path(h5(1:index(h5, '/', back=.true.)) // '.' // &
+            h5(index(h5, '/', back=.true.):), '&output: table', output_table)
+        call check_output_paths('s.nml: ', outputs, inputs(1:0), .true., status)
+        call check(error, index(status%text(), 'are the same file') > 0, &
+            'same file: ' // status%text())
+        call delete(h5)
+        call status%clear()
+        call check_output_paths('s.nml: ', outputs, inputs(1:0), .true., status)
+        call check(error, index(status%text(), 'are the same file') > 0, &
+            'same file not yet written: ' // status%text())
+        call delete(md)
+        call delete(input)
+    end subroutine test_output_files
 
     ! ------------------------------------------------------------------
     ! HDF5

@@ -1,4 +1,5 @@
-!> Whole files as text, with status messages that name the file.
+!> Whole files as text, with status messages that name the file; what a
+!> path names (nothing, a file, a folder; the same file as another).
 module flexmbs_core_files
     use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long_long, c_null_char
     use flexmbs_core_kinds, only: wp, i8
@@ -6,11 +7,14 @@ module flexmbs_core_files
     use flexmbs_core_resources, only: physical_memory, bytes_text
     implicit none
     private
-    public :: read_text_file, same_file, file_kind
-    public :: file_missing, file_regular, file_folder, file_fifo, file_device, file_other
+    public :: read_text_file, read_first_lines, same_file, same_path, file_kind, &
+        make_scratch_folder
 
-    integer, parameter :: file_missing = 0, file_regular = 1, file_folder = 2, file_fifo = 3, &
-        file_device = 4, file_other = 5
+    !> What a path names (file_kind).
+    integer, parameter, public :: file_missing = 0, file_regular = 1, file_folder = 2, &
+        file_fifo = 3, file_device = 4, file_other = 5
+    !> Longest resolved path handled (Linux's PATH_MAX).
+    integer, parameter :: max_path = 4096
 
     interface
         function c_same_file(a, b) bind(C, name='flexmbs_same_file') result(same)
@@ -24,6 +28,20 @@ module flexmbs_core_files
             integer(c_long_long), intent(out) :: size
             integer(c_int) :: kind
         end function c_file_kind
+        function c_resolved_path(path, out, n) bind(C, name='flexmbs_resolved_path') &
+            result(length)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            character(kind=c_char), intent(out) :: out(*)
+            integer(c_int), value :: n
+            integer(c_int) :: length
+        end function c_resolved_path
+        function c_make_scratch_folder(path) bind(C, name='flexmbs_make_scratch_folder') &
+            result(rc)
+            import :: c_char, c_int
+            character(kind=c_char), intent(inout) :: path(*)
+            integer(c_int) :: rc
+        end function c_make_scratch_folder
     end interface
 
 contains
@@ -96,4 +114,63 @@ contains
         character(len=*), intent(in) :: a, b
         same_file = c_same_file(a // c_null_char, b // c_null_char) /= 0
     end function same_file
+
+    !> Whether two paths name one file, existing or not yet written: the same
+    !> device and inode, or the same absolute path once links, '.' and '..'
+    !> of their folders are resolved.
+    logical function same_path(a, b)
+        character(len=*), intent(in) :: a, b
+        character(len=:), allocatable :: ra, rb
+        same_path = same_file(a, b)
+        if (same_path) return
+        ra = resolved(a)
+        rb = resolved(b)
+        same_path = len(ra) > 0 .and. ra == rb
+    end function same_path
+
+    !> A new folder `prefix` // six characters, which no one else has
+    !> (mkdtemp(3)): scratch space that may be removed whole afterwards.
+    subroutine make_scratch_folder(prefix, path, status)
+        character(len=*), intent(in) :: prefix
+        character(len=:), allocatable, intent(out) :: path
+        type(status_t), intent(out) :: status
+        character(kind=c_char, len=len(prefix) + 7) :: buf
+        buf = prefix // 'XXXXXX' // c_null_char
+        if (c_make_scratch_folder(buf) /= 0) then
+            call status%set(status_io_error, prefix // 'XXXXXX: cannot create the folder')
+            return
+        end if
+        path = buf(1:len(buf) - 1)
+    end subroutine make_scratch_folder
+
+    !> The first lines of a text file, as many as `lines` holds: `count` of
+    !> them were read (fewer when the file is shorter or unreadable).
+    subroutine read_first_lines(path, lines, count)
+        character(len=*), intent(in) :: path
+        character(len=*), intent(out) :: lines(:)
+        integer, intent(out) :: count
+        integer :: unit, ios
+        lines = ''
+        count = 0
+        open (newunit=unit, file=path, action='read', status='old', iostat=ios)
+        if (ios /= 0) return
+        do while (count < size(lines))
+            read (unit, '(a)', iostat=ios) lines(count + 1)
+            if (ios /= 0) exit
+            count = count + 1
+        end do
+        close (unit)
+    end subroutine read_first_lines
+
+    !> The absolute path of `path` (flexmbs_resolved_path), '' when its
+    !> folder does not exist.
+    function resolved(path) result(absolute)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: absolute
+        character(kind=c_char, len=max_path) :: buf
+        integer :: length
+        length = int(c_resolved_path(path // c_null_char, buf, int(max_path, c_int)))
+        absolute = ''
+        if (length > 0) absolute = buf(1:length)
+    end function resolved
 end module flexmbs_core_files

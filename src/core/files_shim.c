@@ -1,6 +1,10 @@
 /* File identity for flexmbs_core_files: two paths name the same file when
  * they resolve to the same device and inode, however they are spelled
- * (./s.nml, ../in/s.nml, a link). */
+ * (./s.nml, ../in/s.nml, a link); a path not yet written resolves through
+ * its folder. */
+#include <limits.h>
+#include <stdlib.h>
+#include <string.h>
 #include <sys/stat.h>
 
 /* 1 when both paths exist and are the same file, 0 otherwise. */
@@ -36,4 +40,44 @@ long long flexmbs_physical_memory(void)
     long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
     if (pages <= 0 || size <= 0) return -1;
     return (long long)pages * (long long)size;
+}
+
+/* The absolute path without links, '.' or '..' in `out` (size n): the
+ * file's own when it exists, else its folder's and its name. Its length,
+ * or -1 when the folder does not exist or the result does not fit. */
+int flexmbs_resolved_path(const char *path, char *out, int n)
+{
+    char buf[PATH_MAX], folder[PATH_MAX];
+    const char *slash, *name;
+    size_t len;
+    if (realpath(path, buf) == NULL) {
+        slash = strrchr(path, '/');
+        if (slash == NULL) {
+            strcpy(folder, ".");
+            name = path;
+        } else {
+            len = (size_t)(slash - path);
+            if (len == 0) len = 1; /* "/name" */
+            if (len >= sizeof folder) return -1;
+            memcpy(folder, path, len);
+            folder[len] = '\0';
+            name = slash + 1;
+        }
+        if (realpath(folder, buf) == NULL) return -1;
+        len = strlen(buf);
+        if (len + 1 + strlen(name) + 1 > sizeof buf) return -1;
+        if (buf[len - 1] != '/') strcat(buf, "/");
+        strcat(buf, name);
+    }
+    len = strlen(buf);
+    if ((int)len >= n) return -1;
+    memcpy(out, buf, len + 1);
+    return (int)len;
+}
+
+/* mkdtemp(3): `path` ends in XXXXXX, replaced by the new folder's name
+ * (a folder no one else has); 0 on success. */
+int flexmbs_make_scratch_folder(char *path)
+{
+    return mkdtemp(path) == NULL ? -1 : 0;
 }

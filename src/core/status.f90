@@ -2,7 +2,7 @@
 !>
 !> Library procedures never stop the program; they fill a `status_t` and
 !> return. Only `app/` maps codes to exit codes (bad input 2, solver
-!> failure 3, I/O error 4).
+!> failure 3, I/O error 4, stopped by a signal 128 + its number).
 module flexmbs_core_status
     implicit none
     private
@@ -13,6 +13,9 @@ module flexmbs_core_status
     integer, parameter, public :: status_io_error = 3
     !> A user callback (e.g. SOLOUT) asked to stop: not an error.
     integer, parameter, public :: status_interrupted = 4
+    !> SIGINT or SIGTERM stopped the run (core/signals): outputs flushed and
+    !> closed; `reason` is the signal's number.
+    integer, parameter, public :: status_signal = 5
 
     ! Reasons of a solver failure.
     integer, parameter, public :: reason_none = 0
@@ -26,7 +29,8 @@ module flexmbs_core_status
     integer, parameter, public :: reason_projection = 8
 
     !> Error state: `code` is one of the `status_*` constants, `reason` one of
-    !> the `reason_*` constants for solver failures.
+    !> the `reason_*` constants for solver failures (the signal's number for
+    !> status_signal).
     type, public :: status_t
         integer :: code = status_ok
         integer :: reason = reason_none

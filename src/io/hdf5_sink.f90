@@ -4,7 +4,8 @@
 !>   /time           (steps)        extendible, chunked
 !>   /y              (n, steps)     extendible, chunked: y(:, k) at time(k)
 !>   /<block>        (m, steps)     optional named slices of y (/q, /v, /lambda)
-!>   attributes on / input_text, solver, outcome, NST ... NPRJ, CPU, WALL, t_reached
+!>   attributes on / creator ('flexmbs 0.1.0'), input_text, solver, outcome,
+!>                   NST ... NPRJ, CPU, WALL, t_reached
 !> Each record is written and the file flushed at once, so a run that
 !> fails or is interrupted leaves a file that opens without repair; the
 !> number of complete records is the length of /time (written last).
@@ -17,8 +18,11 @@ module flexmbs_io_hdf5_sink
     use flexmbs_core_status, only: status_t, status_io_error, status_bad_input
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_core_version, only: creator
     implicit none
     private
+
+    public :: hdf5_result_check
 
     !> Attributes stay in the object header below about 64 KiB; larger text
     !> goes to a dataset.
@@ -93,6 +97,8 @@ contains
         per_chunk = max(1, min(time_chunk, chunk_bytes / (8 * n)))
         call create_series(self%file, 'y', n, per_chunk, self%y_dset, err)
         if (check(err, 'create /y')) return
+        call write_string_attribute(self%file, 'creator', creator, err)
+        if (check(err, 'write the attribute creator')) return
         if (present(input_text)) then
             call self%write_text('input_text', input_text, status)
             if (.not. status%ok()) return
@@ -326,7 +332,72 @@ contains
         if (worst < 0) call status%set(status_io_error, self%path // ': HDF5 cannot close')
     end subroutine sink_close
 
+    !> Whether `path` is a result of flexmbs, which a run may replace: an
+    !> HDF5 file whose root attribute `creator` starts with 'flexmbs', or
+    !> one from before that attribute (a root attribute `input_text` and a
+    !> dataset /time). Otherwise `reason` says what it is.
+    subroutine hdf5_result_check(path, ours, reason)
+        character(len=*), intent(in) :: path
+        logical, intent(out) :: ours
+        character(len=:), allocatable, intent(out) :: reason
+        integer(hid_t) :: file
+        integer :: err, close_err
+        logical :: is_hdf5, exists, time_exists
+        character(len=:), allocatable :: text
+        ours = .false.
+        reason = 'is not an HDF5 file'
+        call open_library(err)
+        if (err < 0) return
+        call h5fis_hdf5_f(path, is_hdf5, err)
+        if (err < 0 .or. .not. is_hdf5) return
+        reason = 'is an HDF5 file that cannot be opened (another program writing it?)'
+        call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
+        if (err < 0) return
+        reason = 'is an HDF5 file not written by flexmbs (no root attribute creator = ''' // &
+            'flexmbs ...'')'
+        call h5aexists_f(file, 'creator', exists, err)
+        if (err >= 0 .and. exists) then
+            call read_string_attribute(file, 'creator', text, err)
+            ours = err >= 0 .and. index(text, 'flexmbs') == 1
+        else if (err >= 0) then
+            call h5aexists_f(file, 'input_text', exists, err)
+            time_exists = .false.
+            if (err >= 0 .and. exists) call h5lexists_f(file, 'time', time_exists, err)
+            ours = err >= 0 .and. time_exists
+        end if
+        call h5fclose_f(file, close_err)
+    end subroutine hdf5_result_check
+
     ! ------------------------------------------------------------------
+
+    !> The text of a scalar string attribute of `obj`.
+    subroutine read_string_attribute(obj, name, text, err)
+        integer(hid_t), intent(in) :: obj
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable, intent(out) :: text
+        integer, intent(out) :: err
+        integer(hid_t) :: attr, file_type, mem_type
+        integer(size_t) :: length
+        integer :: close_err
+        call h5aopen_f(obj, name, attr, err)
+        if (err < 0) then
+            text = ''
+            return
+        end if
+        call h5aget_type_f(attr, file_type, err)
+        if (err >= 0) call h5tget_size_f(file_type, length, err)
+        if (err >= 0) call string_type(int(length), mem_type, err)
+        if (err >= 0) then
+            allocate (character(len=max(int(length), 1)) :: text)
+            call h5aread_f(attr, mem_type, text, [1_hsize_t], err)
+            call h5tclose_f(mem_type, close_err)
+            text = trim(text)
+        else
+            text = ''
+        end if
+        call h5tclose_f(file_type, close_err)
+        call h5aclose_f(attr, close_err)
+    end subroutine read_string_attribute
 
     !> Append one record: /y and the blocks first, /time last, then flush.
     subroutine append(self, t, y, status)

@@ -5,8 +5,8 @@
 !> created, so bad input never leaves a half-written file behind.
 module flexmbs_io_scene
     use flexmbs_core_kinds, only: wp, i8
-    use flexmbs_core_status, only: status_t, status_bad_input
-    use flexmbs_core_files, only: same_file
+    use flexmbs_core_status, only: status_t, status_bad_input, status_interrupted, status_signal
+    use flexmbs_core_signals, only: signal_pending, caught_signal, signal_name
     use flexmbs_core_text, only: real_text
     use flexmbs_core_resources, only: physical_memory, bytes_text
     use flexmbs_dae_problem, only: dae_problem_t
@@ -42,8 +42,11 @@ module flexmbs_io_scene
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_progress, only: progress_t, new_progress
     use flexmbs_io_multi_sink, only: multi_sink_t
+    use flexmbs_io_signal_sink, only: signal_sink_t
     use flexmbs_io_table, only: new_stats_row, write_table
     use flexmbs_io_vtk_sink, only: vtk_sink_t
+    use flexmbs_io_output_files, only: named_path_t, named_path, check_output_paths, &
+        output_hdf5, output_vtk, output_table
     implicit none
     private
 
@@ -362,15 +365,18 @@ contains
 
     !> Run a validated scene: build, check, create the outputs, integrate,
     !> store the statistics. `status` is ok, bad_input (before any file is
-    !> created), solver_failure (outputs kept, `result` says how far it
-    !> got) or io_error.
-    subroutine run_scene(scene, quiet, result, status, record)
+    !> created), solver_failure or signal (SIGINT/SIGTERM, checked after
+    !> every accepted step: outputs kept, `result` says how far it got) or
+    !> io_error.
+    subroutine run_scene(scene, quiet, result, status, record, force)
         type(scene_input_t), intent(in) :: scene
         logical, intent(in) :: quiet             !! no progress display
         type(run_result_t), intent(out) :: result
         type(status_t), intent(out) :: status
         !> also given the solution at every output time
         class(sink_t), intent(inout), target, optional :: record
+        !> replace existing files that are not flexmbs's own (io/output_files)
+        logical, intent(in), optional :: force
         class(dae_problem_t), allocatable, target :: problem
         type(monitor_sink_t), target :: monitor
         type(vtk_sink_t), target :: vtk
@@ -381,6 +387,7 @@ contains
         class(linear_solver_t), allocatable :: linear_solver
         type(hdf5_sink_t), target :: h5
         type(progress_t), target :: progress
+        type(signal_sink_t), target :: signals
         type(multi_sink_t) :: sinks
         type(status_t) :: io_status
         integer :: i
@@ -413,14 +420,14 @@ contains
             return
         end if
 
-        ! no output may be one of the run's inputs; checked before any file is created
-        call check_outputs(scene, status)
-        if (.not. status%ok()) return
         ! ParaView output is checked before any file is created
         if (len_trim(scene%vtk) > 0) then
             call setup_vtk()
             if (.not. status%ok()) return
         end if
+        ! which files the run may write; checked before any file is created
+        call check_outputs(scene, vtk, size(options%output_times), force_given(), status)
+        if (.not. status%ok()) return
         if (len(scene%output_file) > 0) then
             call h5%create(scene%output_file, problem%n, status, input_text=scene%text, &
                            every_step=scene%every_step)
@@ -453,6 +460,7 @@ contains
             call progress%watch(solver%native%nstep, solver%native%naccpt)
         end select
         call sinks%attach(progress)
+        call sinks%attach(signals)
         if (present(record)) call sinks%attach(record)
         if (len_trim(scene%vtk) > 0) call sinks%attach(vtk)
         ! drift and energy of formulated mechanical scenes, at the output times
@@ -477,6 +485,9 @@ contains
             call solver%integrate(problem, result%t, result%y, scene%t_end, options, &
                                   result%stats, status, sinks)
         end select
+        if (status%code == status_interrupted .and. signal_pending()) call status%set( &
+            status_signal, 'stopped by ' // signal_name(caught_signal()) // ' at t = ' // &
+            real_text(result%t), caught_signal())
         if (status%ok()) call record_energy(result%y, result%energy_end)
         result%has_energy = result%has_energy .and. status%ok()
 
@@ -572,6 +583,11 @@ contains
                 lambda=result%y(nq + nv + 1:nq + nv + nc))
         end subroutine integrate_mechanical
 
+        logical function force_given()
+            force_given = .false.
+            if (present(force)) force_given = force
+        end function force_given
+
         !> Energies of a flexible body at y = (q, v, ...).
         subroutine record_energy(y, energies)
             real(wp), intent(in) :: y(:)
@@ -590,29 +606,42 @@ contains
         end subroutine record_energy
     end subroutine run_scene
 
-    !> No output of the run (the HDF5 file, the ParaView collection) may be
-    !> one of its inputs (the scene file, a mesh file), however the paths are
-    !> spelled: the input would be overwritten.
-    subroutine check_outputs(scene, status)
+    !> The run's outputs (the HDF5 file, the table, the ParaView collection
+    !> and the pieces of its `records` records) against its inputs (the
+    !> scene file, a mesh file) and each other, and what they would replace
+    !> (io/output_files).
+    subroutine check_outputs(scene, vtk, records, force, status)
         type(scene_input_t), intent(in) :: scene
+        type(vtk_sink_t), intent(in) :: vtk
+        integer, intent(in) :: records
+        logical, intent(in) :: force
         type(status_t), intent(inout) :: status
-        if (len(scene%output_file) > 0) call against_inputs('file', scene%output_file)
-        if (len_trim(scene%vtk) > 0) call against_inputs('vtk', trim(scene%vtk) // '.pvd')
+        type(named_path_t), allocatable :: outputs(:), inputs(:)
+        character(len=:), allocatable :: pieces(:)
+        integer :: n, k
+        allocate (inputs(merge(2, 1, len_trim(scene%body%mesh_file) > 0)))
+        inputs(1) = named_path(scene%path, 'the scene file itself')
+        if (size(inputs) > 1) inputs(2) = named_path(trim(scene%body%mesh_file), &
+            'the mesh file ''' // trim(scene%body%mesh_file) // '''')
+        allocate (character(len=0) :: pieces(0))
+        if (len_trim(scene%vtk) > 0) pieces = vtk%pieces(records)
+        allocate (outputs(3 + size(pieces)))
+        n = 0
+        if (len(scene%output_file) > 0) call add(scene%output_file, 'file', output_hdf5)
+        if (len_trim(scene%table) > 0) call add(trim(scene%table), 'table', output_table)
+        if (len_trim(scene%vtk) > 0) call add(trim(scene%vtk) // '.pvd', 'vtk', output_vtk)
+        do k = 1, size(pieces)
+            call add(trim(pieces(k)), 'vtk', output_vtk)
+            outputs(n)%series = .true.
+        end do
+        call check_output_paths(scene%path // ': ', outputs(1:n), inputs, force, status)
     contains
-        subroutine against_inputs(name, output)
-            character(len=*), intent(in) :: name, output
-            if (.not. status%ok()) return
-            if (same_file(output, scene%path)) then
-                call status%set(status_bad_input, scene%path // ': &output: ' // name // &
-                    ': ''' // output // ''' is the scene file itself: refused, it would be &
-                    &overwritten')
-            else if (len_trim(scene%body%mesh_file) > 0) then
-                if (same_file(output, trim(scene%body%mesh_file))) &
-                    call status%set(status_bad_input, scene%path // ': &output: ' // name // &
-                        ': ''' // output // ''' is the mesh file ''' // &
-                        trim(scene%body%mesh_file) // ''': refused, it would be overwritten')
-            end if
-        end subroutine against_inputs
+        subroutine add(path, name, kind)
+            character(len=*), intent(in) :: path, name
+            integer, intent(in) :: kind
+            n = n + 1
+            outputs(n) = named_path(path, '&output: ' // name, kind)
+        end subroutine add
     end subroutine check_outputs
 
     subroutine delete_file(path)

@@ -21,15 +21,18 @@ module flexmbs_io_study
     use hdf5
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input, status_io_error, &
-        status_solver_failure
+        status_solver_failure, status_signal
+    use flexmbs_core_signals, only: signal_pending, caught_signal, signal_name, signal_number
     use flexmbs_core_text, only: int_text, real_text
-    use flexmbs_core_files, only: same_file
+    use flexmbs_core_files, only: make_scratch_folder
     use flexmbs_dae_error_measure, only: paper_error
     use flexmbs_io_namelist, only: study_input_t, scene_input_t, read_scene
     use flexmbs_io_scene, only: run_result_t, run_scene
     use flexmbs_io_record_sink, only: record_sink_t
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_table, only: stats_row_t, new_stats_row, write_table
+    use flexmbs_io_output_files, only: named_path_t, named_path, check_output_paths, &
+        output_hdf5, output_table
     implicit none
     private
 
@@ -54,7 +57,7 @@ contains
 
     !> The scene of a study with one run's settings: solver, rtol = atol =
     !> tol, and (multibody) the formulation and projection of `stab`, the
-    !> derivative source; no HDF5 file, no table.
+    !> derivative source; no HDF5 file, no table, no ParaView files.
     subroutine configure(base, solver, tol, stab, pmax, derivatives, scene)
         type(scene_input_t), intent(in) :: base
         character(len=*), intent(in) :: solver, stab, derivatives
@@ -68,6 +71,7 @@ contains
         scene%pmax = pmax
         scene%output_file = ''
         scene%table = ''
+        scene%vtk = ''
         if (scene%problem /= 'multibody') return
         select case (stab)
         case ('none')
@@ -100,49 +104,62 @@ contains
         end if
     end subroutine read_study_scene
 
-    !> An output of a study (`name` = `output`: its reference file or its table)
-    !> must not be one of its inputs — the study file, the scene file, the
-    !> scene's mesh file — however spelled, and its folder must exist:
-    !> checked before any run, so that no reference is computed only to be
-    !> refused when it is written, and no input is overwritten.
-    subroutine check_study_output(study, base, name, output, status)
+    !> An output of a study (`name` = `output`: its reference file or its
+    !> table, of `kind` output_hdf5 or output_table): its folder must exist,
+    !> it must not be one of the study's inputs — the study file, the scene
+    !> file, the scene's mesh file, and for the table the reference, which
+    !> the sweep reads — however spelled, and a file there must be flexmbs's
+    !> own of that kind unless `force` (io/output_files). Checked before any
+    !> run, so that no reference is computed only to be refused when it is
+    !> written, and no input is overwritten.
+    subroutine check_study_output(study, base, name, output, kind, force, status)
         type(study_input_t), intent(in) :: study
         type(scene_input_t), intent(in) :: base
         character(len=*), intent(in) :: name, output
+        integer, intent(in) :: kind
+        logical, intent(in) :: force
         type(status_t), intent(inout) :: status
+        type(named_path_t) :: inputs(4), outputs(1)
         character(len=:), allocatable :: folder
         logical :: exists
-        integer :: slash
-        if (same_file(output, study%path) .or. same_file(output, study%scene)) then
-            call status%set(status_bad_input, study%path // ': &study: ' // name // ' = ''' // &
-                output // ''': is an input of the study (the study or its scene file): &
-                &refused, it would be overwritten')
-            return
-        end if
-        if (len_trim(base%body%mesh_file) > 0) then
-            if (same_file(output, trim(base%body%mesh_file))) then
+        integer :: slash, n
+        slash = index(output, '/', back=.true.)
+        if (slash > 1) then
+            folder = output(1:slash - 1)
+            inquire (file=folder // '/.', exist=exists)
+            if (.not. exists) then
                 call status%set(status_bad_input, study%path // ': &study: ' // name // &
-                    ' = ''' // output // ''': is the scene''s mesh file: refused, it would &
-                    &be overwritten')
+                    ' = ''' // output // ''': the folder ''' // folder // ''' does not exist')
                 return
             end if
         end if
-        slash = index(output, '/', back=.true.)
-        if (slash <= 1) return
-        folder = output(1:slash - 1)
-        inquire (file=folder // '/.', exist=exists)
-        if (.not. exists) call status%set(status_bad_input, study%path // ': &study: ' // &
-            name // ' = ''' // output // ''': the folder ''' // folder // ''' does not exist')
+        inputs(1) = named_path(study%path, 'an input of the study (the study file)')
+        inputs(2) = named_path(study%scene, 'an input of the study (its scene file)')
+        n = 2
+        if (len_trim(base%body%mesh_file) > 0) then
+            n = n + 1
+            inputs(n) = named_path(trim(base%body%mesh_file), 'an input of the study &
+                &(the scene''s mesh file)')
+        end if
+        if (kind == output_table) then
+            n = n + 1
+            inputs(n) = named_path(study%reference_file, 'an input of the sweep (the &
+                &reference file)')
+        end if
+        outputs(1) = named_path(output, '&study: ' // name, kind)
+        call check_output_paths(study%path // ': ', outputs, inputs(1:n), force, status)
     end subroutine check_study_output
 
     !> The reference of a study (module header); `log` gets one line per
     !> run. Nothing is written unless both runs succeed.
-    subroutine make_reference(study, version, quiet, log, status)
+    subroutine make_reference(study, version, quiet, log, status, force)
         type(study_input_t), intent(in) :: study
         character(len=*), intent(in) :: version   !! flexmbs version, for the provenance
         logical, intent(in) :: quiet
         character(len=:), allocatable, intent(out) :: log
         type(status_t), intent(out) :: status
+        !> replace a file at reference_file that is not flexmbs's own
+        logical, intent(in), optional :: force
         type(scene_input_t) :: base, scene
         type(run_result_t) :: ref, chk
         type(record_sink_t) :: rec, rec_check
@@ -157,7 +174,8 @@ contains
 
         call read_study_scene(study, base, status)
         if (.not. status%ok()) return
-        call check_study_output(study, base, 'reference_file', study%reference_file, status)
+        call check_study_output(study, base, 'reference_file', study%reference_file, &
+                                output_hdf5, given(force), status)
         if (.not. status%ok()) return
         call one_run('reference', trim(study%reference_solver), study%reference_tolerance, &
                      ref, rec)
@@ -307,13 +325,15 @@ contains
     !> Every run of the study's grid against its reference (module header);
     !> with jobs > 1, in that many processes of `exe` at a time (`exe sweep
     !> STUDY --point K`, through xargs -P): the same rows, CPU apart.
-    subroutine run_sweep(study, quiet, runs, status, jobs, exe)
+    subroutine run_sweep(study, quiet, runs, status, jobs, exe, force)
         type(study_input_t), intent(in) :: study
         logical, intent(in) :: quiet
         type(sweep_run_t), allocatable, intent(out) :: runs(:)
         type(status_t), intent(out) :: status
         integer, intent(in), optional :: jobs
         character(len=*), intent(in), optional :: exe
+        !> replace a file at the table's path that is not flexmbs's own
+        logical, intent(in), optional :: force
         type(scene_input_t) :: base
         type(sweep_point_t), allocatable :: points(:)
         type(stats_row_t), allocatable :: rows(:)
@@ -323,17 +343,26 @@ contains
         call prepare_sweep(study, base, t_ref, y_ref, points, status)
         if (.not. status%ok()) return
         if (len(study%table) > 0) call check_study_output(study, base, 'table', study%table, &
-                                                          status)
+                                                          output_table, given(force), status)
         if (.not. status%ok()) return
         njobs = 1
         if (present(jobs)) njobs = jobs
         allocate (runs(size(points)))
         if (njobs > 1 .and. present(exe)) then
             call run_in_processes(study, exe, njobs, runs, status)
-            if (.not. status%ok()) return
+            if (.not. status%ok()) then
+                deallocate (runs) ! none complete: what there is stays in the points' files
+                return
+            end if
         else
             do k = 1, size(points)
                 runs(k) = point_run(base, points(k), t_ref, y_ref, quiet)
+                if (signal_pending()) then
+                    ! the runs so far, the interrupted one last; no table
+                    runs = runs(1:k)
+                    call stopped(int_text(k) // ' of ' // int_text(size(points)) // ' runs')
+                    return
+                end if
             end do
         end if
         if (study%cpu_reference <= size(runs)) then
@@ -343,6 +372,15 @@ contains
         rows = runs%row
         if (len(study%table) > 0) call write_table(study%table, rows, status, &
                                                    trim(study%layout))
+
+    contains
+
+        subroutine stopped(done)
+            character(len=*), intent(in) :: done
+            call status%set(status_signal, study%path // ': stopped by ' // &
+                signal_name(caught_signal()) // ' after ' // done // '; no table written', &
+                caught_signal())
+        end subroutine stopped
     end subroutine run_sweep
 
     !> What every sweep starts from: the study's scene with the sweep's step
@@ -379,6 +417,8 @@ contains
             return
         end if
         line = record_line(point_run(base, points(k), t_ref, y_ref, .true.))
+        if (signal_pending()) call status%set(status_signal, study%path // ': point ' // &
+            int_text(k) // ': stopped by ' // signal_name(caught_signal()), caught_signal())
     end subroutine run_sweep_point
 
     !> The points in processes: each writes its record to a file of a
@@ -390,14 +430,29 @@ contains
         type(sweep_run_t), intent(inout) :: runs(:)
         type(status_t), intent(inout) :: status
         character(len=:), allocatable :: dir, command, text
-        integer :: k, stat, unit, ios
+        integer :: k, stat, unit, ios, signo
         character(len=4096) :: buffer
-        dir = study%reference_file // '.sweep'
-        command = 'rm -rf "' // dir // '" && mkdir -p "' // dir // '" && seq 1 ' // &
-            int_text(size(runs)) // ' | xargs -P ' // int_text(jobs) // &
-            ' -I{} sh -c ''"$0" sweep "$1" --point {} > "$2/{}.txt" 2>&1'' "' // exe // &
-            '" "' // study%path // '" "' // dir // '"'
+        ! a new folder beside the reference, so that nothing of anyone's is removed
+        call make_scratch_folder(study%reference_file // '.sweep.', dir, status)
+        if (.not. status%ok()) return
+        ! SIGINT (Ctrl-C: the whole process group) and SIGTERM stop the running
+        ! points after their step (they catch the signals that the shell and
+        ! xargs ignore, so that these wait for them); a point so stopped
+        ! leaves the file 'stopped', and no later point starts.
+        command = 'trap '''' INT TERM && seq 1 ' // int_text(size(runs)) // ' | xargs -P ' // &
+            int_text(jobs) // ' -I{} sh -c ''[ -e "$2/stopped" ] && exit 0; "$0" sweep "$1" --point {} > ' // &
+            '"$2/{}.txt" 2>&1; rc=$?; [ $rc -gt 128 ] && : > "$2/stopped"; exit $rc'' "' // &
+            exe // '" "' // study%path // '" "' // dir // '"'
         call execute_command_line(command, exitstat=stat)
+        ! This process ignores SIGINT until the command returns (system(3)):
+        ! the points say whether they were stopped.
+        signo = caught_signal()
+        if (signo == 0) signo = points_signal()
+        if (signo > 0) then
+            call status%set(status_signal, study%path // ': stopped by ' // &
+                signal_name(signo) // ': the sweep''s processes ended; no table written', signo)
+            return
+        end if
         if (stat /= 0) then
             call status%set(status_io_error, study%path // ': the sweep processes failed ' // &
                 '(exit ' // int_text(stat) // '): ' // command)
@@ -424,6 +479,30 @@ contains
             if (.not. status%ok()) return
         end do
         call execute_command_line('rm -rf "' // dir // '"')
+
+    contains
+
+        !> The signal that a point reports it was stopped by ('... stopped by
+        !> SIGINT' in its file), 0 when none was.
+        integer function points_signal() result(signo)
+            integer :: j, at, unit, ios
+            signo = 0
+            do j = 1, size(runs)
+                open (newunit=unit, file=dir // '/' // int_text(j) // '.txt', action='read', &
+                      iostat=ios)
+                if (ios /= 0) cycle
+                do
+                    read (unit, '(a)', iostat=ios) buffer
+                    if (ios /= 0) exit
+                    at = index(buffer, ': stopped by ')
+                    if (at == 0) cycle
+                    signo = signal_number(trim(buffer(at + 13:)))
+                    if (signo > 0) exit
+                end do
+                close (unit)
+                if (signo > 0) return
+            end do
+        end function points_signal
     end subroutine run_in_processes
 
     !> One point of the grid against the reference.
@@ -523,6 +602,13 @@ contains
         run%row%stab = line(b2 + 3:b3 - 1)
         run%summary = line(b3 + 3:)
     end subroutine parse_record
+
+    !> An optional flag's value, false when absent.
+    pure logical function given(flag)
+        logical, intent(in), optional :: flag
+        given = .false.
+        if (present(flag)) given = flag
+    end function given
 
     !> ERR of eq. (13) over all components and output times, rtol = atol = tol.
     pure real(wp) function series_error(y, y_ref, tol) result(err)

@@ -2,11 +2,14 @@
 !>
 !> The columns are those of the paper's Table 3 (solver, TOL, stab., ERR,
 !> NST, NAC, NFE, NJE, CPU) followed by NRJ, NDEC and NSOL. A row whose
-!> error was not measured shows '-' for ERR.
+!> error was not measured shows '-' for ERR. A table file starts with the
+!> comment line 'written by flexmbs 0.1.0' of its format (table_file_ours).
 module flexmbs_io_table
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input, status_io_error
+    use flexmbs_core_version, only: written_by, is_written_by
+    use flexmbs_core_files, only: read_first_lines
     use flexmbs_dae_stats, only: dae_stats_t
     implicit none
     private
@@ -37,7 +40,8 @@ module flexmbs_io_table
         real(wp) :: cpu_unit = 0.0_wp
     end type stats_row_t
 
-    public :: new_stats_row, table_format, table_text, table2_text, layout_text, write_table
+    public :: new_stats_row, table_format, table_text, table2_text, layout_text, write_table, &
+        table_file_ours
 
 contains
 
@@ -229,6 +233,7 @@ contains
         end if
         open (newunit=unit, file=path, access='stream', form='unformatted', &
               status='replace', action='write', iostat=ios, iomsg=msg)
+        if (ios == 0) write (unit, iostat=ios, iomsg=msg) comment(format) // new_line('a')
         if (ios == 0) then
             if (present(layout)) then
                 write (unit, iostat=ios, iomsg=msg) layout_text(rows, format, layout)
@@ -239,6 +244,39 @@ contains
         end if
         if (ios /= 0) call status%set(status_io_error, path // ': cannot write: ' // trim(msg))
     end subroutine write_table
+
+    !> Whether `path` is a table of flexmbs in the format of its extension
+    !> (its first line the comment that write_table writes).
+    logical function table_file_ours(path)
+        character(len=*), intent(in) :: path
+        character(len=256) :: lines(1)
+        integer :: format, count
+        table_file_ours = .false.
+        format = table_format(path)
+        if (format == 0) return
+        call read_first_lines(path, lines, count)
+        if (count == 1) table_file_ours = is_written_by(lines(1), opening(format))
+    end function table_file_ours
+
+    !> The first line of a table file: 'written by flexmbs ...' as a comment.
+    function comment(format) result(line)
+        integer, intent(in) :: format
+        character(len=:), allocatable :: line
+        line = opening(format) // written_by
+        if (format == table_markdown) line = line // ' -->'
+    end function comment
+
+    !> How a comment opens in the format (Markdown: an HTML comment, hidden
+    !> when rendered; CSV: '#', which gnuplot and numpy skip; LaTeX: '%').
+    pure function opening(format) result(text)
+        integer, intent(in) :: format
+        character(len=:), allocatable :: text
+        select case (format)
+        case (table_markdown); text = '<!-- '
+        case (table_csv); text = '# '
+        case default; text = '% '
+        end select
+    end function opening
 
     ! ------------------------------------------------------------------
 

@@ -7,11 +7,14 @@
 !> coordinates first, then a chain's links; point data the body's three
 !> axes), listed with their times in `PREFIX.pvd` (part 0 the mesh, part 1
 !> the bodies). The .pvd is rewritten after every record, so a run that
-!> stops keeps a collection ParaView opens.
+!> stops keeps a collection ParaView opens. Every file's second line is the
+!> comment '<!-- written by flexmbs 0.1.0 -->' (vtk_file_ours).
 module flexmbs_io_vtk_sink
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_io_error
     use flexmbs_core_text, only: int_text
+    use flexmbs_core_version, only: written_by, is_written_by
+    use flexmbs_core_files, only: read_first_lines
     use flexmbs_dae_sink, only: sink_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_mbs_rotation, only: rotation_matrix
@@ -30,22 +33,78 @@ module flexmbs_io_vtk_sink
         real(wp), allocatable :: times(:)
     contains
         procedure :: output => vtk_output
+        procedure :: pieces => vtk_pieces
     end type vtk_sink_t
 
+    !> The XML comment that marks flexmbs's files.
+    character(len=*), parameter :: comment_opening = '<!-- ', comment_closing = ' -->'
+
+    public :: vtk_file_ours
+
 contains
+
+    !> The .vtu files of the first `records` records, as vtk_output names them.
+    function vtk_pieces(self, records) result(paths)
+        class(vtk_sink_t), intent(in) :: self
+        integer, intent(in) :: records
+        character(len=:), allocatable :: paths(:)
+        integer :: k, n, width
+        n = 0
+        if (associated(self%body)) n = n + records
+        if (self%bodies + links(self) > 0) n = n + records
+        width = len(self%prefix) + len('_bodies_') + len(digits(records)) + len('.vtu')
+        allocate (character(len=width) :: paths(n))
+        n = 0
+        do k = 1, records
+            if (associated(self%body)) then
+                n = n + 1
+                paths(n) = mesh_piece(self%prefix, k)
+            end if
+            if (self%bodies + links(self) > 0) then
+                n = n + 1
+                paths(n) = bodies_piece(self%prefix, k)
+            end if
+        end do
+    end function vtk_pieces
+
+    !> Whether `path` is a ParaView file of flexmbs (its marking comment on
+    !> the second line, after the XML declaration).
+    logical function vtk_file_ours(path)
+        character(len=*), intent(in) :: path
+        character(len=256) :: lines(2)
+        integer :: count
+        call read_first_lines(path, lines, count)
+        vtk_file_ours = .false.
+        if (count == 2) vtk_file_ours = is_written_by(lines(2), comment_opening)
+    end function vtk_file_ours
+
+    !> PREFIX_NNNN.vtu, the mesh at record k
+    pure function mesh_piece(prefix, k) result(path)
+        character(len=*), intent(in) :: prefix
+        integer, intent(in) :: k
+        character(len=:), allocatable :: path
+        path = prefix // '_' // digits(k - 1) // '.vtu'
+    end function mesh_piece
+
+    !> PREFIX_bodies_NNNN.vtu, the rigid bodies at record k
+    pure function bodies_piece(prefix, k) result(path)
+        character(len=*), intent(in) :: prefix
+        integer, intent(in) :: k
+        character(len=:), allocatable :: path
+        path = prefix // '_bodies_' // digits(k - 1) // '.vtu'
+    end function bodies_piece
 
     subroutine vtk_output(self, t, y, status)
         class(vtk_sink_t), intent(inout) :: self
         real(wp), intent(in) :: t, y(:)
         type(status_t), intent(inout) :: status
-        character(len=:), allocatable :: stem
         real(wp), allocatable :: tt(:)
         if (.not. status%ok()) return
         self%records = self%records + 1
-        stem = self%prefix // '_' // digits(self%records - 1)
-        if (associated(self%body)) call write_mesh(self, y, stem // '.vtu', status)
+        if (associated(self%body)) call write_mesh(self, y, &
+            mesh_piece(self%prefix, self%records), status)
         if (status%ok() .and. self%bodies + links(self) > 0) call write_bodies(self, y, &
-            self%prefix // '_bodies_' // digits(self%records - 1) // '.vtu', status)
+            bodies_piece(self%prefix, self%records), status)
         if (.not. status%ok()) return
         if (.not. allocated(self%times)) allocate (self%times(0))
         tt = [self%times, t]
@@ -194,6 +253,7 @@ contains
             return
         end if
         write (unit, '(a)') '<?xml version="1.0"?>'
+        write (unit, '(a)') comment_opening // written_by // comment_closing
         write (unit, '(a)') '<VTKFile type="UnstructuredGrid" version="0.1" ' // &
             'byte_order="LittleEndian">'
         write (unit, '(a)') '<UnstructuredGrid>'
@@ -218,16 +278,15 @@ contains
             return
         end if
         write (unit, '(a)') '<?xml version="1.0"?>'
+        write (unit, '(a)') comment_opening // written_by // comment_closing
         write (unit, '(a)') '<VTKFile type="Collection" version="0.1">'
         write (unit, '(a)') '<Collection>'
         do k = 1, self%records
             write (tbuf, '(es23.15e3)') self%times(k)
             if (associated(self%body)) write (unit, '(a)') '<DataSet timestep="' // &
-                trim(adjustl(tbuf)) // '" part="0" file="' // base // '_' // digits(k - 1) // &
-                '.vtu"/>'
+                trim(adjustl(tbuf)) // '" part="0" file="' // mesh_piece(base, k) // '"/>'
             if (self%bodies + links(self) > 0) write (unit, '(a)') '<DataSet timestep="' // &
-                trim(adjustl(tbuf)) // '" part="1" file="' // base // '_bodies_' // &
-                digits(k - 1) // '.vtu"/>'
+                trim(adjustl(tbuf)) // '" part="1" file="' // bodies_piece(base, k) // '"/>'
         end do
         write (unit, '(a)') '</Collection>'
         write (unit, '(a)') '</VTKFile>'

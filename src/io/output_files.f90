@@ -1,0 +1,113 @@
+!> Which files a run may write (DESIGN.md, Errors and failure), checked
+!> before anything is computed: an output is never an input of the run,
+!> two outputs of a run are never one file, and a file already there is
+!> replaced only when it is a result of the same kind written by flexmbs —
+!> an HDF5 file with the root attribute creator = 'flexmbs ...', a ParaView
+!> or table file headed by the comment 'written by flexmbs ...' — anything
+!> else only when the user says `--force`. Paths are compared as files
+!> (device and inode) and, for files not yet written, as absolute paths
+!> with links, '.' and '..' resolved.
+module flexmbs_io_output_files
+    use flexmbs_core_kinds, only: i8
+    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_files, only: same_file, same_path, file_kind, file_missing, file_folder
+    use flexmbs_io_hdf5_sink, only: hdf5_result_check
+    use flexmbs_io_vtk_sink, only: vtk_file_ours
+    use flexmbs_io_table, only: table_file_ours
+    implicit none
+    private
+
+    !> Kinds of output: what a file there must be to be replaced.
+    integer, parameter, public :: output_hdf5 = 1, output_vtk = 2, output_table = 3
+
+    !> A file of a run and how messages name it: an output
+    !> ('&output: file', kind output_*) or an input ('the scene file itself').
+    type, public :: named_path_t
+        character(len=:), allocatable :: path
+        character(len=:), allocatable :: name
+        integer :: kind = 0
+        !> one of a numbered series (ParaView pieces), distinct by construction
+        logical :: series = .false.
+    end type named_path_t
+
+    public :: named_path, check_output_paths
+
+contains
+
+    !> A named path (assigned component by component: gfortran 12's
+    !> structure constructor mis-sizes deferred-length components).
+    function named_path(path, name, kind) result(named)
+        character(len=*), intent(in) :: path, name
+        integer, intent(in), optional :: kind  !! output_*, for an output
+        type(named_path_t) :: named
+        named%path = path
+        named%name = name
+        if (present(kind)) named%kind = kind
+    end function named_path
+
+    !> The rules of the module header for `outputs`, against `inputs`;
+    !> messages start with `where` (e.g. 'scene.nml: '). Bad input names
+    !> the output, its path and the reason.
+    subroutine check_output_paths(where, outputs, inputs, force, status)
+        character(len=*), intent(in) :: where
+        type(named_path_t), intent(in) :: outputs(:), inputs(:)
+        logical, intent(in) :: force  !! replace files that are not flexmbs's own
+        type(status_t), intent(inout) :: status
+        integer :: i, j
+        if (.not. status%ok()) return
+        do i = 1, size(outputs)
+            associate (out => outputs(i))
+                do j = 1, size(inputs)
+                    if (.not. same_file(out%path, inputs(j)%path)) cycle
+                    call status%set(status_bad_input, where // out%name // ': ''' // &
+                        out%path // ''' is ' // inputs(j)%name // ': refused, it would be &
+                        &overwritten')
+                    return
+                end do
+                do j = 1, i - 1
+                    if (out%series .and. outputs(j)%series) cycle
+                    if (.not. same_path(out%path, outputs(j)%path)) cycle
+                    call status%set(status_bad_input, where // outputs(j)%name // ': ''' // &
+                        outputs(j)%path // ''' and ' // out%name // ': ''' // out%path // &
+                        ''' are the same file: refused, one would overwrite the other')
+                    return
+                end do
+                if (force) cycle
+                call check_replace(out)
+                if (.not. status%ok()) return
+            end associate
+        end do
+
+    contains
+
+        !> A file at the output's path must be flexmbs's own of that kind.
+        subroutine check_replace(out)
+            type(named_path_t), intent(in) :: out
+            character(len=:), allocatable :: reason
+            logical :: ours
+            integer(i8) :: size
+            select case (file_kind(out%path, size))
+            case (file_missing)
+                return
+            case (file_folder)
+                ours = .false.
+                reason = 'is a folder'
+            case default
+                select case (out%kind)
+                case (output_hdf5)
+                    call hdf5_result_check(out%path, ours, reason)
+                case (output_vtk)
+                    ours = vtk_file_ours(out%path)
+                    reason = 'is not a ParaView file written by flexmbs (no comment ' // &
+                        '''written by flexmbs'' on its second line)'
+                case default
+                    ours = table_file_ours(out%path)
+                    reason = 'is not a table written by flexmbs (no comment ' // &
+                        '''written by flexmbs'' on its first line)'
+                end select
+            end select
+            if (.not. ours) call status%set(status_bad_input, where // out%name // ': ''' // &
+                out%path // ''' exists and ' // reason // ': refused; --force replaces it')
+        end subroutine check_replace
+    end subroutine check_output_paths
+end module flexmbs_io_output_files
