@@ -131,6 +131,11 @@ contains
                          '&solver rtol = 1e-12, atol = 1e-14 /', 'in.nml', scene, status)
         call check(error, status%ok(), 'tight tolerances stay possible: ' // status%text())
         call check_close(error, scene%rtol, 1.0e-12_wp, 0.0_wp, 'rtol read')
+        ! a solver's own refusal named in the scene's terms
+        status = parse('&simulation problem = ''van_der_pol'', t_end = 1 /' // nl // &
+                       '&solver name = ''ida'', linear_solver = ''band'' /')
+        call expect(error, status, 'in.nml: &solver: linear_solver = ''band'': ''band'' is &
+            &offered with radau5 and ddassl only (ida: ''auto'', ''dense'' or ''klu'') (line 2)')
     end subroutine test_tolerance_floor
 
     subroutine test_rules(error)

@@ -3,7 +3,7 @@ module flexmbs_core_text
     use flexmbs_core_kinds, only: wp
     implicit none
     private
-    public :: real_text, int_text, lower
+    public :: real_text, int_text, lower, excerpt
 
 contains
 
@@ -36,4 +36,19 @@ contains
             if (c >= iachar('A') .and. c <= iachar('Z')) t(i:i) = achar(c + 32)
         end do
     end function lower
+
+    !> The text itself when short; else its start, '...' and its length:
+    !> a message quotes at most ~80 characters of what a user wrote.
+    pure function excerpt(text) result(short)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: short
+        integer, parameter :: max_quote = 80
+        character(len=24) :: buf
+        if (len(text) <= max_quote) then
+            short = text
+        else
+            write (buf, '(i0)') len(text)
+            short = text(1:max_quote - 20) // '... (' // trim(buf) // ' characters)'
+        end if
+    end function excerpt
 end module flexmbs_core_text

@@ -22,7 +22,7 @@
 module flexmbs_fe_mesh_file
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input, status_io_error
-    use flexmbs_core_text, only: int_text, lower
+    use flexmbs_core_text, only: int_text, lower, excerpt
     use flexmbs_core_files, only: read_text_file
     use flexmbs_fe_hexahedron, only: shape_functions
     use flexmbs_fe_tensor, only: det3
@@ -99,7 +99,7 @@ contains
         case ('hex27')
             work%nnode_element = 27
         case default
-            call fail('element type ''' // word // ''': hex8 or hex27 expected')
+            call fail('element type ''' // excerpt(word) // ''': hex8 or hex27 expected')
             return
         end select
         call next_int(nelem, 'element count')
@@ -145,7 +145,7 @@ contains
                 call next_int(nset, 'set size')
                 if (.not. status%ok()) return
                 if (nset < 0) then
-                    call fail('set ''' // name // ''': negative size')
+                    call fail('set ''' // excerpt(name) // ''': negative size')
                     return
                 end if
                 if (lower(word) == 'node_set') then
@@ -155,7 +155,7 @@ contains
                 end if
                 if (.not. status%ok()) return
             case default
-                call fail('''' // word // ''': node_set or element_set expected')
+                call fail('''' // excerpt(word) // ''': node_set or element_set expected')
                 return
             end select
         end do
@@ -174,17 +174,17 @@ contains
             type(node_set_t) :: set
             integer :: j
             if (any([(work%node_sets(j)%name == name, j = 1, size(work%node_sets))])) then
-                call fail('a second node set named ''' // name // '''')
+                call fail('a second node set named ''' // excerpt(name) // '''')
                 return
             end if
             set%name = name
             if (.not. fits(nset, 1, 'set members')) return
             allocate (set%nodes(nset))
             do j = 1, nset
-                call next_int(set%nodes(j), 'node id of set ''' // name // '''')
+                call next_int(set%nodes(j), 'node id of set ''' // excerpt(name) // '''')
                 if (.not. status%ok()) return
                 if (set%nodes(j) < 1 .or. set%nodes(j) > nnode) then
-                    call fail('node set ''' // name // ''' names node ' // &
+                    call fail('node set ''' // excerpt(name) // ''' names node ' // &
                               int_text(set%nodes(j)) // ', outside 1..' // int_text(nnode))
                     return
                 end if
@@ -198,17 +198,17 @@ contains
             type(element_set_t) :: set
             integer :: j
             if (any([(work%element_sets(j)%name == name, j = 1, size(work%element_sets))])) then
-                call fail('a second element set named ''' // name // '''')
+                call fail('a second element set named ''' // excerpt(name) // '''')
                 return
             end if
             set%name = name
             if (.not. fits(nset, 1, 'set members')) return
             allocate (set%elements(nset))
             do j = 1, nset
-                call next_int(set%elements(j), 'element id of set ''' // name // '''')
+                call next_int(set%elements(j), 'element id of set ''' // excerpt(name) // '''')
                 if (.not. status%ok()) return
                 if (set%elements(j) < 1 .or. set%elements(j) > nelem) then
-                    call fail('element set ''' // name // ''' names element ' // &
+                    call fail('element set ''' // excerpt(name) // ''' names element ' // &
                               int_text(set%elements(j)) // ', outside 1..' // int_text(nelem))
                     return
                 end if
@@ -255,7 +255,7 @@ contains
             character(len=:), allocatable :: word
             call next_word(word, '''' // keyword // '''')
             if (.not. status%ok()) return
-            if (lower(word) /= keyword) call fail('''' // word // ''' where ''' // keyword // &
+            if (lower(word) /= keyword) call fail('''' // excerpt(word) // ''' where ''' // keyword // &
                                                   ''' is expected')
         end subroutine expect_word
 
@@ -272,7 +272,7 @@ contains
             else
                 read (word, *, iostat=ios) value
             end if
-            if (ios /= 0) call fail('''' // word // ''' is not an integer (' // what // ')')
+            if (ios /= 0) call fail('''' // excerpt(word) // ''' is not an integer (' // what // ')')
         end subroutine next_int
 
         subroutine next_real(value, what)
@@ -288,7 +288,7 @@ contains
             else
                 read (word, *, iostat=ios) value
             end if
-            if (ios /= 0) call fail('''' // word // ''' is not a number (' // what // ')')
+            if (ios /= 0) call fail('''' // excerpt(word) // ''' is not a number (' // what // ')')
         end subroutine next_real
     end subroutine read_mesh
 

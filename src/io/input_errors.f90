@@ -1,16 +1,14 @@
 !> The errors of one input file, collected so that a user sees all of them
 !> in one run: each 'path: &group: name = value: reason (line n)', the
-!> user's text quoted in at most `max_quote` characters.
+!> user's text quoted in at most 80 characters (core/text excerpt).
 module flexmbs_io_input_errors
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_text, only: excerpt
     implicit none
     private
 
     !> Errors kept per file; more are counted, not listed.
     integer, parameter, public :: max_errors = 25
-    !> Characters of the user's text a message quotes.
-    integer, parameter, public :: max_quote = 80
-
     type :: message_t
         character(len=:), allocatable :: text
     end type message_t
@@ -52,7 +50,7 @@ contains
     end subroutine errors_add
 
     !> 'path: &group: name = value: reason (line n)', value quoted in at
-    !> most max_quote characters.
+    !> most 80 characters.
     subroutine errors_add_value(self, group, name, value, reason, line)
         class(input_errors_t), intent(inout) :: self
         character(len=*), intent(in) :: group, name, value, reason
@@ -87,19 +85,6 @@ contains
         call status%set(status_bad_input, text)
     end subroutine errors_to_status
 
-    !> The text itself when short; else its start, '...' and its length,
-    !> so that a 1 MB value gives a message of one line.
-    pure function excerpt(text) result(short)
-        character(len=*), intent(in) :: text
-        character(len=:), allocatable :: short
-        character(len=24) :: buf
-        if (len(text) <= max_quote) then
-            short = text
-        else
-            write (buf, '(i0)') len(text)
-            short = text(1:max_quote - 20) // '... (' // trim(buf) // ' characters)'
-        end if
-    end function excerpt
 
     !> ' (line n)', or '' for line 0.
     pure function at_line(line) result(text)

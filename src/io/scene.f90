@@ -485,6 +485,11 @@ contains
             call solver%integrate(problem, result%t, result%y, scene%t_end, options, &
                                   result%stats, status, sinks)
         end select
+        ! a solver that refuses its options: say which file and group
+        if (status%code == status_bad_input) then
+            if (index(status%text(), scene%path // ':') /= 1) status%message = scene%path // &
+                ': &solver: ' // status%text()
+        end if
         if (status%code == status_interrupted .and. signal_pending()) call status%set( &
             status_signal, 'stopped by ' // signal_name(caught_signal()) // ' at t = ' // &
             real_text(result%t), caught_signal())

@@ -67,6 +67,10 @@ contains
         end if
         if (all(linear_solver_names /= scene%linear_solver)) call value_error(errors, entries, &
             sol, 'linear_solver', 'must be ' // linear_solver_names_text)
+        if (scene%linear_solver == 'band' .and. (scene%solver_name == 'ida' .or. &
+            scene%solver_name == 'mexax')) call value_error(errors, entries, sol, &
+            'linear_solver', '''band'' is offered with radau5 and ddassl only (' // &
+            trim(scene%solver_name) // ': ''auto'', ''dense'' or ''klu'')')
         if (scene%solver_name == 'ddassl' .and. scene%pmax > 5) call value_error(errors, &
             entries, sol, 'pmax', 'must lie in 1..5 for ddassl (its maximal BDF order)')
     end subroutine check_solver
