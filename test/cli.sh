@@ -387,5 +387,11 @@ sed -e "s#^ *pmax.*#&, reference_file = 'ref.md', table = './ref.md'#" \
 untouched study-table-is-reference "&study: table: './ref.md' is an input of the sweep (the reference file)" \
     ref.md sweep table_is_reference.nml --quiet
 
+# an output grid whose HDF5 file cannot fit on its file system: refused
+# before the run (n_output = 1e8 on the five-body ran for hours)
+sed -e "s/n_output *= *[0-9]*/n_output = 1000000000/" "$root/inputs/five_body.nml" > many_outputs.nml
+bad output-beyond-disk "&output: n_output = 1000000000: the HDF5 file 'many_outputs.h5' would need ~" \
+    many_outputs.nml
+
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

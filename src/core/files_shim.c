@@ -81,3 +81,14 @@ int flexmbs_make_scratch_folder(char *path)
 {
     return mkdtemp(path) == NULL ? -1 : 0;
 }
+
+#include <sys/statvfs.h>
+
+/* Bytes an unprivileged user may still write in the file system holding
+ * `folder`, or -1 when unknown. */
+long long flexmbs_free_space(const char *folder)
+{
+    struct statvfs s;
+    if (statvfs(folder, &s) != 0) return -1;
+    return (long long)s.f_bavail * (long long)s.f_frsize;
+}

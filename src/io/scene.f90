@@ -7,8 +7,8 @@ module flexmbs_io_scene
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input, status_interrupted, status_signal
     use flexmbs_core_signals, only: signal_pending, caught_signal, signal_name
-    use flexmbs_core_text, only: real_text
-    use flexmbs_core_resources, only: physical_memory, bytes_text
+    use flexmbs_core_text, only: real_text, int_text
+    use flexmbs_core_resources, only: physical_memory, free_space, bytes_text
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_options, only: dae_options_t
@@ -284,6 +284,32 @@ contains
             // bytes_text(real(machine, wp)) // ' (''auto'', ''klu'' or ''mumps'' are sparse)')
     end subroutine check_dense_size
 
+    !> The HDF5 file of n_output records (y, its blocks and the time) must
+    !> fit in the free space of its folder: an output grid that cannot be
+    !> written is bad input, said before the run (with every_step the
+    !> number of records is not known in advance).
+    subroutine check_output_size(scene, n, blocks, status)
+        type(scene_input_t), intent(in) :: scene
+        integer, intent(in) :: n
+        type(block_spec_t), intent(in) :: blocks(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: bytes
+        integer(i8) :: free
+        integer :: i, per_record
+        if (len(scene%output_file) == 0 .or. scene%every_step) return
+        per_record = n + 1
+        do i = 1, size(blocks)
+            per_record = per_record + blocks(i)%last - blocks(i)%first + 1
+        end do
+        bytes = 8.0_wp * real(per_record, wp) * real(scene%n_output, wp)
+        free = free_space(scene%output_file(1:index(scene%output_file, '/', back=.true.)))
+        if (free >= 0 .and. bytes > real(free, wp)) call status%set(status_bad_input, &
+            scene%path // ': &output: n_output = ' // int_text(scene%n_output) // ': the &
+            &HDF5 file ''' // scene%output_file // ''' would need ~' // bytes_text(bytes) // &
+            ' (' // int_text(per_record) // ' values a record); its file system has ' // &
+            bytes_text(real(free, wp)) // ' free')
+    end subroutine check_output_size
+
     pure integer function formulation_code(name)
         character(len=*), intent(in) :: name
         select case (trim(name))
@@ -427,6 +453,8 @@ contains
         end if
         ! which files the run may write; checked before any file is created
         call check_outputs(scene, vtk, size(options%output_times), force_given(), status)
+        if (.not. status%ok()) return
+        call check_output_size(scene, problem%n, blocks, status)
         if (.not. status%ok()) return
         if (len(scene%output_file) > 0) then
             call h5%create(scene%output_file, problem%n, status, input_text=scene%text, &
