@@ -206,9 +206,15 @@ printf "%s\n&flexible_body lengths = 1, 1, 1, divisions = 2, 1, 1 /\n&material y
     "$fb" > fb_cover.nml
 bad material-not-covering "fb_cover.nml: &material: elements: element 1 has no material" fb_cover.nml
 
-# I/O error: the output directory does not exist
-printf "%s\n&output file = 'no/such/dir/x.h5' /\n" "$sim" > io_error.nml
-expect io-error 4 "no/such/dir/x.h5: HDF5 cannot create the file" run io_error.nml --quiet
+# a missing output folder is bad input, found while reading; a folder that
+# exists but cannot be written is an I/O error
+printf "%s\n&output file = 'no/such/dir/x.h5' /\n" "$sim" > no_folder.nml
+bad output-no-folder "&output: file = 'no/such/dir/x.h5': the folder 'no/such/dir/' does not exist" \
+    no_folder.nml
+printf "%s\n&output vtk = 'nodir/p', file = 'none' /\n" "$sim" > no_vtk_folder.nml
+bad vtk-no-folder "&output: vtk = 'nodir/p': the folder 'nodir/' does not exist" no_vtk_folder.nml
+printf "%s\n&output file = '/dev/full' /\n" "$sim" > io_error.nml
+expect io-error 4 "/dev/full: HDF5 cannot create the file" run io_error.nml --quiet --force
 
 # A driven four-bar (inputs/four_bar.nml) with every solver
 for s in radau5 ddassl ida mexax; do

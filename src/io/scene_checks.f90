@@ -6,7 +6,7 @@
 module flexmbs_io_scene_checks
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_text, only: lower, real_text
-    use flexmbs_core_files, only: same_file
+    use flexmbs_core_files, only: same_file, file_kind, file_folder
     use flexmbs_core_resources, only: physical_memory, bytes_text
     use flexmbs_linalg_linear_solver, only: linear_solver_names, linear_solver_names_text
     use flexmbs_io_input_errors, only: input_errors_t
@@ -116,7 +116,10 @@ contains
         else if (len(scene%output_file) > 0) then
             scene%output_file = relative_to(dir, scene%output_file)
         end if
+        if (len_trim(scene%table) > 0) call check_folder('table', trim(scene%table))
+        if (len_trim(scene%vtk) > 0) call check_folder('vtk', trim(scene%vtk))
         if (len(scene%output_file) == 0) return
+        if (has_entry(entries, 'output', 'file')) call check_folder('file', scene%output_file)
         ! the same file by any spelling (./s.nml, ../in/s.nml, a link)
         if (scene%output_file /= scene%path .and. .not. same_file(scene%output_file, &
                                                                   scene%path)) return
@@ -126,6 +129,20 @@ contains
             call errors%add('&output: file (default ''' // scene%output_file // '''): would &
                 &overwrite the input file', 0)
         end if
+
+    contains
+
+        !> An output's folder must exist (found now, not after the run).
+        subroutine check_folder(name, path)
+            character(len=*), intent(in) :: name, path
+            integer(i8) :: size
+            character(len=:), allocatable :: folder
+            folder = folder_of(path)
+            if (len(folder) == 0) return
+            if (file_kind(folder, size) /= file_folder) call value_error(errors, entries, &
+                'output', name, 'the folder ''' // folder // ''' does not exist (paths are &
+                &relative to the scene''s folder)')
+        end subroutine check_folder
     end subroutine resolve_paths
 
     !> `name` relative to folder `dir` ('' or ending in '/'), unless absolute.
