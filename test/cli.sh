@@ -189,7 +189,7 @@ kept flexible-body-energy 0 "energy at t_end" cantilever_radau5.h5 run cantileve
 
 # bad flexible-body input: exit 2 before any file exists
 sed "s/fixed     = 'xmin'/fixed = 'xmim'/" "$example" > bad_set.nml
-bad flexible-body-unknown-set "bad_set.nml: &flexible_body: fixed = 'xmim': no such node set" \
+bad flexible-body-unknown-set "bad_set.nml: &flexible_body: fixed = 'xmim': mesh: no node set named 'xmim' (did you mean 'xmin'?)" \
     bad_set.nml
 fb="&simulation t_end = 0.01 /"
 mat="&material youngs_modulus = 7e5, density = 920 /"

@@ -75,6 +75,8 @@ contains
         type(status_t) :: status
         character(len=:), allocatable :: path
         path = scratch('valid.nml')
+        ! its output folder, beside it
+        call execute_command_line('mkdir -p ' // path(1:index(path, '/', back=.true.)) // 'out')
         ! groups out of order, comments, mixed case, '&end', commas
         call write_text(path, &
             '! a scene' // nl // &
@@ -795,13 +797,13 @@ contains
         h5 = scratch('bad_body.h5')
         out = '&output file = ''' // h5 // ''' /' // nl
         call refused(body_scene(', fixed = ''xmin'', ''xmim''', soft() // out), &
-            'in.nml: &flexible_body: fixed = ''xmim'': no such node set in the mesh ' // &
-            '(known: xmin, xmax, ymin, ymax, zmin, zmax, xmin_ymin,')
+            'in.nml: &flexible_body: fixed = ''xmim'': mesh: no node set named ''xmim'' ' // &
+            '(did you mean ''xmin''?) (known: xmin, xmax, ymin, ymax, zmin, zmax, xmin_ymin,')
         call refused(body_scene('', soft() // '&material name = ''tip'', youngs_modulus = 1e7,' &
             // ' density = 1000, elements = ''xmax_layr'' /' // nl // out), &
-            'in.nml: &material ''tip'': elements = ''xmax_layr'': no such element set in ' // &
-            'the mesh (known: all, xmin_layer, xmax_layer, ymin_layer, ymax_layer, ' // &
-            'zmin_layer, zmax_layer) (line 4)')
+            'in.nml: &material ''tip'': elements = ''xmax_layr'': mesh: no element set named ' &
+            // '''xmax_layr'' (did you mean ''xmax_layer''?) (known: all, xmin_layer, ' // &
+            'xmax_layer, ymin_layer, ymax_layer, zmin_layer, zmax_layer) (line 4)')
         call refused(body_scene('', '&material name = ''a'', youngs_modulus = 1, density = 1,' &
             // ' elements = ''all'' /' // nl // '&material name = ''b'', youngs_modulus = 1, ' &
             // 'density = 1, elements = ''xmax_layer'' /' // nl // out), &
@@ -815,7 +817,7 @@ contains
             soft() // out), &
             'in.nml: &flexible_body: load_set = ''xmin'': every node of the set is fixed')
         call refused(body_scene(', load_set = ''tip'', load = 1, 0, 0', soft() // out), &
-            'in.nml: &flexible_body: load_set = ''tip'': no such node set in the mesh')
+            'in.nml: &flexible_body: load_set = ''tip'': mesh: no node set named ''tip''')
         call refused('&simulation t_end = 1 /' // nl // '&flexible_body mesh_file = ''' // &
             'no/such.mesh'' /' // nl // soft() // out, &
             'in.nml: &flexible_body: mesh_file = ''no/such.mesh'': no/such.mesh: no such file')

@@ -8,8 +8,9 @@ module test_scene_input
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_linalg_linear_solver, only: linear_solver_names
     use flexmbs_io_namelist, only: scene_input_t, parse_scene
+    use flexmbs_core_text, only: nearest
     use flexmbs_io_scene_schema, only: schema, kind_real, kind_integer, kind_string, &
-        kind_logical, find_var, nearest
+        kind_logical, find_var
     use flexmbs_io_scene_values, only: rule_reason
     use flexmbs_io_input_errors, only: max_errors
     use testing, only: test_case_t, new_test, error_t, check, check_close
@@ -207,15 +208,22 @@ contains
         type(error_t), allocatable, intent(out) :: error
         type(status_t) :: status
         type(scene_input_t) :: scene
+        character(len=*), parameter :: dir = 'build/test-scene-input/a/'
+        call execute_command_line('mkdir -p ' // dir // 'out')
         call parse_scene('&simulation problem = ''van_der_pol'', t_end = 1 /' // nl // &
-                         '&output file = ''out/r.h5'', table = ''t.csv'', vtk = ''/abs/p'' /', &
-                         'scenes/a/s.nml', scene, status)
+                         '&output file = ''out/r.h5'', table = ''t.csv'', vtk = ''/tmp/p'' /', &
+                         dir // 's.nml', scene, status)
         call check(error, status%ok(), status%text())
-        call check(error, scene%output_file == 'scenes/a/out/r.h5', 'file: ' // scene%output_file)
-        call check(error, scene%table == 'scenes/a/t.csv', 'table: ' // trim(scene%table))
-        call check(error, scene%vtk == '/abs/p', 'absolute kept: ' // trim(scene%vtk))
+        call check(error, scene%output_file == dir // 'out/r.h5', 'file: ' // scene%output_file)
+        call check(error, scene%table == dir // 't.csv', 'table: ' // trim(scene%table))
+        call check(error, scene%vtk == '/tmp/p', 'absolute kept: ' // trim(scene%vtk))
+        ! a folder that does not exist: bad input while reading, not after the run
+        call parse_scene('&simulation problem = ''van_der_pol'', t_end = 1 /' // nl // &
+                         '&output file = ''nowhere/r.h5'' /', dir // 's.nml', scene, status)
+        call expect(error, status, '&output: file = ''nowhere/r.h5'': the folder ''' // dir // &
+                    'nowhere/'' does not exist')
         call parse_scene('&simulation problem = ''van_der_pol'', t_end = 1 /', &
-                         'scenes/a/s.nml', scene, status)
+                         dir // 's.nml', scene, status)
         call check(error, scene%output_file == 's.h5', 'default in the working directory: ' // &
                    scene%output_file)
     end subroutine test_relative_paths

@@ -3,7 +3,7 @@ module flexmbs_core_text
     use flexmbs_core_kinds, only: wp
     implicit none
     private
-    public :: real_text, int_text, lower, excerpt
+    public :: real_text, int_text, lower, excerpt, nearest
 
 contains
 
@@ -51,4 +51,49 @@ contains
             short = text(1:max_quote - 20) // '... (' // trim(buf) // ' characters)'
         end if
     end function excerpt
+
+    !> The candidate closest to `word` by edit distance (insertions,
+    !> deletions, substitutions, transpositions), '' when none is close:
+    !> at most a third of the word's length, and at least 1, may differ.
+    pure function nearest(word, candidates) result(best)
+        character(len=*), intent(in) :: word, candidates(:)
+        character(len=:), allocatable :: best
+        integer :: i, d, dbest
+        best = ''
+        if (len(word) > 64) return
+        dbest = max(1, len(word) / 3) + 1
+        do i = 1, size(candidates)
+            if (len_trim(candidates(i)) == 0) cycle
+            d = edit_distance(lower(word), lower(trim(candidates(i))))
+            if (d < dbest) then
+                dbest = d
+                best = trim(candidates(i))
+            end if
+        end do
+    end function nearest
+
+    !> Optimal string alignment distance (Damerau–Levenshtein without
+    !> repeated edits of one substring).
+    pure integer function edit_distance(a, b) result(d)
+        character(len=*), intent(in) :: a, b
+        integer :: prev2(0:len(b)), prev(0:len(b)), row(0:len(b))
+        integer :: i, j, cost
+        prev2 = 0
+        prev = [(j, j = 0, len(b))]
+        row = 0
+        do i = 1, len(a)
+            row(0) = i
+            do j = 1, len(b)
+                cost = merge(0, 1, a(i:i) == b(j:j))
+                row(j) = min(prev(j) + 1, row(j - 1) + 1, prev(j - 1) + cost)
+                if (i > 1 .and. j > 1) then
+                    if (a(i:i) == b(j - 1:j - 1) .and. a(i - 1:i - 1) == b(j:j)) &
+                        row(j) = min(row(j), prev2(j - 2) + 1)
+                end if
+            end do
+            prev2 = prev
+            prev = row
+        end do
+        d = prev(len(b))
+    end function edit_distance
 end module flexmbs_core_text

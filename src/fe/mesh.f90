@@ -4,7 +4,7 @@
 module flexmbs_fe_mesh
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
-    use flexmbs_core_text, only: int_text
+    use flexmbs_core_text, only: int_text, excerpt, nearest
     implicit none
     private
 
@@ -54,6 +54,7 @@ contains
         character(len=*), intent(in) :: name
         integer, allocatable, intent(out) :: nodes(:)
         type(status_t), intent(out) :: status
+        character(len=64), allocatable :: names(:)
         integer :: i
         if (allocated(self%node_sets)) then
             do i = 1, size(self%node_sets)
@@ -64,7 +65,11 @@ contains
             end do
         end if
         allocate (nodes(0))
-        call status%set(status_bad_input, 'mesh: no node set named ''' // name // '''')
+        names = [character(len=64) ::]
+        if (allocated(self%node_sets)) names = [character(len=64) :: &
+            (self%node_sets(i)%name, i = 1, size(self%node_sets))]
+        call status%set(status_bad_input, 'mesh: no node set named ''' // excerpt(name) // &
+            '''' // known_sets(names, name))
     end subroutine mesh_node_set
 
     !> The elements of the set called `name`; bad input naming the set if absent.
@@ -73,6 +78,7 @@ contains
         character(len=*), intent(in) :: name
         integer, allocatable, intent(out) :: elements(:)
         type(status_t), intent(out) :: status
+        character(len=64), allocatable :: names(:)
         integer :: i
         if (allocated(self%element_sets)) then
             do i = 1, size(self%element_sets)
@@ -83,8 +89,33 @@ contains
             end do
         end if
         allocate (elements(0))
-        call status%set(status_bad_input, 'mesh: no element set named ''' // name // '''')
+        names = [character(len=64) ::]
+        if (allocated(self%element_sets)) names = [character(len=64) :: &
+            (self%element_sets(i)%name, i = 1, size(self%element_sets))]
+        call status%set(status_bad_input, 'mesh: no element set named ''' // excerpt(name) // &
+            '''' // known_sets(names, name))
     end subroutine mesh_element_set
+
+    !> ' (did you mean ''x''?) (known: a, b, ...)', at most ~80 characters
+    !> of names; ' (the mesh has none)' without sets.
+    function known_sets(names, name) result(text)
+        character(len=*), intent(in) :: names(:), name
+        character(len=:), allocatable :: text, list, best
+        integer :: i
+        if (size(names) == 0) then
+            text = ' (the mesh has none)'
+            return
+        end if
+        list = ''
+        do i = 1, size(names)
+            if (i > 1) list = list // ', '
+            list = list // trim(names(i))
+        end do
+        best = nearest(name, names)
+        text = ''
+        if (len(best) > 0) text = ' (did you mean ''' // best // '''?)'
+        text = text // ' (known: ' // excerpt(list) // ')'
+    end function known_sets
 
     !> Consistency: 8 or 27 nodes per element, connectivity within the nodes
     !> and without repeats, set members in range, set names unique per kind.

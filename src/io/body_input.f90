@@ -75,8 +75,7 @@ contains
                 call mesh%node_set(trim(b%fixed(k)), set, status)
                 if (.not. status%ok()) then
                     call status%set(status_bad_input, where // 'fixed = ''' // trim(b%fixed(k)) &
-                        // ''': no such node set in the mesh (known: ' // node_set_names(mesh) &
-                        // ')')
+                        // ''': ' // status%text())
                     return
                 end if
                 fixed = [fixed, set]
@@ -93,8 +92,7 @@ contains
                 call mesh%node_set(trim(b%load_set), set, status)
                 if (.not. status%ok()) then
                     call status%set(status_bad_input, where // 'load_set = ''' // &
-                        trim(b%load_set) // ''': no such node set in the mesh (known: ' // &
-                        node_set_names(mesh) // ')')
+                        trim(b%load_set) // ''': ' // status%text())
                     return
                 end if
                 nfree = count([(any(body%dof(:, set(i)) > 0), i = 1, size(set))])
@@ -156,8 +154,7 @@ contains
                 call mesh%element_set(trim(m%elements), set, status)
                 if (.not. status%ok()) then
                     call status%set(status_bad_input, where // 'elements = ''' // &
-                        trim(m%elements) // ''': no such element set in the mesh (known: ' // &
-                        element_set_names(mesh) // ')' // at(m%line))
+                        trim(m%elements) // ''': ' // status%text() // at(m%line))
                     return
                 end if
                 do j = 1, size(set)
@@ -197,30 +194,6 @@ contains
         energies(2) = body%kinetic_energy(v)
         energies(3) = energies(1) + energies(2) - dot_product(body%applied_force, q - q_ref)
     end subroutine body_energies
-
-    function node_set_names(mesh) result(list)
-        type(mesh_t), intent(in) :: mesh
-        character(len=:), allocatable :: list
-        integer :: i
-        list = ''
-        if (.not. allocated(mesh%node_sets)) return
-        do i = 1, size(mesh%node_sets)
-            if (i > 1) list = list // ', '
-            list = list // mesh%node_sets(i)%name
-        end do
-    end function node_set_names
-
-    function element_set_names(mesh) result(list)
-        type(mesh_t), intent(in) :: mesh
-        character(len=:), allocatable :: list
-        integer :: i
-        list = ''
-        if (.not. allocated(mesh%element_sets)) return
-        do i = 1, size(mesh%element_sets)
-            if (i > 1) list = list // ', '
-            list = list // mesh%element_sets(i)%name
-        end do
-    end function element_set_names
 
     pure function at(line) result(text)
         integer, intent(in) :: line

@@ -4,7 +4,7 @@
 !> checks and the scene reference all come from this one table.
 module flexmbs_io_scene_schema
     use flexmbs_core_kinds, only: wp
-    use flexmbs_core_text, only: lower
+    use flexmbs_core_text, only: lower, nearest
     implicit none
     private
 
@@ -287,7 +287,7 @@ module flexmbs_io_scene_schema
         'material', 'rigid_body', 'marker', 'joint', 'driver', 'rigid_chain']
 
     public :: find_group, find_var, known_vars, group_vars, string_length, choice_list, &
-        is_choice, nearest, did_you_mean, split_choices
+        is_choice, did_you_mean, split_choices
 
 contains
 
@@ -387,26 +387,6 @@ contains
         end do
     end function choice_list
 
-    !> The candidate closest to `word` by edit distance (insertions,
-    !> deletions, substitutions, transpositions), '' when none is close:
-    !> at most a third of the word's length, and at least 1, may differ.
-    pure function nearest(word, candidates) result(best)
-        character(len=*), intent(in) :: word, candidates(:)
-        character(len=:), allocatable :: best
-        integer :: i, d, dbest
-        best = ''
-        if (len(word) > 64) return
-        dbest = max(1, len(word) / 3) + 1
-        do i = 1, size(candidates)
-            if (len_trim(candidates(i)) == 0) cycle
-            d = edit_distance(lower(word), lower(trim(candidates(i))))
-            if (d < dbest) then
-                dbest = d
-                best = trim(candidates(i))
-            end if
-        end do
-    end function nearest
-
     !> ' (did you mean ''x''?)' or ''.
     pure function did_you_mean(word, candidates) result(hint)
         character(len=*), intent(in) :: word, candidates(:)
@@ -416,28 +396,4 @@ contains
         if (len(best) > 0 .and. best /= word) hint = ' (did you mean ''' // best // '''?)'
     end function did_you_mean
 
-    !> Optimal string alignment distance (Damerau–Levenshtein without
-    !> repeated edits of one substring).
-    pure integer function edit_distance(a, b) result(d)
-        character(len=*), intent(in) :: a, b
-        integer :: prev2(0:len(b)), prev(0:len(b)), row(0:len(b))
-        integer :: i, j, cost
-        prev2 = 0
-        prev = [(j, j = 0, len(b))]
-        row = 0
-        do i = 1, len(a)
-            row(0) = i
-            do j = 1, len(b)
-                cost = merge(0, 1, a(i:i) == b(j:j))
-                row(j) = min(prev(j) + 1, row(j - 1) + 1, prev(j - 1) + cost)
-                if (i > 1 .and. j > 1) then
-                    if (a(i:i) == b(j - 1:j - 1) .and. a(i - 1:i - 1) == b(j:j)) &
-                        row(j) = min(row(j), prev2(j - 2) + 1)
-                end if
-            end do
-            prev2 = prev
-            prev = row
-        end do
-        d = prev(len(b))
-    end function edit_distance
 end module flexmbs_io_scene_schema
