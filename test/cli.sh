@@ -217,9 +217,31 @@ printf "%s\n&flexible_body lengths = 1, 1, 1, divisions = 2, 1, 1 /\n&material y
     "$fb" > fb_cover.nml
 bad material-not-covering "fb_cover.nml: &material: elements: element 1 has no material" fb_cover.nml
 
-# I/O error: the output directory does not exist
-printf "%s\n&output file = 'no/such/dir/x.h5' /\n" "$sim" > io_error.nml
-expect io-error 4 "no/such/dir/x.h5: HDF5 cannot create the file" run io_error.nml --quiet
+# outputs that cannot be written where they are: bad input, found before
+# anything is built (a missing folder used to be found by HDF5, exit 4)
+printf "%s\n&output file = 'no/such/dir/x.h5' /\n" "$sim" > no_folder.nml
+bad output-no-folder \
+    "no_folder.nml: &output: file = 'no/such/dir/x.h5': the folder 'no/such/dir' does not exist" \
+    no_folder.nml
+mkdir -p out/folder
+printf "%s\n&output file = 'out/folder' /\n" "$sim" > out_folder.nml
+bad output-is-folder "'out/folder' is a folder, not a file" out_folder.nml
+sed -e "s#^&output#\&output table = 'table.md',#" "$root/inputs/van_der_pol.nml" > table.md
+untouched table-is-scene "table = 'table.md': writes 'table.md', the scene file itself" \
+    table.md run table.md --quiet
+printf "%s\n&output table = 'no/dir/t.md' /\n" "$sim" > table_folder.nml
+bad table-no-folder "&output: table = 'no/dir/t.md': the folder 'no/dir' does not exist" \
+    table_folder.nml
+# a FIFO as the scene: refused at once (reading it blocked until a writer came)
+mkfifo pipe.nml
+output=$(timeout 10 "$exe" run pipe.nml --quiet 2>&1)
+rc=$?
+if [ "$rc" -eq 2 ] && grep -qF "pipe.nml: not a regular file" <<<"$output"; then
+    pass scene-is-fifo
+else fail scene-is-fifo "exit $rc: $output"; fi
+# I/O error: the folder exists, the file cannot be made there
+printf "%s\n&output file = '/proc/flexmbs-cli.h5' /\n" "$sim" > io_error.nml
+expect io-error 4 "/proc/flexmbs-cli.h5: HDF5 cannot create the file" run io_error.nml --quiet
 
 # A driven four-bar (inputs/four_bar.nml) with every solver
 for s in radau5 ddassl ida mexax; do

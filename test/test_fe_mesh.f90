@@ -208,6 +208,14 @@ contains
         call expect('version', 'flexmbs-mesh 2' // nl, ':1: format version 2')
         call expect('truncated', head(1:index(head, '8 0 1 1') - 1), &
                     ':9: file ends where a node id is expected')
+        ! a count sizes nothing beyond what the file holds (2e9 nodes were
+        ! allocated first, 48 GB: a runtime error)
+        call expect('node-count', 'flexmbs-mesh 1' // nl // 'nodes 2000000000' // nl // &
+                    '1 0 0 0' // nl, ':3: file ends where a node id is expected')
+        call expect('element-count', head // 'elements hex8 1000000000' // nl // &
+                    '1 1 2 3 4 5 6 7 8' // nl, ':12: file ends where a element id is expected')
+        call expect('set-size', head // good_element // 'node_set base 2147483647' // nl // &
+                    '1 2 3 4' // nl, ':14: file ends where a node id of set ''base'' is expected')
         call expect('number', head(1:index(head, '2 1 0 0') - 1) // '2 1 x0 0' // nl, &
                     ':4: ''x0'' is not a number')
         call expect('range', head // 'elements hex8 1' // nl // '1 1 2 3 4 5 6 7 9' // nl, &

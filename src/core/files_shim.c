@@ -3,6 +3,19 @@
  * (./s.nml, ../in/s.nml, a link). */
 #include <sys/stat.h>
 
+/* What a path names, links followed: 0 nothing, 1 a regular file, 2 a
+ * folder, 3 anything else (a FIFO, a device, a socket). Reading a FIFO
+ * blocks until some writer opens it, and a device may never end, so only
+ * regular files are read as inputs or replaced as outputs. */
+int flexmbs_file_kind(const char *path)
+{
+    struct stat s;
+    if (stat(path, &s) != 0) return 0;
+    if (S_ISREG(s.st_mode)) return 1;
+    if (S_ISDIR(s.st_mode)) return 2;
+    return 3;
+}
+
 /* 1 when both paths exist and are the same file, 0 otherwise. */
 int flexmbs_same_file(const char *a, const char *b)
 {

@@ -51,6 +51,7 @@ contains
         type(mesh_t) :: work
         integer :: pos, nnode, nelem, i, a, k, id, nset
         character(len=:), allocatable :: word, name
+        character(len=256) :: message
         real(wp) :: x(3)
         call read_text_file(path, text, status)
         if (.not. status%ok()) return
@@ -72,7 +73,14 @@ contains
             call fail('node count must be positive')
             return
         end if
-        allocate (work%x(3, nnode))
+        ! A count sizes nothing beyond what the file can hold (a corrupt
+        ! header asked for 48 GB): a file too short for its count ends inside
+        ! the loop below, which says where.
+        allocate (work%x(3, min(nnode, (tok%n - pos) / 4 + 1)), stat=k, errmsg=message)
+        if (k /= 0) then
+            call fail('cannot allocate ' // int_text(nnode) // ' nodes: ' // trim(message))
+            return
+        end if
         do i = 1, nnode
             call next_int(id, 'node id')
             if (.not. status%ok()) return
@@ -106,7 +114,12 @@ contains
             call fail('element count must be positive')
             return
         end if
-        allocate (work%connectivity(work%nnode_element, nelem))
+        allocate (work%connectivity(work%nnode_element, min(nelem, (tok%n - pos) / &
+                  (1 + work%nnode_element) + 1)), stat=k, errmsg=message)
+        if (k /= 0) then
+            call fail('cannot allocate ' // int_text(nelem) // ' elements: ' // trim(message))
+            return
+        end if
         allocate (work%node_sets(0), work%element_sets(0))
         do i = 1, nelem
             call next_int(id, 'element id')
@@ -175,7 +188,11 @@ contains
                 return
             end if
             set%name = name
-            allocate (set%nodes(nset))
+            allocate (set%nodes(min(nset, tok%n - pos + 1)), stat=j, errmsg=message)
+            if (j /= 0) then
+                call fail('set ''' // name // ''': cannot allocate: ' // trim(message))
+                return
+            end if
             do j = 1, nset
                 call next_int(set%nodes(j), 'node id of set ''' // name // '''')
                 if (.not. status%ok()) return
@@ -198,7 +215,11 @@ contains
                 return
             end if
             set%name = name
-            allocate (set%elements(nset))
+            allocate (set%elements(min(nset, tok%n - pos + 1)), stat=j, errmsg=message)
+            if (j /= 0) then
+                call fail('set ''' // name // ''': cannot allocate: ' // trim(message))
+                return
+            end if
             do j = 1, nset
                 call next_int(set%elements(j), 'element id of set ''' // name // '''')
                 if (.not. status%ok()) return

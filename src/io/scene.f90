@@ -6,7 +6,8 @@
 module flexmbs_io_scene
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
-    use flexmbs_core_files, only: same_file
+    use flexmbs_core_files, only: same_file, file_kind, folder_of, file_missing, file_folder, &
+        file_special
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_options, only: dae_options_t
@@ -348,6 +349,10 @@ contains
         character(len=:), allocatable :: outcome
         real(wp), allocatable :: y_start(:)
 
+        ! no output may be one of the run's inputs, and each must be writable
+        ! where it is: checked before anything is built or created
+        call check_outputs(scene, status)
+        if (.not. status%ok()) return
         call build_problem(scene, problem, result%y, blocks, status, mechanical)
         if (.not. status%ok()) return
         result%q_first = 1
@@ -374,9 +379,6 @@ contains
             return
         end if
 
-        ! no output may be one of the run's inputs; checked before any file is created
-        call check_outputs(scene, status)
-        if (.not. status%ok()) return
         ! ParaView output is checked before any file is created
         if (len_trim(scene%vtk) > 0) then
             call setup_vtk()
@@ -435,6 +437,9 @@ contains
             call solver%integrate(problem, result%t, result%y, scene%t_end, options, &
                                   result%stats, status, sinks)
         end select
+        ! a solver that refuses its settings names itself: say which file set them
+        if (status%code == status_bad_input .and. index(status%message, scene%path) /= 1) &
+            status%message = scene%path // ': &solver: ' // status%message
         if (status%ok()) call record_energy(result%y, result%energy_end)
         result%has_energy = result%has_energy .and. status%ok()
 
@@ -548,29 +553,73 @@ contains
         end subroutine record_energy
     end subroutine run_scene
 
-    !> No output of the run (the HDF5 file, the ParaView collection) may be
-    !> one of its inputs (the scene file, a mesh file), however the paths are
-    !> spelled: the input would be overwritten.
+    !> No output of the run (the HDF5 file, the ParaView files, the table) may
+    !> be one of its inputs (the scene file, a mesh file), however the paths
+    !> are spelled: the input would be overwritten. And each must be writable
+    !> where it is: its folder exists, and it is a regular file or not there
+    !> yet (HDF5 cannot make a folder its file, a FIFO would block the run, a
+    !> device swallow it). Bad input, found before anything is built, so that
+    !> a path mistake costs no computing and leaves no file.
     subroutine check_outputs(scene, status)
         type(scene_input_t), intent(in) :: scene
         type(status_t), intent(inout) :: status
-        if (len(scene%output_file) > 0) call against_inputs('file', scene%output_file)
-        if (len_trim(scene%vtk) > 0) call against_inputs('vtk', trim(scene%vtk) // '.pvd')
+        if (len(scene%output_file) > 0) call check('file', scene%output_file, &
+                                                   scene%output_file)
+        if (len_trim(scene%vtk) > 0) call check('vtk', trim(scene%vtk), trim(scene%vtk) // '.pvd')
+        if (len_trim(scene%table) > 0) call check('table', trim(scene%table), trim(scene%table))
     contains
-        subroutine against_inputs(name, output)
-            character(len=*), intent(in) :: name, output
+        !> `output`, the file that variable `name` = `value` makes.
+        subroutine check(name, value, output)
+            character(len=*), intent(in) :: name, value, output
+            character(len=:), allocatable :: where, folder
             if (.not. status%ok()) return
-            if (same_file(output, scene%path)) then
-                call status%set(status_bad_input, scene%path // ': &output: ' // name // &
-                    ': ''' // output // ''' is the scene file itself: refused, it would be &
-                    &overwritten')
+            where = scene%path // ': &output: ' // name // ' = ''' // value // ''': '
+            folder = folder_of(output)
+            if (same_file(output, scene%path) .or. vtk_file_of(name, value, scene%path)) then
+                call status%set(status_bad_input, where // 'writes ''' // output // &
+                    ''', the scene file itself: refused, it would be overwritten')
             else if (len_trim(scene%body%mesh_file) > 0) then
-                if (same_file(output, trim(scene%body%mesh_file))) &
-                    call status%set(status_bad_input, scene%path // ': &output: ' // name // &
-                        ': ''' // output // ''' is the mesh file ''' // &
-                        trim(scene%body%mesh_file) // ''': refused, it would be overwritten')
+                if (same_file(output, trim(scene%body%mesh_file)) .or. &
+                    vtk_file_of(name, value, trim(scene%body%mesh_file))) &
+                    call status%set(status_bad_input, where // 'writes ''' // output // &
+                        ''', which is the mesh file ''' // trim(scene%body%mesh_file) // &
+                        ''': refused, it would be overwritten')
             end if
-        end subroutine against_inputs
+            if (.not. status%ok()) return
+            if (len(folder) > 0 .and. file_kind(folder) == file_missing) then
+                call status%set(status_bad_input, where // 'the folder ''' // folder // &
+                    ''' does not exist')
+            else if (len(folder) > 0 .and. file_kind(folder) /= file_folder) then
+                call status%set(status_bad_input, where // '''' // folder // &
+                    ''' is not a folder')
+            else if (file_kind(output) == file_folder) then
+                call status%set(status_bad_input, where // '''' // output // &
+                    ''' is a folder, not a file')
+            else if (file_kind(output) == file_special) then
+                call status%set(status_bad_input, where // '''' // output // &
+                    ''' is not a regular file (a FIFO, a device or a socket): refused')
+            end if
+        end subroutine check
+
+        !> `input` is one of the ParaView files PREFIX_NNNN.vtu or
+        !> PREFIX_bodies_NNNN.vtu that `vtk` = prefix writes.
+        logical function vtk_file_of(name, prefix, input)
+            character(len=*), intent(in) :: name, prefix, input
+            character(len=:), allocatable :: base, stem, middle
+            integer :: slash
+            vtk_file_of = .false.
+            if (name /= 'vtk') return
+            slash = index(input, '/', back=.true.)
+            base = input(slash + 1:)
+            slash = index(prefix, '/', back=.true.)
+            stem = prefix(slash + 1:) // '_'
+            if (len(base) < len(stem) + 5) return
+            if (base(1:len(stem)) /= stem .or. base(len(base) - 3:) /= '.vtu') return
+            middle = base(len(stem) + 1:len(base) - 4)
+            if (index(middle, 'bodies_') == 1) middle = middle(8:)
+            if (len(middle) == 0 .or. verify(middle, '0123456789') /= 0) return
+            vtk_file_of = same_file(input, prefix(1:slash) // base)
+        end function vtk_file_of
     end subroutine check_outputs
 
     subroutine delete_file(path)
