@@ -14,7 +14,7 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := run
 
 APT_PACKAGES := gfortran libsundials-dev libsundials-fortran-dev libsuitesparse-dev \
-                liblapack-dev libopenblas-dev libhdf5-dev libmumps-seq-dev
+                liblapack-dev libopenblas-dev libhdf5-dev libmumps-seq-dev python3-h5py
 BUILD        := $(CURDIR)/build
 VENV         := $(BUILD)/venv
 # One set of flags for every fpm call: changing them makes fpm rebuild everything.
@@ -90,7 +90,8 @@ run: build
 
 # Root suites, then the classic fixed-form drivers linked against the
 # installed library exactly as a user links them, then the command-line
-# checks of test/cli.sh; one summary line last.
+# checks of test/cli.sh and the fuzzer of the scene input (test/fuzz, about
+# a thousand mutated scenes, two at a time); one summary line last.
 test: deps
 	@mkdir -p $(BUILD)
 	@set -o pipefail; $(FPM) test --profile debug 2>&1 | tee $(BUILD)/test-root.log; \
@@ -100,7 +101,10 @@ test: deps
 	    cat $(BUILD)/test-legacy.log
 	@set -o pipefail; FPM="$(FPM)" bash test/cli.sh 2>&1 | tee $(BUILD)/test-cli.log; \
 	    echo "exit $$?" >> $(BUILD)/test-cli.log
-	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log $(BUILD)/test-cli.log
+	@set -o pipefail; FPM="$(FPM)" bash test/fuzz/run.sh 2>&1 | tee $(BUILD)/test-fuzz.log; \
+	    echo "exit $$?" >> $(BUILD)/test-fuzz.log
+	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log $(BUILD)/test-cli.log \
+	    $(BUILD)/test-fuzz.log
 
 PROFILE     ?= debug
 PREFIX_USED ?= $(PREFIX_DEBUG)
