@@ -22,6 +22,9 @@ Asserted for every case:
   exit-2-no-output an exit 2 leaves no new file anywhere in the case folder
   exit-2-message   an exit 2 says why, naming the scene file as given, in
                    flexmbs's words (no raw namelist or runtime message)
+  own-messages     whatever the exit, every line on standard error is
+                   flexmbs's own ('flexmbs: ...'): no compiler or library
+                   note (gfortran's floating-point note, HDF5-DIAG, ...)
   valid-output     an exit 0 or 3 leaves a readable HDF5 file where the
                    variant says (h5py when importable, else its signature)
   invalid-refused  a variant that the operator makes invalid (an unknown
@@ -1132,6 +1135,10 @@ def judge(r, work):
         r.problems['inputs-unchanged'] = 'changed: ' + ', '.join(r.changed)
     if r.crash:
         return
+    foreign = [line for line in r.stderr.split('\n') if line.strip()
+               and not line.startswith('flexmbs: ')]
+    if foreign:
+        r.problems['own-messages'] = 'not flexmbs\'s: %r' % foreign[0][:200]
     if r.code == 2:
         if r.outputs:
             r.problems['exit-2-no-output'] = 'written: ' + ', '.join(r.outputs)
@@ -1153,7 +1160,7 @@ def judge(r, work):
 
 
 PROPERTIES = ['no-crash', 'no-hang', 'inputs-unchanged', 'exit-2-no-output', 'exit-2-message',
-              'valid-output', 'invalid-refused', 'stages', 'tally']
+              'own-messages', 'valid-output', 'invalid-refused', 'stages', 'tally']
 
 
 def find_exe():
