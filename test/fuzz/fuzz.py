@@ -50,9 +50,10 @@ Usage:
     python3 test/fuzz/fuzz.py --case 123 --show    # print its files, run nothing
 Without --exe the debug build is used (found through fpm, as test/cli.sh
 does); h5py comes with Debian's python3-h5py (test/fuzz/run.sh picks the
-python3 that has it). Known open defects: test/fuzz/KNOWN.md. Saved reproducers in test/fuzz/cases/ (NAME.nml, optional NAME.mesh;
-a first line `! expect: exit 2` or `! expect: run`) run after the generated
-cases, as cases 'cases/NAME'.
+python3 that has it). Known open defects: test/fuzz/KNOWN.md. Saved
+reproducers in test/fuzz/cases/ (NAME.nml, optional NAME.mesh for its
+'bar.mesh'; a first line `! expect: exit 2` or `! expect: run`) run after
+the generated cases, as cases 'cases/NAME'.
 """
 
 import argparse
