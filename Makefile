@@ -90,8 +90,9 @@ run: build
 
 # Root suites, then the classic fixed-form drivers linked against the
 # installed library exactly as a user links them, then the command-line
-# checks of test/cli.sh and the signals of test/kill.sh (python3-h5py
-# reads the files they leave); one summary line last.
+# checks of test/cli.sh, the signals of test/kill.sh (python3-h5py reads
+# the files they leave) and the fuzzer of the scene input (test/fuzz, about
+# a thousand mutated scenes, two at a time); one summary line last.
 test: deps
 	@mkdir -p $(BUILD)
 	@set -o pipefail; $(FPM) test --profile debug 2>&1 | tee $(BUILD)/test-root.log; \
@@ -103,8 +104,10 @@ test: deps
 	    echo "exit $$?" >> $(BUILD)/test-cli.log
 	@set -o pipefail; FPM="$(FPM)" bash test/kill.sh 2>&1 | tee $(BUILD)/test-kill.log; \
 	    echo "exit $$?" >> $(BUILD)/test-kill.log
+	@set -o pipefail; FPM="$(FPM)" bash test/fuzz/run.sh 2>&1 | tee $(BUILD)/test-fuzz.log; \
+	    echo "exit $$?" >> $(BUILD)/test-fuzz.log
 	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log $(BUILD)/test-cli.log \
-	    $(BUILD)/test-kill.log
+	    $(BUILD)/test-kill.log $(BUILD)/test-fuzz.log
 
 PROFILE     ?= debug
 PREFIX_USED ?= $(PREFIX_DEBUG)

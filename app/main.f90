@@ -283,7 +283,7 @@ contains
     !> Message on standard error and the exit code of the status.
     subroutine stop_on(status)
         type(status_t), intent(in) :: status
-        write (error_unit, '(a)') 'flexmbs: ' // status%text()
+        call say(status%text())
         select case (status%code)
         case (status_bad_input)
             call finish(exit_bad_input)
@@ -295,6 +295,27 @@ contains
             call finish(exit_solver)
         end select
     end subroutine stop_on
+
+    !> A message on standard error, each line headed 'flexmbs: '; control
+    !> characters a file may carry (escape sequences) shown as '?'.
+    subroutine say(text)
+        character(len=*), intent(in) :: text
+        character(len=len(text)) :: clean
+        integer :: i, start
+        clean = text
+        do i = 1, len(clean)
+            if (clean(i:i) == new_line('a')) cycle
+            if (iachar(clean(i:i)) < 32 .or. iachar(clean(i:i)) == 127) clean(i:i) = '?'
+        end do
+        start = 1
+        do i = 1, len(clean) + 1
+            if (i <= len(clean)) then
+                if (clean(i:i) /= new_line('a')) cycle
+            end if
+            write (error_unit, '(a)') 'flexmbs: ' // clean(start:i - 1)
+            start = i + 1
+        end do
+    end subroutine say
 
     !> 128 + the number of the signal that stopped the run (the status's
     !> reason; a sweep's processes may have caught it instead of this one).
@@ -366,7 +387,8 @@ contains
         integer, intent(in) :: code
         flush (output_unit)
         flush (error_unit)
-        if (code == 0) stop
+        ! quiet: a plain STOP added gfortran's note on the floating-point
+        ! flags still raised to the standard error of successful runs
         stop code, quiet = .true.
     end subroutine finish
 end program flexmbs_main

@@ -211,6 +211,14 @@ contains
                     ':2: 8 nodes declared, but the file holds only 28 more values')
         call expect('truncated_set', head // good_element // 'node_set base 4' // nl // &
                     '1 2 3' // nl, ':13: 4 set members declared, but the file holds only 3 more')
+        ! a count sizes nothing beyond what the file holds (2e9 nodes were
+        ! allocated first, 48 GB: a runtime error)
+        call expect('node-count', 'flexmbs-mesh 1' // nl // 'nodes 2000000000' // nl // &
+                    '1 0 0 0' // nl, ':2: 2000000000 nodes declared, but the file holds only 4')
+        call expect('element-count', head // 'elements hex8 1000000000' // nl // &
+                    '1 1 2 3 4 5 6 7 8' // nl, ':11: 1000000000 elements declared, but the file')
+        call expect('set-size', head // good_element // 'node_set base 2147483647' // nl // &
+                    '1 2 3 4' // nl, ':13: 2147483647 set members declared, but the file holds')
         call expect('number', head(1:index(head, '2 1 0 0') - 1) // '2 1 x0 0' // &
                     head(index(head, '2 1 0 0') + 7:), ':4: ''x0'' is not a number')
         call expect('range', head // 'elements hex8 1' // nl // '1 1 2 3 4 5 6 7 9' // nl, &

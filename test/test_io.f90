@@ -766,9 +766,9 @@ contains
         call expect(error, parse_status(body_scene('', tip // '''xmax_layer'' /' // nl // &
             '&material name = ''b'', youngs_modulus = 1, density = 1, elements = ' // &
             '''xmax_layer'' /')), '&material: elements = ''xmax_layer'': the same set as ' // &
-            '&material ''tip'' (line 3)')
+            '&material ''tip'' at line 3 (line 4)')
         call expect(error, parse_status(body_scene('', soft() // soft())), &
-            '&material: name = ''soft'': also the name of the &material (line 3)')
+            '&material: name = ''soft'': also the name of the &material at line 3 (line 4)')
         call expect(error, parse_status(body_scene(', load = 0, 0, 1', soft())), &
             '&flexible_body: load = 0, 0, 1: needs load_set (the node set that carries it)')
         call expect(error, parse_status(body_scene(', load_set = ''xmax''', soft())), &

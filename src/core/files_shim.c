@@ -33,13 +33,22 @@ int flexmbs_file_kind(const char *path, long long *size)
 }
 
 #include <unistd.h>
+#include <sys/resource.h>
 
-/* The machine's physical memory in bytes, or -1 when unknown. */
+/* The memory this process may use in bytes: the machine's physical memory,
+ * or less when a resource limit (ulimit -v, -d) says so; -1 when unknown. */
 long long flexmbs_physical_memory(void)
 {
     long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
+    long long bytes;
+    struct rlimit lim;
     if (pages <= 0 || size <= 0) return -1;
-    return (long long)pages * (long long)size;
+    bytes = (long long)pages * (long long)size;
+    if (getrlimit(RLIMIT_AS, &lim) == 0 && lim.rlim_cur != RLIM_INFINITY &&
+        (long long)lim.rlim_cur < bytes) bytes = (long long)lim.rlim_cur;
+    if (getrlimit(RLIMIT_DATA, &lim) == 0 && lim.rlim_cur != RLIM_INFINITY &&
+        (long long)lim.rlim_cur < bytes) bytes = (long long)lim.rlim_cur;
+    return bytes;
 }
 
 /* The absolute path without links, '.' or '..' in `out` (size n): the

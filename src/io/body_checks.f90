@@ -6,7 +6,7 @@ module flexmbs_io_body_checks
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_text, only: int_text, real_text
     use flexmbs_core_resources, only: physical_memory, bytes_text
-    use flexmbs_io_input_errors, only: input_errors_t, at_line
+    use flexmbs_io_input_errors, only: input_errors_t, at_other
     use flexmbs_io_scene_lexer, only: entry_t, has_entry, entry_index
     use flexmbs_io_scene_values, only: value_error, required_error
     use flexmbs_io_scene_input, only: scene_input_t
@@ -100,12 +100,12 @@ contains
                 do j = 1, i - 1
                     if (scene%materials(j)%name == m%name) then
                         call value_error(errors, entries, mat, 'name', 'also the name of the &
-                            &&material' // at_line(scene%materials(j)%line), i)
+                            &&material' // at_other(scene%materials(j)%line), i)
                     else if (scene%materials(j)%elements == m%elements .and. &
                              len_trim(m%elements) > 0) then
                         call value_error(errors, entries, mat, 'elements', 'the same set as &
                             &&material ''' // trim(scene%materials(j)%name) // '''' // &
-                            at_line(scene%materials(j)%line), i)
+                            at_other(scene%materials(j)%line), i)
                     else if (scene%materials(j)%elements == m%elements) then
                         call errors%add('&material ''' // trim(m%name) // ''': elements: not &
                             &given here nor in &material ''' // trim(scene%materials(j)%name) &

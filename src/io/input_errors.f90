@@ -26,7 +26,7 @@ module flexmbs_io_input_errors
         procedure :: to_status => errors_to_status
     end type input_errors_t
 
-    public :: excerpt, at_line
+    public :: excerpt, at_line, at_other
 
 contains
 
@@ -96,4 +96,14 @@ contains
         write (buf, '(i0)') line
         text = ' (line ' // trim(buf) // ')'
     end function at_line
+
+    !> ' at line n': where the other group of a clash starts (a message's
+    !> own '(line m)' is its value's).
+    pure function at_other(line) result(text)
+        integer, intent(in) :: line
+        character(len=:), allocatable :: text
+        character(len=24) :: buf
+        write (buf, '(i0)') line
+        text = ' at line ' // trim(buf)
+    end function at_other
 end module flexmbs_io_input_errors

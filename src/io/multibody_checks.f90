@@ -7,7 +7,7 @@
 module flexmbs_io_multibody_checks
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_text, only: int_text
-    use flexmbs_io_input_errors, only: input_errors_t, excerpt, at_line
+    use flexmbs_io_input_errors, only: input_errors_t, excerpt, at_other
     use flexmbs_io_scene_schema, only: did_you_mean, len_name
     use flexmbs_io_scene_lexer, only: entry_t, has_entry
     use flexmbs_io_scene_values, only: value_error, required_error
@@ -45,11 +45,11 @@ contains
                 do j = 1, i - 1
                     if (scene%chain(j)%name == b%parent) found = .true.
                     if (scene%chain(j)%name == b%name) call bad('name', i, &
-                        'also the name of the &rigid_chain' // at_line(scene%chain(j)%line))
+                        'also the name of the &rigid_chain' // at_other(scene%chain(j)%line))
                 end do
                 if (.not. found) call bad('parent', i, 'must be ''ground'' or a body of an &
                     &earlier &rigid_chain group' // did_you_mean(trim(b%parent), &
-                    [scene%chain(1:i - 1)%name, 'ground']))
+                    [character(len=len_name) :: scene%chain(1:i - 1)%name, 'ground']))
                 if (b%joint == 'spherical' .and. .not. norm2(b%rotation_axis) > 0.0_wp) &
                     call bad('rotation_axis', i, 'must not be zero')
                 if (.not. norm2(b%joint_axis) > 0.0_wp) call bad('joint_axis', i, &
@@ -105,7 +105,7 @@ contains
                 do j = 1, i - 1
                     if (scene%rigid_bodies(j)%name == b%name) call value_error(errors, entries, &
                         'rigid_body', 'name', 'also the name of the &rigid_body' // &
-                        at_line(scene%rigid_bodies(j)%line), i)
+                        at_other(scene%rigid_bodies(j)%line), i)
                 end do
                 if (b%name == 'ground') call value_error(errors, entries, 'rigid_body', 'name', &
                     '''ground'' is reserved', i)
@@ -190,7 +190,7 @@ contains
                 do j = 1, i - 1
                     if (scene%markers(j)%name == m%name) call value_error(errors, entries, &
                         'marker', 'name', 'also the name of the &marker' // &
-                        at_line(scene%markers(j)%line), i)
+                        at_other(scene%markers(j)%line), i)
                 end do
             end associate
         end subroutine check_marker

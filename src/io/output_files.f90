@@ -10,7 +10,8 @@
 module flexmbs_io_output_files
     use flexmbs_core_kinds, only: i8
     use flexmbs_core_status, only: status_t, status_bad_input
-    use flexmbs_core_files, only: same_file, same_path, file_kind, file_missing, file_folder
+    use flexmbs_core_files, only: same_file, same_path, file_kind, file_missing, file_folder, &
+        file_fifo, file_device, file_other
     use flexmbs_io_hdf5_sink, only: hdf5_result_check
     use flexmbs_io_vtk_sink, only: vtk_file_ours
     use flexmbs_io_table, only: table_file_ours
@@ -54,6 +55,7 @@ contains
         logical, intent(in) :: force  !! replace files that are not flexmbs's own
         type(status_t), intent(inout) :: status
         integer :: i, j
+        integer(i8) :: bytes
         if (.not. status%ok()) return
         do i = 1, size(outputs)
             associate (out => outputs(i))
@@ -72,6 +74,12 @@ contains
                         ''' are the same file: refused, one would overwrite the other')
                     return
                 end do
+                ! a FIFO is never written, even with --force: opening it blocks
+                if (file_kind(out%path, bytes) == file_fifo) then
+                    call status%set(status_bad_input, where // out%name // ': ''' // &
+                        out%path // ''' is a FIFO: refused (even with --force)')
+                    return
+                end if
                 if (force) cycle
                 call check_replace(out)
                 if (.not. status%ok()) return
@@ -92,6 +100,10 @@ contains
             case (file_folder)
                 ours = .false.
                 reason = 'is a folder'
+            case (file_fifo, file_device, file_other)
+                ! never opened: reading a FIFO blocks until a writer comes
+                ours = .false.
+                reason = 'is not a regular file (a FIFO, device or socket)'
             case default
                 select case (out%kind)
                 case (output_hdf5)

@@ -172,8 +172,7 @@ contains
             name = lower(variable_word(clean, pos))
             call skip_blank(clean, pos, line)
             ! a word without '=' on the line of the value before it: a unit?
-            if (len(previous) > 0 .and. p == previous_line .and. (pos > n .or. &
-                                                         .not. starts_with_equals(clean, pos))) then
+            if (len(previous) > 0 .and. p == previous_line .and. .not. equals_at(clean, pos)) then
                 if (skip) then
                     continue
                 else if (previous_quoted) then
@@ -279,11 +278,13 @@ contains
         end do
     end subroutine read_group_body
 
-    pure logical function starts_with_equals(text, pos)
+    !> text(pos:pos) is '=' (false past the end).
+    pure logical function equals_at(text, pos)
         character(len=*), intent(in) :: text
         integer, intent(in) :: pos
-        starts_with_equals = text(pos:pos) == '='
-    end function starts_with_equals
+        equals_at = .false.
+        if (pos <= len(text)) equals_at = text(pos:pos) == '='
+    end function equals_at
 
     !> ' (in SI units: m)' from the schema, or ''.
     pure function unit_hint(group, name) result(hint)
