@@ -411,5 +411,32 @@ sed -e "s/n_output *= *[0-9]*/n_output = 1000000000/" "$root/inputs/five_body.nm
 bad output-beyond-disk "&output: n_output = 1000000000: the HDF5 file 'many_outputs.h5' would need ~" \
     many_outputs.nml
 
+# issue 16's remaining defects, each as the user met it:
+# an output grid beyond memory died in an allocation
+sed -e "s/n_output *= *[0-9]*/n_output = 2147483647/" "$root/inputs/van_der_pol.nml" > n_huge.nml
+bad n-output-beyond-memory "&output: n_output = 2147483647: 2.147484E+09 output times need ~17.2 GB" \
+    n_huge.nml
+# a marker whose x axis is its z axis ran
+sed -e "s/&marker name = 'A1', body = 'crank',   position = -0.05, 0.0, 0.0 \//\&marker name = 'A1', body = 'crank', position = -0.05, 0.0, 0.0, z_axis = 0, 0, 1, x_axis = 0, 0, 2 \//" \
+    "$root/inputs/four_bar.nml" > parallel_axes.nml
+bad marker-axes-parallel "&marker: x_axis = 0, 0, 2: must not be parallel to z_axis" parallel_axes.nml
+# inputs of 3 GiB and 4.5 GiB (sparse files): 'cannot determine its size' and
+# a 4.5 GiB file read as 512 MiB before sizes were counted in 64 bits
+truncate -s 3G big3.nml && truncate -s 4500M big45.nml
+expect input-3-gib 2 "big3.nml: 3.2 GB, larger than an input can be (2 GiB)" run big3.nml --quiet
+expect input-4-5-gib 2 "big45.nml: 4.7 GB, larger than an input can be (2 GiB)" run big45.nml --quiet
+rm -f big3.nml big45.nml
+# a mesh file relative to the scene's folder, run from elsewhere (it was
+# resolved against the working directory)
+mkdir -p scenes/m
+cp "$root/inputs/meshes/bar_hex8.mesh" scenes/m/bar.mesh
+printf '%s\n' "&simulation problem = 'flexible_body', t_end = 1e-3 /" \
+    "&flexible_body mesh_file = 'bar.mesh', fixed = 'clamp' /" \
+    "&material youngs_modulus = 7e5, density = 920 /" \
+    "&output file = 'r.h5', n_output = 2 /" > scenes/m/bar.nml
+expect mesh-relative-to-scene 0 "radau5: NST=" run scenes/m/bar.nml --quiet
+if [ -s scenes/m/r.h5 ]; then pass output-relative-to-scene
+else fail output-relative-to-scene "scenes/m/r.h5 was not written: $(ls scenes/m)"; fi
+
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]
