@@ -6,6 +6,7 @@
 module test_scene_input
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_files, only: read_text_file
     use flexmbs_linalg_linear_solver, only: linear_solver_names
     use flexmbs_io_namelist, only: scene_input_t, parse_scene
     use flexmbs_core_text, only: nearest
@@ -32,7 +33,8 @@ contains
                  new_test('tolerance_floor', test_tolerance_floor), &
                  new_test('rules', test_rules), &
                  new_test('schema_defaults', test_schema_defaults), &
-                 new_test('paths_relative_to_scene', test_relative_paths)]
+                 new_test('paths_relative_to_scene', test_relative_paths), &
+                 new_test('schema_documented', test_schema_documented)]
     end function collect_scene_input
 
     !> Three mistakes in three groups: three lines, each naming its variable.
@@ -227,6 +229,21 @@ contains
         call check(error, scene%output_file == 's.h5', 'default in the working directory: ' // &
                    scene%output_file)
     end subroutine test_relative_paths
+
+    !> Every variable of the schema is in the README's scene reference.
+    subroutine test_schema_documented(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(status_t) :: status
+        character(len=:), allocatable :: readme
+        integer :: i
+        call read_text_file('README.md', readme, status)
+        call check(error, status%ok(), 'README.md: ' // status%text())
+        if (allocated(error)) return
+        do i = 1, size(schema)
+            call check(error, index(readme, '`' // trim(schema(i)%name) // '`') > 0, &
+                       'README lacks &' // trim(schema(i)%group) // ' ' // trim(schema(i)%name))
+        end do
+    end subroutine test_schema_documented
 
     ! ------------------------------------------------------------------
 
