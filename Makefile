@@ -191,6 +191,15 @@ extremes: deps
 	@bin=$$($(FPM) run --profile release flexmbs --runner echo 2>/dev/null | tail -1); \
 	OPENBLAS_NUM_THREADS=1 bash inputs/paper/extremes.sh $$bin results/extremes
 
+# A one-node Slurm on this machine (munged, slurmctld, slurmd in a private
+# temporary folder, on ports of their own; test/cluster/slurm.sh) runs job
+# arrays, a failed and a cancelled task and a dependent job with the debug
+# flexmbs (test/cluster/run.sh, well under a minute); docs/cluster.md.
+.PHONY: test-cluster
+test-cluster:
+	@$(MAKE) --no-print-directory deps EXTRA_PACKAGES="slurm-wlm munge"
+	@FPM="$(FPM)" bash test/cluster/run.sh
+
 bench: deps
 	$(FPM) build --profile release
 	bash bench/run.sh

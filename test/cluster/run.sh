@@ -1,0 +1,176 @@
+#!/usr/bin/env bash
+# The cluster test: a one-node Slurm started by test/cluster/slurm.sh runs
+#  - a job array of 4 tasks, each writing its task id; task 1 runs
+#    `flexmbs --version`, task 2 a small scene (the same output as run here,
+#    apart from the CPU and wall times);
+#  - a job array of 3 tasks: one succeeds, one exits 3, one is cancelled
+#    while running (scancel JOB_3), and a job that depends on the array
+#    (afterany, as a merge job will) runs once all three have ended and
+#    sees which are missing;
+# then the daemons stop and leave nothing behind.
+#
+#   bash test/cluster/run.sh [path/to/flexmbs]
+#
+# Without an argument the debug build is used (built if needed). Every wait
+# is a poll with a time limit. The last line is `N passed, M failed`; the
+# exit status is non-zero on failures. `make test-cluster` installs Slurm
+# and munge and runs it.
+set -u
+. "$(dirname "$0")/../executable.sh" cluster "$@"
+. "$root/test/cluster/slurm.sh"
+passed=0
+failed=0
+
+pass() { passed=$((passed + 1)); echo "pass cluster/$1"; }
+fail() { failed=$((failed + 1)); echo "FAIL cluster/$1: $2"; }
+summary() { echo "${passed} passed, ${failed} failed"; [ "$failed" -eq 0 ]; }
+
+# field JOB NAME: NAME's value in `scontrol show job JOB` (one task of an
+# array as JOB_TASK).
+field() {
+    scontrol -o show job "$1" 2>/dev/null | tr ' ' '\n' | sed -n "s/^$2=//p" | head -n 1
+}
+
+# state NAME JOB STATE EXITCODE: the job ended in STATE with EXITCODE.
+state() {
+    local s e
+    s=$(field "$2" JobState)
+    e=$(field "$2" ExitCode)
+    if [ "$s" = "$3" ] && [ "$e" = "$4" ]; then
+        pass "$1"
+    else
+        fail "$1" "job $2 is '$s' exit '$e', expected '$3' exit '$4'"
+    fi
+}
+
+t0=$(date +%s)
+if cluster_start 60; then
+    pass "start ($(($(date +%s) - t0)) s, $FLEXMBS_SLURM_DIR)"
+else
+    fail start "the cluster did not come up (messages above)"
+    summary
+    exit 1
+fi
+cluster_dir=$FLEXMBS_SLURM_DIR
+daemons=$(cat "$cluster_dir"/run/*.child)
+node=$(sinfo -h -N -o '%N %T %c' 2>&1)
+if [ "$node" = "$(hostname -s) idle 2" ]; then pass node-idle-2-cpus; else fail node-idle-2-cpus "$node"; fi
+
+work=$cluster_dir/work
+mkdir -p "$work/a" "$work/b" && cd "$work" || exit 1
+
+# the small scene of test/cli.sh
+printf '%s\n%s\n%s\n' "&simulation problem = 'van_der_pol', t_end = 2 /" \
+    "&solver rtol = 1e-4, atol = 1e-4, h0 = 1e-6 /" "&output file = 'vdp.h5' /" > vdp.nml
+
+# Array A: every task writes its id and its exit status to a/N.txt.
+cat > a.sh <<EOF
+#!/bin/bash
+t=\$SLURM_ARRAY_TASK_ID
+cd $(printf %q "$work/a") || exit 1
+echo "task \$t of \$SLURM_ARRAY_JOB_ID" > \$t.txt
+status=0
+case \$t in
+    1) $(printf %q "$exe") --version > version.txt 2>&1 || status=\$? ;;
+    2) mkdir -p scene && cd scene && cp ../../vdp.nml . \\
+           && $(printf %q "$exe") run vdp.nml --quiet > ../scene.txt 2>&1 || status=\$?
+       cd .. ;;
+esac
+echo "status \$status" >> \$t.txt
+exit \$status
+EOF
+
+# Array B: task 1 succeeds, task 2 fails (exit 3), task 3 waits (at most
+# 2 minutes) for the scancel.
+cat > b.sh <<EOF
+#!/bin/bash
+t=\$SLURM_ARRAY_TASK_ID
+cd $(printf %q "$work/b") || exit 1
+case \$t in
+    2) exit 3 ;;
+    3) touch started.3
+       for i in \$(seq 1200); do sleep 0.1; done ;;
+esac
+echo done > done.\$t
+EOF
+
+# The dependent job: what it finds when it starts.
+cat > dep.sh <<EOF
+#!/bin/bash
+cd $(printf %q "$work") || exit 1
+{ echo "queue: [\$(squeue -h -j \$1 -o %i)]"; ls b; } > dep.txt
+EOF
+
+a=$(sbatch --parsable --array=1-4 -J a -o "$work/a/slurm-%A_%a.out" a.sh 2>&1)
+b=$(sbatch --parsable --array=1-3 -J b -o "$work/b/slurm-%A_%a.out" b.sh 2>&1)
+dep=$(sbatch --parsable --dependency=afterany:"$b" -J dep -o "$work/dep.out" dep.sh "$b" 2>&1)
+if [[ "$a" =~ ^[0-9]+$ && "$b" =~ ^[0-9]+$ && "$dep" =~ ^[0-9]+$ ]]; then
+    pass submit
+else
+    fail submit "sbatch answered '$a', '$b', '$dep'"
+    summary
+    exit 1
+fi
+if [ "$(field "$dep" JobState)" = PENDING ]; then pass dependent-pending; else
+    fail dependent-pending "job $dep is '$(field "$dep" JobState)' before the array ended"; fi
+
+# cancel task 3 of B once it runs
+deadline=$(( $(date +%s) + 90 ))
+until [ -e b/started.3 ] || [ "$(date +%s)" -ge "$deadline" ]; do sleep 0.2; done
+if [ -e b/started.3 ]; then
+    scancel "${b}_3"
+    pass cancel-running-task
+else
+    fail cancel-running-task "task ${b}_3 did not start within 90 s: $(squeue 2>&1)"
+fi
+
+if cluster_wait 90 "$a" "$b" "$dep"; then pass "all-ended ($(($(date +%s) - t0)) s)"; else
+    fail all-ended "time limit"; fi
+
+# A: every task completed, wrote its id and status 0
+for t in 1 2 3 4; do
+    state "array-task-$t" "${a}_$t" COMPLETED 0:0
+    got=$(cat "a/$t.txt" 2>&1)
+    want=$(printf 'task %s of %s\nstatus 0' "$t" "$a")
+    if [ "$got" = "$want" ]; then pass "array-task-$t-output"; else
+        fail "array-task-$t-output" "a/$t.txt is '$got'; slurm output: $(cat "a/slurm-${a}_$t.out" 2>&1)"
+    fi
+done
+if grep -q "^flexmbs 0\." a/version.txt 2>/dev/null; then pass flexmbs-version; else
+    fail flexmbs-version "$(cat a/version.txt 2>&1)"; fi
+# the scene run in the job equals the one here, but for the times
+here=$(mkdir -p here && cd here && cp ../vdp.nml . && "$exe" run vdp.nml --quiet 2>&1)
+strip() { sed -E 's/ (CPU|WALL)=[^ ]*//g; s|trajectory: .*|trajectory|'; }
+if [ -s a/scene/vdp.h5 ] && grep -q 'y(1) =  1.7061611' a/scene.txt \
+    && [ "$(strip < a/scene.txt)" = "$(strip <<<"$here")" ]; then
+    pass flexmbs-scene-as-here
+else
+    fail flexmbs-scene-as-here "in the job: $(cat a/scene.txt 2>&1); here: $here"
+fi
+
+# B: the outcome of each task is visible to Slurm and in the files
+state array-ok "${b}_1" COMPLETED 0:0
+state array-failed "${b}_2" FAILED 3:0
+state array-cancelled "${b}_3" CANCELLED 0:15
+missing=""
+for t in 1 2 3; do [ -e "b/done.$t" ] || missing="$missing $t"; done
+if [ "$missing" = " 2 3" ]; then pass missing-tasks-detected; else
+    fail missing-tasks-detected "tasks without output:$missing, expected 2 3"; fi
+
+# the dependent job ran after all of B, and saw task 1's output only
+state dependent-ran "$dep" COMPLETED 0:0
+if [ "$(head -n 1 dep.txt 2>&1)" = "queue: []" ] && grep -qx done.1 dep.txt \
+    && ! grep -qE '^done\.[23]$' dep.txt; then
+    pass dependent-after-array
+else
+    fail dependent-after-array "dep.txt: $(cat dep.txt 2>&1); $(cat dep.out 2>&1)"
+fi
+
+# the stop leaves no daemon and no folder (but with FLEXMBS_SLURM_KEEP=1)
+cd "$root" || exit 1
+cluster_stop
+left=""
+for pid in $daemons; do _cluster_alive "$pid" && left="$left $pid"; done
+if [ -z "$left" ] && { [ ! -e "$cluster_dir" ] || [ "${FLEXMBS_SLURM_KEEP:-0}" = 1 ]; }; then pass "stop ($(($(date +%s) - t0)) s in all)"; else
+    fail stop "still running:$left; folder: $(ls -d "$cluster_dir" 2>&1)"; fi
+summary
