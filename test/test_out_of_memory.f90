@@ -8,6 +8,8 @@ module test_out_of_memory
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_ok, status_solver_failure
     use flexmbs_linalg_csc, only: csc_matrix_t
+    use flexmbs_fe_mesh, only: mesh_t
+    use flexmbs_fe_box_mesh, only: box_mesh
     use flexmbs_linalg_matrix, only: matrix_t, storage_dense, storage_identity, storage_none
     use flexmbs_linalg_dense, only: dense_solver_t
     use flexmbs_linalg_band, only: band_solver_t
@@ -43,6 +45,7 @@ contains
         tests = [new_test('dense_solver', test_dense_solver), &
                  new_test('band_solver', test_band_solver), &
                  new_test('csc_build_under_rlimit', test_csc_build), &
+                 new_test('box_mesh_under_rlimit', test_box_mesh), &
                  new_test('radau5_ddassl_ida', test_integrators)]
     end function collect_out_of_memory
 
@@ -121,6 +124,22 @@ contains
             index(status%text(), ' GB)') > 0, 'message: ' // status%text())
         call check(error, .not. a%is_built(), 'a failed build left a pattern')
     end subroutine test_csc_build
+
+    !> 1000³ hex8 elements: 1e9 nodes, 24 GB of coordinates.
+    subroutine test_box_mesh(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(mesh_t) :: mesh
+        type(status_t) :: status
+        if (.not. limit_address_space(256_c_long * 2**20)) then
+            call check(error, .false., 'cannot lower RLIMIT_AS')
+            return
+        end if
+        call box_mesh(mesh, 8, [1000, 1000, 1000], [1.0_wp, 1.0_wp, 1.0_wp], status)
+        call restore_address_space()
+        call check(error, status%code == status_solver_failure .and. &
+            index(status%text(), 'out of memory: box mesh node coordinates') == 1 .and. &
+            index(status%text(), ' GB)') > 0, 'message: ' // status%text())
+    end subroutine test_box_mesh
 
     !> Each integrator with its own dense matrix of order 1e7 (ida: M, whose
     !> dense J SUNDIALS would allocate later).
