@@ -41,6 +41,7 @@ program flexmbs_tests
     use test_study, only: collect_study
     use test_chain_coupling, only: collect_chain_coupling
     use test_sparse_formulation, only: collect_sparse_formulation
+    use test_out_of_memory, only: collect_out_of_memory
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -90,6 +91,7 @@ program flexmbs_tests
     call run_suite('chain_coupling', collect_chain_coupling(), filter, npassed, nfailed)
     call run_suite('sparse_formulation', collect_sparse_formulation(), filter, npassed, &
                    nfailed)
+    call run_suite('out_of_memory', collect_out_of_memory(), filter, npassed, nfailed)
     call run_suite('node_frame', collect_node_frame(), filter, npassed, nfailed)
     call run_suite('study', collect_study(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'

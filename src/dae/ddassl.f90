@@ -9,7 +9,8 @@
 !> later revision (§2.9). A `dae_problem_t` is integrated as G = M y' − F.
 module flexmbs_dae_ddassl
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_text, only: real_text, int_text
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         status_interrupted, reason_step_too_small, reason_max_steps, reason_singular_matrix, &
@@ -242,6 +243,7 @@ contains
         real(wp), allocatable :: ypw(:)
         type(status_t) :: local
         logical :: ddaini
+        integer :: stat
 
         if (problem%has_projection()) then
             call status%set(status_bad_input, 'ddassl: projection is refused, it disturbs ' // &
@@ -254,7 +256,11 @@ contains
         end if
         res%problem => problem
         res%n = problem%n
-        allocate (ypw(problem%n))
+        allocate (ypw(problem%n), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'ddassl initial derivative', int(problem%n, i8), 8)
+            return
+        end if
         ddaini = self%initial_derivative
         if (present(yp)) then
             if (size(yp) /= problem%n) then
@@ -301,7 +307,7 @@ contains
 
         real(wp), allocatable :: y0(:), ytmp(:)
         type(timer_t) :: timer
-        integer :: iout, nout
+        integer :: iout, nout, stat
         real(wp) :: dir, tout_h0, hmin
         logical :: want_steps, stop_requested, done
 
@@ -332,7 +338,15 @@ contains
             call self%begin(res, t, y, yp, tout_h0, options, status, initial_derivative)
         end if
         if (.not. allocated(self%work%phi)) return  ! bad input: nothing was set up
-        allocate (ytmp(size(y)))
+        if (allocated(self%dense%phi)) deallocate (self%dense%phi)
+        allocate (ytmp(size(y)), self%dense%phi(size(self%work%phi, 1), size(self%work%phi, 2)), &
+            stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'ddassl output work', &
+                size(y, kind=i8) + size(self%work%phi, kind=i8), 8)
+            call finish()
+            return
+        end if
 
         ! Outputs at t0.
         want_steps = .false.
@@ -443,12 +457,7 @@ contains
 
         subroutine copy_dense()
             associate (w => self%work)
-                if (.not. allocated(self%dense%phi)) then
-                    allocate (self%dense%phi, mold=w%phi)
-                else if (any(shape(self%dense%phi) /= shape(w%phi))) then
-                    deallocate (self%dense%phi)
-                    allocate (self%dense%phi, mold=w%phi)
-                end if
+                ! allocated with its shape after begin, so nothing is allocated here
                 self%dense%phi = w%phi
                 self%dense%psi = w%psi
                 self%dense%kold = w%kold
@@ -544,7 +553,7 @@ contains
         class(linear_solver_t), allocatable :: ls
         type(status_t) :: st
         type(status_t) :: model_failure !! the model's last refusal in this step
-        integer :: n, pmax, k, kold, ns, iphase, jcalc, nef, ncf, nsf, knew
+        integer :: n, pmax, k, kold, ns, iphase, jcalc, nef, ncf, nsf, knew, stat
         real(wp) :: tn, h, hold, cj, cjlast, cjold, s, hmin, hmax, dir, uround
         real(wp) :: t0, h_fixed, est, erkm1, terkm1, terk, r
         logical :: fd, ires_stop, direct
@@ -604,11 +613,14 @@ contains
                 call bad('fixed_step needs a positive h0')
                 return
             end if
-                        allocate (rtol(n), atol(n), wt(n), in_test(n), classes(n))
+            allocate (rtol(n), atol(n), wt(n), in_test(n), classes(n), scaled(n), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, 'ddassl weights and index classes', 6_i8 * n, 8)
+                return
+            end if
             call options%tolerances(rtol, atol)
             call res%index_classes(classes)
             in_test = .true.
-            allocate (scaled(n))
             scaled = .false.
             if (self%exclude_index23) then
                 in_test = classes < 2
@@ -644,11 +656,22 @@ contains
             if (fd) then
                 ! The difference PD is held as −PD and factored with shift 0.
                 bmat%storage = storage_dense
-                allocate (bmat%dense(n, n))
+                allocate (bmat%dense(n, n), stat=stat)
+                if (stat /= 0) then
+                    call out_of_memory(status, 'ddassl difference iteration matrix', &
+                        int(n, i8) * n, 8)
+                    return
+                end if
             end if
             call ls%init(amat, bmat, status)
             if (.not. status%ok()) return
-            allocate (phi(n, pmax + 1), delta(n), e(n), ytmp(n), yptmp(n), ysave(n), ypsave(n))
+            allocate (phi(n, pmax + 1), delta(n), e(n), ytmp(n), yptmp(n), ysave(n), ypsave(n), &
+                stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, 'ddassl history and workspace', &
+                    int(n, i8) * (pmax + 7), 8)
+                return
+            end if
             phi = 0.0_wp
             delta = 0.0_wp
             e = 0.0_wp

@@ -36,6 +36,7 @@ module flexmbs_dae_ida
         IDA_FIRST_RES_FAIL, IDA_LINESEARCH_FAIL, IDA_NO_RECOVERY, IDA_BAD_EWT
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_text, only: real_text, int_text
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         status_interrupted, reason_step_too_small, reason_max_steps, reason_singular_matrix, &
         reason_newton_failure, reason_user_function, reason_non_finite, reason_det_f
@@ -209,7 +210,7 @@ contains
         real(wp), allocatable, target :: yw(:), ypw(:), atolw(:), idw(:), dkyw(:)
         real(c_double) :: tret(1)
         integer(c_int) :: retval
-        integer :: n, nout, iout, retval_solve
+        integer :: n, nout, iout, retval_solve, stat
         integer, allocatable :: classes(:)
         logical, allocatable :: flags(:)
         real(wp) :: x, x_old, tout, posneg
@@ -230,14 +231,17 @@ contains
 
         data%problem => problem
         data%n = n
-        allocate (data%f(n), data%rtol(n), data%atol(n))
+        allocate (data%f(n), data%rtol(n), data%atol(n), yw(n), ypw(n), atolw(n), idw(n), &
+            dkyw(n), classes(n), flags(n), data%scaled(n), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'ida vectors', 11_i8 * n, 8)
+            return
+        end if
         call options%tolerances(data%rtol, data%atol)
-        allocate (yw(n), ypw(n), atolw(n), idw(n), dkyw(n), classes(n), flags(n))
         yw = y
         call problem%index_classes(classes)
         call problem%differential_flags(flags)
         suppress = self%suppress_alg .and. any(classes > 1)
-        allocate (data%scaled(n))
         call problem%correction_flags(data%scaled)
         data%scaled = data%scaled .and. suppress .and. classes > 1
         if (any(classes >= 3)) stats%warning = index3_warning('ida')
@@ -382,7 +386,11 @@ contains
             data%mass%storage = problem%mass_storage()
             select case (data%mass%storage)
             case (storage_dense)
-                allocate (data%mass%dense(n, n))
+                allocate (data%mass%dense(n, n), stat=stat)
+                if (stat /= 0) then
+                    call out_of_memory(st, 'ida dense mass matrix', int(n, i8) * n, 8)
+                    return
+                end if
                 call problem%mass_dense(data%mass%dense)
             case (storage_sparse)
                 call problem%mass_sparse(data%mass%csc, st)
@@ -439,7 +447,11 @@ contains
             case (storage_dense)
                 ! Structural non-zeros of the dense M.
                 nm = count(data%mass%dense /= 0.0_wp)
-                allocate (mrows(nm), mcols(nm))
+                allocate (mrows(nm), mcols(nm), stat=stat)
+                if (stat /= 0) then
+                    call out_of_memory(st, 'ida mass pattern positions', 2_i8 * nm, 4)
+                    return
+                end if
                 k = 0
                 do j = 1, n
                     do i = 1, n
@@ -463,7 +475,11 @@ contains
             end select
             nj = int(data%jac%nnz)
             nm = int(data%mass_csc%nnz)
-            allocate (rows(nj + nm), cols(nj + nm))
+            allocate (rows(nj + nm), cols(nj + nm), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(st, 'ida iteration pattern positions', 2_i8 * (nj + nm), 4)
+                return
+            end if
             k = 0
             call append_pattern(data%jac, rows, cols, k)
             call append_pattern(data%mass_csc, rows, cols, k)
@@ -562,7 +578,8 @@ contains
                 a_mat => FSUNSparseMatrix(int(n, c_int64_t), int(n, c_int64_t), &
                     int(data%nnz, c_int64_t), CSC_MAT, ctx)
                 if (.not. associated(a_mat)) then
-                    call sundials_failure('SUNSparseMatrix')
+                    ! NULL only when its malloc failed: values and row indices
+                    call out_of_memory(status, 'ida sparse iteration matrix', 2 * data%nnz, 8)
                     return
                 end if
                 lin_solver => FSUNLinSol_KLU(nv_y, a_mat, ctx)
@@ -570,7 +587,8 @@ contains
             else
                 a_mat => FSUNDenseMatrix(int(n, c_int64_t), int(n, c_int64_t), ctx)
                 if (.not. associated(a_mat)) then
-                    call sundials_failure('SUNDenseMatrix')
+                    ! NULL only when its malloc failed
+                    call out_of_memory(status, 'ida dense iteration matrix', int(n, i8) * n, 8)
                     return
                 end if
                 lin_solver => FSUNLinSol_Dense(nv_y, a_mat, ctx)

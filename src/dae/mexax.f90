@@ -28,6 +28,7 @@ module flexmbs_dae_mexax
         status_interrupted, reason_step_too_small, reason_max_steps, reason_singular_matrix, &
         reason_non_finite, reason_projection, reason_user_function, reason_det_f
     use flexmbs_core_text, only: real_text, int_text
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_timer, only: timer_t
     use flexmbs_linalg_csc, only: csc_matrix_t, pattern_matvec
     use flexmbs_linalg_klu, only: klu_ordering_auto
@@ -252,7 +253,7 @@ contains
         type(status_t) :: fst
         type(status_t) :: refusal !! the model's last refusal since an accepted step
         real(wp), allocatable :: yout(:)
-        integer :: k, kc, kopt, km, decision, j, iout, nout, nstab_nonfinite
+        integer :: k, kc, kopt, km, decision, j, iout, nout, nstab_nonfinite, stat
         real(wp) :: h, hmax, posneg, tscale, rmin, c, t_old
         logical :: first, last, reject, need_start, basic_entry, want_steps, stop_requested
 
@@ -310,7 +311,16 @@ contains
             options%sparse_ordering, options%classic_lu)
         if (.not. status%ok()) return
         call options%tolerances(w%rtol, w%atol)
-        allocate (yout(w%nq + w%nv + w%nc))
+        self%dense = mexax_dense_t()  ! drops the last run's arrays
+        associate (m => w%nq + w%nv + w%nc)
+            allocate (yout(m), self%dense%y0(m), self%dense%y1(m), self%dense%d0(m), &
+                self%dense%d1(m), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, 'mexax output vectors', 5_i8 * m, 8)
+                self%dense = mexax_dense_t()
+                return
+            end if
+        end associate
         w%p0 = q
         w%v0 = v
         w%a0 = 0.0_wp
@@ -640,10 +650,6 @@ contains
             integer :: nq, nv
             nq = w%nq
             nv = w%nv
-            if (allocated(self%dense%y0)) deallocate (self%dense%y0, self%dense%y1, &
-                self%dense%d0, self%dense%d1)
-            allocate (self%dense%y0(size(yout)), self%dense%y1(size(yout)), &
-                self%dense%d0(size(yout)), self%dense%d1(size(yout)))
             self%dense%t_old = t
             self%dense%t = t
             self%dense%y1(1:nq) = w%p0
@@ -741,7 +747,8 @@ contains
         character(len=*), intent(in), optional :: ordering !! 'auto' | 'amd' | 'nd'
         !> dense: the classic elimination order (options%classic_lu)
         logical, intent(in), optional :: classic_lu
-        integer :: j, nq, nv, nc
+        integer :: j, nq, nv, nc, stat
+        integer(i8) :: entries
         call default_blas_threads()
         if (present(classic_lu)) w%classic_lu = classic_lu
         nq = problem%nq
@@ -773,11 +780,15 @@ contains
         w%err = 0.0_wp
         w%hh = 0.0_wp
         w%work = 0.0_wp
-        allocate (w%rtol(w%ne), w%atol(w%ne), w%wt(w%ne), w%wst(nv))
-        allocate (w%p0(nq), w%v0(nv), w%a0(nv), w%lam0(nc), w%f0(nv), w%pdot0(nq))
-        allocate (w%rhs(w%na))
-        allocate (w%p(nq), w%pp(nq), w%pn(nq), w%v(nv), w%vp(nv), w%f(nv), w%pdot(nq), w%gt(nc))
-        allocate (w%acc(nv), w%lam(nc), w%x(w%ny), w%d(w%ny), w%tab(w%ny, km))
+        allocate (w%rtol(w%ne), w%atol(w%ne), w%wt(w%ne), w%wst(nv), w%p0(nq), w%v0(nv), &
+            w%a0(nv), w%lam0(nc), w%f0(nv), w%pdot0(nq), w%rhs(w%na), w%p(nq), w%pp(nq), &
+            w%pn(nq), w%v(nv), w%vp(nv), w%f(nv), w%pdot(nq), w%gt(nc), w%acc(nv), w%lam(nc), &
+            w%x(w%ny), w%d(w%ny), w%tab(w%ny, km), stat=stat)
+        if (stat /= 0) then
+            entries = 3_i8 * w%ne + w%na + 6_i8 * nq + 8_i8 * nv + 3_i8 * nc + (2_i8 + km) * w%ny
+            call out_of_memory(status, 'mexax workspace', entries, 8)
+            return
+        end if
         select case (trim(adjustl(linear_solver)))
         case ('auto')
             w%sparse = problem%has_sparse() .and. w%na >= mexax_auto_klu_order
@@ -803,8 +814,13 @@ contains
             call setup_sparse(w, problem, status)
         else
             allocate (w%m0%dense(nv, nv), w%g0%dense(nc, nv), w%mm%dense(nv, nv), &
-                w%gm%dense(nc, nv), w%gn%dense(nc, nv))
-            call w%kkt%init_dense(nv, nc, w%classic_lu)
+                w%gm%dense(nc, nv), w%gn%dense(nc, nv), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, 'mexax dense M and G', &
+                    int(nv, i8) * (2_i8 * nv + 3_i8 * nc), 8)
+                return
+            end if
+            call w%kkt%init_dense(nv, nc, w%classic_lu, status)
         end if
     end subroutine setup_workspace
 
@@ -814,7 +830,7 @@ contains
         type(workspace_t), intent(inout) :: w
         class(mechanical_problem_t), intent(inout) :: problem
         type(status_t), intent(out) :: status
-        integer :: nv, nc
+        integer :: nv, nc, stat
         nv = w%nv
         nc = w%nc
         call problem%mass_pattern(w%mpat, status)
@@ -826,8 +842,10 @@ contains
             status%message = 'mexax: ' // status%message
             return
         end if
-        allocate (w%m0%values(w%mpat%nnz), w%mm%values(w%mpat%nnz))
-        allocate (w%g0%values(w%gpat%nnz), w%gm%values(w%gpat%nnz), w%gn%values(w%gpat%nnz))
+        allocate (w%m0%values(w%mpat%nnz), w%mm%values(w%mpat%nnz), w%g0%values(w%gpat%nnz), &
+            w%gm%values(w%gpat%nnz), w%gn%values(w%gpat%nnz), stat=stat)
+        if (stat /= 0) call out_of_memory(status, 'mexax sparse M and G values', &
+            2 * w%mpat%nnz + 3 * w%gpat%nnz, 8)
     contains
         logical function pattern_ok(pattern, nrow, ncol, what) result(ok)
             type(csc_matrix_t), intent(in) :: pattern

@@ -10,7 +10,8 @@
 !> literally, so the native counters are those of the classic code.
 module flexmbs_dae_radau5
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_text, only: real_text, int_text
     use flexmbs_core_status, only: status_t, status_ok, status_bad_input, &
         status_solver_failure, status_interrupted, reason_step_too_small, reason_max_steps, &
@@ -172,7 +173,7 @@ contains
         type(status_t) :: fstatus
         type(status_t) :: rejection  !! why the last step since an acceptance failed
 
-        integer :: n, nind1, nind2, nind3, nit, newt, block, i, nout, iout
+        integer :: n, nind1, nind2, nind3, nit, newt, block, i, nout, iout, stat
         real(wp) :: x, h, xend, posneg, hmaxn, hhfac, faccon, theta, thet, thq, thqold
         real(wp) :: dyno, dynold, dyth, qnewt, fnewt, err, fac, quot, hnew, hacc, erracc
         real(wp) :: facgus, hopt, hold, xold, fac1, alphn, betan, c3q, sig1, sig2, sig3
@@ -230,7 +231,11 @@ contains
             call bad('need fac_min <= 1 <= fac_max')
             return
         end if
-        allocate (rtolt(n), atolt(n))
+        allocate (rtolt(n), atolt(n), classes(n), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'radau5 tolerances and index classes', 3_i8 * n, 8)
+            return
+        end if
         call options%tolerances(rtolt, atolt)
         if (any(atolt <= 0.0_wp) .or. any(rtolt <= 10.0_wp * uround)) then
             call bad('tolerances must satisfy atol > 0 and rtol > 10*uround')
@@ -252,7 +257,6 @@ contains
                 return
             end if
         end if
-        allocate (classes(n))
         call problem%index_classes(classes)
         if (any(classes < 1 .or. classes > 3)) then
             call bad('index classes must be 1, 2 or 3')
@@ -285,10 +289,14 @@ contains
         call ls%init(mass, jac, status)
         if (.not. status%ok()) return
 
-        allocate (z1(n), z2(n), z3(n), w1(n), w2(n), w3(n), f1(n), f2(n), f3(n), f0(n))
-        allocate (scal(n), cont(n), ytmp(n), mw(n), zc(n))
         if (allocated(self%dense%cont)) deallocate (self%dense%cont)
-        allocate (self%dense%cont(n, 0:3))
+        allocate (z1(n), z2(n), z3(n), w1(n), w2(n), w3(n), f1(n), f2(n), f3(n), f0(n), &
+            scal(n), cont(n), ytmp(n), mw(n), zc(n), self%dense%cont(n, 0:3), stat=stat)
+        if (stat /= 0) then
+            ! 14 real vectors, zc complex (2), the dense output's 4 columns
+            call out_of_memory(status, 'radau5 workspace', 20_i8 * n, 8)
+            return
+        end if
 
         posneg = sign(1.0_wp, xend - x)
         if (options%hmax > 0.0_wp) then
@@ -828,20 +836,25 @@ contains
                 jac%storage = storage_sparse
                 call problem%jacobian_pattern(jac%csc, st)
                 if (.not. st%ok()) return
-            case (storage_dense)
-                jac%storage = storage_dense
-                allocate (jac%dense(n, n))
             case default
-                ! Difference Jacobian, held as dense values.
-                fd_jacobian = .true.
+                ! A dense J, or a difference Jacobian held as dense values.
+                fd_jacobian = storage /= storage_dense
                 jac%storage = storage_dense
-                allocate (jac%dense(n, n))
+                allocate (jac%dense(n, n), stat=stat)
+                if (stat /= 0) then
+                    call out_of_memory(st, 'radau5 dense Jacobian', int(n, i8) * n, 8)
+                    return
+                end if
             end select
             mass%n = n
             mass%storage = problem%mass_storage()
             select case (mass%storage)
             case (storage_dense)
-                allocate (mass%dense(n, n))
+                allocate (mass%dense(n, n), stat=stat)
+                if (stat /= 0) then
+                    call out_of_memory(st, 'radau5 dense mass matrix', int(n, i8) * n, 8)
+                    return
+                end if
                 call problem%mass_dense(mass%dense)
             case (storage_sparse)
                 call problem%mass_sparse(mass%csc, st)

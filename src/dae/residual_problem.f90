@@ -5,7 +5,8 @@
 !> `dae_problem_t` becomes a residual problem through `dae_residual_t`:
 !> G = M y' − F(t, y), so A = M (constant) and B = J = ∂F/∂y (DESIGN.md).
 module flexmbs_dae_residual_problem
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_identity, &
         storage_dense, storage_sparse
@@ -141,7 +142,7 @@ contains
         logical, intent(in) :: differenced
         type(matrix_t), intent(inout) :: a, b
         type(status_t), intent(inout) :: status
-        integer :: n
+        integer :: n, stat
         if (.not. associated(self%problem)) then
             call status%set(status_bad_input, 'dae_residual_t: no problem attached')
             return
@@ -149,13 +150,21 @@ contains
         n = self%problem%n
         self%n = n
         if (allocated(self%work)) deallocate (self%work)
-        allocate (self%work(n))
+        allocate (self%work(n), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'residual work vector', int(n, i8), 8)
+            return
+        end if
         self%mass%n = n
         self%mass%storage = self%problem%mass_storage()
         select case (self%mass%storage)
         case (storage_dense)
             if (allocated(self%mass%dense)) deallocate (self%mass%dense)
-            allocate (self%mass%dense(n, n))
+            allocate (self%mass%dense(n, n), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, 'dense mass matrix', int(n, i8) * n, 8)
+                return
+            end if
             call self%problem%mass_dense(self%mass%dense)
         case (storage_sparse)
             call self%problem%mass_sparse(self%mass%csc, status)
@@ -172,7 +181,8 @@ contains
             call self%problem%jacobian_pattern(b%csc, status)
         case (storage_dense)
             if (allocated(b%dense)) deallocate (b%dense)
-            allocate (b%dense(n, n))
+            allocate (b%dense(n, n), stat=stat)
+            if (stat /= 0) call out_of_memory(status, 'dense Jacobian', int(n, i8) * n, 8)
         case default
             b%storage = storage_none
         end select

@@ -8,8 +8,9 @@
 !>   'xmax_layer', 'ymin_layer', … (the elements touching that face; for a
 !>   bar along x the paper's stiffer tips are 'xmin_layer' and 'xmax_layer').
 module flexmbs_fe_box_mesh
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_fe_hexahedron, only: hex8, hex27, hex_node_xi
     use flexmbs_fe_mesh, only: mesh_t, node_set_t, element_set_t
     implicit none
@@ -29,6 +30,7 @@ contains
         type(status_t), intent(out) :: status
         real(wp), intent(in), optional :: origin(3) !! lower corner (default 0)
         integer :: p, grid(3), i, j, k, e, a, ex, ey, ez, idx(3), d, d2, b, n, level, lv(2)
+        integer :: stat
         real(wp) :: x0(3)
         character(len=120) :: msg
         character(len=4), parameter :: face_names(2, 3) = reshape( &
@@ -50,7 +52,17 @@ contains
         p = merge(1, 2, nnode_element == hex8)
         grid = p * divisions + 1
         mesh%nnode_element = nnode_element
-        allocate (mesh%x(3, product(grid)), mesh%connectivity(nnode_element, product(divisions)))
+        allocate (mesh%x(3, product(grid)), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'box mesh node coordinates', 3 * product(int(grid, i8)), 8)
+            return
+        end if
+        allocate (mesh%connectivity(nnode_element, product(divisions)), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'box mesh connectivity', &
+                nnode_element * product(int(divisions, i8)), 4)
+            return
+        end if
         do k = 0, grid(3) - 1
             do j = 0, grid(2) - 1
                 do i = 0, grid(1) - 1

@@ -20,7 +20,8 @@
 !> centre must be positive. `write_mesh` writes reals in es24.16e3, so a
 !> round trip is exact.
 module flexmbs_fe_mesh_file
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input, status_io_error
     use flexmbs_core_text, only: int_text, lower, excerpt
     use flexmbs_core_files, only: read_text_file
@@ -49,12 +50,13 @@ contains
         character(len=:), allocatable :: text
         type(tokens_t) :: tok
         type(mesh_t) :: work
-        integer :: pos, nnode, nelem, i, a, k, id, nset
+        integer :: pos, nnode, nelem, i, a, k, id, nset, stat
         character(len=:), allocatable :: word, name
         real(wp) :: x(3)
         call read_text_file(path, text, status)
         if (.not. status%ok()) return
-        call tokenise(text, tok)
+        call tokenise(text, tok, status)
+        if (.not. status%ok()) return
         pos = 0
         call expect_word(magic)
         if (.not. status%ok()) return
@@ -74,7 +76,11 @@ contains
         end if
         ! counts beyond what the text can hold are refused before allocating
         if (.not. fits(nnode, 4, 'nodes')) return
-        allocate (work%x(3, nnode))
+        allocate (work%x(3, nnode), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, path // ': node coordinates', 3_i8 * nnode, 8)
+            return
+        end if
         do i = 1, nnode
             call next_int(id, 'node id')
             if (.not. status%ok()) return
@@ -109,7 +115,12 @@ contains
             return
         end if
         if (.not. fits(nelem, work%nnode_element + 1, 'elements')) return
-        allocate (work%connectivity(work%nnode_element, nelem))
+        allocate (work%connectivity(work%nnode_element, nelem), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, path // ': connectivity', &
+                int(work%nnode_element, i8) * nelem, 4)
+            return
+        end if
         allocate (work%node_sets(0), work%element_sets(0))
         do i = 1, nelem
             call next_int(id, 'element id')
@@ -179,7 +190,11 @@ contains
             end if
             set%name = name
             if (.not. fits(nset, 1, 'set members')) return
-            allocate (set%nodes(nset))
+            allocate (set%nodes(nset), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, path // ': node set', int(nset, i8), 4)
+                return
+            end if
             do j = 1, nset
                 call next_int(set%nodes(j), 'node id of set ''' // excerpt(name) // '''')
                 if (.not. status%ok()) return
@@ -203,7 +218,11 @@ contains
             end if
             set%name = name
             if (.not. fits(nset, 1, 'set members')) return
-            allocate (set%elements(nset))
+            allocate (set%elements(nset), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, path // ': element set', int(nset, i8), 4)
+                return
+            end if
             do j = 1, nset
                 call next_int(set%elements(j), 'element id of set ''' // excerpt(name) // '''')
                 if (.not. status%ok()) return
@@ -348,9 +367,10 @@ contains
     end subroutine write_mesh
 
     !> Split text into whitespace-separated tokens, dropping # comments.
-    subroutine tokenise(text, tok)
+    subroutine tokenise(text, tok, status)
         character(len=*), intent(in) :: text
         type(tokens_t), intent(out) :: tok
+        type(status_t), intent(inout) :: status
         integer :: i, line, start, capacity
         logical :: comment
         character :: c
@@ -368,6 +388,7 @@ contains
             if (c == new_line('a') .or. c == char(13) .or. c == ' ' .or. c == char(9) &
                 .or. (c == '#' .and. .not. comment)) then
                 if (start > 0) call push(start, i - 1)
+                if (.not. status%ok()) return
                 start = 0
                 if (c == '#') comment = .true.
                 if (c == new_line('a')) then
@@ -383,18 +404,23 @@ contains
 
         subroutine push(first, last)
             integer, intent(in) :: first, last
-            integer, allocatable :: tmp(:)
+            integer, allocatable :: tmp_first(:), tmp_last(:), tmp_line(:)
+            integer :: stat
             if (tok%n == capacity) then
-                capacity = 2 * capacity
-                allocate (tmp(capacity))
-                tmp(1:tok%n) = tok%first(1:tok%n)
-                call move_alloc(tmp, tok%first)
-                allocate (tmp(capacity))
-                tmp(1:tok%n) = tok%last(1:tok%n)
-                call move_alloc(tmp, tok%last)
-                allocate (tmp(capacity))
-                tmp(1:tok%n) = tok%line(1:tok%n)
-                call move_alloc(tmp, tok%line)
+                ! a token takes at least 2 characters: len(text) bounds the count
+                capacity = int(min(2_i8 * capacity, len(text, i8) / 2 + 1, int(huge(1), i8)))
+                allocate (tmp_first(capacity), tmp_last(capacity), tmp_line(capacity), &
+                    stat=stat)
+                if (stat /= 0) then
+                    call out_of_memory(status, 'mesh file tokens', 3_i8 * capacity, 4)
+                    return
+                end if
+                tmp_first(1:tok%n) = tok%first(1:tok%n)
+                call move_alloc(tmp_first, tok%first)
+                tmp_last(1:tok%n) = tok%last(1:tok%n)
+                call move_alloc(tmp_last, tok%last)
+                tmp_line(1:tok%n) = tok%line(1:tok%n)
+                call move_alloc(tmp_line, tok%line)
             end if
             tok%n = tok%n + 1
             tok%first(tok%n) = first

@@ -25,7 +25,8 @@
 !> as converged.
 module flexmbs_fe_statics
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         reason_newton_failure, reason_step_too_small
     use flexmbs_core_text, only: real_text, int_text
@@ -79,7 +80,7 @@ contains
         real(wp), allocatable :: zero_v(:), q_last(:), q_prev(:), q_trial(:), q_base(:), r(:), &
             dq(:), k(:), history(:), decrements(:)
         real(wp) :: lambda_last, lambda_prev, dlambda, lambda, gnorm, size_scale, floor
-        integer :: e
+        integer :: e, stat
         logical :: converged
         integer :: nhist
         character(len=:), allocatable :: why
@@ -104,11 +105,16 @@ contains
             if (present(report)) report = rep
             return
         end if
-        allocate (zero_v(body%nv), source=0.0_wp)
-        allocate (q_last, source=q)
-        allocate (q_prev, q_trial, q_base, r, dq, k, mold=q)
-        allocate (history(opt%max_iterations + 1), decrements(opt%max_iterations))
-        q_prev = q
+        allocate (zero_v(body%nv), history(opt%max_iterations + 1), &
+            decrements(opt%max_iterations), stat=stat)
+        if (stat == 0) allocate (q_last, q_prev, q_trial, q_base, r, dq, k, source=q, stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'static equilibrium workspace', &
+                body%nv + 2_i8 * opt%max_iterations + 1 + 7_i8 * size(q), 8)
+            if (present(report)) report = rep
+            return
+        end if
+        zero_v = 0.0_wp
         gnorm = 0.0_wp
         if (body%nv > 0) gnorm = maxval(abs(body%applied_force))
         size_scale = maxval(body%mesh%x) - minval(body%mesh%x)

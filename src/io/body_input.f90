@@ -10,7 +10,8 @@
 !> velocity is rigid: v = v₀ + ω × (X − X̄), X̄ the mean of the nodes.
 !> Every error names the file, the group, the variable and the reason.
 module flexmbs_io_body_input
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_text, only: int_text
     use flexmbs_fe_hexahedron, only: hex8, hex27
@@ -40,7 +41,7 @@ contains
         integer, allocatable :: element_material(:), fixed(:), set(:)
         character(len=:), allocatable :: where
         real(wp) :: centroid(3), w(3)
-        integer :: k, i, nfree, nnode_element
+        integer :: k, i, nfree, nnode_element, stat
 
         where = scene%path // ': &flexible_body: '
         associate (b => scene%body)
@@ -112,7 +113,11 @@ contains
             end if
 
             q0 = body%free_positions()
-            allocate (v0(body%nv))
+            allocate (v0(body%nv), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, where // 'initial velocities', int(body%nv, i8), 8)
+                return
+            end if
             centroid = sum(mesh%x, dim=2) / real(mesh%node_count(), wp)
             do i = 1, mesh%node_count()
                 w = b%initial_velocity + cross(b%initial_angular_velocity, &
@@ -132,11 +137,17 @@ contains
         integer, allocatable, intent(out) :: element_material(:)
         type(status_t), intent(inout) :: status
         integer, allocatable :: set(:)
-        integer :: i, j, e, rest
+        integer :: i, j, e, rest, stat
         character(len=:), allocatable :: where
 
         allocate (materials(size(scene%materials)))
-        allocate (element_material(mesh%element_count()), source=0)
+        allocate (element_material(mesh%element_count()), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, scene%path // ': material of each element', &
+                int(mesh%element_count(), i8), 4)
+            return
+        end if
+        element_material = 0
         rest = 0
         do i = 1, size(scene%materials)
             associate (m => scene%materials(i))

@@ -378,7 +378,7 @@ contains
         integer, intent(out) :: err
         integer(hid_t) :: attr, file_type, mem_type
         integer(size_t) :: length
-        integer :: close_err
+        integer :: close_err, stat
         call h5aopen_f(obj, name, attr, err)
         if (err < 0) then
             text = ''
@@ -388,7 +388,14 @@ contains
         if (err >= 0) call h5tget_size_f(file_type, length, err)
         if (err >= 0) call string_type(int(length), mem_type, err)
         if (err >= 0) then
-            allocate (character(len=max(int(length), 1)) :: text)
+            ! the length is the file's word: a damaged one is a failed read
+            allocate (character(len=max(int(length), 1)) :: text, stat=stat)
+            if (stat /= 0) then
+                err = -1
+                call h5tclose_f(mem_type, close_err)
+            end if
+        end if
+        if (err >= 0) then
             call h5aread_f(attr, mem_type, text, [1_hsize_t], err)
             call h5tclose_f(mem_type, close_err)
             text = trim(text)

@@ -13,7 +13,8 @@
 !> our sign of λ), 12 numbers per joint and record: F_i, n_i, F_j, n_j.
 module flexmbs_io_monitor_sink
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
@@ -46,7 +47,7 @@ contains
         class(monitor_sink_t), intent(inout) :: self
         real(wp), intent(in) :: t, y(:)
         type(status_t), intent(inout) :: status
-        if (.not. self%every_step) call record(self, t, y)
+        if (.not. self%every_step) call record(self, t, y, status)
     end subroutine monitor_output
 
     logical function monitor_wants_steps(self)
@@ -61,17 +62,18 @@ contains
         class(dense_output_t), intent(in) :: dense
         logical, intent(inout) :: stop
         type(status_t), intent(inout) :: status
-        if (self%every_step) call record(self, t, y)
+        if (self%every_step) call record(self, t, y, status)
     end subroutine monitor_step
 
     !> Append one row (the table doubles when full).
-    subroutine record(self, t, y)
+    subroutine record(self, t, y, status)
         class(monitor_sink_t), intent(inout) :: self
         real(wp), intent(in) :: t, y(:)
-        real(wp), allocatable :: grown(:, :)
+        type(status_t), intent(inout) :: status
+        real(wp), allocatable :: grown(:, :), grown_reactions(:, :)
         real(wp) :: position, velocity, force(3, 2), torque(3, 2)
         type(status_t) :: st
-        integer :: k, nj
+        integer :: k, nj, stat
         nj = 0
         select type (m => self%mechanical)
         type is (mbs_system_t)
@@ -80,12 +82,16 @@ contains
         if (.not. allocated(self%table)) allocate (self%table(4, 64), &
                                                    self%reactions(12 * nj, 64))
         if (self%records == size(self%table, 2)) then
-            allocate (grown(4, 2 * size(self%table, 2)))
+            allocate (grown(4, 2 * self%records), grown_reactions(12 * nj, 2 * self%records), &
+                stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, 'monitor table', (4 + 12_i8 * nj) * 2 * self%records, 8)
+                return
+            end if
             grown(:, 1:self%records) = self%table
             call move_alloc(grown, self%table)
-            allocate (grown(12 * nj, size(self%table, 2)))
-            grown(:, 1:self%records) = self%reactions
-            call move_alloc(grown, self%reactions)
+            grown_reactions(:, 1:self%records) = self%reactions
+            call move_alloc(grown_reactions, self%reactions)
         end if
         call self%formulation%drift(t, y, position, velocity, st)
         self%records = self%records + 1

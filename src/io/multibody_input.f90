@@ -11,7 +11,8 @@
 !> by the formulation's consistent-initial projection (scene.f90), which
 !> fails with its own message when no assembly is found.
 module flexmbs_io_multibody_input
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_text, only: int_text, real_text
     use flexmbs_linalg_lapack, only: dgesvd
@@ -259,7 +260,7 @@ contains
         character(len=*), intent(in) :: labels(:) !! per system joint
         type(status_t), intent(inout) :: status
         real(wp), allocatable :: g(:, :), gt(:, :), sv(:), u(:, :), vt(:, :), work(:)
-        integer :: nc, nv, info, rank, k, row, first, last, nj
+        integer :: nc, nv, info, rank, k, row, first, last, nj, stat
         character(len=:), allocatable :: names
         nc = sys%nc
         nv = sys%nv
@@ -270,7 +271,13 @@ contains
                 &the constraint set is redundant')
             return
         end if
-        allocate (g(nc, nv), sv(nc), u(1, 1), vt(nc, nc), work(max(1, 5 * (nc + nv))))
+        allocate (g(nc, nv), gt(nv, nc), sv(nc), u(1, 1), vt(nc, nc), &
+            work(max(1, 5 * (nc + nv))), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, scene%path // ': dense constraint Jacobian for its rank', &
+                2 * int(nc, i8) * nv + int(nc, i8) * nc, 8)
+            return
+        end if
         call sys%constraint_jacobian(scene%t_start, q0, g, status)
         if (.not. status%ok()) return
         ! Gᵀ = U Σ Vᵀ: a dependence yᵀ G = 0 among the rows is the last row of Vᵀ.

@@ -1,7 +1,8 @@
 !> A sink that keeps the solution at the output times in memory (the
 !> studies compare runs with a reference at these times).
 module flexmbs_io_record_sink
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t
     use flexmbs_dae_sink, only: sink_t
     implicit none
@@ -23,11 +24,25 @@ contains
         real(wp), intent(in) :: t, y(:)
         type(status_t), intent(inout) :: status
         real(wp), allocatable :: tt(:), yy(:, :)
-        if (.not. allocated(self%t)) allocate (self%t(128), self%y(size(y), 128))
-        if (self%records == size(self%t)) then
-            allocate (tt(2 * self%records), yy(size(y), 2 * self%records))
-            tt(1:self%records) = self%t
-            yy(:, 1:self%records) = self%y
+        integer :: capacity, stat
+        if (.not. allocated(self%t)) then
+            capacity = 128
+        else if (self%records == size(self%t)) then
+            capacity = 2 * self%records
+        else
+            capacity = 0
+        end if
+        if (capacity > 0) then
+            allocate (tt(capacity), yy(size(y), capacity), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, 'recorded trajectory', &
+                    (size(y) + 1_i8) * capacity, 8)
+                return
+            end if
+            if (self%records > 0) then
+                tt(1:self%records) = self%t(1:self%records)
+                yy(:, 1:self%records) = self%y(:, 1:self%records)
+            end if
             call move_alloc(tt, self%t)
             call move_alloc(yy, self%y)
         end if

@@ -19,7 +19,8 @@
 !> row `cpu_reference` (the paper's Tables 2 and 3 normalise to one run).
 module flexmbs_io_study
     use hdf5
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input, status_io_error, &
         status_solver_failure, status_signal
     use flexmbs_core_signals, only: signal_pending, caught_signal, signal_name, signal_number
@@ -252,7 +253,7 @@ contains
         type(status_t), intent(out) :: status
         integer(hid_t) :: file, dset, space
         integer(hsize_t) :: dims(2), maxdims(2)
-        integer :: err
+        integer :: err, stat
         logical :: exists
         inquire (file=path, exist=exists)
         if (.not. exists) then
@@ -270,8 +271,12 @@ contains
         if (err >= 0) then
             call h5dget_space_f(dset, space, err)
             call h5sget_simple_extent_dims_f(space, dims(1:1), maxdims(1:1), err)
-            allocate (t(dims(1)))
-            call h5dread_f(dset, H5T_NATIVE_DOUBLE, t, dims(1:1), err)
+            allocate (t(dims(1)), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, path // ': /time', int(dims(1), i8), 8)
+                err = -1
+            end if
+            if (err >= 0) call h5dread_f(dset, H5T_NATIVE_DOUBLE, t, dims(1:1), err)
             call h5sclose_f(space, err)
             call h5dclose_f(dset, err)
         end if
@@ -279,12 +284,17 @@ contains
         if (err >= 0) then
             call h5dget_space_f(dset, space, err)
             call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
-            allocate (y(dims(1), dims(2)))
-            call h5dread_f(dset, H5T_NATIVE_DOUBLE, y, dims, err)
+            allocate (y(dims(1), dims(2)), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, path // ': /y', int(dims(1) * dims(2), i8), 8)
+                err = -1
+            end if
+            if (err >= 0) call h5dread_f(dset, H5T_NATIVE_DOUBLE, y, dims, err)
             call h5sclose_f(space, err)
             call h5dclose_f(dset, err)
         end if
-        if (err < 0) call status%set(status_io_error, path // ': cannot read /time and /y')
+        if (err < 0 .and. status%ok()) &
+            call status%set(status_io_error, path // ': cannot read /time and /y')
         call h5fclose_f(file, err)
     end subroutine read_reference
 

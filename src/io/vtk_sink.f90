@@ -10,7 +10,8 @@
 !> stops keeps a collection ParaView opens. Every file's second line is the
 !> comment '<!-- written by flexmbs 0.1.0 -->' (vtk_file_ours).
 module flexmbs_io_vtk_sink
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_io_error
     use flexmbs_core_text, only: int_text
     use flexmbs_core_version, only: written_by, is_written_by
@@ -127,12 +128,17 @@ contains
         type(status_t), intent(inout) :: status
         real(wp), allocatable :: x(:, :), v(:, :), sigma(:, :), mises(:)
         type(status_t) :: stress_status
-        integer :: unit, ios, n, ne, nn, i, j, celltype
+        integer :: unit, ios, n, ne, nn, i, j, celltype, stat
         associate (body => self%body, mesh => self%body%mesh)
             n = mesh%node_count()
             ne = mesh%element_count()
             nn = size(mesh%connectivity, 1)
-            allocate (x(3, n), v(3, n), sigma(6, ne), mises(ne))
+            allocate (x(3, n), v(3, n), sigma(6, ne), mises(ne), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, path // ': node and element fields', &
+                    6_i8 * n + 7_i8 * ne, 8)
+                return
+            end if
             x = mesh%x
             v = 0.0_wp
             do i = 1, n

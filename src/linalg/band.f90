@@ -15,6 +15,7 @@
 module flexmbs_linalg_band
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         reason_singular_matrix
     use flexmbs_linalg_matrix, only: matrix_t, storage_identity, storage_dense, storage_sparse
@@ -83,7 +84,7 @@ contains
         class(band_solver_t), intent(inout) :: self
         type(matrix_t), intent(in) :: mass, jac
         type(status_t), intent(out) :: status
-        integer :: n, wj(2), wm(2)
+        integer :: n, wj(2), wm(2), stat
         character(len=200) :: msg
 
         n = jac%n
@@ -137,9 +138,25 @@ contains
         self%ldab = 2 * self%ml + self%mu + 1
         self%real_ready = .false.
         self%complex_ready = .false.
-        if (allocated(self%ab)) deallocate (self%ab, self%zab, self%ipiv, self%zipiv)
-        allocate (self%ab(self%ldab, n), self%zab(self%ldab, n), self%ipiv(n), self%zipiv(n))
+        call release(self)
+        allocate (self%ab(self%ldab, n), self%zab(self%ldab, n), self%ipiv(n), self%zipiv(n), &
+            stat=stat)
+        if (stat /= 0) then
+            ! ab real, zab complex: 3 values of 8 bytes a band entry
+            call out_of_memory(status, 'band solver storage', 3 * int(self%ldab, i8) * n, 8)
+            call release(self)
+        end if
     end subroutine band_init
+
+    ! What init allocates; a failed init leaves none of it (check_layout then
+    ! says 'factor called before init', the next init starts clean).
+    subroutine release(self)
+        type(band_solver_t), intent(inout) :: self
+        if (allocated(self%ab)) deallocate (self%ab)
+        if (allocated(self%zab)) deallocate (self%zab)
+        if (allocated(self%ipiv)) deallocate (self%ipiv)
+        if (allocated(self%zipiv)) deallocate (self%zipiv)
+    end subroutine release
 
     logical function fits(n, a)
         integer, intent(in) :: n

@@ -11,6 +11,7 @@
 module flexmbs_linalg_block_assembly
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_text, only: int_text
     use flexmbs_linalg_csc, only: csc_matrix_t
     implicit none
@@ -100,7 +101,7 @@ contains
         type(status_t), intent(out) :: status
         integer, allocatable :: rows(:), cols(:)
         integer(i8) :: nt, k, p
-        integer :: id, j, i, r, c
+        integer :: id, j, i, r, c, stat
         nt = 0
         do id = 1, self%nblocks
             if (self%blocks(id)%diagonal) then
@@ -109,7 +110,11 @@ contains
                 nt = nt + self%blocks(id)%pattern%nnz
             end if
         end do
-        allocate (rows(nt), cols(nt))
+        allocate (rows(nt), cols(nt), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'block assembly positions', 2 * nt, 4)
+            return
+        end if
         k = 0
         do id = 1, self%nblocks
             associate (b => self%blocks(id))
@@ -134,16 +139,25 @@ contains
             status%message = 'block assembly: ' // status%message
             return
         end if
+        deallocate (rows, cols)
         do id = 1, self%nblocks
             associate (b => self%blocks(id))
                 if (b%diagonal) then
-                    allocate (b%slot(b%n))
+                    allocate (b%slot(b%n), stat=stat)
+                    if (stat /= 0) then
+                        call out_of_memory(status, 'block assembly slots', int(b%n, i8), 8)
+                        return
+                    end if
                     do i = 1, b%n
                         b%slot(i) = self%matrix%find(b%row0 + i, b%col0 + i)
                     end do
                     cycle
                 end if
-                allocate (b%slot(b%pattern%nnz))
+                allocate (b%slot(b%pattern%nnz), stat=stat)
+                if (stat /= 0) then
+                    call out_of_memory(status, 'block assembly slots', b%pattern%nnz, 8)
+                    return
+                end if
                 do j = 1, b%pattern%ncol
                     do p = b%pattern%colptr(j) + 1, b%pattern%colptr(j + 1)
                         call position(b, int(b%pattern%rowind(p)) + 1, j, r, c)
@@ -229,21 +243,30 @@ contains
         type(status_t), intent(out) :: status
         integer, allocatable :: rows(:), cols(:), mark(:)
         integer(i8) :: nt, p, q
-        integer :: j, k, i, pass
+        integer :: j, k, i, pass, stat
         if (a%ncol /= b%nrow) then
             call status%set(status_bad_input, 'sparse product: A is ' // int_text(a%nrow) // &
                 ' x ' // int_text(a%ncol) // ', B is ' // int_text(b%nrow) // ' x ' // &
                 int_text(b%ncol))
             return
         end if
-        allocate (mark(a%nrow), source=0)
+        allocate (mark(a%nrow), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'sparse product marks', int(a%nrow, i8), 4)
+            return
+        end if
+        mark = 0
         allocate (rows(0), cols(0))
         ! pass 1 counts the entries of each column, pass 2 lists them
         nt = 0
         do pass = 1, 2
             if (pass == 2) then
                 deallocate (rows, cols)
-                allocate (rows(nt), cols(nt))
+                allocate (rows(nt), cols(nt), stat=stat)
+                if (stat /= 0) then
+                    call out_of_memory(status, 'sparse product positions', 2 * nt, 4)
+                    return
+                end if
                 mark = 0
                 nt = 0
             end if
@@ -293,8 +316,12 @@ contains
         type(status_t), intent(out) :: status
         integer, allocatable :: rows(:), cols(:)
         integer(i8) :: p
-        integer :: j
-        allocate (rows(a%nnz), cols(a%nnz))
+        integer :: j, stat
+        allocate (rows(a%nnz), cols(a%nnz), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'transpose positions', 2 * a%nnz, 4)
+            return
+        end if
         do j = 1, a%ncol
             do p = a%colptr(j) + 1, a%colptr(j + 1)
                 rows(p) = j
@@ -303,7 +330,11 @@ contains
         end do
         call at%build(a%ncol, a%nrow, rows, cols, status)
         if (.not. status%ok()) return
-        allocate (map(at%nnz))
+        allocate (map(at%nnz), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'transpose slot map', at%nnz, 8)
+            return
+        end if
         do p = 1, a%nnz
             map(at%triplet_map(p)) = p
         end do

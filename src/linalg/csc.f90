@@ -7,6 +7,7 @@
 module flexmbs_linalg_csc
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_resources, only: out_of_memory
     implicit none
     private
 
@@ -41,7 +42,7 @@ contains
         type(status_t), intent(out) :: status
         integer(i8), allocatable :: count(:), start(:), tmp_row(:), tmp_k(:)
         integer(i8) :: k, nt, p, q
-        integer :: j, i
+        integer :: j, i, stat
         character(len=160) :: msg
 
         nt = size(rows, kind=i8)
@@ -60,16 +61,19 @@ contains
         self%nrow = nrow
         self%ncol = ncol
         ! Bucket triplets by column (counting sort), keeping triplet numbers.
-        allocate (count(ncol + 1), source=0_i8)
+        allocate (count(ncol + 1), start(ncol + 1), tmp_row(nt), tmp_k(nt), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'sparse pattern work arrays', 2 * (ncol + 1_i8 + nt), 8)
+            return
+        end if
+        count = 0
         do k = 1, nt
             count(cols(k) + 1) = count(cols(k) + 1) + 1
         end do
-        allocate (start(ncol + 1))
         start(1) = 1
         do j = 1, ncol
             start(j + 1) = start(j) + count(j + 1)
         end do
-        allocate (tmp_row(nt), tmp_k(nt))
         count(:ncol) = start(:ncol)
         do k = 1, nt
             j = cols(k)
@@ -94,7 +98,12 @@ contains
         if (allocated(self%rowind)) deallocate (self%rowind)
         if (allocated(self%values)) deallocate (self%values)
         if (allocated(self%triplet_map)) deallocate (self%triplet_map)
-        allocate (self%colptr(ncol + 1), self%rowind(nt), self%triplet_map(nt))
+        allocate (self%colptr(ncol + 1), self%rowind(nt), self%triplet_map(nt), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'sparse pattern', ncol + 1_i8 + 2 * nt, 8)
+            call forget()
+            return
+        end if
         self%nnz = 0
         self%colptr(1) = 0
         do j = 1, ncol
@@ -110,8 +119,21 @@ contains
             self%colptr(j + 1) = self%nnz
         end do
         self%rowind = self%rowind(:self%nnz)
-        allocate (self%values(self%nnz), source=0.0_wp)
+        allocate (self%values(self%nnz), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'sparse matrix values', self%nnz, 8)
+            call forget()
+            return
+        end if
+        self%values = 0.0_wp
     contains
+        ! A pattern half built is no pattern: is_built must stay false.
+        subroutine forget()
+            if (allocated(self%colptr)) deallocate (self%colptr)
+            if (allocated(self%rowind)) deallocate (self%rowind)
+            if (allocated(self%triplet_map)) deallocate (self%triplet_map)
+            self%nnz = 0
+        end subroutine forget
         pure subroutine swap(a, b)
             integer(i8), intent(inout) :: a, b
             integer(i8) :: t

@@ -1,7 +1,9 @@
 !> Dense LU (LAPACK getrf/getrs) of real and complex shifted matrices, and
 !> the real LU in the classic elimination order for the classic faces.
 module flexmbs_linalg_dense
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
+    use flexmbs_core_text, only: int_text
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         reason_singular_matrix
     use flexmbs_linalg_matrix, only: matrix_t, storage_identity, storage_dense, storage_sparse
@@ -36,20 +38,42 @@ contains
         class(dense_solver_t), intent(inout) :: self
         type(matrix_t), intent(in) :: mass, jac
         type(status_t), intent(out) :: status
-        integer :: n
+        integer :: n, stat
+        integer(i8) :: entries
         n = jac%n
         if (n <= 0) then
             call status%set(status_bad_input, 'dense solver: matrix order must be positive')
             return
         end if
         self%n = n
-        if (allocated(self%a)) deallocate (self%a, self%za, self%ipiv, self%zipiv)
-        allocate (self%a(n, n), self%za(n, n), self%ipiv(n), self%zipiv(n))
+        call release(self)
+        ! a (real), za (complex) and, for sparse M or J, their dense copies
+        entries = 3 * int(n, i8) * n
+        if (mass%storage == storage_sparse) entries = entries + int(n, i8) * n
+        if (jac%storage == storage_sparse) entries = entries + int(n, i8) * n
+        allocate (self%a(n, n), self%za(n, n), self%ipiv(n), self%zipiv(n), stat=stat)
+        if (stat == 0 .and. mass%storage == storage_sparse) &
+            allocate (self%mass_work(n, n), stat=stat)
+        if (stat == 0 .and. jac%storage == storage_sparse) allocate (self%jac_work(n, n), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'dense solver matrices of order ' // int_text(n), &
+                entries, 8)
+            call release(self)
+            self%n = 0
+        end if
+    end subroutine dense_init
+
+    ! What init allocates; a failed init leaves none of it, so that the next
+    ! init starts clean.
+    subroutine release(self)
+        type(dense_solver_t), intent(inout) :: self
+        if (allocated(self%a)) deallocate (self%a)
+        if (allocated(self%za)) deallocate (self%za)
+        if (allocated(self%ipiv)) deallocate (self%ipiv)
+        if (allocated(self%zipiv)) deallocate (self%zipiv)
         if (allocated(self%mass_work)) deallocate (self%mass_work)
         if (allocated(self%jac_work)) deallocate (self%jac_work)
-        if (mass%storage == storage_sparse) allocate (self%mass_work(n, n))
-        if (jac%storage == storage_sparse) allocate (self%jac_work(n, n))
-    end subroutine dense_init
+    end subroutine release
 
     !> Write c*M - J (real part of the shift only) into a.
     subroutine shifted(self, c, mass, jac, a)

@@ -49,15 +49,12 @@ contains
         class(klu_solver_t), intent(inout) :: self
         type(matrix_t), intent(in) :: mass, jac
         type(status_t), intent(out) :: status
-        integer(i8) :: nnz
 
         call self%pattern%build(mass, jac, who, status)
         if (.not. status%ok()) return
         self%n = self%pattern%order()
-        nnz = self%pattern%nonzeros()
-        if (allocated(self%values)) deallocate (self%values)
-        if (allocated(self%zvalues)) deallocate (self%zvalues)
-        allocate (self%values(nnz), self%zvalues(nnz))
+        call self%pattern%value_arrays(self%values, self%zvalues, who, status)
+        if (.not. status%ok()) return
         call self%lu%analyse(self%n, self%pattern%column_pointers(), &
             self%pattern%row_indices(), status, self%ordering)
     end subroutine klu_solver_init

@@ -55,15 +55,12 @@ contains
         class(mumps_solver_t), intent(inout) :: self
         type(matrix_t), intent(in) :: mass, jac
         type(status_t), intent(out) :: status
-        integer(i8) :: nnz
 
         call self%pattern%build(mass, jac, who, status)
         if (.not. status%ok()) return
         self%n = self%pattern%order()
-        nnz = self%pattern%nonzeros()
-        if (allocated(self%values)) deallocate (self%values)
-        if (allocated(self%zvalues)) deallocate (self%zvalues)
-        allocate (self%values(nnz), self%zvalues(nnz))
+        call self%pattern%value_arrays(self%values, self%zvalues, who, status)
+        if (.not. status%ok()) return
         call analyse(self%lu, self, status)
         if (.not. status%ok()) return
         call analyse(self%zlu, self, status)

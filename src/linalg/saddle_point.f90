@@ -20,7 +20,8 @@
 !> the zero block needs no slots and no shift. MEXAX's augmented systems
 !> [M(q̃) G(q̃)ᵀ; G(q) 0] take B ≠ A on the same pattern.
 module flexmbs_linalg_saddle_point
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_threads, only: default_blas_threads
     use flexmbs_core_status, only: status_t, status_solver_failure, reason_singular_matrix
     use flexmbs_linalg_csc, only: csc_matrix_t
@@ -75,17 +76,30 @@ contains
 
     !> A dense K of order nv + nc; `classic_order` selects the classic
     !> elimination order instead of LAPACK's (the classic faces' counters).
-    subroutine saddle_init_dense(self, nv, nc, classic_order)
+    subroutine saddle_init_dense(self, nv, nc, classic_order, status)
         class(saddle_point_t), intent(inout) :: self
         integer, intent(in) :: nv, nc
         logical, intent(in), optional :: classic_order
+        !> Out of memory; without it, a failed allocation stops the program.
+        type(status_t), intent(out), optional :: status
+        integer :: stat
         call default_blas_threads()
         self%sparse = .false.
         self%nv = nv
         self%nc = nc
         if (present(classic_order)) self%classic_order = classic_order
-        if (allocated(self%kd)) deallocate (self%kd, self%ipiv)
-        allocate (self%kd(nv + nc, nv + nc), self%ipiv(nv + nc))
+        if (allocated(self%kd)) deallocate (self%kd)
+        if (allocated(self%ipiv)) deallocate (self%ipiv)
+        if (.not. present(status)) then
+            allocate (self%kd(nv + nc, nv + nc), self%ipiv(nv + nc))
+            return
+        end if
+        allocate (self%kd(nv + nc, nv + nc), self%ipiv(nv + nc), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'dense saddle-point matrix', &
+                int(nv + nc, i8) * (nv + nc), 8)
+            if (allocated(self%kd)) deallocate (self%kd)
+        end if
     end subroutine saddle_init_dense
 
     !> Dense K from M, A and B (B = A when absent).

@@ -13,6 +13,7 @@
 module flexmbs_linalg_shifted_pattern
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_identity, storage_dense, &
         storage_sparse
@@ -44,6 +45,7 @@ module flexmbs_linalg_shifted_pattern
         procedure :: complex_values => pattern_complex_values
         procedure :: order => pattern_order
         procedure :: nonzeros => pattern_nonzeros
+        procedure :: value_arrays => pattern_value_arrays
         procedure :: column_pointers => pattern_column_pointers
         procedure :: row_indices => pattern_row_indices
     end type shifted_pattern_t
@@ -57,7 +59,7 @@ contains
         type(matrix_t), intent(in) :: mass, jac
         character(len=*), intent(in) :: who
         type(status_t), intent(out) :: status
-        integer :: n
+        integer :: n, stat
 
         n = jac%n
         call check_operands(n, mass, jac, who, status)
@@ -75,15 +77,24 @@ contains
         if (allocated(self%diag_slot)) deallocate (self%diag_slot)
         if (allocated(self%jvalues)) deallocate (self%jvalues)
         if (allocated(self%mvalues)) deallocate (self%mvalues)
-        allocate (self%jac_slot(self%jac_nnz), self%mass_slot(self%mass_nnz), self%diag_slot(n))
+        allocate (self%jac_slot(self%jac_nnz), self%mass_slot(self%mass_nnz), self%diag_slot(n), &
+            stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, who // ' slot maps', self%jac_nnz + self%mass_nnz + n, 8)
+            return
+        end if
 
         if (self%full_pattern) then
-            call full_union(self, n, mass, jac)
+            call full_union(self, n, mass, jac, who, status)
         else
             call sparse_union(self, n, mass, jac, status)
-            if (.not. status%ok()) return
         end if
-        allocate (self%jvalues(self%colptr(n + 1)), self%mvalues(self%colptr(n + 1)))
+        if (.not. status%ok()) return
+        allocate (self%jvalues(self%colptr(n + 1)), self%mvalues(self%colptr(n + 1)), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, who // ' values of J and M', 2 * self%colptr(n + 1), 8)
+            return
+        end if
         self%n = n
     end subroutine pattern_build
 
@@ -132,14 +143,20 @@ contains
     end function operand_fits
 
     !> All n² slots, column by column; slot of (i, j) is (j-1)*n + i.
-    subroutine full_union(self, n, mass, jac)
+    subroutine full_union(self, n, mass, jac, who, status)
         type(shifted_pattern_t), intent(inout) :: self
         integer, intent(in) :: n
         type(matrix_t), intent(in) :: mass, jac
-        integer :: i, j
+        character(len=*), intent(in) :: who
+        type(status_t), intent(inout) :: status
+        integer :: i, j, stat
         if (allocated(self%colptr)) deallocate (self%colptr)
         if (allocated(self%rowind)) deallocate (self%rowind)
-        allocate (self%colptr(n + 1), self%rowind(int(n, i8) * n))
+        allocate (self%colptr(n + 1), self%rowind(int(n, i8) * n), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, who // ' full pattern', n + 1_i8 + int(n, i8) * n, 8)
+            return
+        end if
         do j = 1, n
             self%colptr(j) = int(j - 1, i8) * n
             do i = 1, n
@@ -176,10 +193,14 @@ contains
         type(csc_matrix_t) :: union
         integer, allocatable :: rows(:), cols(:)
         integer(i8) :: nt, k
-        integer :: i
+        integer :: i, stat
 
         nt = n + self%jac_nnz + self%mass_nnz
-        allocate (rows(nt), cols(nt))
+        allocate (rows(nt), cols(nt), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'union pattern positions', 2 * nt, 4)
+            return
+        end if
         do i = 1, n
             rows(i) = i
             cols(i) = i
@@ -321,6 +342,23 @@ contains
     end function pattern_order
 
     !> Slots of the union pattern (0 before build).
+    !> Real and complex arrays of one value per slot, for the solvers' c*M - J
+    !> (allocated once, at init).
+    subroutine pattern_value_arrays(self, values, zvalues, who, status)
+        class(shifted_pattern_t), intent(in) :: self
+        real(wp), allocatable, intent(out) :: values(:)
+        complex(wp), allocatable, intent(out) :: zvalues(:)
+        character(len=*), intent(in) :: who
+        type(status_t), intent(inout) :: status
+        integer :: stat
+        allocate (values(self%nonzeros()), zvalues(self%nonzeros()), stat=stat)
+        if (stat /= 0) then
+            ! real and complex: 3 values of 8 bytes a slot
+            call out_of_memory(status, who // ' values', 3 * self%nonzeros(), 8)
+            if (allocated(values)) deallocate (values)
+        end if
+    end subroutine pattern_value_arrays
+
     pure integer(i8) function pattern_nonzeros(self)
         class(shifted_pattern_t), intent(in) :: self
         pattern_nonzeros = 0

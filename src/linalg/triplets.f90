@@ -4,6 +4,7 @@
 module flexmbs_linalg_triplets
     use flexmbs_core_kinds, only: i8
     use flexmbs_core_status, only: status_t
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_linalg_csc, only: csc_matrix_t
     implicit none
     private
@@ -13,6 +14,9 @@ module flexmbs_linalg_triplets
         private
         integer, allocatable :: rows(:), cols(:)
         integer :: n = 0
+        !> Entries a failed growth asked for (0: none failed); `add` has no
+        !> status (it is called per entry), so `build` reports the failure.
+        integer(i8) :: failed = 0
     contains
         procedure :: add => triplets_add
         procedure :: add_range => triplets_add_range
@@ -26,15 +30,23 @@ contains
     subroutine triplets_add(self, i, j)
         class(triplets_t), intent(inout) :: self
         integer, intent(in) :: i, j
-        integer, allocatable :: tmp(:)
+        integer, allocatable :: tmp_rows(:), tmp_cols(:)
+        integer :: stat
+        if (self%failed > 0) return
         if (.not. allocated(self%rows)) allocate (self%rows(256), self%cols(256))
         if (self%n == size(self%rows)) then
-            allocate (tmp(2 * self%n))
-            tmp(1:self%n) = self%rows
-            call move_alloc(tmp, self%rows)
-            allocate (tmp(2 * self%n))
-            tmp(1:self%n) = self%cols
-            call move_alloc(tmp, self%cols)
+            ! Past huge(n) / 2 the doubled size is no default integer.
+            stat = 1
+            if (self%n <= huge(self%n) / 2) &
+                allocate (tmp_rows(2 * self%n), tmp_cols(2 * self%n), stat=stat)
+            if (stat /= 0) then
+                self%failed = 4_i8 * self%n
+                return
+            end if
+            tmp_rows(1:self%n) = self%rows
+            call move_alloc(tmp_rows, self%rows)
+            tmp_cols(1:self%n) = self%cols
+            call move_alloc(tmp_cols, self%cols)
         end if
         self%n = self%n + 1
         self%rows(self%n) = i
@@ -74,7 +86,9 @@ contains
         type(csc_matrix_t), intent(inout) :: pattern
         type(status_t), intent(out) :: status
         integer :: empty(0)
-        if (self%n == 0) then
+        if (self%failed > 0) then
+            call out_of_memory(status, 'sparse pattern positions', self%failed, 4)
+        else if (self%n == 0) then
             call pattern%build(nrow, ncol, empty, empty, status)
         else
             call pattern%build(nrow, ncol, self%rows(1:self%n), self%cols(1:self%n), status)

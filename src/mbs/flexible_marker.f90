@@ -21,7 +21,8 @@
 !> linear maps of the set's nodal displacements; with nodal velocities they
 !> give the marker's velocity and angular velocity.
 module flexmbs_mbs_flexible_marker
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure
     use flexmbs_core_text, only: int_text
     use flexmbs_linalg_lapack, only: dgesvd, dgetrf, dgetrs
@@ -58,7 +59,7 @@ contains
         type(status_t), intent(out) :: status
         real(wp), intent(in), optional :: origin(3), axes(3, 3)
         real(wp) :: centre(3), a(3, 3), sv(3), u(3, 3), vt(3, 3), work(64)
-        integer :: i, info
+        integer :: i, info, stat
         if (size(nodes) < 3 .or. any(nodes < 1 .or. nodes > size(x_ref, 2))) then
             call status%set(status_bad_input, 'flexible marker: needs at least 3 nodes ' // &
                             'within 1..' // int_text(size(x_ref, 2)))
@@ -67,7 +68,11 @@ contains
         marker%nodes = nodes
         marker%weight = 1.0_wp / size(nodes)
         centre = sum(x_ref(:, nodes), dim=2) * marker%weight
-        allocate (marker%dx_ref(3, size(nodes)))
+        allocate (marker%dx_ref(3, size(nodes)), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'flexible marker offsets', 3 * size(nodes, kind=i8), 8)
+            return
+        end if
         do i = 1, size(nodes)
             marker%dx_ref(:, i) = x_ref(:, nodes(i)) - centre
         end do

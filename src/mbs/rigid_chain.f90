@@ -33,7 +33,8 @@
 !>
 !> Markers on chain bodies: their pose and their Jacobians ∂(ẋ, ω)/∂v.
 module flexmbs_mbs_rigid_chain
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_text, only: int_text
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
@@ -107,7 +108,7 @@ contains
         type(chain_marker_t), intent(in), optional :: markers(:)
         real(wp), intent(in), optional :: gravity(3)
         type(rigid_chain_t) :: self
-        integer :: i, n
+        integer :: i, n, stat
         character(len=:), allocatable :: where
         n = size(bodies)
         do i = 1, n
@@ -155,7 +156,11 @@ contains
         self%nv = self%iv(n + 1)
         self%nc = 0
         allocate (self%o(3, 0:n), self%r(3, 3, 0:n), self%s(6, self%nv), self%vel(6, 0:n), &
-                  self%acc(6, 0:n), self%inert(6, 6, n), self%comp(6, 6, n), self%frc(6, n))
+                  self%acc(6, 0:n), self%inert(6, 6, n), self%comp(6, 6, n), self%frc(6, n), &
+                  stat=stat)
+        ! 3 + 9 + 6 + 6 values per frame (n + 1), 6 per velocity, 36 + 36 + 6 per body
+        if (stat /= 0) call out_of_memory(status, 'rigid chain workspace', &
+            24 * (n + 1_i8) + 6_i8 * self%nv + 78_i8 * n, 8)
     end function new_rigid_chain
 
     !> Forward kinematics: frames o, R, motion subspaces S and spatial
