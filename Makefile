@@ -6,6 +6,8 @@
 #   make paper   the paper's studies on the five-body mechanism (coarse and fine coupler
 #                mesh, about 20 min) into results/
 #   make extremes  every solver at extreme tolerances, materials and times
+#   make check-memory  install valgrind if missing, build (debug), run the numerical
+#                suites and every scene of inputs/ (cut to a few steps) under valgrind
 #   make install PREFIX=...   install library, modules and the classic faces
 #   OPENMP=1     (with any of them) thread the finite-element assembly
 #   LTO=1        (with any of them) link-time optimisation
@@ -52,13 +54,15 @@ SYSLIBS      := -lsundials_fida_mod -lsundials_fnvecserial_mod \
                 -lhdf5_serial_fortran -lhdf5_serial -llapack -lblas
 MAIN_INPUT   := inputs/five_body.nml
 
-.PHONY: run test bench paper extremes deps build build-debug install legacy-test clean help
+.PHONY: run test bench paper extremes check-memory deps build build-debug install legacy-test \
+        clean help
 
 help:
-	@echo "make run | make test | make bench | make paper | make install PREFIX=dir | make clean"
+	@echo "make run | make test | make bench | make paper | make check-memory |" \
+	    "make install PREFIX=dir | make clean"
 
 # Install the system packages and fpm when they are missing (make paper
-# adds gnuplot for its plots).
+# adds gnuplot for its plots, make check-memory valgrind).
 deps:
 	@missing=""; \
 	for p in $(APT_PACKAGES) $(EXTRA_PACKAGES); do \
@@ -199,6 +203,12 @@ extremes: deps
 test-cluster:
 	@$(MAKE) --no-print-directory deps EXTRA_PACKAGES="slurm-wlm munge"
 	@FPM="$(FPM)" bash test/cluster/run.sh
+
+# valgrind's memcheck on the debug build (test/memory.sh): one line per
+# suite or scene, `N passed, M failed` last; any finding fails.
+check-memory:
+	@$(MAKE) --no-print-directory deps EXTRA_PACKAGES=valgrind
+	@FPM="$(FPM)" bash test/memory.sh
 
 bench: deps
 	$(FPM) build --profile release

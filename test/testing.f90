@@ -16,8 +16,11 @@ module testing
         end subroutine test_i
     end interface
 
+    !> The name has a fixed length: collect_* functions build their lists as
+    !> array constructors of new_test results, and gfortran 12 never frees
+    !> the allocatable components of such results.
     type, public :: test_case_t
-        character(len=:), allocatable :: name
+        character(len=64) :: name = ''
         procedure(test_i), pointer, nopass :: run => null()
     end type test_case_t
 
@@ -29,6 +32,7 @@ contains
         character(len=*), intent(in) :: name
         procedure(test_i) :: run
         type(test_case_t) :: test
+        if (len(name) > len(test%name)) error stop 'new_test: name too long: ' // name
         test%name = name
         test%run => run
     end function new_test
@@ -78,7 +82,7 @@ contains
         integer :: i
         character(len=:), allocatable :: full
         do i = 1, size(tests)
-            full = suite // '/' // tests(i)%name
+            full = suite // '/' // trim(tests(i)%name)
             if (len_trim(filter) > 0) then
                 if (index(full, trim(filter)) == 0) cycle
             end if

@@ -277,10 +277,14 @@ contains
     end subroutine scatter
 
     !> The free positions of the reference configuration (the natural q0).
+    !> An allocatable result: for `q = body%free_positions()` into an
+    !> unallocated q, gfortran's bounds check of an explicit-shape result
+    !> reads the undefined bounds of q (valgrind: uninitialised value).
     pure function body_free_positions(self) result(q)
         class(flexible_body_t), intent(in) :: self
-        real(wp) :: q(self%nq)
+        real(wp), allocatable :: q(:)
         integer :: i, j
+        allocate (q(self%nq))
         do i = 1, size(self%dof, 2)
             do j = 1, 3
                 if (self%dof(j, i) > 0) q(self%dof(j, i)) = self%mesh%x(j, i)

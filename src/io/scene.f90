@@ -143,8 +143,9 @@ contains
             allocate (y0(pendulum%n))
             call pendulum_initial(pendulum, y0)
             ! y = (x, y, u, v, λ[, μ])
-            blocks = [block_spec_t('q', 1, 2), block_spec_t('v', 3, 4), &
-                      block_spec_t('lambda', 5, 5)]
+            call append_block(blocks, 'q', 1, 2)
+            call append_block(blocks, 'v', 3, 4)
+            call append_block(blocks, 'lambda', 5, 5)
             allocate (problem, source=pendulum)
             if (scene%solver_name == 'mexax' .and. present(mechanical)) then
                 allocate (mechanical, source=new_pendulum_mechanical(mass=scene%pendulum_mass, &
@@ -171,7 +172,8 @@ contains
             allocate (y0(formulation%n), source=0.0_wp)
             y0(1:nq) = q0
             y0(nq + 1:2 * nq) = v0
-            blocks = [block_spec_t('q', 1, nq), block_spec_t('v', nq + 1, 2 * nq)]
+            call append_block(blocks, 'q', 1, nq)
+            call append_block(blocks, 'v', nq + 1, 2 * nq)
             allocate (problem, source=formulation)
         case ('multibody')
             allocate (mbs_system_t :: mechanical)
@@ -216,10 +218,10 @@ contains
                 if (present(assembly)) assembly = moves
             end select
             if (.not. status%ok()) return
-            blocks = [block_spec_t('q', formulation%oq + 1, formulation%oq + formulation%nq), &
-                      block_spec_t('v', formulation%ov + 1, formulation%ov + formulation%nv)]
-            if (formulation%nc > 0) blocks = [blocks, block_spec_t('lambda', &
-                formulation%ol + 1, formulation%ol + formulation%nc)]
+            call append_block(blocks, 'q', formulation%oq + 1, formulation%oq + formulation%nq)
+            call append_block(blocks, 'v', formulation%ov + 1, formulation%ov + formulation%nv)
+            if (formulation%nc > 0) call append_block(blocks, 'lambda', formulation%ol + 1, &
+                formulation%ol + formulation%nc)
             allocate (problem, source=formulation)
         case ('rigid_chain')
             allocate (rigid_chain_t :: mechanical)
@@ -245,8 +247,8 @@ contains
                 call formulation%consistent_initial(scene%t_start, y0, yp0, status)
                 if (.not. status%ok()) return
             end if
-            blocks = [block_spec_t('q', formulation%oq + 1, formulation%oq + formulation%nq), &
-                      block_spec_t('v', formulation%ov + 1, formulation%ov + formulation%nv)]
+            call append_block(blocks, 'q', formulation%oq + 1, formulation%oq + formulation%nq)
+            call append_block(blocks, 'v', formulation%ov + 1, formulation%ov + formulation%nv)
             allocate (problem, source=formulation)
         case ('brusselator_1d', 'brusselator_2d')
             bruss = new_reaction_diffusion(merge(1, 2, scene%problem == 'brusselator_1d'), &
@@ -309,6 +311,20 @@ contains
             ' (' // int_text(per_record) // ' values a record); its file system has ' // &
             bytes_text(real(free, wp)) // ' free')
     end subroutine check_output_size
+
+    !> Add the block y(first:last) named `name`. Through a named variable:
+    !> gfortran 12 leaks the allocatable name of a structure constructor
+    !> inside an array constructor (`[blocks, block_spec_t(...)]`).
+    subroutine append_block(blocks, name, first, last)
+        type(block_spec_t), allocatable, intent(inout) :: blocks(:)
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: first, last
+        type(block_spec_t) :: block
+        block%name = name
+        block%first = first
+        block%last = last
+        blocks = [blocks, block]
+    end subroutine append_block
 
     pure integer function formulation_code(name)
         character(len=*), intent(in) :: name

@@ -95,7 +95,9 @@ module flexmbs_mbs_formulation
         type(saddle_point_t) :: kkt          !! dense [M Gᵀ; G 0] (the sparse one is in sp)
         logical :: mass_factored = .false.
         logical :: sparse = .false.          !! the sparse path (module header)
-        type(sparse_formulation_t) :: sp
+        !> allocated on the sparse path only. Allocatable: gfortran 12's
+        !> finalization wrapper skipped a matrix of a non-allocatable sp (trq)
+        type(sparse_formulation_t), allocatable :: sp
     contains
         procedure :: rhs => formulation_rhs
         procedure :: jacobian_storage => formulation_jacobian_storage
@@ -184,6 +186,7 @@ contains
         if (present(sparse)) self%sparse = sparse .and. mechanical%has_sparse() .and. &
             mechanical%has_sparse_derivatives()
         if (self%sparse) then
+            allocate (self%sp)
             call self%sp%init(mechanical, sparse_layout_t(form=form, &
                 accelerations=self%accelerations, ggl=form == formulation_ggl, n=self%n, &
                 nq=nq, nv=nv, nc=nc, oq=self%oq, ov=self%ov, oa=self%oa, ol=self%ol, &

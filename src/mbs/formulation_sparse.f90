@@ -43,7 +43,9 @@ module flexmbs_mbs_formulation_sparse
     type, public :: sparse_formulation_t
         private
         type(sparse_layout_t) :: lay
-        type(mechanical_patterns_t) :: pat
+        !> allocatable, as mbs_system_t%patterns: gfortran 12's finalization
+        !> wrapper frees such a non-allocatable component only in part
+        type(mechanical_patterns_t), allocatable :: pat
         type(block_assembly_t) :: jac, mass
         type(saddle_point_t) :: kkt
         ! block ids in jac
@@ -93,6 +95,7 @@ contains
         type(status_t), intent(inout) :: status
         integer :: rf
         self%lay = lay
+        if (.not. allocated(self%pat)) allocate (self%pat)
         call mech%derivative_patterns(self%pat, status)
         if (.not. status%ok()) return
         associate (p => self%pat, j => self%jac, oq => lay%oq, ov => lay%ov, oa => lay%oa, &

@@ -189,8 +189,10 @@ module flexmbs_mbs_system
         !> the derivative blocks' patterns (derivative_patterns) and one
         !> accumulator per block (block_*), dense or sparse, which the
         !> derivative code adds into: each keeps its shape and pattern, so
-        !> no evaluation allocates
-        type(mechanical_patterns_t) :: patterns
+        !> no evaluation allocates. Allocatable: gfortran 12's finalization
+        !> wrapper, which frees a polymorphic mbs_system_t, skipped three of
+        !> the eight matrices of a non-allocatable `patterns` (a leak).
+        type(mechanical_patterns_t), allocatable :: patterns
         type(accumulator_t) :: acc(7)
         !> each flexible body's tangent slots in patterns%force_q and %force_v
         type(tangent_slots_t), allocatable :: flex_slots(:)
