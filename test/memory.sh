@@ -147,10 +147,14 @@ done
 cut() {
     local scene=$1 copy=$2 base vtk=""
     base=$(basename "$scene" .nml)
-    if grep -qiE '^[[:space:]]*&(multibody|flexible_body)' "$scene"; then
+    # (a chain alone has no bodies to draw; it may still give &multibody)
+    if grep -qiE '^[[:space:]]*&(multibody|flexible_body)' "$scene" &&
+        ! grep -qiE "problem[[:space:]]*=[[:space:]]*'rigid_chain'" "$scene"; then
         vtk="    vtk = '$work/$base'"
     fi
-    awk -v fraction="$span_fraction" -v file="$work/$base.h5" -v vtk="$vtk" '
+    # a mesh file is relative to the scene's folder: the copy names it absolutely
+    awk -v fraction="$span_fraction" -v file="$work/$base.h5" -v vtk="$vtk" \
+        -v folder="$(dirname "$scene")" '
         function value(line) {
             sub(/^[^=]*=[[:space:]]*/, "", line); sub(/[[:space:]!\/].*$/, "", line)
             gsub(/[dD]/, "e", line)
@@ -161,6 +165,9 @@ cut() {
             lines[++n] = "T_END " value($0); has_end = 1; next
         }
         tolower($0) ~ /^[[:space:]]*(n_output|file|every_step|vtk)[[:space:]]*=/ { next }
+        tolower($0) ~ /mesh_file[[:space:]]*=[[:space:]]*'\''[^\/]/ {
+            sub(/mesh_file[[:space:]]*=[[:space:]]*'\''/, "mesh_file = '\''" folder "/")
+        }
         { lines[++n] = $0 }
         tolower($0) ~ /^[[:space:]]*&output/ { output(); has_output = 1 }
         function output() {

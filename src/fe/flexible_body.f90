@@ -10,6 +10,7 @@
 module flexmbs_fe_flexible_body
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_text, only: int_text
     !$ use omp_lib, only: omp_get_max_threads, omp_get_thread_num
     use flexmbs_linalg_csc, only: csc_matrix_t
@@ -139,7 +140,12 @@ contains
             return
         end if
         allocate (body%dndx(3, body%hex%nnode, body%hex%ngauss, mesh%element_count()), &
-                  body%wdv(body%hex%ngauss, mesh%element_count()))
+                  body%wdv(body%hex%ngauss, mesh%element_count()), stat=e)
+        if (e /= 0) then
+            call out_of_memory(status, 'shape function gradients', 4_i8 * body%hex%nnode * &
+                               body%hex%ngauss * int(mesh%element_count(), i8), 8)
+            return
+        end if
         do e = 1, mesh%element_count()
             call reference_gradients(body%hex, mesh%x(:, mesh%connectivity(:, e)), &
                                      body%dndx(:, :, :, e), body%wdv(:, e), status)
@@ -218,7 +224,12 @@ contains
             end do
         end do
         body%triplet_start(body%mesh%element_count() + 1) = nt + 1
-        allocate (rows(nt), cols(nt), mrows(nm), mcols(nm), mvals(nm))
+        ! the largest arrays of a body: one triplet per free-free pair
+        allocate (rows(nt), cols(nt), mrows(nm), mcols(nm), mvals(nm), stat=e)
+        if (e /= 0) then
+            call out_of_memory(status, 'tangent and mass triplets', 2_i8 * nt + 3_i8 * nm, 8)
+            return
+        end if
         allocate (body%applied_force(body%nv), source=0.0_wp)
         nt = 0
         nm = 0

@@ -43,6 +43,7 @@ module flexmbs_linalg_mumps
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         reason_singular_matrix, reason_none
+    use flexmbs_core_resources, only: out_of_memory
     implicit none
     private
 
@@ -134,10 +135,11 @@ module flexmbs_linalg_mumps
         end subroutine run_i
         !> Allocate IRN, JCN, A of the MUMPS structure and fill IRN, JCN from
         !> the 0-based CSC pattern.
-        subroutine attach_i(self, colptr, rowind)
-            import :: mumps_factor_t, i8
+        subroutine attach_i(self, colptr, rowind, status)
+            import :: mumps_factor_t, i8, status_t
             class(mumps_factor_t), intent(inout) :: self
             integer(i8), intent(in) :: colptr(:), rowind(:)
+            type(status_t), intent(inout) :: status
         end subroutine attach_i
         !> Deallocate the arrays `attach` allocated.
         subroutine release_i(self)
@@ -272,7 +274,8 @@ contains
         self%stage = stage_initialised
         self%owner = address_of(self)
         call set_controls(self)
-        call self%attach(colptr, rowind)
+        call self%attach(colptr, rowind, status)
+        if (.not. status%ok()) return
         self%n = n
         self%nnz = colptr(n + 1)
         call execute(self, job_analyse, 'mumps analyse', status)

@@ -43,7 +43,8 @@
 !> the kinematics that are not constraints (unit quaternions): with projection
 !> on, the formulation keeps them; without it they drift at tolerance level.
 module flexmbs_mbs_formulation
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         reason_singular_matrix, reason_projection
     use flexmbs_linalg_matrix, only: storage_dense, storage_sparse
@@ -141,7 +142,7 @@ contains
         type(status_t), intent(out) :: status
         logical, intent(in), optional :: sparse      !! sparse matrices (default false)
         type(formulation_t) :: self
-        integer :: nq, nv, nc, nk
+        integer :: nq, nv, nc, nk, ios
         character(len=160) :: msg
 
         nq = mechanical%nq
@@ -198,16 +199,28 @@ contains
                 return
             end if
             allocate (self%force(nv), self%w(nv), self%b(nv), self%c(nc), self%ct(nc), &
-                      self%tq(nq), self%q0(nq), self%kkt_rhs(nk))
+                      self%tq(nq), self%q0(nq), self%kkt_rhs(nk), stat=ios)
+            if (ios /= 0) then
+                call out_of_memory(status, 'formulation vectors', int(nq + nv + nk, i8), 8)
+                self%n = 0
+            end if
             return
         end if
+        ! dense: a dozen n x n blocks, the largest of all
         allocate (self%m(nv, nv), self%gmat(nc, nv), self%force(nv), self%w(nv), self%b(nv), &
                   self%c(nc), self%ct(nc), self%qq(nq, nq), self%vq(nv, nq), self%vv(nv, nv), &
                   self%cq(nc, nq), self%cq2(nc, nq), self%cv(nc, nv), self%tq(nq), &
                   self%gtlq(nv, nq), self%minv_gt(nv, nc), &
                   self%q0(nq), self%mass_lu(nv, nv), self%kkt_rhs(nk), &
-                  self%mass_pivots(nv))
-        call self%kkt%init_dense(nv, nc)
+                  self%mass_pivots(nv), stat=ios)
+        if (ios /= 0) then
+            call out_of_memory(status, 'dense formulation matrices', &
+                               8_i8 * int(nq + nv + nc, i8)**2, 8)
+            self%n = 0
+            return
+        end if
+        call self%kkt%init_dense(nv, nc, status=status)
+        if (.not. status%ok()) self%n = 0
     end function new_formulation
 
     !> Factor the constant M once (constant-mass layout, index 1 needs M⁻¹).

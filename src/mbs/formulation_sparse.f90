@@ -19,6 +19,7 @@
 module flexmbs_mbs_formulation_sparse
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_linalg_csc, only: csc_matrix_t, pattern_matvec, pattern_matvec_transpose
     use flexmbs_linalg_block_assembly, only: block_assembly_t, product_pattern, &
         product_values, transpose_pattern
@@ -93,7 +94,7 @@ contains
         type(sparse_layout_t), intent(in) :: lay
         real(wp), intent(in) :: q_mass(:) !! where the constant M is evaluated
         type(status_t), intent(inout) :: status
-        integer :: rf
+        integer :: rf, ios
         self%lay = lay
         if (.not. allocated(self%pat)) allocate (self%pat)
         call mech%derivative_patterns(self%pat, status)
@@ -141,9 +142,15 @@ contains
                     call add_full_block(j, lay%nc, lay%nv, ol, ov, self%id_iv, status)
                     call add_full_block(j, lay%nc, lay%nc, ol, ol, self%id_il, status)
                     if (.not. status%ok()) return
+                    ! nc dense rows (index 1, constant mass)
                     allocate (self%zmat(lay%nv, lay%nc), self%wq(lay%nc, lay%nq), &
                               self%wvv(lay%nc, lay%nv), self%wl(lay%nc, lay%nc), &
-                              self%f(lay%nv))
+                              self%f(lay%nv), stat=ios)
+                    if (ios /= 0) then
+                        call out_of_memory(status, 'index-1 constraint rows', &
+                            int(lay%nc, i8) * int(2 * lay%nv + lay%nq + lay%nc, i8), 8)
+                        return
+                    end if
                 end if
             end select
             call j%build(lay%n, lay%n, status)
@@ -166,7 +173,12 @@ contains
                       self%m(p%mass%nnz), self%m0(p%mass%nnz), self%g(p%constraint_v%nnz), &
                       self%gv(p%constraint_v%nnz), self%cq(p%constraint_q%nnz), &
                       self%cq2(p%constraint_q%nnz), self%rq(p%reaction_q%nnz), &
-                      self%wv(lay%nv), self%zc(lay%nc))
+                      self%wv(lay%nv), self%zc(lay%nc), stat=ios)
+            if (ios /= 0) then
+                call out_of_memory(status, 'sparse formulation values', int(p%force_q%nnz, i8) &
+                    * 3_i8 + int(p%mass%nnz, i8) * 2_i8 + int(p%constraint_q%nnz, i8) * 2_i8, 8)
+                return
+            end if
             self%zc = 0.0_wp
         end associate
         ! constant M of the constant-mass layout

@@ -40,6 +40,7 @@
 module flexmbs_mbs_system
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_text, only: int_text
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t, mechanical_patterns_t, &
         difference_step

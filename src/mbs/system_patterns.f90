@@ -271,7 +271,11 @@ contains
         allocate (self%flex_slots(size(self%flex)))
         do f = 1, size(self%flex)
             associate (st => self%flex(f)%stiffness, sl => self%flex_slots(f))
-                allocate (sl%q(st%nnz), sl%v(st%nnz))
+                allocate (sl%q(st%nnz), sl%v(st%nnz), stat=i)
+                if (i /= 0) then
+                    call out_of_memory(status, 'tangent slot maps', 2_i8 * st%nnz, 8)
+                    return
+                end if
                 do i = 1, st%ncol
                     do p = st%colptr(i) + 1, st%colptr(i + 1)
                         sl%q(p) = patterns%force_q%find(self%flex_v(f) + int(st%rowind(p)) + 1, &
