@@ -25,7 +25,9 @@ TIME=$(command -v /usr/bin/time || true)
 
 # scene FILE -> variant with solver settings and sed edits: variant OUT SRC SOLVER LS SEDEXPR
 variant() {
-    sed -e "s/^    name = 'radau5'/    name = '$3'\n    linear_solver = '$4'/" -e "$5" "$2" > "$1"
+    # a mesh file is relative to its scene's folder: the copy names it from there
+    sed -e "s/^    name = 'radau5'/    name = '$3'\n    linear_solver = '$4'/" -e "$5" \
+        -e "s#mesh_file = '\([^/']\)#mesh_file = '$PWD/$(dirname "$2")/\1#" "$2" > "$1"
     grep -q "linear_solver = '$4'" "$1" || sed -i "s/^&solver/\&solver\n    name = '$3'\n    linear_solver = '$4'/" "$1"
 }
 
