@@ -362,6 +362,8 @@ contains
             'for a chain in relative coordinates &rigid_chain', &
             '(see README.md for every variable, its type, unit and default).', &
             'STUDY.nml holds one &study group naming a scene file and the grid.', &
+            'Paths in a scene or study file are relative to that file''s folder;', &
+            'every error of a file is listed, one per line.', &
             '--quiet turns the progress display on standard error off.', &
             'An output never replaces an input, and two outputs of a run are never one', &
             'file. A file already at an output''s path is replaced only when it is', &
