@@ -282,6 +282,15 @@ contains
             end do
             call check(error, maxval(abs(fd - k)) <= 1.0e-6_wp * maxval(abs(k)), &
                        'k_el = dU/dq')
+            ! the mechanical problem's energy binding: U + T - f·(q - q_ref)
+            v = 1.0e-3_wp
+            associate (u => body%strain_energy(q, status), t => body%kinetic_energy(v))
+                call check(error, abs(body%total_energy(q, v, q) - (u + t)) <= &
+                           1.0e-12_wp * (u + t), 'total energy from q_ref = q')
+                call check(error, abs(body%total_energy(q, v) - (u + t - dot_product( &
+                           body%applied_force, q - body%free_positions()))) <= 1.0e-12_wp * &
+                           (u + t), 'total energy from the reference configuration')
+            end associate
             deallocate (dq, v, k, fd)
         end do
     end subroutine test_strain_energy

@@ -24,6 +24,7 @@
 !> `*_sparse` bindings refill their values in place. The formulations then
 !> assemble a sparse ∂F/∂y without any n x n array.
 module flexmbs_dae_mechanical_problem
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_linalg_csc, only: csc_matrix_t
@@ -60,6 +61,7 @@ module flexmbs_dae_mechanical_problem
         procedure :: constraint_jacobian_pattern => default_constraint_jacobian_pattern
         procedure :: constraint_jacobian_sparse => default_constraint_jacobian_sparse
         procedure :: normalize => default_normalize
+        procedure :: total_energy => default_total_energy
         procedure :: admissible => default_admissible
         procedure :: kinematics_derivative => default_kinematics_derivative
         procedure :: mass_derivative => default_mass_derivative
@@ -142,6 +144,16 @@ contains
     !> quaternion's unit length: T w is tangent to the unit sphere, so the
     !> length is an invariant of q' = T w that the integration lets drift).
     !> Called by the formulations' projection; default: nothing to restore.
+    !> Kinetic plus potential energy at (q, v) [J], the work of constant
+    !> applied forces counted from positions q_ref; NaN when the model
+    !> does not define it.
+    real(wp) function default_total_energy(self, q, v, q_ref) result(e)
+        class(mechanical_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(in), optional :: q_ref(:)
+        e = ieee_value(1.0_wp, ieee_quiet_nan)
+    end function default_total_energy
+
     subroutine default_normalize(self, q)
         class(mechanical_problem_t), intent(inout) :: self
         real(wp), intent(inout) :: q(:)

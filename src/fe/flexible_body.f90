@@ -66,6 +66,7 @@ module flexmbs_fe_flexible_body
         procedure :: free_positions => body_free_positions
         procedure :: strain_energy => body_strain_energy
         procedure :: kinetic_energy => body_kinetic_energy
+        procedure :: total_energy => body_total_energy
         procedure :: momenta => body_momenta
         procedure :: add_nodal_load => body_add_nodal_load
         procedure :: admissible => body_admissible
@@ -554,6 +555,21 @@ contains
             end do
         end do
     end function body_strain_energy
+
+    !> Strain plus kinetic energy, less the work of the constant applied
+    !> forces from q_ref (default: the reference configuration).
+    real(wp) function body_total_energy(self, q, v, q_ref) result(e)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(in), optional :: q_ref(:)
+        type(status_t) :: st
+        e = self%strain_energy(q, st) + self%kinetic_energy(v)
+        if (present(q_ref)) then
+            e = e - dot_product(self%applied_force, q - q_ref)
+        else
+            e = e - dot_product(self%applied_force, q - self%free_positions())
+        end if
+    end function body_total_energy
 
     !> det F > 0 at every quadrature point of every element; otherwise a
     !> solver failure with reason_det_f naming the element.

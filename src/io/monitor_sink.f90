@@ -12,7 +12,6 @@
 !> exerts on the body of marker i and of marker j (mbs_system_t%joint_reaction,
 !> our sign of λ), 12 numbers per joint and record: F_i, n_i, F_j, n_j.
 module flexmbs_io_monitor_sink
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t
@@ -20,8 +19,6 @@ module flexmbs_io_monitor_sink
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_mbs_system, only: mbs_system_t
-    use flexmbs_mbs_rigid_chain, only: rigid_chain_t
-    use flexmbs_fe_flexible_body, only: flexible_body_t
     implicit none
     private
 
@@ -114,18 +111,11 @@ contains
     real(wp) function energy(self, q, v) result(e)
         class(monitor_sink_t), intent(inout) :: self
         real(wp), intent(in) :: q(:), v(:)
-        real(wp) :: ek, ep
-        type(status_t) :: st
-        e = ieee_value(1.0_wp, ieee_quiet_nan)
-        select type (m => self%mechanical)
-        type is (mbs_system_t)
-            e = m%energy(q, v)
-        type is (rigid_chain_t)
-            call m%energy(q, v, ek, ep)
-            e = ek + ep
-        type is (flexible_body_t)
-            e = m%strain_energy(q, st) + m%kinetic_energy(v)
-            if (allocated(self%q_start)) e = e - dot_product(m%applied_force, q - self%q_start)
-        end select
+        ! the work of applied loads counted from the run's start
+        if (allocated(self%q_start)) then
+            e = self%mechanical%total_energy(q, v, self%q_start)
+        else
+            e = self%mechanical%total_energy(q, v)
+        end if
     end function energy
 end module flexmbs_io_monitor_sink

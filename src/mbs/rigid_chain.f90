@@ -93,6 +93,7 @@ module flexmbs_mbs_rigid_chain
         procedure :: marker_pose => chain_marker_pose
         procedure :: marker_jacobian => chain_marker_jacobian
         procedure :: energy => chain_energy
+        procedure :: total_energy => chain_total_energy
         procedure :: body_velocity => chain_body_velocity
     end type rigid_chain_t
 
@@ -462,4 +463,14 @@ contains
                 self%o(:, i) + matmul(self%r(:, :, i), self%bodies(i)%centre))
         end do
     end subroutine chain_energy
+
+    !> Kinetic plus potential energy (mechanical_problem_t%total_energy).
+    real(wp) function chain_total_energy(self, q, v, q_ref) result(e)
+        class(rigid_chain_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(in), optional :: q_ref(:)
+        real(wp) :: kinetic, potential
+        call self%energy(q, v, kinetic, potential)
+        e = kinetic + potential
+    end function chain_total_energy
 end module flexmbs_mbs_rigid_chain

@@ -237,6 +237,7 @@ module flexmbs_mbs_system
         procedure :: joint_first_row => system_joint_first_row
         procedure :: joint_reaction => system_joint_reaction
         procedure :: energy => system_energy
+        procedure :: total_energy => system_total_energy
         procedure :: momenta => system_momenta
     end type mbs_system_t
 
@@ -365,6 +366,11 @@ module flexmbs_mbs_system
             class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: q(:), v(:)
         end function system_energy
+        real(wp) module function system_total_energy(self, q, v, q_ref) result(e)
+            class(mbs_system_t), intent(inout) :: self
+            real(wp), intent(in) :: q(:), v(:)
+            real(wp), intent(in), optional :: q_ref(:)
+        end function system_total_energy
         module subroutine system_momenta(self, q, v, linear, angular)
             class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: q(:), v(:)

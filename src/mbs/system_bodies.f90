@@ -175,6 +175,12 @@ contains
         end do
     end procedure system_energy
 
+    !> The energy through the mechanical problem's binding (the reference
+    !> of the flexible bodies' loads is their reference configuration).
+    module procedure system_total_energy
+        e = self%energy(q, v)
+    end procedure system_total_energy
+
     !> Total linear momentum and angular momentum about the global origin.
     module procedure system_momenta
         real(wp) :: lf(3), af(3)
