@@ -15,6 +15,8 @@ module test_io
         output_hdf5, output_table
     use flexmbs_core_version, only: version
     use flexmbs_io_progress, only: progress_t, new_progress
+    use flexmbs_dae_radau5, only: radau5_t
+    use flexmbs_dae_ida, only: ida_t
     use flexmbs_io_scene, only: run_result_t, run_scene, build_problem, block_spec_t
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
@@ -546,21 +548,27 @@ contains
         type(progress_t) :: progress
         type(status_t) :: status
         type(still_t) :: dense
+        type(radau5_t), target :: radau5
+        type(ida_t), target :: ida
         character(len=:), allocatable :: path, text
-        integer :: unit, attempted, accepted
+        integer :: unit
         logical :: stop
         path = scratch('progress.txt')
         open (newunit=unit, file=path, status='replace', action='write')
         progress = new_progress(0.0_wp, 2.0_wp, quiet=.false., unit=unit)
-        attempted = 12
-        accepted = 10
-        call progress%watch(attempted, accepted)
+        ! the solver's live counts through dae_solver_t%step_counts
+        radau5%native%nstep = 12
+        radau5%native%naccpt = 10
+        call progress%watch(radau5)
         stop = .false.
         call check(error, progress%wants_steps(), 'wants steps')
         call progress%step(11, 0.9_wp, 1.0_wp, [0.0_wp], dense, stop, status)
         call check(error, index(progress%line(), '50.0 %') > 0, 'percent: ' // progress%line())
         call check(error, index(progress%line(), 'steps 10') > 0, 'steps')
         call check(error, index(progress%line(), 'rejected 2') > 0, 'rejected')
+        call progress%watch(ida)
+        call check(error, index(progress%line(), 'rejected') == 0, 'no counts, no rejections')
+        call progress%watch(radau5)
         call progress%finish(status)
         close (unit)
         text = read_text(path)

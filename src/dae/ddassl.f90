@@ -160,6 +160,7 @@ module flexmbs_dae_ddassl
         procedure :: step => ddassl_step
         procedure :: interpolate => ddassl_interpolate
         procedure :: name => ddassl_name
+        procedure :: step_counts => ddassl_step_counts
     end type ddassl_t
 
 contains
@@ -169,6 +170,14 @@ contains
         character(len=:), allocatable :: name
         name = 'ddassl'
     end function ddassl_name
+
+    !> Live counts for a display: DDASSL's NST counts accepted steps only.
+    subroutine ddassl_step_counts(self, attempted, accepted)
+        class(ddassl_t), intent(in) :: self
+        integer, intent(out) :: attempted, accepted
+        attempted = self%native%nst
+        accepted = self%native%nst
+    end subroutine ddassl_step_counts
 
     subroutine dense_evaluate(self, s, y)
         class(ddassl_dense_t), intent(in) :: self

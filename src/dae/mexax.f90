@@ -154,6 +154,7 @@ module flexmbs_dae_mexax
         procedure :: integrate_mechanical => mexax_integrate_mechanical
         procedure :: extrapolate => mexax_extrapolate
         procedure :: name => mexax_name
+        procedure :: step_counts => mexax_step_counts
     end type mexax_t
 
     !> M (nv x nv) or G (nc x nv) at one point: dense, or the values in the
@@ -192,6 +193,14 @@ contains
         character(len=:), allocatable :: name
         name = 'mexax'
     end function mexax_name
+
+    !> Live counts for a display: the classic counters NSTEP and NACCPT.
+    subroutine mexax_step_counts(self, attempted, accepted)
+        class(mexax_t), intent(in) :: self
+        integer, intent(out) :: attempted, accepted
+        attempted = self%native%nstep
+        accepted = self%native%naccpt
+    end subroutine mexax_step_counts
 
     subroutine dense_evaluate(self, s, y)
         class(mexax_dense_t), intent(in) :: self

@@ -117,6 +117,7 @@ module flexmbs_dae_radau5
     contains
         procedure :: integrate => radau5_integrate
         procedure :: name => radau5_name
+        procedure :: step_counts => radau5_step_counts
     end type radau5_t
 
 contains
@@ -126,6 +127,14 @@ contains
         character(len=:), allocatable :: name
         name = 'radau5'
     end function radau5_name
+
+    !> Live counts for a display: the classic counters NSTEP and NACCPT.
+    subroutine radau5_step_counts(self, attempted, accepted)
+        class(radau5_t), intent(in) :: self
+        integer, intent(out) :: attempted, accepted
+        attempted = self%native%nstep
+        accepted = self%native%naccpt
+    end subroutine radau5_step_counts
 
     subroutine dense_evaluate(self, s, y)
         class(radau5_dense_t), intent(in) :: self

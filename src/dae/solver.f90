@@ -14,6 +14,7 @@ module flexmbs_dae_solver
     contains
         procedure(integrate_i), deferred :: integrate
         procedure(name_i), deferred :: name
+        procedure :: step_counts => default_step_counts
     end type dae_solver_t
 
     abstract interface
@@ -40,4 +41,15 @@ module flexmbs_dae_solver
             character(len=:), allocatable :: name
         end function name_i
     end interface
+
+contains
+
+    !> Steps attempted and accepted so far in the running integration, for
+    !> a live display; 0 and 0 from a solver that does not count as it goes.
+    subroutine default_step_counts(self, attempted, accepted)
+        class(dae_solver_t), intent(in) :: self
+        integer, intent(out) :: attempted, accepted
+        attempted = 0
+        accepted = 0
+    end subroutine default_step_counts
 end module flexmbs_dae_solver

@@ -11,6 +11,7 @@ module flexmbs_io_progress
     use flexmbs_core_status, only: status_t
     use flexmbs_core_timer, only: timer_t
     use flexmbs_dae_sink, only: sink_t, dense_output_t
+    use flexmbs_dae_solver, only: dae_solver_t
     implicit none
     private
 
@@ -31,9 +32,9 @@ module flexmbs_io_progress
         real(wp) :: t_start = 0.0_wp, t_end = 1.0_wp
         real(wp) :: t = 0.0_wp
         integer :: steps = 0
-        !> Live step counters of the running solver (attempted, accepted);
-        !> rejections are shown only when they are known.
-        integer, pointer :: attempted => null(), accepted => null()
+        !> The running solver, asked for its live step counts
+        !> (dae_solver_t%step_counts); rejections are shown only with it.
+        class(dae_solver_t), pointer :: solver => null()
         logical :: drawn = .false.
         real(wp) :: last_draw = -huge(1.0_wp)
         type(timer_t) :: clock
@@ -74,13 +75,12 @@ contains
         stderr_is_terminal = c_isatty(2_c_int) == 1_c_int
     end function stderr_is_terminal
 
-    !> Show rejections from counters that the solver updates as it goes
-    !> (e.g. RADAU5's native NSTEP and NACCPT); they must outlive the display.
-    subroutine progress_watch(self, attempted, accepted)
+    !> Show rejections from the counts the solver keeps as it goes; it must
+    !> outlive the display.
+    subroutine progress_watch(self, solver)
         class(progress_t), intent(inout) :: self
-        integer, intent(in), target :: attempted, accepted
-        self%attempted => attempted
-        self%accepted => accepted
+        class(dae_solver_t), intent(in), target :: solver
+        self%solver => solver
     end subroutine progress_watch
 
     subroutine progress_output(self, t, y, status)
@@ -127,6 +127,7 @@ contains
         character(len=:), allocatable :: line
         character(len=160) :: buf
         real(wp) :: percent, span
+        integer :: attempted, accepted
         span = self%t_end - self%t_start
         percent = 100.0_wp
         if (span /= 0.0_wp) percent = 100.0_wp * (self%t - self%t_start) / span
@@ -134,9 +135,12 @@ contains
         write (buf, '(a,es12.5,a,f6.1,a,i0)') 't = ', self%t, ' s  ', percent, &
             ' %  steps ', self%steps
         line = trim(buf)
-        if (associated(self%attempted) .and. associated(self%accepted)) then
-            write (buf, '(a,i0)') '  rejected ', self%attempted - self%accepted
-            line = line // trim(buf)
+        if (associated(self%solver)) then
+            call self%solver%step_counts(attempted, accepted)
+            if (attempted > 0) then
+                write (buf, '(a,i0)') '  rejected ', attempted - accepted
+                line = line // trim(buf)
+            end if
         end if
     end function progress_line
 

@@ -494,15 +494,7 @@ contains
             call sinks%attach(h5)
         end if
         progress = new_progress(scene%t_start, scene%t_end, quiet .or. .not. scene%progress)
-        select type (solver)
-        type is (radau5_t)
-            call progress%watch(solver%native%nstep, solver%native%naccpt)
-        type is (ddassl_t)
-            ! Native NST counts accepted steps only.
-            call progress%watch(solver%native%nst, solver%native%nst)
-        type is (mexax_t)
-            call progress%watch(solver%native%nstep, solver%native%naccpt)
-        end select
+        call progress%watch(solver)
         call sinks%attach(progress)
         call sinks%attach(signals)
         if (present(record)) call sinks%attach(record)
