@@ -9,7 +9,7 @@ module test_scene_input
     use flexmbs_core_files, only: read_text_file
     use flexmbs_linalg_linear_solver, only: linear_solver_names
     use flexmbs_io_namelist, only: scene_input_t, parse_scene
-    use flexmbs_core_text, only: nearest
+    use flexmbs_core_text, only: nearest, int_text
     use flexmbs_io_scene_schema, only: schema, kind_real, kind_integer, kind_string, &
         kind_logical, find_var
     use flexmbs_io_scene_values, only: rule_reason
@@ -62,12 +62,12 @@ contains
         integer :: i
         text = '&simulation problem = ''van_der_pol'', t_end = 1 /' // nl // '&solver'
         do i = 1, 300
-            text = text // nl // ' x' // itoa(i) // ' = 1'
+            text = text // nl // ' x' // int_text(i) // ' = 1'
         end do
         status = parse(text // ' /')
         call check(error, lines(status%text()) == max_errors + 1, 'listed: ' // &
-                   itoa(lines(status%text())))
-        call expect(error, status, '... and ' // itoa(300 - max_errors) // ' more errors')
+                   int_text(lines(status%text())))
+        call expect(error, status, '... and ' // int_text(300 - max_errors) // ' more errors')
     end subroutine test_error_limit
 
     subroutine test_did_you_mean(error)
@@ -113,13 +113,13 @@ contains
         status = parse('&simulation problem = ''van_der_pol'', t_end = 1 /' // nl // &
                        '&solver ' // huge_word // ' = 1 /')
         call expect(error, status, 'unknown variable')
-        call check(error, len(status%text()) < 600, 'short message: ' // itoa(len(status%text())))
+        call check(error, len(status%text()) < 600, 'short message: ' // int_text(len(status%text())))
         call expect(error, status, '(4194304 characters)')
         status = parse('&simulation problem = ''van_der_pol'', t_end = 1, title = ''' // &
                        huge_word // ''' /')
         call expect(error, status, 'title = ''aaaa')
         call expect(error, status, 'longer than 256 characters')
-        call check(error, len(status%text()) < 400, 'short message: ' // itoa(len(status%text())))
+        call check(error, len(status%text()) < 400, 'short message: ' // int_text(len(status%text())))
     end subroutine test_bounded_messages
 
     subroutine test_tolerance_floor(error)
@@ -285,11 +285,4 @@ contains
         end do
     end function lines
 
-    pure function itoa(i) result(s)
-        integer, intent(in) :: i
-        character(len=:), allocatable :: s
-        character(len=24) :: buf
-        write (buf, '(i0)') i
-        s = trim(buf)
-    end function itoa
 end module test_scene_input

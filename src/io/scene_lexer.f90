@@ -23,17 +23,15 @@ module flexmbs_io_scene_lexer
     type, public :: entry_t
         character(len=:), allocatable :: group, name, value
         integer :: line = 0
-        logical :: quoted = .false.
         integer :: instance = 1  !! which occurrence of a repeatable group
         logical :: bad = .false.
         type(item_t), allocatable :: items(:)
     end type entry_t
 
-    !> Text span [first, last] of one group, from '&name' to its closing '/'.
+    !> One group of the text: which, its occurrence, and where it starts.
     type, public :: span_t
         integer :: group = 0     !! index in group_names
         integer :: instance = 1  !! occurrence of that group
-        integer :: first = 0, last = 0
         integer :: line = 0      !! line of '&name'
     end type span_t
 
@@ -49,7 +47,7 @@ contains
         type(entry_t), allocatable, intent(out) :: entries(:)
         type(span_t), allocatable, intent(out) :: spans(:)
         character(len=:), allocatable :: clean, group, word
-        integer :: pos, line, g, n, first, first_line, instance, nentries, nspans
+        integer :: pos, line, g, n, first_line, instance, nentries, nspans
         logical :: skip
 
         allocate (entries(16), spans(8))
@@ -74,7 +72,6 @@ contains
                 end do
                 cycle
             end if
-            first = pos
             first_line = line
             pos = pos + 1
             group = lower(name_word(clean, pos))
@@ -103,7 +100,7 @@ contains
             if (.not. skip) then
                 if (nspans == size(spans)) spans = [spans, spans]
                 nspans = nspans + 1
-                spans(nspans) = span_t(g, instance, first, pos - 1, first_line)
+                spans(nspans) = span_t(g, instance, first_line)
             end if
         end do
         entries = entries(1:nentries)
@@ -268,8 +265,8 @@ contains
             if (.not. skip .and. spec > 0 .and. .not. duplicate) then
                 if (nentries == size(entries)) entries = [entries, entries]
                 nentries = nentries + 1
-                entries(nentries) = entry_t(group, name, value, vline, &
-                    all(items(1:nitems)%quoted), instance, bad, items(1:nitems))
+                entries(nentries) = entry_t(group, name, value, vline, instance, bad, &
+                                            items(1:nitems))
             end if
             previous_quoted = all(items(1:nitems)%quoted)
             previous_line = line

@@ -4,12 +4,12 @@
 !> schema; every error of the file reported at once.
 module flexmbs_io_study_file
     use flexmbs_core_kinds, only: wp
-    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_status, only: status_t
     use flexmbs_core_files, only: read_text_file
     use flexmbs_core_text, only: lower
     use flexmbs_io_input_errors, only: input_errors_t
     use flexmbs_io_scene_schema, only: group_names, len_name, len_path
-    use flexmbs_io_scene_lexer, only: entry_t, span_t, tokenise, has_entry
+    use flexmbs_io_scene_lexer, only: entry_t, span_t, tokenise
     use flexmbs_io_scene_values, only: check_types, check_rules, get, get_list, value_error, &
         required_error
     use flexmbs_io_scene_checks, only: relative_to, folder_of
