@@ -20,9 +20,9 @@ program flexmbs_main
     use flexmbs_core_signals, only: install_signals, caught_signal
     use flexmbs_core_version, only: version
     use flexmbs_io_namelist, only: scene_input_t, read_scene
-    use flexmbs_io_scene, only: run_result_t, run_scene
+    use flexmbs_run_runner, only: run_result_t, run_scene
     use flexmbs_io_namelist, only: study_input_t, read_study
-    use flexmbs_io_study, only: make_reference, run_sweep, run_sweep_point, sweep_run_t, &
+    use flexmbs_run_study, only: make_reference, run_sweep, run_sweep_point, sweep_run_t, &
         read_reference
     use flexmbs_io_table, only: layout_text, table_markdown, stats_row_t
     implicit none

@@ -51,7 +51,10 @@ module flexmbs
         table_markdown, table_csv, table_latex
     use flexmbs_io_progress, only: progress_t, new_progress
     use flexmbs_io_multi_sink, only: multi_sink_t
-    use flexmbs_io_scene, only: run_scene, run_result_t, build_problem, build_solver
+    use flexmbs_run_runner, only: run_scene, run_result_t
+    use flexmbs_run_plan, only: run_plan_t, make_plan
+    use flexmbs_run_problem_factory, only: build_problem
+    use flexmbs_run_solver_factory, only: build_solver
     implicit none
     public
 end module flexmbs

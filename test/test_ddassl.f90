@@ -19,7 +19,9 @@ module test_ddassl
     use flexmbs_problems_pendulum, only: pendulum_t, new_pendulum, pendulum_initial, &
         pendulum_reference, pendulum_index2, pendulum_ggl, pendulum_index3
     use flexmbs_io_namelist, only: scene_input_t, parse_scene
-    use flexmbs_io_scene, only: run_result_t, run_scene
+    use flexmbs_run_runner, only: run_result_t, run_scene
+    use flexmbs_run_solver_factory, only: build_solver
+    use flexmbs_dae_solver, only: dae_solver_t
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
     private
@@ -851,14 +853,23 @@ contains
         type(scene_input_t) :: scene
         type(status_t) :: status
         type(run_result_t) :: result
+        class(dae_solver_t), allocatable :: solver
         character(len=*), parameter :: sim = &
             '&simulation problem = ''robertson'', t_end = 40 /' // new_line('a')
         call parse_scene(sim // '&solver name = ''DDASSL'', pmax = 2, rtol = 1e-6, ' // &
             'atol = 1e-10, initial_derivative = .true., netlib = .true. /', 'rober.nml', &
             scene, status)
         call check(error, status%ok(), 'parse: ' // status%text())
-        call check(error, scene%initial_derivative .and. scene%netlib .and. &
-            scene%exclude_index23, 'DDASSL switches')
+        if (allocated(error)) return
+        ! the given switches; exclude_index23 keeps ddassl_t's default (.true.)
+        call build_solver(scene, solver, status)
+        select type (solver)
+        type is (ddassl_t)
+            call check(error, solver%initial_derivative .and. solver%netlib .and. &
+                solver%exclude_index23, 'DDASSL switches')
+        class default
+            call check(error, .false., 'not a ddassl_t')
+        end select
         if (allocated(error)) return
         call run_scene(scene, .true., result, status)
         call check(error, status%ok(), 'run: ' // status%text())

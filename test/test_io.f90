@@ -15,9 +15,13 @@ module test_io
         output_hdf5, output_table
     use flexmbs_core_version, only: version
     use flexmbs_io_progress, only: progress_t, new_progress
-    use flexmbs_dae_radau5, only: radau5_t
+    use flexmbs_dae_radau5, only: radau5_t, radau5_controller_classical
+    use flexmbs_dae_solver, only: dae_solver_t
+    use flexmbs_io_scene_input, only: setting_given
+    use flexmbs_run_solver_factory, only: build_solver
     use flexmbs_dae_ida, only: ida_t
-    use flexmbs_io_scene, only: run_result_t, run_scene, build_problem, block_spec_t
+    use flexmbs_run_runner, only: run_result_t, run_scene
+    use flexmbs_run_problem_factory, only: build_problem, block_spec_t
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_fe_mesh, only: mesh_t
@@ -75,6 +79,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         type(scene_input_t) :: scene
         type(status_t) :: status
+        class(dae_solver_t), allocatable :: solver
         character(len=:), allocatable :: path
         path = scratch('valid.nml')
         ! its output folder, beside it
@@ -115,8 +120,23 @@ contains
                    'out/run.h5', 'file: ' // scene%output_file)
         call check(error, scene%n_output == 5, 'n_output')
         call check(error, scene%every_step, 'every_step')
-        call check(error, scene%nit == 7, 'nit default')
         call check(error, index(scene%text, '&SOLVER') > 0, 'text kept')
+        if (allocated(error)) return
+        ! given settings reach the solver; the others keep its type's defaults
+        call check(error, setting_given(scene, 'thet') .and. .not. setting_given(scene, 'nit'), &
+                   'settings given')
+        call build_solver(scene, solver, status)
+        call check(error, status%ok(), 'build_solver: ' // status%text())
+        if (allocated(error)) return
+        select type (solver)
+        type is (radau5_t)
+            call check(error, solver%nit == 7 .and. solver%thet == -1.0_wp .and. &
+                solver%zero_start .and. solver%controller == radau5_controller_classical .and. &
+                solver%quot2 == 1.2_wp, 'RADAU5: the given settings, NIT 7 and QUOT2 1.2 &
+                &of radau5_t')
+        class default
+            call check(error, .false., 'not a radau5_t: ' // solver%name())
+        end select
         call delete(path)
     end subroutine test_valid_file
 

@@ -19,7 +19,7 @@ module test_mexax
     use flexmbs_problems_pendulum_chain, only: pendulum_chain_t, new_pendulum_chain, &
         pendulum_chain_initial, chain_anchor_t1
     use flexmbs_io_namelist, only: scene_input_t, parse_scene
-    use flexmbs_io_scene, only: run_result_t, run_scene
+    use flexmbs_run_runner, only: run_result_t, run_scene
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
     private

@@ -6,10 +6,10 @@ module test_multibody_scene
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_io_namelist, only: scene_input_t, read_scene, parse_scene
-    use flexmbs_io_scene, only: run_result_t, run_scene
+    use flexmbs_run_runner, only: run_result_t, run_scene
     use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_problems_mechanisms, only: four_bar_exact, crank_angle, bar_b
-    use flexmbs_io_chain_input, only: build_rigid_chain
+    use flexmbs_run_chain_builder, only: build_rigid_chain
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     use flexmbs_mbs_flexible_marker, only: flexible_marker_t, new_flexible_marker
     use testing, only: test_case_t, new_test, error_t, check

@@ -17,7 +17,8 @@ module test_sparse_formulation
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_io_namelist, only: scene_input_t, read_scene
-    use flexmbs_io_scene, only: run_result_t, run_scene, build_problem, block_spec_t
+    use flexmbs_run_runner, only: run_result_t, run_scene
+    use flexmbs_run_problem_factory, only: build_problem, block_spec_t
     use testing, only: test_case_t, new_test, error_t, check
     implicit none
     private

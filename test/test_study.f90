@@ -6,7 +6,7 @@ module test_study
     use flexmbs_core_status, only: status_t
     use flexmbs_io_namelist, only: study_input_t, parse_study, parse_scene, scene_input_t, &
         read_study
-    use flexmbs_io_study, only: make_reference, run_sweep, read_reference, sweep_run_t
+    use flexmbs_run_study, only: make_reference, run_sweep, read_reference, sweep_run_t
     use flexmbs_io_table, only: table_text, table2_text, table_markdown, stats_row_t
     use testing, only: test_case_t, new_test, error_t, check
     implicit none

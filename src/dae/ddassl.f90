@@ -154,7 +154,7 @@ module flexmbs_dae_ddassl
         type(ddassl_dense_t) :: dense
         type(ddassl_work_t) :: work  !! the state between steps (begin/step)
     contains
-        procedure :: integrate => ddassl_integrate
+        procedure :: integrate_dae => ddassl_integrate
         procedure :: integrate_residual => ddassl_integrate_residual
         procedure :: begin => ddassl_begin
         procedure :: step => ddassl_step

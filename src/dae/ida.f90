@@ -86,7 +86,7 @@ module flexmbs_dae_ida
         !> Linear solver used by the last integration: 'dense' or 'klu'.
         character(len=8) :: linear_solver_used = ''
     contains
-        procedure :: integrate => ida_integrate
+        procedure :: integrate_dae => ida_integrate
         procedure :: name => ida_name
     end type ida_t
 

@@ -150,8 +150,9 @@ module flexmbs_dae_mexax
         integer :: failed_in = mexax_failed_none !! mexax_failed_step | _projection
         type(mexax_dense_t) :: dense
     contains
-        procedure :: integrate => mexax_integrate
+        procedure :: integrate_dae => mexax_integrate
         procedure :: integrate_mechanical => mexax_integrate_mechanical
+        procedure :: integrate_system => mexax_integrate_system
         procedure :: extrapolate => mexax_extrapolate
         procedure :: name => mexax_name
         procedure :: step_counts => mexax_step_counts
@@ -234,9 +235,39 @@ contains
         real(wp), intent(inout), optional :: yp(:)
         stats%t_reached = t
         call status%set(status_bad_input, 'mexax: integrates mechanical problems only &
-            &(q'' = T v, M v'' = f - G^T lambda, projection built in); call &
-            &integrate_mechanical with a mechanical_problem_t, not an index formulation')
+            &(q'' = T v, M v'' = f - G^T lambda, projection built in); give integrate &
+            &a mechanical_problem_t with its formulation, not a formulation alone')
     end subroutine mexax_integrate
+
+    !> The mechanical problem through the common interface: y = (q, v, λ)
+    !> (the layout of `formulation`, the index-2 formulation with constant
+    !> mass, which MEXAX itself does not need).
+    subroutine mexax_integrate_system(self, mechanical, formulation, t, y, t_end, options, &
+                                      stats, status, sink)
+        class(mexax_t), intent(inout) :: self
+        class(mechanical_problem_t), intent(inout) :: mechanical
+        class(dae_problem_t), intent(inout) :: formulation
+        real(wp), intent(inout) :: t
+        real(wp), intent(inout) :: y(:)
+        real(wp), intent(in) :: t_end
+        type(dae_options_t), intent(in) :: options
+        type(dae_stats_t), intent(out) :: stats
+        type(status_t), intent(out) :: status
+        class(sink_t), intent(inout), optional :: sink
+        integer :: nq, nv, nc
+        nq = mechanical%nq
+        nv = mechanical%nv
+        nc = mechanical%nc
+        if (size(y) /= nq + nv + nc) then
+            stats%t_reached = t
+            call status%set(status_bad_input, 'mexax: y has ' // int_text(size(y)) // &
+                ' components; the mechanical problem''s (q, v, lambda) has ' // &
+                int_text(nq + nv + nc))
+            return
+        end if
+        call self%integrate_mechanical(mechanical, t, y(1:nq), y(nq + 1:nq + nv), t_end, &
+            options, stats, status, sink, lambda=y(nq + nv + 1:nq + nv + nc))
+    end subroutine mexax_integrate_system
 
     !> Integrate the mechanical problem from (t, q, v) to t_end. On return
     !> t, q, v hold the last accepted point (t_end on success), `lambda` and

@@ -115,7 +115,7 @@ module flexmbs_dae_radau5
         integer :: nsol_error = 0          !! error-estimate solves (not in native NSOL)
         type(radau5_dense_t) :: dense
     contains
-        procedure :: integrate => radau5_integrate
+        procedure :: integrate_dae => radau5_integrate
         procedure :: name => radau5_name
         procedure :: step_counts => radau5_step_counts
     end type radau5_t

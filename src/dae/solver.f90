@@ -1,9 +1,15 @@
 !> The abstract DAE solver: every solver integrates a problem from (t, y)
 !> to t_end with common options, feeds a sink and fills common statistics.
+!>
+!> `integrate` takes either a `dae_problem_t` or a mechanical problem with
+!> its formulation (a `dae_problem_t` over the same bodies): a solver with
+!> a mechanical core (MEXAX) integrates the mechanical form directly, every
+!> other one the formulation, so no caller needs to know which is which.
 module flexmbs_dae_solver
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t
     use flexmbs_dae_problem, only: dae_problem_t
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_sink, only: sink_t
@@ -12,7 +18,9 @@ module flexmbs_dae_solver
 
     type, abstract, public :: dae_solver_t
     contains
-        procedure(integrate_i), deferred :: integrate
+        procedure(integrate_i), deferred :: integrate_dae
+        procedure :: integrate_system => default_integrate_system
+        generic :: integrate => integrate_dae, integrate_system
         procedure(name_i), deferred :: name
         procedure :: step_counts => default_step_counts
     end type dae_solver_t
@@ -43,6 +51,27 @@ module flexmbs_dae_solver
     end interface
 
 contains
+
+    !> Integrate a mechanical problem from (t, y) to t_end. y is the state
+    !> of `formulation`, the mechanical problem formulated as a DAE over the
+    !> same bodies; a solver with a mechanical core overrides this and reads
+    !> y as (q, v, λ), the layout of the index-2 formulation with constant
+    !> mass. By default the formulation is integrated. On return as
+    !> `integrate` on a dae_problem_t.
+    subroutine default_integrate_system(self, mechanical, formulation, t, y, t_end, options, &
+                                        stats, status, sink)
+        class(dae_solver_t), intent(inout) :: self
+        class(mechanical_problem_t), intent(inout) :: mechanical
+        class(dae_problem_t), intent(inout) :: formulation
+        real(wp), intent(inout) :: t
+        real(wp), intent(inout) :: y(:)
+        real(wp), intent(in) :: t_end
+        type(dae_options_t), intent(in) :: options
+        type(dae_stats_t), intent(out) :: stats
+        type(status_t), intent(out) :: status
+        class(sink_t), intent(inout), optional :: sink
+        call self%integrate_dae(formulation, t, y, t_end, options, stats, status, sink)
+    end subroutine default_integrate_system
 
     !> Steps attempted and accepted so far in the running integration, for
     !> a live display; 0 and 0 from a solver that does not count as it goes.

@@ -28,7 +28,7 @@ module flexmbs_io_namelist
     private
 
     public :: scene_input_t, study_input_t
-    public :: read_scene, parse_scene, scene_dae_options, controller_code, read_study, &
+    public :: read_scene, parse_scene, scene_dae_options, read_study, &
         parse_study
 
 contains
@@ -71,16 +71,6 @@ contains
         call resolve_paths(scene, entries, errors)
         call errors%to_status(status)
     end subroutine parse_scene
-
-    !> RADAU5's controller switch: 1 predictive (Gustafsson), 2 classical; 0 unknown.
-    pure integer function controller_code(name)
-        character(len=*), intent(in) :: name
-        select case (lower(trim(name)))
-        case ('predictive'); controller_code = 1
-        case ('classical'); controller_code = 2
-        case default; controller_code = 0
-        end select
-    end function controller_code
 
     !> Common options of the scene: tolerances, steps, output times.
     function scene_dae_options(scene) result(options)

@@ -5,10 +5,12 @@
 !> output on an input. Every error goes to the list.
 module flexmbs_io_scene_checks
     use flexmbs_core_kinds, only: wp, i8
-    use flexmbs_core_text, only: lower, real_text
+    use flexmbs_core_text, only: lower, real_text, int_text
     use flexmbs_core_files, only: same_file, file_kind, file_folder
     use flexmbs_core_resources, only: physical_memory, bytes_text
     use flexmbs_linalg_linear_solver, only: linear_solver_names, linear_solver_names_text
+    use flexmbs_run_catalogue, only: solver_info_t, solver_info, problem_info_t, problem_info, &
+        mechanical_problem_names, band_solver_names
     use flexmbs_io_input_errors, only: input_errors_t
     use flexmbs_io_scene_schema, only: schema, find_var, split_choices, choice_list
     use flexmbs_io_scene_lexer, only: entry_t, has_entry, entry_index
@@ -57,22 +59,24 @@ contains
         type(entry_t), intent(in) :: entries(:)
         type(input_errors_t), intent(inout) :: errors
         character(len=*), parameter :: sol = 'solver'
-        if (scene%solver_name == 'mexax' .and. valid(entries, 'simulation', 'problem') .and. &
-            all([character(len=16) :: 'pendulum', 'flexible_body', 'multibody', 'rigid_chain'] &
-                /= scene%problem)) then
-            ! MEXAX integrates the mechanical form only.
-            call value_error(errors, entries, sol, 'name', '''mexax'' integrates mechanical &
-                &problems only: problem must be ''pendulum'', ''flexible_body'', &
-                &''multibody'' or ''rigid_chain''')
+        type(solver_info_t) :: solver
+        type(problem_info_t) :: problem
+        solver = solver_info(scene%solver_name)
+        problem = problem_info(scene%problem)
+        if (solver%mechanical_only .and. valid(entries, 'simulation', 'problem') .and. &
+            .not. problem%mechanical) then
+            call value_error(errors, entries, sol, 'name', '''' // trim(solver%name) // &
+                ''' integrates mechanical problems only: problem must be ' // &
+                mechanical_problem_names())
         end if
         if (all(linear_solver_names /= scene%linear_solver)) call value_error(errors, entries, &
             sol, 'linear_solver', 'must be ' // linear_solver_names_text)
-        if (scene%linear_solver == 'band' .and. (scene%solver_name == 'ida' .or. &
-            scene%solver_name == 'mexax')) call value_error(errors, entries, sol, &
-            'linear_solver', '''band'' is offered with radau5 and ddassl only (' // &
-            trim(scene%solver_name) // ': ''auto'', ''dense'' or ''klu'')')
-        if (scene%solver_name == 'ddassl' .and. scene%pmax > 5) call value_error(errors, &
-            entries, sol, 'pmax', 'must lie in 1..5 for ddassl (its maximal BDF order)')
+        if (scene%linear_solver == 'band' .and. .not. solver%band) call value_error(errors, &
+            entries, sol, 'linear_solver', '''band'' is offered with ' // band_solver_names() // &
+            ' only (' // trim(solver%name) // ': ''auto'', ''dense'' or ''klu'')')
+        if (solver%max_order > 0 .and. scene%pmax > solver%max_order) call value_error(errors, &
+            entries, sol, 'pmax', 'must lie in 1..' // int_text(solver%max_order) // ' for ' // &
+            trim(solver%name) // ' (its maximal BDF order)')
     end subroutine check_solver
 
     !> The output grid must fit in memory (its times are held as reals).

@@ -148,6 +148,10 @@ module flexmbs_io_scene_input
         character(len=len_name) :: linear_solver
         character(len=len_name) :: sparse_ordering !! KLU: 'auto' | 'amd' | 'nd'
         character(len=len_name) :: jacobian
+        !> A solver's own settings (below, down to mexax_base) count only
+        !> when given: the solver factory leaves every other at the solver
+        !> type's default, which is kept nowhere else. Their names:
+        character(len=24), allocatable :: solver_settings(:)
         integer :: nit
         real(wp) :: thet
         real(wp) :: fnewt !! 0 = the solver's default
@@ -187,4 +191,16 @@ module flexmbs_io_scene_input
         ! &rigid_chain
         type(chain_body_input_t), allocatable :: chain(:)
     end type scene_input_t
+
+    public :: setting_given
+
+contains
+
+    !> Whether the scene gives the solver setting `name` (&solver).
+    pure logical function setting_given(scene, name)
+        type(scene_input_t), intent(in) :: scene
+        character(len=*), intent(in) :: name
+        setting_given = .false.
+        if (allocated(scene%solver_settings)) setting_given = any(scene%solver_settings == name)
+    end function setting_given
 end module flexmbs_io_scene_input

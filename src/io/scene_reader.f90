@@ -84,6 +84,12 @@ contains
         type(entry_t), intent(in) :: e(:)
         type(scene_input_t), intent(inout) :: scene
         character(len=*), parameter :: g = 'solver'
+        !> the solvers' own settings, which have no default here (scene_input)
+        character(len=24), parameter :: own_settings(15) = [character(len=24) :: 'nit', &
+            'thet', 'fnewt', 'quot1', 'quot2', 'safe', 'fac_min', 'fac_max', 'controller', &
+            'zero_start', 'initial_derivative', 'exclude_index23', 'netlib', &
+            'max_extrapolation', 'mexax_base']
+        integer :: k
         call get(e, g, 'name', scene%solver_name)
         scene%solver_name = lower(scene%solver_name)
         call get(e, g, 'rtol', scene%rtol)
@@ -115,6 +121,8 @@ contains
         call get(e, g, 'max_extrapolation', scene%max_extrapolation)
         call get(e, g, 'mexax_base', scene%mexax_base)
         scene%mexax_base = lower(scene%mexax_base)
+        scene%solver_settings = pack(own_settings, [(has_entry(e, g, trim(own_settings(k))), &
+            k=1, size(own_settings))])
     end subroutine read_solver
 
     !> `file` stays as written; resolving it is the checks' business.

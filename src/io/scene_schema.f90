@@ -5,6 +5,7 @@
 module flexmbs_io_scene_schema
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_text, only: lower, nearest
+    use flexmbs_run_catalogue, only: solver_choices, problem_choices
     implicit none
     private
 
@@ -42,8 +43,7 @@ module flexmbs_io_scene_schema
 
     type(var_spec_t), parameter, public :: schema(*) = [ &
         var_spec_t('simulation', 'title', kind_string, doc='free text, stored with the result'), &
-        var_spec_t('simulation', 'problem', kind_string, choices='van_der_pol|pendulum|&
-            &robertson|brusselator_1d|brusselator_2d|flexible_body|multibody|rigid_chain', &
+        var_spec_t('simulation', 'problem', kind_string, choices=problem_choices, &
             doc='what to integrate (default: from the groups given)'), &
         var_spec_t('simulation', 't_start', kind_real, default='0', unit='s', &
             doc='start time'), &
@@ -69,7 +69,7 @@ module flexmbs_io_scene_schema
         var_spec_t('simulation', 'npoints', kind_integer, default='100', rule='[1,inf)', &
             doc='Brusselator: grid points per direction'), &
         var_spec_t('solver', 'name', kind_string, default='radau5', &
-            choices='radau5|ddassl|ida|mexax', doc='the integrator'), &
+            choices=solver_choices, doc='the integrator'), &
         var_spec_t('solver', 'rtol', kind_real, default='1e-6', rule='tolerance', &
             doc='relative tolerance'), &
         var_spec_t('solver', 'atol', kind_real, default='1e-6', rule='tolerance', &
@@ -86,37 +86,37 @@ module flexmbs_io_scene_schema
             choices='auto|amd|nd', doc='KLU fill-reducing ordering'), &
         var_spec_t('solver', 'jacobian', kind_string, default='analytic', &
             choices='analytic|fd', doc='Jacobian: analytic or finite differences'), &
-        var_spec_t('solver', 'nit', kind_integer, default='7', rule='[1,inf)', &
+        var_spec_t('solver', 'nit', kind_integer, rule='[1,inf)', &
             doc='RADAU5: most Newton iterations per step'), &
-        var_spec_t('solver', 'thet', kind_real, default='0.001', rule='(-inf,1)', &
+        var_spec_t('solver', 'thet', kind_real, rule='(-inf,1)', &
             doc='RADAU5: Jacobian reuse threshold'), &
-        var_spec_t('solver', 'fnewt', kind_real, default='0', rule='nonnegative', &
-            doc='RADAU5: Newton stopping criterion (0: the default)'), &
-        var_spec_t('solver', 'quot1', kind_real, default='1', rule='(0,1]', &
+        var_spec_t('solver', 'fnewt', kind_real, rule='nonnegative', &
+            doc='RADAU5: Newton stopping criterion (0: from rtol)'), &
+        var_spec_t('solver', 'quot1', kind_real, rule='(0,1]', &
             doc='RADAU5: keep the step when h_new/h lies in [quot1, quot2]'), &
-        var_spec_t('solver', 'quot2', kind_real, default='1.2', rule='[1,inf)', &
+        var_spec_t('solver', 'quot2', kind_real, rule='[1,inf)', &
             doc='RADAU5: see quot1'), &
-        var_spec_t('solver', 'safe', kind_real, default='0.9', rule='(0.001,1)', &
+        var_spec_t('solver', 'safe', kind_real, rule='(0.001,1)', &
             doc='safety factor of the step size control'), &
-        var_spec_t('solver', 'fac_min', kind_real, default='0.2', rule='(0,1]', &
+        var_spec_t('solver', 'fac_min', kind_real, rule='(0,1]', &
             doc='smallest step size ratio'), &
-        var_spec_t('solver', 'fac_max', kind_real, default='8', rule='[1,inf)', &
+        var_spec_t('solver', 'fac_max', kind_real, rule='[1,inf)', &
             doc='largest step size ratio'), &
-        var_spec_t('solver', 'controller', kind_string, default='predictive', &
+        var_spec_t('solver', 'controller', kind_string, &
             choices='predictive|classical', doc='RADAU5: step size controller'), &
-        var_spec_t('solver', 'zero_start', kind_logical, default='.false.', &
+        var_spec_t('solver', 'zero_start', kind_logical, &
             doc='RADAU5: start Newton from zero'), &
         var_spec_t('solver', 'pmax', kind_integer, default='5', rule='[1,12]', &
             doc='largest order (BDF: 1..5)'), &
-        var_spec_t('solver', 'initial_derivative', kind_logical, default='.false.', &
+        var_spec_t('solver', 'initial_derivative', kind_logical, &
             doc='DDASSL: compute consistent y'' at t_start'), &
-        var_spec_t('solver', 'exclude_index23', kind_logical, default='.true.', &
+        var_spec_t('solver', 'exclude_index23', kind_logical, &
             doc='DDASSL: index-2/3 variables out of the error test'), &
-        var_spec_t('solver', 'netlib', kind_logical, default='.false.', &
+        var_spec_t('solver', 'netlib', kind_logical, &
             doc='DDASSL: the later netlib revision'), &
-        var_spec_t('solver', 'max_extrapolation', kind_integer, default='12', rule='[2,12]', &
+        var_spec_t('solver', 'max_extrapolation', kind_integer, rule='[2,12]', &
             doc='MEXAX: extrapolation columns'), &
-        var_spec_t('solver', 'mexax_base', kind_string, default='midpoint', &
+        var_spec_t('solver', 'mexax_base', kind_string, &
             choices='midpoint|euler', doc='MEXAX: basic step'), &
         var_spec_t('output', 'file', kind_string, &
             doc='HDF5 result (default: the scene''s name with .h5; ''none'': no file)'), &
@@ -252,15 +252,15 @@ module flexmbs_io_scene_schema
         var_spec_t('study', 'reference_file', kind_string, &
             doc='HDF5 reference (default: STUDY_reference.h5)'), &
         var_spec_t('study', 'reference_solver', kind_string, default='radau5', &
-            choices='radau5|ddassl|ida|mexax', doc='solver of the reference'), &
+            choices=solver_choices, doc='solver of the reference'), &
         var_spec_t('study', 'reference_tolerance', kind_real, default='1e-10', &
             rule='tolerance', doc='tolerance of the reference'), &
         var_spec_t('study', 'check_solver', kind_string, default='ddassl', &
-            choices='radau5|ddassl|ida|mexax|none', doc='second solver checking the reference'), &
+            choices=solver_choices // '|none', doc='second solver checking the reference'), &
         var_spec_t('study', 'check_tolerance', kind_real, default='0', &
             doc='its tolerance (0: the reference tolerance)'), &
         var_spec_t('study', 'solvers', kind_string, max_study_solvers, &
-            choices='radau5|ddassl|ida|mexax', doc='solvers of the grid (default: all four)'), &
+            choices=solver_choices, doc='solvers of the grid (default: all four)'), &
         var_spec_t('study', 'stabilisations', kind_string, 3, choices='none|ggl|projection', &
             doc='stabilisations of the grid (default: none, ggl)'), &
         var_spec_t('study', 'tolerances', kind_real, max_study_tolerances, .true., &

@@ -7,6 +7,7 @@ module flexmbs_io_study_file
     use flexmbs_core_status, only: status_t
     use flexmbs_core_files, only: read_text_file
     use flexmbs_core_text, only: lower
+    use flexmbs_run_catalogue, only: solvers
     use flexmbs_io_input_errors, only: input_errors_t
     use flexmbs_io_scene_schema, only: group_names, len_name, len_path
     use flexmbs_io_scene_lexer, only: entry_t, span_t, tokenise
@@ -93,8 +94,8 @@ contains
         input%layout = lower(input%layout)
         call get(entries, g, 'cpu_reference', input%cpu_reference)
         call get_list(entries, g, 'solvers', input%solvers)
-        if (size(input%solvers) == 0) input%solvers = [character(len=len_name) :: 'radau5', &
-            'ddassl', 'ida', 'mexax']
+        if (size(input%solvers) == 0) input%solvers = [character(len=len_name) :: &
+            solvers%name]
         call get_list(entries, g, 'stabilisations', input%stabilisations)
         if (size(input%stabilisations) == 0) input%stabilisations = &
             [character(len=len_name) :: 'none', 'ggl']

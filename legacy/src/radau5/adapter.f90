@@ -31,16 +31,10 @@ module flexmbs_legacy_radau5_adapter
 
     public :: radau5_classic, contr5_value
 
-    ! Defaults of the option slots (ALGORITHMS.md §1.13).
+    ! Defaults of the option slots (ALGORITHMS.md §1.13) that are not
+    ! RADAU5's own settings; those (a zero slot) come from radau5_t.
     real(wp), parameter :: uround_default = 1.0e-16_wp
-    real(wp), parameter :: safe_default = 0.9_wp
-    real(wp), parameter :: thet_default = 0.001_wp
-    real(wp), parameter :: quot1_default = 1.0_wp
-    real(wp), parameter :: quot2_default = 1.2_wp
-    real(wp), parameter :: fac_min_default = 0.2_wp
-    real(wp), parameter :: fac_max_default = 8.0_wp
     integer, parameter :: nmax_default = 100000
-    integer, parameter :: nit_default = 7
     ! §1.12: δ_j = sqrt(uround · max(1e-5, |y_j|)).
     real(wp), parameter :: delta_floor = 1.0e-5_wp
     ! Option slots read: WORK(1..9), IWORK(1..10); statistics IWORK(14..20).
@@ -133,6 +127,7 @@ contains
         type(classic_problem_t) :: problem
         type(classic_sink_t) :: sink
         type(radau5_t) :: solver
+        type(radau5_t) :: defaults !! its settings' defaults, for zero slots
         type(dae_options_t) :: options
         type(dae_stats_t) :: stats
         type(status_t) :: status
@@ -184,7 +179,7 @@ contains
             call reject('IWORK(2) = NMAX = ' // itoa(nmax) // ': must be positive')
             return
         end if
-        nit = merge(nit_default, iwork(3), iwork(3) == 0)
+        nit = merge(defaults%nit, iwork(3), iwork(3) == 0)
         if (nit <= 0) then
             call reject('IWORK(3) = NIT = ' // itoa(nit) // ': must be positive')
             return
@@ -205,12 +200,12 @@ contains
             return
         end if
         nm1 = n - m1
-        safe = merge(safe_default, work(2), work(2) == 0.0_wp)
+        safe = merge(defaults%safe, work(2), work(2) == 0.0_wp)
         if (safe <= 0.001_wp .or. safe >= 1.0_wp) then
             call reject('WORK(2) = SAFE = ' // rtoa(safe) // ': must lie in (0.001, 1)')
             return
         end if
-        thet = merge(thet_default, work(3), work(3) == 0.0_wp)
+        thet = merge(defaults%thet, work(3), work(3) == 0.0_wp)
         if (thet >= 1.0_wp) then
             call reject('WORK(3) = THET = ' // rtoa(thet) // ': must be below 1')
             return
@@ -223,15 +218,15 @@ contains
                 // rtoa(uround / rtol1))
             return
         end if
-        quot1 = merge(quot1_default, work(5), work(5) == 0.0_wp)
-        quot2 = merge(quot2_default, work(6), work(6) == 0.0_wp)
+        quot1 = merge(defaults%quot1, work(5), work(5) == 0.0_wp)
+        quot2 = merge(defaults%quot2, work(6), work(6) == 0.0_wp)
         if (quot1 > 1.0_wp .or. quot2 < 1.0_wp) then
             call reject('WORK(5..6) = QUOT1, QUOT2 = ' // rtoa(quot1) // ', ' // rtoa(quot2) &
                 // ': need QUOT1 <= 1 <= QUOT2')
             return
         end if
-        fac_min = merge(fac_min_default, work(8), work(8) == 0.0_wp)
-        fac_max = merge(fac_max_default, work(9), work(9) == 0.0_wp)
+        fac_min = merge(defaults%fac_min, work(8), work(8) == 0.0_wp)
+        fac_max = merge(defaults%fac_max, work(9), work(9) == 0.0_wp)
         if (fac_min > 1.0_wp .or. fac_max < 1.0_wp) then
             call reject('WORK(8..9) = ' // rtoa(fac_min) // ', ' // rtoa(fac_max) // &
                 ': need WORK(8) <= 1 <= WORK(9)')

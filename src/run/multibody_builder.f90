@@ -10,7 +10,7 @@
 !> names the joints involved. Inconsistent initial positions are corrected
 !> by the formulation's consistent-initial projection (scene.f90), which
 !> fails with its own message when no assembly is found.
-module flexmbs_io_multibody_input
+module flexmbs_run_multibody_builder
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input
@@ -26,8 +26,8 @@ module flexmbs_io_multibody_input
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
         driver_t, node_frame_t
     use flexmbs_io_namelist, only: scene_input_t
-    use flexmbs_io_body_input, only: build_flexible_body
-    use flexmbs_io_chain_input, only: build_rigid_chain
+    use flexmbs_run_body_builder, only: build_flexible_body
+    use flexmbs_run_chain_builder, only: build_rigid_chain
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
     implicit none
@@ -361,4 +361,4 @@ contains
         case default; driver_kind = primitive_distance
         end select
     end function driver_kind
-end module flexmbs_io_multibody_input
+end module flexmbs_run_multibody_builder

@@ -9,7 +9,7 @@
 !> shared equally by the set's nodes that are not fixed. The initial
 !> velocity is rigid: v = v₀ + ω × (X − X̄), X̄ the mean of the nodes.
 !> Every error names the file, the group, the variable and the reason.
-module flexmbs_io_body_input
+module flexmbs_run_body_builder
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input
@@ -211,4 +211,4 @@ contains
         character(len=:), allocatable :: text
         text = ' (line ' // int_text(line) // ')'
     end function at
-end module flexmbs_io_body_input
+end module flexmbs_run_body_builder

@@ -11,7 +11,7 @@
 !> Reactions (multibody systems): for joint k, the force and torque it
 !> exerts on the body of marker i and of marker j (mbs_system_t%joint_reaction,
 !> our sign of λ), 12 numbers per joint and record: F_i, n_i, F_j, n_j.
-module flexmbs_io_monitor_sink
+module flexmbs_run_monitor_sink
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t
@@ -118,4 +118,4 @@ contains
             e = self%mechanical%total_energy(q, v)
         end if
     end function energy
-end module flexmbs_io_monitor_sink
+end module flexmbs_run_monitor_sink

@@ -4,7 +4,7 @@
 !> (R0 = I), so joint_axis is given in the parent's frame. A spherical
 !> joint's coordinates are the unit quaternion of rotation_axis and
 !> rotation_angle, its rates the angular_rate in the child's frame.
-module flexmbs_io_chain_input
+module flexmbs_run_chain_builder
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_text, only: int_text
@@ -67,4 +67,4 @@ contains
         if (.not. status%ok()) call status%set(status_bad_input, scene%path // ': ' // &
                                                status%text())
     end subroutine build_rigid_chain
-end module flexmbs_io_chain_input
+end module flexmbs_run_chain_builder

@@ -5,7 +5,7 @@
 !> assembly_tolerance` is bad input: a position typo would otherwise be
 !> corrected silently. The message names the body and the joint on it
 !> that the given positions violate most.
-module flexmbs_io_assembly_check
+module flexmbs_run_assembly_check
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_text, only: real_text
@@ -116,4 +116,4 @@ contains
                 real_text(best) // ')'
         end function joint_hint
     end subroutine check_assembly
-end module flexmbs_io_assembly_check
+end module flexmbs_run_assembly_check

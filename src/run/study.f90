@@ -17,7 +17,7 @@
 !> per tolerance ('projection'). A run that fails is a row with ERR '-' and
 !> the reason on its summary line. CPU in the table is normalised to the
 !> row `cpu_reference` (the paper's Tables 2 and 3 normalise to one run).
-module flexmbs_io_study
+module flexmbs_run_study
     use hdf5
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_resources, only: out_of_memory
@@ -27,8 +27,9 @@ module flexmbs_io_study
     use flexmbs_core_text, only: int_text, real_text
     use flexmbs_core_files, only: make_scratch_folder
     use flexmbs_dae_error_measure, only: paper_error
+    use flexmbs_run_catalogue, only: solver_projects, solver_pmax_grid, problem_stabilisations
     use flexmbs_io_namelist, only: study_input_t, scene_input_t, read_scene
-    use flexmbs_io_scene, only: run_result_t, run_scene
+    use flexmbs_run_runner, only: run_result_t, run_scene
     use flexmbs_io_record_sink, only: record_sink_t
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_table, only: stats_row_t, new_stats_row, write_table
@@ -73,7 +74,7 @@ contains
         scene%output_file = ''
         scene%table = ''
         scene%vtk = ''
-        if (scene%problem /= 'multibody') return
+        if (.not. problem_stabilisations(scene%problem)) return
         select case (stab)
         case ('none')
             scene%multibody%formulation = 'index2'
@@ -309,7 +310,7 @@ contains
         integer :: is, ib, it, ip, id, np
         stabs = [character(len=32) :: '-']
         sources = [character(len=32) :: '']
-        if (base%problem == 'multibody') then
+        if (problem_stabilisations(base%problem)) then
             stabs = [character(len=32) :: study%stabilisations]
             sources = [character(len=32) :: study%derivatives]
         end if
@@ -317,10 +318,10 @@ contains
         do is = 1, size(study%solvers)
             solver = trim(study%solvers(is))
             do ib = 1, size(stabs)
-                ! MEXAX projects internally: once per tolerance
-                if (solver == 'mexax' .and. ib > 1) exit
+                ! a solver that projects by itself (MEXAX): once per tolerance
+                if (solver_projects(solver) .and. ib > 1) exit
                 do it = 1, size(study%tolerances)
-                    np = merge(size(study%pmax), 1, solver == 'ddassl')
+                    np = merge(size(study%pmax), 1, solver_pmax_grid(solver))
                     do ip = 1, np
                         do id = 1, size(sources)
                             points = [points, sweep_point_t(solver, stabs(ib), &
@@ -532,10 +533,11 @@ contains
         source = trim(point%source)
         tol = point%tol
         label = solver
-        if (solver == 'ddassl') label = label // ' p_max=' // int_text(point%pmax)
+        if (solver_pmax_grid(solver)) label = label // ' p_max=' // int_text(point%pmax)
         if (len(source) > 0 .and. source /= 'analytic') label = label // ' (' // source // ')'
         stab_label = trim(point%stab)
-        if (solver == 'mexax' .and. base%problem == 'multibody') stab_label = 'projection'
+        if (solver_projects(solver) .and. problem_stabilisations(base%problem)) &
+            stab_label = 'projection'
         call configure(base, solver, tol, trim(point%stab), point%pmax, source, scene)
         call run_scene(scene, quiet, result, run_status, rec)
         run%ok = run_status%ok()
@@ -625,4 +627,4 @@ contains
         real(wp), intent(in) :: y(:, :), y_ref(:, :), tol
         err = paper_error(reshape(y, [size(y)]), reshape(y_ref, [size(y_ref)]), tol, tol)
     end function series_error
-end module flexmbs_io_study
+end module flexmbs_run_study

@@ -1,0 +1,327 @@
+!> The runner: from a validated scene to a finished run — its plan
+!> (run/plan: problem, solver, options), the output sinks, the run itself
+!> and what it produced.
+!>
+!> Everything that can be checked is checked before any output file is
+!> created, so bad input never leaves a half-written file behind.
+module flexmbs_run_runner
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_status, only: status_t, status_bad_input, status_interrupted, status_signal
+    use flexmbs_core_signals, only: signal_pending, caught_signal, signal_name
+    use flexmbs_core_text, only: real_text, int_text
+    use flexmbs_core_resources, only: free_space, bytes_text
+    use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_sink, only: sink_t
+    use flexmbs_fe_flexible_body, only: flexible_body_t
+    use flexmbs_mbs_formulation, only: formulation_t
+    use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_io_namelist, only: scene_input_t
+    use flexmbs_io_hdf5_sink, only: hdf5_sink_t
+    use flexmbs_io_progress, only: progress_t, new_progress
+    use flexmbs_io_multi_sink, only: multi_sink_t
+    use flexmbs_io_signal_sink, only: signal_sink_t
+    use flexmbs_io_table, only: new_stats_row, write_table
+    use flexmbs_io_vtk_sink, only: vtk_sink_t
+    use flexmbs_io_output_files, only: named_path_t, named_path, check_output_paths, &
+        output_hdf5, output_vtk, output_table
+    use flexmbs_run_problem_factory, only: block_spec_t
+    use flexmbs_run_plan, only: run_plan_t, make_plan, scene_stab
+    use flexmbs_run_monitor_sink, only: monitor_sink_t
+    use flexmbs_run_body_builder, only: body_energies
+    implicit none
+    private
+
+    !> What a run produced, successful or not.
+    type, public :: run_result_t
+        real(wp) :: t = 0.0_wp                !! last time reached
+        real(wp), allocatable :: y(:)         !! state there
+        type(dae_stats_t) :: stats
+        character(len=:), allocatable :: solver_name
+        logical :: hdf5_written = .false.     !! an HDF5 file was created (and kept)
+        !> A flexible body: strain, kinetic and total energy (with the
+        !> potential of gravity and loads) at the start and at the end [J].
+        logical :: has_energy = .false.
+        real(wp) :: energy_start(3) = 0.0_wp, energy_end(3) = 0.0_wp
+        !> A formulated mechanical scene: ‖g‖∞ and ‖G v + g_I‖∞ at the end
+        !> (the whole history is /monitor in the HDF5 file), constraint rows.
+        logical :: has_drift = .false.
+        real(wp) :: drift_end(2) = 0.0_wp
+        integer :: constraints = 0
+        !> a multibody scene: how far the initial assembly moved each body
+        character(len=:), allocatable :: assembly
+        !> the positions in y (block 'q'), all of y when there is none
+        integer :: q_first = 0, q_last = 0
+    end type run_result_t
+
+    public :: run_scene
+
+contains
+
+    !> The HDF5 file of n_output records (y, its blocks and the time) must
+    !> fit in the free space of its folder: an output grid that cannot be
+    !> written is bad input, said before the run (with every_step the
+    !> number of records is not known in advance).
+    subroutine check_output_size(scene, n, blocks, status)
+        type(scene_input_t), intent(in) :: scene
+        integer, intent(in) :: n
+        type(block_spec_t), intent(in) :: blocks(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: bytes
+        integer(i8) :: free
+        integer :: i, per_record
+        if (len(scene%output_file) == 0 .or. scene%every_step) return
+        per_record = n + 1
+        do i = 1, size(blocks)
+            per_record = per_record + blocks(i)%last - blocks(i)%first + 1
+        end do
+        bytes = 8.0_wp * real(per_record, wp) * real(scene%n_output, wp)
+        free = free_space(scene%output_file(1:index(scene%output_file, '/', back=.true.)))
+        if (free >= 0 .and. bytes > real(free, wp)) call status%set(status_bad_input, &
+            scene%path // ': &output: n_output = ' // int_text(scene%n_output) // ': the &
+            &HDF5 file ''' // scene%output_file // ''' would need ~' // bytes_text(bytes) // &
+            ' (' // int_text(per_record) // ' values a record); its file system has ' // &
+            bytes_text(real(free, wp)) // ' free')
+    end subroutine check_output_size
+
+    !> Run a validated scene: build, check, create the outputs, integrate,
+    !> store the statistics. `status` is ok, bad_input (before any file is
+    !> created), solver_failure or signal (SIGINT/SIGTERM, checked after
+    !> every accepted step: outputs kept, `result` says how far it got) or
+    !> io_error.
+    subroutine run_scene(scene, quiet, result, status, record, force)
+        type(scene_input_t), intent(in) :: scene
+        logical, intent(in) :: quiet             !! no progress display
+        type(run_result_t), intent(out) :: result
+        type(status_t), intent(out) :: status
+        !> also given the solution at every output time
+        class(sink_t), intent(inout), target, optional :: record
+        !> replace existing files that are not flexmbs's own (io/output_files)
+        logical, intent(in), optional :: force
+        type(run_plan_t), target :: plan
+        type(monitor_sink_t), target :: monitor
+        type(vtk_sink_t), target :: vtk
+        type(hdf5_sink_t), target :: h5
+        type(progress_t), target :: progress
+        type(signal_sink_t), target :: signals
+        type(multi_sink_t) :: sinks
+        type(status_t) :: io_status
+        integer :: i
+        character(len=:), allocatable :: outcome
+        real(wp), allocatable :: y_start(:)
+
+        call make_plan(scene, plan, status)
+        if (.not. status%ok()) return
+        result%y = plan%y0
+        if (allocated(plan%assembly)) result%assembly = plan%assembly
+        result%q_first = plan%q_first
+        result%q_last = plan%q_last
+        result%solver_name = plan%solver%name()
+        result%t = scene%t_start
+
+        ! ParaView output is checked before any file is created
+        if (len_trim(scene%vtk) > 0) then
+            call setup_vtk()
+            if (.not. status%ok()) return
+        end if
+        ! which files the run may write; checked before any file is created
+        call check_outputs(scene, vtk, size(plan%options%output_times), force_given(), status)
+        if (.not. status%ok()) return
+        call check_output_size(scene, plan%problem%n, plan%blocks, status)
+        if (.not. status%ok()) return
+        if (len(scene%output_file) > 0) then
+            call h5%create(scene%output_file, plan%problem%n, status, input_text=scene%text, &
+                           every_step=scene%every_step)
+            if (.not. status%ok()) then
+                call h5%close(io_status)
+                return
+            end if
+            result%hdf5_written = .true.
+            do i = 1, size(plan%blocks)
+                call h5%add_block(plan%blocks(i)%name, plan%blocks(i)%first, &
+                                  plan%blocks(i)%last, status)
+                if (.not. status%ok()) return
+            end do
+            call h5%write_text('problem', trim(scene%problem), status)
+            if (status%ok()) call h5%write_text('title', trim(scene%title), status)
+            if (status%ok()) call h5%write_text('input_file', scene%path, status)
+            if (status%ok() .and. allocated(result%assembly)) call h5%write_text('assembly', &
+                'moves of the initial assembly from the given positions: ' // &
+                result%assembly, status)
+            if (.not. status%ok()) return
+            call sinks%attach(h5)
+        end if
+        progress = new_progress(scene%t_start, scene%t_end, quiet .or. .not. scene%progress)
+        call progress%watch(plan%solver)
+        call sinks%attach(progress)
+        call sinks%attach(signals)
+        if (present(record)) call sinks%attach(record)
+        if (len_trim(scene%vtk) > 0) call sinks%attach(vtk)
+        ! drift and energy of formulated mechanical scenes, at the output times
+        select type (p => plan%problem)
+        type is (formulation_t)
+            if (allocated(plan%mechanical)) then
+                monitor%formulation => p
+                monitor%mechanical => plan%mechanical
+                monitor%every_step = scene%every_step
+                monitor%q_start = result%y(p%oq + 1:p%oq + p%nq)
+                call sinks%attach(monitor)
+                result%constraints = p%nc
+            end if
+        end select
+
+        y_start = result%y
+        call record_energy(y_start, result%energy_start)
+        call plan%integrate(result%t, result%y, scene%t_end, result%stats, status, sinks)
+        ! a solver that refuses its options: say which file and group
+        if (status%code == status_bad_input) then
+            if (index(status%text(), scene%path // ':') /= 1) status%message = scene%path // &
+                ': &solver: ' // status%text()
+        end if
+        if (status%code == status_interrupted .and. signal_pending()) call status%set( &
+            status_signal, 'stopped by ' // signal_name(caught_signal()) // ' at t = ' // &
+            real_text(result%t), caught_signal())
+        if (status%ok()) call record_energy(result%y, result%energy_end)
+        result%has_energy = result%has_energy .and. status%ok()
+
+        if (monitor%records > 0) then
+            result%has_drift = .true.
+            result%drift_end = monitor%table(2:3, monitor%records)
+        end if
+        if (h5%is_open) then
+            if (monitor%records > 0) then
+                call h5%write_matrix('monitor', monitor%table(:, 1:monitor%records), io_status)
+                if (io_status%ok()) call h5%write_text('monitor_columns', &
+                    't, |g|_inf, |G v + g_I|_inf, energy [J]', io_status)
+                if (io_status%ok() .and. size(monitor%reactions, 1) > 0) then
+                    call h5%write_matrix('reactions', &
+                        monitor%reactions(:, 1:monitor%records), io_status)
+                    if (io_status%ok()) call h5%write_text('reactions_columns', 'per joint &
+                        &of the system: force and torque on the body of marker i, then of &
+                        &marker j (N, N m; global; torque about the marker)', io_status)
+                end if
+                if (status%ok() .and. .not. io_status%ok()) status = io_status
+            end if
+            outcome = 'ok'
+            if (.not. status%ok()) outcome = status%text()
+            call h5%write_statistics(result%stats, io_status, result%solver_name, outcome)
+            if (status%ok() .and. .not. io_status%ok()) status = io_status
+            call h5%close(io_status)
+            if (status%ok() .and. .not. io_status%ok()) status = io_status
+            ! A solver that refused its input computed nothing: leave no file.
+            if (status%code == status_bad_input .and. h5%records == 0) then
+                call delete_file(scene%output_file)
+                result%hdf5_written = .false.
+            end if
+        end if
+        if (len_trim(scene%table) > 0 .and. status%code /= status_bad_input) then
+            call write_table(trim(scene%table), [new_stats_row(result%solver_name, &
+                scene%rtol, scene_stab(scene), result%stats)], io_status)
+            if (status%ok() .and. .not. io_status%ok()) status = io_status
+        end if
+
+    contains
+
+        !> ParaView output of the flexible body and the rigid bodies (y starts
+        !> with q in every layout: the bodies' (r, p), then v behind q).
+        subroutine setup_vtk()
+            vtk%prefix = trim(scene%vtk)
+            if (.not. allocated(plan%mechanical)) then
+                call status%set(status_bad_input, scene%path // ': &output: vtk: problem = ''' &
+                    // trim(scene%problem) // ''' has no bodies to draw')
+                return
+            end if
+            select type (m => plan%mechanical)
+            type is (flexible_body_t)
+                vtk%body => m
+                vtk%oq = 0
+                vtk%ov = m%nq
+            type is (mbs_system_t)
+                vtk%bodies = size(m%rigid%bodies)
+                if (size(m%chains) > 0) then
+                    vtk%chain => m%chains(1)
+                    vtk%chain_q = m%chain_q(1)
+                end if
+                if (size(m%flex) > 0) then
+                    vtk%body => m%flex(1)
+                    vtk%oq = m%flex_q(1)
+                    vtk%ov = m%nq + m%flex_v(1)
+                    select type (p => plan%problem)
+                    type is (formulation_t)
+                        vtk%oq = p%oq + m%flex_q(1)
+                        vtk%ov = p%ov + m%flex_v(1)
+                    end select
+                end if
+            class default
+                call status%set(status_bad_input, scene%path // ': &output: vtk: problem = ''' &
+                    // trim(scene%problem) // ''' has no bodies to draw')
+            end select
+        end subroutine setup_vtk
+
+        logical function force_given()
+            force_given = .false.
+            if (present(force)) force_given = force
+        end function force_given
+
+        !> Energies of a flexible body at y = (q, v, ...).
+        subroutine record_energy(y, energies)
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(out) :: energies(3)
+            type(status_t) :: energy_status
+            energies = 0.0_wp
+            if (.not. allocated(plan%mechanical)) return
+            select type (body => plan%mechanical)
+            type is (flexible_body_t)
+                associate (nq => body%nq)
+                    call body_energies(body, y(1:nq), y(nq + 1:2 * nq), y_start(1:nq), &
+                                       energies, energy_status)
+                end associate
+                result%has_energy = energy_status%ok()
+            end select
+        end subroutine record_energy
+    end subroutine run_scene
+
+    !> The run's outputs (the HDF5 file, the table, the ParaView collection
+    !> and the pieces of its `records` records) against its inputs (the
+    !> scene file, a mesh file) and each other, and what they would replace
+    !> (io/output_files).
+    subroutine check_outputs(scene, vtk, records, force, status)
+        type(scene_input_t), intent(in) :: scene
+        type(vtk_sink_t), intent(in) :: vtk
+        integer, intent(in) :: records
+        logical, intent(in) :: force
+        type(status_t), intent(inout) :: status
+        type(named_path_t), allocatable :: outputs(:), inputs(:)
+        character(len=:), allocatable :: pieces(:)
+        integer :: n, k
+        allocate (inputs(merge(2, 1, len_trim(scene%body%mesh_file) > 0)))
+        inputs(1) = named_path(scene%path, 'the scene file itself')
+        if (size(inputs) > 1) inputs(2) = named_path(trim(scene%body%mesh_file), &
+            'the mesh file ''' // trim(scene%body%mesh_file) // '''')
+        allocate (character(len=0) :: pieces(0))
+        if (len_trim(scene%vtk) > 0) pieces = vtk%pieces(records)
+        allocate (outputs(3 + size(pieces)))
+        n = 0
+        if (len(scene%output_file) > 0) call add(scene%output_file, 'file', output_hdf5)
+        if (len_trim(scene%table) > 0) call add(trim(scene%table), 'table', output_table)
+        if (len_trim(scene%vtk) > 0) call add(trim(scene%vtk) // '.pvd', 'vtk', output_vtk)
+        do k = 1, size(pieces)
+            call add(trim(pieces(k)), 'vtk', output_vtk)
+            outputs(n)%series = .true.
+        end do
+        call check_output_paths(scene%path // ': ', outputs(1:n), inputs, force, status)
+    contains
+        subroutine add(path, name, kind)
+            character(len=*), intent(in) :: path, name
+            integer, intent(in) :: kind
+            n = n + 1
+            outputs(n) = named_path(path, '&output: ' // name, kind)
+        end subroutine add
+    end subroutine check_outputs
+
+    subroutine delete_file(path)
+        character(len=*), intent(in) :: path
+        integer :: unit, ios
+        open (newunit=unit, file=path, status='old', iostat=ios)
+        if (ios == 0) close (unit, status='delete')
+    end subroutine delete_file
+end module flexmbs_run_runner
