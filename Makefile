@@ -93,7 +93,8 @@ run: build
 	$(FPM) run --profile release flexmbs -- run $(MAIN_INPUT)
 
 # Root suites, then the classic fixed-form drivers linked against the
-# installed library exactly as a user links them, then the command-line
+# installed library exactly as a user links them, the architecture's rules
+# on the sources (test/layers.py), then the command-line
 # checks of test/cli.sh, the signals of test/kill.sh (python3-h5py reads
 # the files they leave) and the fuzzer of the scene input (test/fuzz, about
 # a thousand mutated scenes, two at a time); one summary line last.
@@ -104,14 +105,17 @@ test: deps
 	@$(MAKE) --no-print-directory legacy-test PREFIX_USED=$(PREFIX_DEBUG) PROFILE=debug \
 	    > $(BUILD)/test-legacy.log 2>&1; echo "exit $$?" >> $(BUILD)/test-legacy.log; \
 	    cat $(BUILD)/test-legacy.log
+	@set -o pipefail; python3 test/layers.py 2>&1 | tee $(BUILD)/test-layers.log; \
+	    echo "exit $$?" >> $(BUILD)/test-layers.log
 	@set -o pipefail; FPM="$(FPM)" bash test/cli.sh 2>&1 | tee $(BUILD)/test-cli.log; \
 	    echo "exit $$?" >> $(BUILD)/test-cli.log
 	@set -o pipefail; FPM="$(FPM)" bash test/kill.sh 2>&1 | tee $(BUILD)/test-kill.log; \
 	    echo "exit $$?" >> $(BUILD)/test-kill.log
 	@set -o pipefail; FPM="$(FPM)" bash test/fuzz/run.sh 2>&1 | tee $(BUILD)/test-fuzz.log; \
 	    echo "exit $$?" >> $(BUILD)/test-fuzz.log
-	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log $(BUILD)/test-cli.log \
-	    $(BUILD)/test-kill.log $(BUILD)/test-fuzz.log
+	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log \
+	    $(BUILD)/test-layers.log $(BUILD)/test-cli.log $(BUILD)/test-kill.log \
+	    $(BUILD)/test-fuzz.log
 
 PROFILE     ?= debug
 PREFIX_USED ?= $(PREFIX_DEBUG)

@@ -1,5 +1,6 @@
-!> One benchmark run: integrate a problem with RADAU5, DDASSL or IDA and
-!> print one line of figures (counters, CPU and wall time, time per step,
+!> One benchmark run: integrate a problem with a solver of the catalogue
+!> (run/catalogue), planned as `flexmbs run` plans a scene, and print one
+!> line of figures (counters, CPU and wall time, time per step,
 !> peak memory) and the accuracy reached at t_end.
 !>
 !>   flexmbs-bench INTEGRATOR PROBLEM N SOLVER [MAX_STEPS] [RTOL] [REFERENCE]
@@ -8,13 +9,15 @@
 !>   flexmbs-bench ad fourbar|slidercrank
 !>   flexmbs-bench sparse_lu hex NX NY NZ | sparse_lu rd1d|rd2d N
 !>
-!> INTEGRATOR: radau5 | ddassl | ddassl-p2 (maximal BDF order 2) | ida |
-!> mexax (midpoint base) | mexax-euler (half-explicit Euler base).
-!> PROBLEM: vdp | rd1d | rd2d | pend3 | pend2 | pendggl (N: unknowns for
-!> rd1d, grid points per side for rd2d, ignored otherwise); for mexax only,
-!> the mechanical forms pendmech (the same pendulum) and chain (N bars, the
-!> chain of ALGORITHMS.md §8; ERR over (x1, y1, φ1) at t = 1 against the
-!> original's TOL 1e-11 values for N = 8, none otherwise); SOLVER: dense |
+!> INTEGRATOR: a solver of the catalogue (radau5 | ddassl | ida | mexax),
+!> or NAME-p2 (maximal BDF order 2) or NAME-euler (MEXAX's half-explicit
+!> Euler base).
+!> PROBLEM: vdp | rd1d | rd2d | pend3 | pend2 | pendggl | pendmech (the
+!> index-2 pendulum, for MEXAX's mechanical form) (N: unknowns for rd1d,
+!> grid points per side for rd2d, ignored otherwise); and chain (N bars,
+!> the chain of ALGORITHMS.md §8, no scene's problem: its index-2
+!> formulation; ERR over (x1, y1, φ1) at t = 1 against the original's
+!> TOL 1e-11 values for N = 8, none otherwise); SOLVER: dense |
 !> klu | band | auto. ERR is eq. (13) of `paper_error` at t_end with
 !> atol = rtol: van der Pol against its tight reference, the pendulum
 !> (φ0 = 1, t_end = 3, index 3, index 2 or GGL) over the positions against
@@ -48,33 +51,28 @@ program flexmbs_bench
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, reason_max_steps
-    use flexmbs_dae_problem, only: dae_problem_t
+    use flexmbs_core_text, only: int_text
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_solver, only: dae_solver_t
-    use flexmbs_dae_radau5, only: radau5_t
-    use flexmbs_dae_ddassl, only: ddassl_t
-    use flexmbs_dae_ida, only: ida_t
     use flexmbs_dae_mexax, only: mexax_t, mexax_base_euler
-    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
-    use flexmbs_problems_pendulum, only: pendulum_mechanical_t, new_pendulum_mechanical, &
-        pendulum_mechanical_initial, pendulum_angle_exact, pendulum_default_gravity, &
-        pendulum_default_length
+    use flexmbs_dae_error_measure, only: paper_error
     use flexmbs_problems_pendulum_chain, only: pendulum_chain_t, new_pendulum_chain, &
         pendulum_chain_initial, chain_anchor_t1
-    use flexmbs_dae_error_measure, only: paper_error
-    use flexmbs_problems_van_der_pol, only: new_van_der_pol
-    use flexmbs_problems_reaction_diffusion, only: reaction_diffusion_t, &
-        new_reaction_diffusion, reaction_diffusion_initial
-    use flexmbs_problems_pendulum, only: pendulum_t, new_pendulum, pendulum_initial, &
-        pendulum_reference, pendulum_index2, pendulum_index3, pendulum_ggl
+    use flexmbs_problems_reaction_diffusion, only: reaction_diffusion_t
+    use flexmbs_problems_pendulum, only: pendulum_t, pendulum_reference
+    use flexmbs_io_namelist, only: scene_input_t, parse_scene
+    use flexmbs_run_catalogue, only: solvers, solver_radau5, solver_choices
+    use flexmbs_run_solver_factory, only: new_solver
+    use flexmbs_run_plan, only: run_plan_t, make_plan
     use flexmbs_fe_hexahedron, only: hex8, hex27
     use flexmbs_fe_neo_hooke, only: neo_hooke_t, new_neo_hooke
     use flexmbs_fe_mesh, only: mesh_t
     use flexmbs_fe_box_mesh, only: box_mesh
     use flexmbs_fe_flexible_body, only: flexible_body_t, new_flexible_body
     use flexmbs_mbs_system, only: mbs_system_t
-    use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_ggl
+    use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_ggl, &
+        formulation_index2
     use flexmbs_problems_mechanisms, only: new_mechanism, mechanism_slider_crank, &
         mechanism_four_bar
     use flexmbs_problems_node_graph, only: node_graph_jacobian, node_graph_mass
@@ -88,8 +86,6 @@ program flexmbs_bench
     !$ use omp_lib, only: omp_get_max_threads
     implicit none
 
-    real(wp), parameter :: pendulum_phi0 = 1.0_wp   !! start angle [rad], as in test/
-    real(wp), parameter :: pendulum_t_end = 3.0_wp
     !> van der Pol, ε = 1e-6, y(2) from y(0) = (2, −0.66): RADAU5 at
     !> rtol = atol = 1e-14, the reference of test/test_radau5.f90 (which
     !> confirms it by the independent Lobatto IIIC integrator to 1e-11).
@@ -102,7 +98,9 @@ program flexmbs_bench
     real(wp) :: rtol, t, t_end, err
     real(wp), allocatable :: y(:), y_ref(:)
     logical, allocatable :: mask(:)
-    class(dae_problem_t), allocatable :: problem
+    !> the run as `flexmbs run` plans it (run/plan; `target`: a mechanical
+    !> problem's formulation points into it)
+    type(run_plan_t), target :: plan
     class(dae_solver_t), allocatable :: solver
     type(dae_options_t) :: options
     type(dae_stats_t) :: stats
@@ -132,7 +130,7 @@ program flexmbs_bench
         end if
     end if
     if (command_argument_count() < 4) then
-        write (*, '(a)') 'usage: flexmbs-bench radau5|ddassl|ddassl-p2|ida|mexax|mexax-euler ' &
+        write (*, '(a)') 'usage: flexmbs-bench ' // solver_choices // '[-p2|-euler] ' &
             // 'vdp|rd1d|rd2d|pend3|pend2|pendggl|pendmech|chain N dense|klu|band|auto ' // &
             '[MAX_STEPS] [RTOL] [REFERENCE]', &
             '       flexmbs-bench reference PROBLEM N FILE [RTOL]', &
@@ -169,49 +167,16 @@ program flexmbs_bench
         if (command_argument_count() >= 7) call get_command_argument(7, reference_file)
     end if
 
-    if (integrator_name(1:5) == 'mexax') then
-        call run_mexax()
+    if (problem_name == 'chain') then
+        call run_chain()
         stop
     end if
-    call make_problem(trim(problem_name), npar, trim(solver_name))
-    n_row = problem%n
-    options%rtol = rtol
-    options%atol = rtol
-    options%max_steps = max_steps
-    options%linear_solver = solver_name
-
-    select case (trim(integrator_name))
-    case ('radau5', 'reference')
-        allocate (radau5_t :: solver)
-    case ('ddassl')
-        allocate (ddassl_t :: solver)
-    case ('ddassl-p2')
-        allocate (ddassl_t :: solver)
-        options%pmax = 2
-    case ('ida')
-        allocate (ida_t :: solver)
-        ! IDA offers dense and KLU only; its 'band' would silently be 'auto'.
-        if (solver_name == 'band') then
-            t = 0.0_wp
-            call print_row('unsupported')
-            stop
-        end if
-    case default
-        write (*, '(a)') 'unknown integrator ' // trim(integrator_name)
-        error stop 2
-    end select
-
+    call make_plan_for(trim(problem_name))
+    n_row = plan%problem%n
+    y = plan%y0
     t = 0.0_wp
-    call solver%integrate(problem, t, y, t_end, options, stats, status)
-    if (status%ok()) then
-        outcome = 'done'
-    else if (status%reason == reason_max_steps) then
-        outcome = 'capped'
-    else
-        outcome = 'failed'
-        write (0, '(a)') trim(integrator_name) // ' ' // trim(problem_name) // ': ' // &
-            status%text()
-    end if
+    call plan%integrate(t, y, t_end, stats, status)
+    call set_outcome()
     if (integrator_name == 'reference') then
         call write_reference()
         stop
@@ -228,47 +193,9 @@ program flexmbs_bench
 
 contains
 
-    !> MEXAX on a mechanical problem: the pendulum (as pend2/pendggl, phi0 = 1,
-    !> t_end = 3) or the chain of N bars to t = 1.
-    subroutine run_mexax()
-        type(mexax_t) :: mexax
-        class(mechanical_problem_t), allocatable :: mech
-        real(wp), allocatable :: q(:), v(:), lam(:)
-        real(wp) :: phi, dphi
-        type(status_t) :: st
-        if (integrator_name == 'mexax-euler') mexax%base = mexax_base_euler
-        select case (trim(problem_name))
-        case ('pendmech')
-            allocate (mech, source=new_pendulum_mechanical())
-            allocate (q(mech%nq), v(mech%nv), lam(mech%nc))
-            select type (mech)
-            type is (pendulum_mechanical_t)
-                call pendulum_mechanical_initial(mech, pendulum_phi0, q, v, lam)
-            end select
-            t_end = pendulum_t_end
-            call pendulum_angle_exact(pendulum_phi0, sqrt(pendulum_default_gravity / &
-                pendulum_default_length), t_end, phi, dphi, st)
-            y_ref = [sin(phi), -cos(phi)] * pendulum_default_length
-        case ('chain')
-            allocate (mech, source=new_pendulum_chain(npar))
-            allocate (q(mech%nq), v(mech%nv), lam(mech%nc))
-            select type (mech)
-            type is (pendulum_chain_t)
-                call pendulum_chain_initial(mech, q, v, lam)
-            end select
-            t_end = 1.0_wp
-            if (npar == 8) y_ref = chain_anchor_t1
-        case default
-            write (*, '(a)') 'mexax runs the mechanical problems pendmech and chain only'
-            error stop 2
-        end select
-        n_row = mech%nq + mech%nv + mech%nc
-        options%rtol = rtol
-        options%atol = rtol
-        options%max_steps = max_steps
-        options%linear_solver = solver_name
-        t = 0.0_wp
-        call mexax%integrate_mechanical(mech, t, q, v, t_end, options, stats, status, lambda=lam)
+    !> The run's outcome from its status: done, capped (max_steps) or
+    !> failed (the reason to standard error).
+    subroutine set_outcome()
         if (status%ok()) then
             outcome = 'done'
         else if (status%reason == reason_max_steps) then
@@ -278,64 +205,145 @@ contains
             write (0, '(a)') trim(integrator_name) // ' ' // trim(problem_name) // ': ' // &
                 status%text()
         end if
-        err = ieee_value(err, ieee_quiet_nan)
-        if (outcome == 'done' .and. allocated(y_ref)) err = paper_error(q(1:size(y_ref)), &
-            y_ref, rtol, rtol)
-        call print_row(outcome)
-    end subroutine run_mexax
+    end subroutine set_outcome
 
-    !> The problem, its initial values, t_end and (when known) the reference
-    !> at t_end. Sparse storage of the Jacobian (and M) except for dense LU
-    !> on the small problems, where the dense Jacobian is the natural one.
-    subroutine make_problem(name, npar, linear_solver)
-        character(len=*), intent(in) :: name, linear_solver
-        integer, intent(in) :: npar
+    !> INTEGRATOR as a catalogue solver and its settings (&solver entries):
+    !> NAME, NAME-p2 (p_max = 2), NAME-euler (the half-explicit Euler basic
+    !> step); 'reference' is RADAU5.
+    subroutine solver_of(integrator, name, settings)
+        character(len=*), intent(in) :: integrator
+        character(len=:), allocatable, intent(out) :: name, settings
+        integer :: dash
+        settings = ''
+        if (integrator == 'reference') then
+            name = trim(solvers(solver_radau5)%name)
+            return
+        end if
+        dash = index(integrator, '-')
+        if (dash == 0) then
+            name = integrator
+            return
+        end if
+        name = integrator(1:dash - 1)
+        select case (integrator(dash + 1:))
+        case ('p2')
+            settings = ', pmax = 2'
+        case ('euler')
+            settings = ', mexax_base = ''euler'''
+        case default
+            write (*, '(a)') 'unknown variant ' // integrator(dash:)
+            error stop 2
+        end select
+    end subroutine solver_of
+
+    !> The run as a scene (problem, solver, tolerances, linear solver) and
+    !> its plan, as `flexmbs run` makes it; t_end, and the reference at
+    !> t_end when one is known. A combination the scene checks refuse
+    !> (IDA or MEXAX with the band LU) is a row 'unsupported'.
+    subroutine make_plan_for(name)
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable :: simulation, solver, settings, text
+        character(len=*), parameter :: nl = new_line('a')
+        type(scene_input_t) :: scene
         type(status_t) :: st
-        logical :: sparse
-        sparse = linear_solver /= 'dense'
+        character(len=32) :: rtol_text
+        write (rtol_text, '(es24.16e3)') rtol
+        call solver_of(trim(integrator_name), solver, settings)
         select case (name)
         case ('vdp')
-            allocate (problem, source=new_van_der_pol(1.0e-6_wp, sparse=sparse))
-            y = [2.0_wp, -0.66_wp]
-            t_end = 2.0_wp
-            options%h0 = 1.0e-6_wp
+            simulation = 'problem = ''van_der_pol'', t_end = 2, vdp_eps = 1e-6, &
+                &vdp_y1 = 2, vdp_y2 = -0.66'
+            settings = settings // ', h0 = 1e-6'
             y_ref = vdp_reference
         case ('rd1d')
-            allocate (problem, source=new_reaction_diffusion(1, npar / 2))
-            t_end = 10.0_wp
+            simulation = 'problem = ''brusselator_1d'', t_end = 10, npoints = ' // &
+                int_text(npar / 2)
         case ('rd2d')
-            allocate (problem, source=new_reaction_diffusion(2, npar))
-            t_end = 1.0_wp
-        case ('pend3')
-            allocate (problem, source=new_pendulum(pendulum_index3, pendulum_phi0, &
-                sparse=sparse, sparse_mass=sparse))
-        case ('pend2')
-            allocate (problem, source=new_pendulum(pendulum_index2, pendulum_phi0, &
-                sparse=sparse, sparse_mass=sparse))
-        case ('pendggl')
-            allocate (problem, source=new_pendulum(pendulum_ggl, pendulum_phi0, &
-                sparse=sparse, sparse_mass=sparse))
+            simulation = 'problem = ''brusselator_2d'', t_end = 1, npoints = ' // int_text(npar)
+        case ('pend3', 'pend2', 'pendggl', 'pendmech')
+            simulation = 'problem = ''pendulum'', t_end = 3, pendulum_angle = 1, &
+                &pendulum_formulation = ''' // merge('index3', 'index2', name == 'pend3') // ''''
+            if (name == 'pendggl') simulation = 'problem = ''pendulum'', t_end = 3, &
+                &pendulum_angle = 1, pendulum_formulation = ''ggl'''
         case default
             write (*, '(a)') 'unknown problem ' // name
             error stop 2
         end select
-        select type (problem)
+        text = '&simulation ' // simulation // ' /' // nl // '&solver name = ''' // solver // &
+            ''', rtol = ' // trim(rtol_text) // ', atol = ' // trim(rtol_text) // &
+            ', max_steps = ' // int_text(max_steps) // ', linear_solver = ''' // &
+            trim(solver_name) // '''' // settings // ' /' // nl // &
+            '&output file = ''none'', n_output = 2, progress = .false. /' // nl
+        call parse_scene(text, 'bench.nml', scene, status)
+        if (status%ok()) call make_plan(scene, plan, status)
+        if (.not. status%ok()) then
+            write (0, '(a)') trim(integrator_name) // ' ' // name // ': ' // status%text()
+            t = 0.0_wp
+            n_row = npar
+            call print_row('unsupported')
+            stop
+        end if
+        t_end = scene%t_end
+        select type (problem => plan%problem)
         type is (reaction_diffusion_t)
-            allocate (y(problem%n))
-            call reaction_diffusion_initial(problem, y)
             if (len_trim(reference_file) > 0 .and. integrator_name /= 'reference') &
                 call read_reference()
         type is (pendulum_t)
-            allocate (y(problem%n), y_ref(problem%n), mask(problem%n))
-            call pendulum_initial(problem, y)
-            t_end = pendulum_t_end
+            allocate (y_ref(problem%n), mask(problem%n))
             call pendulum_reference(problem, t_end, y_ref, st)
             if (.not. st%ok()) deallocate (y_ref)
             ! Positions only, as in test/: λ and μ are index-2/3 variables.
             mask = .false.
             mask(1:2) = .true.
         end select
-    end subroutine make_problem
+    end subroutine make_plan_for
+
+    !> The chain of N bars (ALGORITHMS.md §8; no scene offers it) to t = 1,
+    !> through the common interface: the catalogue's solver integrates the
+    !> mechanical problem with its index-2 formulation (MEXAX the mechanical
+    !> form itself); ERR over (x1, y1, φ1) against the original's values for
+    !> N = 8.
+    subroutine run_chain()
+        type(pendulum_chain_t), target :: chain
+        type(formulation_t) :: formulation
+        real(wp), allocatable :: q(:), v(:), lam(:)
+        character(len=:), allocatable :: name, settings
+        type(status_t) :: st
+        call solver_of(trim(integrator_name), name, settings)
+        call new_solver(name, solver, st)
+        if (.not. st%ok()) then
+            write (*, '(a)') st%text()
+            error stop 2
+        end if
+        select type (solver)
+        type is (mexax_t)
+            if (index(settings, 'euler') > 0) solver%base = mexax_base_euler
+        end select
+        chain = new_pendulum_chain(npar)
+        allocate (q(chain%nq), v(chain%nv), lam(chain%nc))
+        call pendulum_chain_initial(chain, q, v, lam)
+        formulation = new_formulation(chain, formulation_index2, q, constant_mass=.true., &
+            status=st, sparse=solver_name /= 'dense')
+        if (.not. st%ok()) then
+            write (*, '(a)') 'chain: ' // st%text()
+            error stop 1
+        end if
+        y = [q, v, lam]
+        t_end = 1.0_wp
+        if (npar == 8) y_ref = chain_anchor_t1
+        n_row = size(y)
+        options%rtol = rtol
+        options%atol = rtol
+        options%max_steps = max_steps
+        options%linear_solver = solver_name
+        t = 0.0_wp
+        call solver%integrate(chain, formulation, t, y, t_end, options, stats, status)
+        call set_outcome()
+        err = ieee_value(err, ieee_quiet_nan)
+        if (outcome == 'done' .and. allocated(y_ref)) err = paper_error(y(1:size(y_ref)), &
+            y_ref, rtol, rtol)
+        call print_row(outcome)
+    end subroutine run_chain
 
     !> y(t_end) of the reference run, one value a line after n.
     subroutine write_reference()
@@ -345,11 +353,12 @@ contains
             error stop 1
         end if
         open (newunit=unit, file=trim(reference_file), action='write', status='replace')
-        write (unit, '(i0)') problem%n
+        write (unit, '(i0)') plan%problem%n
         write (unit, '(es25.17e3)') (y(i), i=1, size(y))
         close (unit)
         write (*, '(a,1x,a,1x,i0,a,es8.1,a,i0,a,es10.3,a)') 'reference', trim(problem_name), &
-            problem%n, ': RADAU5 rtol = atol =', rtol, ', NST ', stats%nst, ', CPU ', &
+            plan%problem%n, ': ' // trim(solvers(solver_radau5)%name) // ' rtol = atol =', &
+            rtol, ', NST ', stats%nst, ', CPU ', &
             stats%cpu, ' s'
     end subroutine write_reference
 
@@ -359,7 +368,7 @@ contains
         open (newunit=unit, file=trim(reference_file), action='read', status='old', iostat=ios)
         if (ios /= 0) return
         read (unit, *, iostat=ios) n_file
-        if (ios == 0 .and. n_file == problem%n) then
+        if (ios == 0 .and. n_file == plan%problem%n) then
             allocate (y_ref(n_file))
             read (unit, *, iostat=ios) (y_ref(i), i=1, n_file)
             if (ios /= 0) deallocate (y_ref)
@@ -452,13 +461,18 @@ contains
             if (status%ok()) call node_graph_mass(jac%n, mass, status)
         else
             write (mesh, '(a,"-",i0)') trim(problem_name), nx
-            call make_problem(trim(problem_name), nx, 'klu') ! y: the initial value
+            ! the Brusselator as a scene makes it, at its initial value
+            integrator_name = 'reference'
+            solver_name = 'klu'
+            npar = nx
+            call make_plan_for(trim(problem_name))
             jac%storage = storage_sparse
-            jac%n = problem%n
-            call problem%jacobian_pattern(jac%csc, status)
-            if (status%ok()) call problem%jacobian_sparse(0.0_wp, y, jac%csc%values, status)
+            jac%n = plan%problem%n
+            call plan%problem%jacobian_pattern(jac%csc, status)
+            if (status%ok()) call plan%problem%jacobian_sparse(0.0_wp, plan%y0, &
+                jac%csc%values, status)
             mass%storage = storage_identity
-            mass%n = problem%n
+            mass%n = plan%problem%n
         end if
         n = jac%n
         if (status%ok()) call pattern%build(mass, jac, 'sparse_lu', status)
@@ -556,13 +570,14 @@ contains
         character(len=8), parameter :: modes(3) = ['analytic', 'ad      ', 'ad_full ']
         type(mbs_system_t), target :: sys
         type(formulation_t) :: dae
-        type(radau5_t) :: radau5
+        class(dae_solver_t), allocatable :: radau5
         real(wp) :: q0(21), v0(18), t_deriv(3), t_run(3), tt
         real(wp), allocatable :: c(:), g(:, :), cq(:, :), ct(:), gam(:), y(:), yp(:), y0(:)
         integer :: mech, m, i, calls, runs, batch
         integer(8) :: c0, c1, rate
         call get_command_argument(2, problem_name)
         mech = merge(mechanism_four_bar, mechanism_slider_crank, problem_name == 'fourbar')
+        call new_solver(solvers(solver_radau5)%name, radau5, status)
         do m = 1, 3
             call new_mechanism(mech, sys, q0, status, trim(modes(m)))
             if (.not. status%ok()) then

@@ -202,6 +202,12 @@ contains
             'normal mode missed output times')
         call check(error, maxval(abs(y - y_plain)) <= 1.0e-12_wp, &
             'the two modes take different steps')
+        ! output times and no sink: the same steps, and t_end is reached
+        ! (the loop once asked for the first output time again forever)
+        call run_vdp(solver, 1.0e-6_wp, y_plain, stats, status, options_in=options)
+        call check(error, status%ok() .and. stats%t_reached == 2.0_wp .and. &
+            maxval(abs(y - y_plain)) <= 1.0e-12_wp, 'output times without a sink: ' // &
+            status%text())
     end subroutine test_output
 
     subroutine robertson_reference(error)

@@ -629,14 +629,14 @@ contains
                     return
                 end if
                 if (.not. admissible()) return
-                if (present(sink)) then
-                    do while (iout <= nout)
-                        if (options%output_times(iout) /= tout) exit
-                        call sink%output(tout, yw, status)
-                        iout = iout + 1
-                        if (.not. status%ok()) return
-                    end do
-                end if
+                ! past this output time whether or not a sink takes it (without
+                ! one the loop would ask for the same time again forever)
+                do while (iout <= nout)
+                    if (options%output_times(iout) /= tout) exit
+                    if (present(sink)) call sink%output(tout, yw, status)
+                    iout = iout + 1
+                    if (.not. status%ok()) return
+                end do
                 if (tout == t_end .or. retval_solve == IDA_TSTOP_RETURN) exit
             end do
         end subroutine to_output_times

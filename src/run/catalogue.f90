@@ -143,13 +143,21 @@ contains
     !> for a message: 'pendulum', 'flexible_body', ... or 'rigid_chain'.
     function mechanical_problem_names() result(text)
         character(len=:), allocatable :: text
-        text = joined(problems%name, problems%mechanical, '''', ' or ')
+        character(len=len(problems%name)) :: names(size(problems))
+        logical :: chosen(size(problems))
+        names = problems%name
+        chosen = problems%mechanical
+        text = joined(names, chosen, '''', ' or ')
     end function mechanical_problem_names
 
     !> The solvers that offer the band LU, for a message: radau5 and ddassl.
     function band_solver_names() result(text)
         character(len=:), allocatable :: text
-        text = joined(solvers%name, solvers%band, '', ' and ')
+        character(len=len(solvers%name)) :: names(size(solvers))
+        logical :: chosen(size(solvers))
+        names = solvers%name
+        chosen = solvers%band
+        text = joined(names, chosen, '', ' and ')
     end function band_solver_names
 
     !> The names where `chosen`, each in `quote`s, joined by ', ' and

@@ -1,0 +1,129 @@
+#!/usr/bin/env python3
+"""The architecture's rules, checked on the sources (run by `make test`).
+
+- src/io/ reads and writes: it imports no solver module, and of the run
+  layer only the catalogue's table of names (run/catalogue).
+- A solver's name ('radau5', 'ddassl', 'ida', 'mexax') is written as a
+  string only in the solver's own module in src/dae/, in the catalogue
+  (src/run/catalogue.f90) and in the scene schema; everywhere else in
+  src/, app/ and bench/ the code asks the catalogue by capability.
+- bench/ and the command line build solvers through the catalogue's
+  factories: bench/ uses no solver module's type.
+
+Prints `pass layers/...` or `FAIL layers/...: why` lines and
+`N passed, M failed` last; exits non-zero on failures.
+"""
+import os
+import re
+import sys
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..')
+SOLVERS = ('radau5', 'ddassl', 'ida', 'mexax')
+SOLVER_MODULE = re.compile(r'^\s*use\s+flexmbs_dae_(radau5|ddassl|ida|mexax)\b', re.I)
+RUN_MODULE = re.compile(r'^\s*use\s+(flexmbs_run_\w+)', re.I)
+OWNERS = {'src/dae/radau5.f90', 'src/dae/ddassl.f90', 'src/dae/ida.f90',
+          'src/dae/mexax.f90', 'src/run/catalogue.f90', 'src/io/scene_schema.f90'}
+
+passed = failed = 0
+
+
+def report(name, problems):
+    global passed, failed
+    if problems:
+        failed += 1
+        print('FAIL layers/%s: %s' % (name, '; '.join(problems[:8]) +
+                                      (' (+%d more)' % (len(problems) - 8)
+                                       if len(problems) > 8 else '')))
+    else:
+        passed += 1
+        print('pass layers/%s' % name)
+
+
+def sources(*folders):
+    for folder in folders:
+        for base, _, files in os.walk(os.path.join(ROOT, folder)):
+            for f in sorted(files):
+                if f.endswith(('.f90', '.F90', '.inc')):
+                    path = os.path.join(base, f)
+                    yield os.path.relpath(path, ROOT), path
+
+
+def strings(line):
+    """The character literals of a Fortran source line, comments left out
+    (a continued literal's pieces count as separate strings)."""
+    out, i, n = [], 0, len(line)
+    while i < n:
+        c = line[i]
+        if c == '!':
+            break
+        if c in '\'"':
+            j, text = i + 1, ''
+            while j < n:
+                if line[j] == c:
+                    if j + 1 < n and line[j + 1] == c:
+                        text += c
+                        j += 2
+                        continue
+                    break
+                text += line[j]
+                j += 1
+            out.append(text)
+            i = j + 1
+        else:
+            i += 1
+    return out
+
+
+io_imports = []
+for rel, path in sources('src/io'):
+    for k, line in enumerate(open(path, encoding='utf-8'), 1):
+        if SOLVER_MODULE.match(line):
+            io_imports.append('%s:%d imports %s' % (rel, k, line.split()[1].rstrip(',')))
+        m = RUN_MODULE.match(line)
+        if m and m.group(1).lower() != 'flexmbs_run_catalogue':
+            io_imports.append('%s:%d imports %s' % (rel, k, m.group(1)))
+report('io-imports-no-solver-or-runner', io_imports)
+
+named = []
+word = re.compile(r'\b(%s)\b' % '|'.join(SOLVERS), re.I)
+for rel, path in sources('src', 'app', 'bench'):
+    if rel in OWNERS:
+        continue
+    for k, line in enumerate(open(path, encoding='utf-8'), 1):
+        for text in strings(line):
+            m = word.search(text)
+            if m:
+                named.append('%s:%d names %s in %r' % (rel, k, m.group(1), text[:60]))
+report('solver-names-only-in-catalogue-schema-and-solvers', named)
+
+bench_types = []
+for rel, path in sources('bench'):
+    for k, line in enumerate(open(path, encoding='utf-8'), 1):
+        m = SOLVER_MODULE.match(line)
+        if m and not re.search(r'only:\s*mexax_t\s*,\s*mexax_base_euler', line):
+            bench_types.append('%s:%d imports %s' % (rel, k, line.split()[1].rstrip(',')))
+report('bench-builds-solvers-from-the-catalogue', bench_types)
+
+# The catalogue's names are the solvers' own.
+names = {}
+for s in SOLVERS:
+    text = open(os.path.join(ROOT, 'src/dae/%s.f90' % s), encoding='utf-8').read()
+    m = re.search(r'function\s+%s_name\b.*?name\s*=\s*\'(\w+)\'' % s, text, re.S | re.I)
+    names[s] = m.group(1) if m else None
+catalogue = open(os.path.join(ROOT, 'src/run/catalogue.f90'), encoding='utf-8').read()
+listed = re.findall(r"solver_info_t\('(\w+)'", catalogue)
+problems = ['%s_t%%name() is %r' % (s, names[s]) for s in SOLVERS if names[s] != s]
+if sorted(listed) != sorted(SOLVERS):
+    problems.append('the catalogue lists %s' % listed)
+choices = re.search(r"solver_choices\s*=\s*'([^']*)'", catalogue)
+if not choices or choices.group(1).split('|') != listed:
+    problems.append('solver_choices %r differs from the table %s'
+                    % (choices.group(1) if choices else None, listed))
+pnames = re.findall(r"problem_info_t\('(\w+)'", catalogue)
+pchoices = re.search(r"problem_choices\s*=\s*'([^']*)'", catalogue, re.S)
+if not pchoices or re.sub(r"&\s*&", '', pchoices.group(1)).split('|') != pnames:
+    problems.append('problem_choices differs from the table %s' % pnames)
+report('catalogue-names-are-the-solvers-names', problems)
+
+print('%d passed, %d failed' % (passed, failed))
+sys.exit(1 if failed else 0)
