@@ -96,7 +96,8 @@ run: build
 # installed library exactly as a user links them, the architecture's rules
 # on the sources (test/layers.py), then the command-line
 # checks of test/cli.sh, the signals of test/kill.sh (python3-h5py reads
-# the files they leave) and the fuzzer of the scene input (test/fuzz, about
+# the files they leave), every example scene with empty standard error
+# (test/examples.sh) and the fuzzer of the scene input (test/fuzz, about
 # a thousand mutated scenes, two at a time); one summary line last.
 test: deps
 	@mkdir -p $(BUILD)
@@ -111,11 +112,13 @@ test: deps
 	    echo "exit $$?" >> $(BUILD)/test-cli.log
 	@set -o pipefail; FPM="$(FPM)" bash test/kill.sh 2>&1 | tee $(BUILD)/test-kill.log; \
 	    echo "exit $$?" >> $(BUILD)/test-kill.log
+	@set -o pipefail; FPM="$(FPM)" bash test/examples.sh 2>&1 | tee $(BUILD)/test-examples.log; \
+	    echo "exit $$?" >> $(BUILD)/test-examples.log
 	@set -o pipefail; FPM="$(FPM)" bash test/fuzz/run.sh 2>&1 | tee $(BUILD)/test-fuzz.log; \
 	    echo "exit $$?" >> $(BUILD)/test-fuzz.log
 	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log \
 	    $(BUILD)/test-layers.log $(BUILD)/test-cli.log $(BUILD)/test-kill.log \
-	    $(BUILD)/test-fuzz.log
+	    $(BUILD)/test-examples.log $(BUILD)/test-fuzz.log
 
 PROFILE     ?= debug
 PREFIX_USED ?= $(PREFIX_DEBUG)

@@ -54,7 +54,9 @@ module flexmbs
     use flexmbs_run_runner, only: run_scene, run_result_t
     use flexmbs_run_plan, only: run_plan_t, make_plan
     use flexmbs_run_problem_factory, only: build_problem
-    use flexmbs_run_solver_factory, only: build_solver
+    use flexmbs_run_solver_factory, only: build_solver, new_solver
+    use flexmbs_run_catalogue, only: solver_info_t, problem_info_t, &
+        solver_info, problem_info
     implicit none
     public
 end module flexmbs

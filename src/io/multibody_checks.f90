@@ -9,7 +9,7 @@ module flexmbs_io_multibody_checks
     use flexmbs_core_text, only: int_text
     use flexmbs_io_input_errors, only: input_errors_t, excerpt, at_other
     use flexmbs_io_scene_schema, only: did_you_mean, len_name
-    use flexmbs_io_scene_lexer, only: entry_t, has_entry
+    use flexmbs_io_scene_lexer, only: entry_t, has_entry, instance_ranges
     use flexmbs_io_scene_values, only: value_error, required_error
     use flexmbs_io_scene_input, only: scene_input_t
     implicit none
@@ -79,6 +79,7 @@ contains
         character(len=16), parameter :: mb_groups(5) = [character(len=16) :: 'multibody', &
             'rigid_body', 'marker', 'joint', 'driver']
         integer :: i, j, g
+        integer, allocatable :: ranges(:, :)
         if (scene%problem /= 'multibody') then
             do g = 1, size(mb_groups)
                 ! a chain takes gravity and formulation from &multibody
@@ -93,11 +94,13 @@ contains
         end if
         if (size(scene%rigid_bodies) + size(scene%chain) == 0) call errors%add('&simulation: &
             &problem = ''multibody'': needs at least one &rigid_body or &rigid_chain group', 0)
+        ! each occurrence's own entries: linear in the number of groups
+        ranges = instance_ranges(entries, 'rigid_body', size(scene%rigid_bodies))
         do i = 1, size(scene%rigid_bodies)
-            associate (b => scene%rigid_bodies(i))
-                if (.not. has_entry(entries, 'rigid_body', 'mass', i)) call required_error( &
+            associate (b => scene%rigid_bodies(i), own => entries(ranges(1, i):ranges(2, i)))
+                if (.not. has_entry(own, 'rigid_body', 'mass', i)) call required_error( &
                     errors, 'rigid_body', 'mass', 'in kg', b%name, b%line)
-                if (.not. has_entry(entries, 'rigid_body', 'inertia', i)) call required_error( &
+                if (.not. has_entry(own, 'rigid_body', 'inertia', i)) call required_error( &
                     errors, 'rigid_body', 'inertia', 'Jxx, Jyy, Jzz in kg m^2 about the centre &
                     &of mass', b%name, b%line)
                 if (.not. norm2(b%rotation_axis) > 0.0_wp) call value_error(errors, entries, &
@@ -111,12 +114,14 @@ contains
                     '''ground'' is reserved', i)
             end associate
         end do
+        ranges = instance_ranges(entries, 'marker', size(scene%markers))
         do i = 1, size(scene%markers)
-            call check_marker(i)
+            call check_marker(i, entries(ranges(1, i):ranges(2, i)))
         end do
+        ranges = instance_ranges(entries, 'joint', size(scene%joints))
         do i = 1, size(scene%joints)
-            associate (jt => scene%joints(i))
-                if (.not. has_entry(entries, 'joint', 'type', i)) then
+            associate (jt => scene%joints(i), own => entries(ranges(1, i):ranges(2, i)))
+                if (.not. has_entry(own, 'joint', 'type', i)) then
                     call required_error(errors, 'joint', 'type', 'spherical, revolute, ...', &
                                         jt%name, jt%line)
                 else
@@ -130,9 +135,10 @@ contains
                 end if
             end associate
         end do
+        ranges = instance_ranges(entries, 'driver', size(scene%drivers))
         do i = 1, size(scene%drivers)
-            associate (d => scene%drivers(i))
-                if (.not. has_entry(entries, 'driver', 'type', i)) then
+            associate (d => scene%drivers(i), own => entries(ranges(1, i):ranges(2, i)))
+                if (.not. has_entry(own, 'driver', 'type', i)) then
                     call required_error(errors, 'driver', 'type', 'angle, translation or &
                         &distance', d%name, d%line)
                 else
@@ -159,8 +165,9 @@ contains
             end select
         end function given
 
-        subroutine check_marker(i)
+        subroutine check_marker(i, own)
             integer, intent(in) :: i
+            type(entry_t), intent(in) :: own(:) !! the marker's entries
             integer :: j
             real(wp) :: c(3)
             associate (m => scene%markers(i))
@@ -179,7 +186,7 @@ contains
                 end if
                 if (.not. norm2(m%z_axis) > 0.0_wp) then
                     call value_error(errors, entries, 'marker', 'z_axis', 'must not be zero', i)
-                else if (has_entry(entries, 'marker', 'x_axis', i)) then
+                else if (has_entry(own, 'marker', 'x_axis', i)) then
                     c = [m%x_axis(2) * m%z_axis(3) - m%x_axis(3) * m%z_axis(2), &
                          m%x_axis(3) * m%z_axis(1) - m%x_axis(1) * m%z_axis(3), &
                          m%x_axis(1) * m%z_axis(2) - m%x_axis(2) * m%z_axis(1)]

@@ -35,7 +35,8 @@ module flexmbs_io_scene_lexer
         integer :: line = 0      !! line of '&name'
     end type span_t
 
-    public :: tokenise, has_entry, entry_index, is_letter, is_digit, unquoted_length
+    public :: tokenise, has_entry, entry_index, instance_ranges, is_letter, is_digit, &
+        unquoted_length
 
 contains
 
@@ -506,6 +507,28 @@ contains
             k = i
         end do
     end function entry_index
+
+    !> For each occurrence 1..n of `group`, the first and last index of its
+    !> entries in `entries` (1 and 0 for an occurrence without entries), in
+    !> one pass: readers and checks look a variable up in its occurrence's
+    !> slice, so that a scene of n groups is read in time linear in n.
+    pure function instance_ranges(entries, group, n) result(ranges)
+        type(entry_t), intent(in) :: entries(:)
+        character(len=*), intent(in) :: group
+        integer, intent(in) :: n
+        integer :: ranges(2, n)
+        integer :: i, k
+        ranges(1, :) = huge(1)
+        ranges(2, :) = 0
+        do i = 1, size(entries)
+            if (entries(i)%group /= group) cycle
+            k = entries(i)%instance
+            if (k < 1 .or. k > n) cycle
+            ranges(1, k) = min(ranges(1, k), i)
+            ranges(2, k) = max(ranges(2, k), i)
+        end do
+        where (ranges(2, :) == 0) ranges(1, :) = 1
+    end function instance_ranges
 
     !> Whether `name` is given in `group` (in occurrence `instance` if present).
     pure logical function has_entry(entries, group, name, instance)

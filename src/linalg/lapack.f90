@@ -1,9 +1,11 @@
 !> Explicit interfaces to the LAPACK routines flexmbs calls.
 module flexmbs_linalg_lapack
+    use, intrinsic :: ieee_exceptions, only: ieee_status_type, ieee_get_status, ieee_set_status
     use flexmbs_core_kinds, only: wp
     implicit none
     private
     public :: dgetrf, dgetrs, zgetrf, zgetrs, dgbtrf, dgbtrs, zgbtrf, zgbtrs, dgesvd, dsyev
+    public :: dgesvd_quiet, dsyev_quiet
 
     interface
         subroutine dgetrf(m, n, a, lda, ipiv, info)
@@ -79,4 +81,36 @@ module flexmbs_linalg_lapack
             integer, intent(out) :: info
         end subroutine dsyev
     end interface
+
+contains
+
+    !> dgesvd, leaving the IEEE flags as they were: LAPACK's IEEECK
+    !> (called through ILAENV) computes 1/0 and 0/0 on purpose to test the
+    !> arithmetic, which would otherwise leave the divide-by-zero and
+    !> invalid flags signalling after every successful run. A flag our own
+    !> arithmetic raised before the call stays raised.
+    subroutine dgesvd_quiet(jobu, jobvt, m, n, a, lda, s, u, ldu, vt, ldvt, work, lwork, info)
+        character, intent(in) :: jobu, jobvt
+        integer, intent(in) :: m, n, lda, ldu, ldvt, lwork
+        real(wp), intent(inout) :: a(lda, *)
+        real(wp), intent(out) :: s(*), u(ldu, *), vt(ldvt, *), work(*)
+        integer, intent(out) :: info
+        type(ieee_status_type) :: saved
+        call ieee_get_status(saved)
+        call dgesvd(jobu, jobvt, m, n, a, lda, s, u, ldu, vt, ldvt, work, lwork, info)
+        call ieee_set_status(saved)
+    end subroutine dgesvd_quiet
+
+    !> dsyev, leaving the IEEE flags as they were (see dgesvd_quiet).
+    subroutine dsyev_quiet(jobz, uplo, n, a, lda, w, work, lwork, info)
+        character, intent(in) :: jobz, uplo
+        integer, intent(in) :: n, lda, lwork
+        real(wp), intent(inout) :: a(lda, *)
+        real(wp), intent(out) :: w(*), work(*)
+        integer, intent(out) :: info
+        type(ieee_status_type) :: saved
+        call ieee_get_status(saved)
+        call dsyev(jobz, uplo, n, a, lda, w, work, lwork, info)
+        call ieee_set_status(saved)
+    end subroutine dsyev_quiet
 end module flexmbs_linalg_lapack

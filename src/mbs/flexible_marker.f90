@@ -25,7 +25,7 @@ module flexmbs_mbs_flexible_marker
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure
     use flexmbs_core_text, only: int_text
-    use flexmbs_linalg_lapack, only: dgesvd, dgetrf, dgetrs
+    use flexmbs_linalg_lapack, only: dgesvd_quiet, dgetrf, dgetrs
     use flexmbs_mbs_rotation, only: cross
     use flexmbs_fe_tensor, only: det3
     implicit none
@@ -78,7 +78,7 @@ contains
         end do
         ! the set must span a plane at least: second singular value of A(X)
         a = matmul(marker%dx_ref, transpose(marker%dx_ref)) * marker%weight
-        call dgesvd('N', 'N', 3, 3, a, 3, sv, u, 3, vt, 3, work, size(work), info)
+        call dgesvd_quiet('N', 'N', 3, 3, a, 3, sv, u, 3, vt, 3, work, size(work), info)
         if (info /= 0 .or. sv(2) <= 1.0e-12_wp * sv(1)) then
             call status%set(status_bad_input, 'flexible marker: the node set is collinear ' // &
                             '(no orientation can be defined)')
@@ -116,7 +116,7 @@ contains
         end do
         a = a * self%weight
         work_a = a
-        call dgesvd('A', 'A', 3, 3, work_a, 3, sv, v, 3, wt, 3, work, size(work), info)
+        call dgesvd_quiet('A', 'A', 3, 3, work_a, 3, sv, v, 3, wt, 3, work, size(work), info)
         if (info /= 0) then
             call status%set(status_solver_failure, 'flexible marker: SVD failed')
             return

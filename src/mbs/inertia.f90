@@ -9,7 +9,7 @@
 module flexmbs_mbs_inertia
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_text, only: real_text
-    use flexmbs_linalg_lapack, only: dsyev
+    use flexmbs_linalg_lapack, only: dsyev_quiet
     implicit none
     private
 
@@ -37,7 +37,7 @@ contains
         integer :: info
         why = ''
         a = j
-        call dsyev('N', 'U', 3, a, 3, w, work, size(work), info)
+        call dsyev_quiet('N', 'U', 3, a, 3, w, work, size(work), info)
         if (info /= 0 .or. .not. all(abs(w) <= huge(1.0_wp))) then
             why = 'the inertia tensor has no principal moments (not finite)'
             return

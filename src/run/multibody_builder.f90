@@ -15,7 +15,7 @@ module flexmbs_run_multibody_builder
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_text, only: int_text, real_text
-    use flexmbs_linalg_lapack, only: dgesvd
+    use flexmbs_linalg_lapack, only: dgesvd_quiet
     use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle, cross
     use flexmbs_mbs_rigid_body, only: rigid_body_t
     use flexmbs_mbs_inertia, only: inertia_tensor, inertia_defect
@@ -282,7 +282,7 @@ contains
         if (.not. status%ok()) return
         ! Gᵀ = U Σ Vᵀ: a dependence yᵀ G = 0 among the rows is the last row of Vᵀ.
         gt = transpose(g)
-        call dgesvd('N', 'A', nv, nc, gt, nv, sv, u, 1, vt, nc, work, size(work), info)
+        call dgesvd_quiet('N', 'A', nv, nc, gt, nv, sv, u, 1, vt, nc, work, size(work), info)
         if (info /= 0) return
         rank = count(sv > rank_tolerance * sv(1))
         if (rank == nc) return
