@@ -855,7 +855,8 @@ contains
         type(run_result_t) :: result
         class(dae_solver_t), allocatable :: solver
         character(len=*), parameter :: sim = &
-            '&simulation problem = ''robertson'', t_end = 40 /' // new_line('a')
+            '&simulation problem = ''robertson'', t_end = 40 /' // new_line('a') // &
+            '&output file = ''none'', progress = .false. /' // new_line('a')
         call parse_scene(sim // '&solver name = ''DDASSL'', pmax = 2, rtol = 1e-6, ' // &
             'atol = 1e-10, initial_derivative = .true., netlib = .true. /', 'rober.nml', &
             scene, status)

@@ -7,6 +7,7 @@ module test_run
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_dae_solver, only: dae_solver_t
+    use flexmbs_dae_ddassl, only: ddassl_max_order
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_error_measure, only: paper_error
@@ -71,8 +72,8 @@ contains
         info = solver_info('mexax   ')
         call check(error, info%mechanical_only .and. info%projects, 'mexax capabilities')
         info = solver_info('ddassl')
-        call check(error, info%pmax_grid .and. info%max_order == 5 .and. info%band, &
-            'ddassl capabilities')
+        call check(error, info%pmax_grid .and. info%max_order == ddassl_max_order .and. &
+            info%band, 'ddassl capabilities (max_order: the solver''s own)')
         info = solver_info('nonsense')
         call check(error, len_trim(info%name) == 0 .and. .not. info%mechanical_only, &
             'unknown name')

@@ -20,8 +20,8 @@ module flexmbs_legacy_ddassl_adapter
     use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_identity, storage_dense
     use flexmbs_dae_residual_problem, only: residual_problem_t
     use flexmbs_dae_options, only: dae_options_t
-    use flexmbs_dae_ddassl, only: ddassl_t, ddassl_fail_none, ddassl_fail_tolerances, &
-        ddassl_fail_initial
+    use flexmbs_dae_ddassl, only: ddassl_t, ddassl_max_order, ddassl_fail_none, &
+        ddassl_fail_tolerances, ddassl_fail_initial
     use flexmbs_legacy_ddassl_interface, only: ddassl_res_i, ddassl_jac_i
     implicit none
     private
@@ -115,14 +115,14 @@ contains
         ! ---- illegal input (IDID -33, §2.11) ----
         illegal = 0
         first = info(1) == 0
-        maxord = 5
+        maxord = ddassl_max_order
         ml = 0
         mu = 0
         if (any(info(1:11) /= 0 .and. info(1:11) /= 1)) illegal = 1
         if (illegal == 0 .and. neq <= 0) illegal = 2
         if (illegal == 0 .and. info(9) == 1) then
             maxord = iwork(3)
-            if (maxord < 1 .or. maxord > 5) illegal = 3
+            if (maxord < 1 .or. maxord > ddassl_max_order) illegal = 3
         end if
         if (illegal == 0 .and. info(6) == 1) then
             ml = iwork(1)
