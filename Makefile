@@ -16,7 +16,7 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := run
 
 APT_PACKAGES := gfortran libsundials-dev libsundials-fortran-dev libsuitesparse-dev \
-                liblapack-dev libopenblas-dev libhdf5-dev libmumps-seq-dev python3-h5py
+                liblapack-dev libopenblas-dev libhdf5-dev libmumps-seq-dev python3-h5py pkgconf
 BUILD        := $(CURDIR)/build
 VENV         := $(BUILD)/venv
 # One set of flags for every fpm call: changing them makes fpm rebuild everything.
@@ -53,6 +53,18 @@ SYSLIBS      := -lsundials_fida_mod -lsundials_fnvecserial_mod \
                 -ldmumps_seq -lzmumps_seq -lmumps_common_seq -lmpiseq_seq -lpord_seq \
                 -lhdf5_serial_fortran -lhdf5_serial -llapack -lblas
 MAIN_INPUT   := inputs/five_body.nml
+VERSION      := $(shell sed -n 's/^version *= *"\(.*\)"/\1/p' fpm.toml)
+
+# pkg-config files of an install under $(1) (pkgconfig/*.pc.in): then
+# `gfortran prog.f90 $$(pkg-config --cflags --libs flexmbs)` builds a program.
+define write_pkgconfig
+	@mkdir -p $(1)/lib/pkgconfig
+	@for pc in flexmbs flexmbs-legacy; do \
+	    sed -e 's#@PREFIX@#$(1)#' -e 's#@VERSION@#$(VERSION)#' \
+	        -e 's#@SYSLIBS@#$(strip $(OMP_LINK) $(SYSLIBS))#' \
+	        pkgconfig/$$pc.pc.in > $(1)/lib/pkgconfig/$$pc.pc || exit 1; \
+	done
+endef
 
 .PHONY: run test bench paper extremes check-memory deps build build-debug install legacy-test \
         clean help
@@ -125,22 +137,25 @@ PREFIX_USED ?= $(PREFIX_DEBUG)
 LEGACY_DRIVERS := $(wildcard legacy/test/*.f)
 LEGACY_MODERN  := $(wildcard legacy/test/*.f90)
 
-# Classic drivers: plain `gfortran -std=legacy`, linked against the install;
-# modern callers (*.f90) use the installed interface modules. The root is
-# installed too (--no-prune: the whole library), for `-lflexmbs`.
+# Classic drivers: plain `gfortran -std=legacy`, linked against the install
+# with the link line of its pkg-config file (flexmbs-legacy.pc); modern
+# callers (*.f90) use the installed interface modules. The root is installed
+# too (--no-prune: the whole library), for `-lflexmbs`.
 legacy-test:
 	@$(FPM) install --no-prune --profile $(PROFILE) --prefix $(PREFIX_USED) >/dev/null
 	@cd legacy && $(FPM) install --profile $(PROFILE) --prefix $(PREFIX_USED) >/dev/null
+	$(call write_pkgconfig,$(PREFIX_USED))
 	@mkdir -p $(BUILD)/legacy-test
 	@for src in $(LEGACY_DRIVERS) $(LEGACY_MODERN); do \
 	    name=$$(basename $$src); exe=$(BUILD)/legacy-test/$${name%.*}; \
 	    case $$src in \
 	        *.f) flags="-std=legacy" ;; \
-	        *) flags="-std=f2018 -I$(PREFIX_USED)/include -J$(BUILD)/legacy-test" ;; \
+	        *) flags="-std=f2018 -J$(BUILD)/legacy-test $$(PKG_CONFIG_PATH=$(PREFIX_USED)/lib/pkgconfig \
+	               pkg-config --cflags flexmbs-legacy)" ;; \
 	    esac; \
 	    echo "== $$src"; \
-	    gfortran $$flags $(OMP_LINK) -o $$exe $$src -L$(PREFIX_USED)/lib \
-	        -lflexmbs-legacy -lflexmbs $(SYSLIBS) \
+	    gfortran $$flags $(OMP_LINK) -o $$exe $$src \
+	        $$(PKG_CONFIG_PATH=$(PREFIX_USED)/lib/pkgconfig pkg-config --libs flexmbs-legacy) \
 	        || { echo "FAIL compile $$src"; continue; }; \
 	    ( cd $(BUILD)/legacy-test && $$exe ) || echo "FAIL run $$src (exit $$?)"; \
 	done
@@ -149,6 +164,7 @@ legacy-test:
 install: deps
 	$(FPM) install --no-prune --profile release --prefix $(PREFIX)
 	cd legacy && $(FPM) install --profile release --prefix $(PREFIX)
+	$(call write_pkgconfig,$(abspath $(PREFIX)))
 
 # The paper's studies (inputs/paper/five_body_*.nml) into results/, on the
 # coarse and on the fine coupler mesh: the references (two at a time), then
