@@ -522,7 +522,20 @@ contains
             '  flexmbs sweep STUDY.nml [-j N] [--quiet] [--force]', &
             '                                          run the study''s grid of solvers and', &
             '                                          tolerances, ERR against the reference;', &
-            '                                          -j N: N processes at a time', &
+            '                                          -j N: N processes at a time, each', &
+            '                                          point''s record kept in STUDY_points/', &
+            '  flexmbs sweep STUDY.nml --point K       run grid point K alone, its record', &
+            '                                          into the results folder', &
+            '  flexmbs sweep STUDY.nml --merge         the table from the records there;', &
+            '                                          lists the points missing or failed', &
+            '                                          and the commands that run only those', &
+            '  flexmbs sweep STUDY.nml --slurm [--chunk K] [--partition P] [--time T]', &
+            '                                [--mem M] [--submit]', &
+            '                                          write a Slurm job array (one task per', &
+            '                                          K points) and a merge job into the', &
+            '                                          results folder; --submit submits both', &
+            '                                          (the merge after the array), else the', &
+            '                                          sbatch commands are shown', &
             '  flexmbs columns FILE.h5 K [K ...]       t and components K of y of a', &
             '                                          trajectory, as text columns', &
             '  flexmbs --help                          show this text', &
@@ -542,8 +555,12 @@ contains
             'flexmbs''s own of that kind (an HDF5 result, a ParaView file, a table);', &
             '--force replaces anything else too.', &
             '', &
+            'The results folder of a study is <study name>_points/ beside its table, or', &
+            'beside the study file when it names no table (docs/studies_on_a_cluster.md).', &
+            '', &
             'exit codes: 0 success, 2 bad input (no output written),', &
-            '            3 solver failure (outputs kept), 4 I/O error,', &
+            '            3 solver failure (outputs kept); sweep --merge and -j: a point', &
+            '            has no current record (no table written), 4 I/O error,', &
             '            130 / 143 stopped by SIGINT / SIGTERM after the current step', &
             '            (outputs flushed and closed; a second signal ends it at once)'
     end subroutine usage
