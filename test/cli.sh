@@ -390,11 +390,13 @@ for sig in TERM INT; do
         [ $busy -eq 2 ] && break
         sleep 0.1
     done
+    kids=$(pgrep -P $pid)
     if [ $sig = INT ]; then kill -INT -- -$pid; else kill -TERM $pid; fi
     wait $pid
     rc=$?
     want=$([ $sig = INT ] && echo 130 || echo 143)
-    left=$(pgrep -f "sweep sig.nml --point" | tr '\n' ' ')
+    left=""
+    for c in $kids; do kill -0 "$c" 2>/dev/null && left="$left $c"; done
     if [ "$rc" = "$want" ] && grep -q "stopped by SIG$sig" sig.out && [ ! -e sig.md ] \
         && [ -z "$left" ] && ! compgen -G "sig_points/*.rec" > /dev/null \
         && grep -q "point 1: stopped by SIG$sig; no record written" sig_points/point_1.log \
