@@ -221,7 +221,9 @@ extremes: deps
 # A one-node Slurm on this machine (munged, slurmctld, slurmd in a private
 # temporary folder, on ports of their own; test/cluster/slurm.sh) runs job
 # arrays, a failed and a cancelled task and a dependent job with the debug
-# flexmbs (test/cluster/run.sh, well under a minute); docs/cluster.md.
+# flexmbs, and the quick five-body study by `sweep --slurm --submit`, merged,
+# resumed after cancelled tasks (test/cluster/run.sh, well under a minute);
+# docs/cluster.md.
 .PHONY: test-cluster
 test-cluster:
 	@$(MAKE) --no-print-directory deps EXTRA_PACKAGES="slurm-wlm munge"

@@ -3,13 +3,17 @@
 !>   flexmbs run FILE.nml [--quiet] [--force]          run a scene
 !>   flexmbs reference STUDY.nml [--quiet] [--force]   a study's reference solution
 !>   flexmbs sweep STUDY.nml [-j N] [--quiet] [--force]  a study's grid of runs against it
-!>   (sweep --point K runs point K alone and prints its record: the child of -j)
+!>   flexmbs sweep STUDY.nml --point K        point K alone, its record into the results folder
+!>   flexmbs sweep STUDY.nml --merge          the table from the records there
+!>   flexmbs sweep STUDY.nml --slurm [--chunk K] [--partition P] [--time T] [--mem M] [--submit]
+!>                                            a Slurm job array and merge job for the study
 !>   flexmbs columns FILE.h5 K [K ...]           t and y(K) of a trajectory as text
 !>   flexmbs --help | --version
 !>
 !> Exit codes: 0 success, 2 bad input (nothing written), 3 solver failure
-!> (outputs kept), 4 I/O error, 130 / 143 stopped by SIGINT / SIGTERM
-!> (outputs flushed and closed). Only this program decides exit codes.
+!> (outputs kept; for `sweep --merge` and `-j`: points without a record),
+!> 4 I/O error, 130 / 143 stopped by SIGINT / SIGTERM (outputs flushed and
+!> closed). Only this program decides exit codes.
 program flexmbs_main
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use, intrinsic :: ieee_exceptions, only: ieee_status_type, ieee_flag_type, ieee_get_status, &
@@ -22,12 +26,19 @@ program flexmbs_main
         reason_name, reason_none
     use flexmbs_core_signals, only: install_signals, caught_signal
     use flexmbs_core_version, only: version
+    use flexmbs_core_processes, only: executable_path
     use flexmbs_io_namelist, only: scene_input_t, read_scene
     use flexmbs_run_runner, only: run_result_t, run_scene
     use flexmbs_io_namelist, only: study_input_t, read_study
     use flexmbs_run_study, only: make_reference, run_sweep, run_sweep_point, sweep_run_t, &
-        read_reference
+        read_reference, prepare_points
+    use flexmbs_run_study_grid, only: array_task_count
+    use flexmbs_run_study_merge, only: merged_t, merge_records, merge_report
+    use flexmbs_run_study_slurm, only: slurm_options_t, check_slurm_options, &
+        write_slurm_scripts, shell_word
     use flexmbs_io_table, only: layout_text, table_markdown, stats_row_t
+    use flexmbs_app_parallel_sweep, only: run_points_in_processes
+    use flexmbs_app_slurm_submit, only: submit_study
     implicit none
 
     integer, parameter :: exit_ok = 0, exit_bad_input = 2, exit_solver = 3, exit_io = 4
@@ -37,9 +48,10 @@ program flexmbs_main
     !> Largest state printed whole; larger ones are summarised.
     integer, parameter :: max_printed = 12
 
-    character(len=:), allocatable :: command, file, arg, value
-    logical :: quiet, force
+    character(len=:), allocatable :: command, file, arg, value, slurm_only
+    logical :: quiet, force, merging, slurm, submit, jobs_given
     integer :: i, nargs, jobs, point, ios
+    type(slurm_options_t) :: cluster
     !> the IEEE flags at the start, all quiet (finish)
     type(ieee_status_type) :: quiet_flags
 
@@ -64,6 +76,11 @@ program flexmbs_main
         file = ''
         jobs = 1
         point = 0
+        merging = .false.
+        slurm = .false.
+        submit = .false.
+        jobs_given = .false.
+        slurm_only = ''
         i = 1
         do while (i < nargs)
             i = i + 1
@@ -72,19 +89,19 @@ program flexmbs_main
                 quiet = .true.
             else if (arg == '--force') then
                 force = .true.
-            else if (command == 'sweep' .and. (arg == '-j' .or. arg == '--point')) then
-                if (i == nargs) call fail_usage(arg // ' needs a number')
+            else if (command == 'sweep' .and. any(arg == [character(len=11) :: '-j', &
+                     '--point', '--chunk', '--partition', '--time', '--mem'])) then
+                if (i == nargs) call fail_usage(arg // ' needs a value')
                 i = i + 1
                 value = argument(i)
-                if (arg == '-j') then
-                    read (value, *, iostat=ios) jobs
-                    if (ios /= 0 .or. jobs < 1) call fail_usage('-j ' // value // &
-                        ': needs a whole number >= 1')
-                else
-                    read (value, *, iostat=ios) point
-                    if (ios /= 0 .or. point < 1) call fail_usage('--point ' // value // &
-                        ': needs a whole number >= 1')
-                end if
+                call sweep_option(arg, value)
+            else if (command == 'sweep' .and. arg == '--merge') then
+                merging = .true.
+            else if (command == 'sweep' .and. arg == '--slurm') then
+                slurm = .true.
+            else if (command == 'sweep' .and. arg == '--submit') then
+                submit = .true.
+                slurm_only = arg
             else if (arg == '--help' .or. arg == '-h') then
                 call usage(output_unit)
                 call finish(exit_ok)
@@ -110,10 +127,17 @@ program flexmbs_main
             call reference(file, quiet, force)
         case ('sweep')
             if (len(file) == 0) call fail_usage('sweep needs a study file')
+            call check_sweep_modes()
             if (point > 0) then
                 call sweep_point(file, point)
+            else if (merging) then
+                call sweep_merge(file, force)
+            else if (slurm) then
+                call sweep_slurm(file, cluster, submit, force)
+            else if (jobs > 1) then
+                call sweep_parallel(file, jobs, force)
             else
-                call sweep(file, quiet, jobs, force)
+                call sweep(file, quiet, force)
             end if
         end select
     case ('columns')
@@ -173,35 +197,181 @@ contains
         call finish(exit_ok)
     end subroutine reference
 
-    !> A study's grid of runs against its reference: a line per run, then
-    !> the table (also written to the study's table file, if named).
-    subroutine sweep(path, quiet, jobs, force)
+    !> A value of a sweep's option (`arg value`), checked as a number
+    !> where it is one; --chunk's range is the Slurm options' check.
+    subroutine sweep_option(arg, value)
+        character(len=*), intent(in) :: arg, value
+        select case (arg)
+        case ('-j')
+            read (value, *, iostat=ios) jobs
+            if (ios /= 0 .or. jobs < 1) call fail_usage('-j ' // value // &
+                ': needs a whole number >= 1')
+            jobs_given = .true.
+        case ('--point')
+            read (value, *, iostat=ios) point
+            if (ios /= 0 .or. point < 1) call fail_usage('--point ' // value // &
+                ': needs a whole number >= 1')
+        case ('--chunk')
+            read (value, *, iostat=ios) cluster%chunk
+            if (ios /= 0 .or. verify(trim(adjustl(value)), '+-0123456789') /= 0) &
+                call fail_usage('--chunk ' // value // ': needs a whole number >= 1')
+        case ('--partition')
+            cluster%partition = value
+        case ('--time')
+            cluster%time = value
+        case ('--mem')
+            cluster%mem = value
+        end select
+        if (arg /= '-j' .and. arg /= '--point') slurm_only = arg
+    end subroutine sweep_option
+
+    !> A sweep does one of: all points here (-j N), one point (--point),
+    !> the merge (--merge), the Slurm scripts (--slurm); the Slurm options
+    !> only with --slurm.
+    subroutine check_sweep_modes()
+        character(len=:), allocatable :: modes
+        modes = ''
+        if (jobs_given) modes = modes // ' -j'
+        if (point > 0) modes = modes // ' --point'
+        if (merging) modes = modes // ' --merge'
+        if (slurm) modes = modes // ' --slurm'
+        if (count([jobs_given, point > 0, merging, slurm]) > 1) call fail_usage('sweep:' // &
+            modes // ': only one of -j, --point, --merge and --slurm at a time')
+        if (len(slurm_only) > 0 .and. .not. slurm) call fail_usage(slurm_only // &
+            ': only with --slurm')
+    end subroutine check_sweep_modes
+
+    !> A study's grid of runs against its reference, here one after the
+    !> other: a line per run, then the table (also written to the study's
+    !> table file, if named).
+    subroutine sweep(path, quiet, force)
         character(len=*), intent(in) :: path
         logical, intent(in) :: quiet, force
-        integer, intent(in) :: jobs
         type(study_input_t) :: study
         type(status_t) :: status
         type(sweep_run_t), allocatable :: runs(:)
-        type(stats_row_t), allocatable :: rows(:)
-        integer :: k
         call read_study(path, study, status)
         if (.not. status%ok()) call stop_on(status)
-        call run_sweep(study, quiet, runs, status, jobs, argument(0), force)
+        call run_sweep(study, quiet, runs, status, force)
         if (allocated(runs)) then
-            do k = 1, size(runs)
-                write (output_unit, '(a)') runs(k)%summary
-            end do
-            rows = runs%row
-            write (output_unit, '(a)', advance='no') layout_text(rows, table_markdown, &
-                trim(study%layout))
-            write (output_unit, '(i0,a,i0,a)') count(runs%ok), ' runs finished, ', &
-                count(.not. runs%ok), ' failed'
+            call print_runs(runs, study)
             if (len(study%table) > 0 .and. status%ok()) &
                 write (output_unit, '(a)') 'table: ' // study%table
         end if
         if (.not. status%ok()) call stop_on(status)
         call finish(exit_ok)
     end subroutine sweep
+
+    !> A line per run, the table in the study's layout, the count.
+    subroutine print_runs(runs, study)
+        type(sweep_run_t), intent(in) :: runs(:)
+        type(study_input_t), intent(in) :: study
+        type(stats_row_t), allocatable :: rows(:)
+        integer :: k
+        do k = 1, size(runs)
+            write (output_unit, '(a)') runs(k)%summary
+        end do
+        rows = runs%row
+        write (output_unit, '(a)', advance='no') layout_text(rows, table_markdown, &
+            trim(study%layout))
+        write (output_unit, '(i0,a,i0,a)') count(runs%ok), ' runs finished, ', &
+            count(.not. runs%ok), ' failed'
+    end subroutine print_runs
+
+    !> `sweep -j N`: the points in N processes at a time
+    !> (app/parallel_sweep), then the table from their records.
+    subroutine sweep_parallel(path, jobs, force)
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: jobs
+        logical, intent(in) :: force
+        type(study_input_t) :: study
+        type(status_t) :: status
+        character(len=:), allocatable :: folder, problems
+        integer :: npoints
+        call read_study(path, study, status)
+        if (.not. status%ok()) call stop_on(status)
+        call prepare_points(study, npoints, folder, status, force)
+        if (.not. status%ok()) call stop_on(status)
+        call run_points_in_processes(this_program(), path, npoints, folder, jobs, problems, &
+                                     status)
+        if (len(problems) > 0) call say(problems(1:len(problems) - 1))
+        if (.not. status%ok()) call stop_on(status)
+        call merge_and_report(study, force)
+    end subroutine sweep_parallel
+
+    !> `sweep --merge`: the table from the records of the results folder.
+    subroutine sweep_merge(path, force)
+        character(len=*), intent(in) :: path
+        logical, intent(in) :: force
+        type(study_input_t) :: study
+        type(status_t) :: status
+        call read_study(path, study, status)
+        if (.not. status%ok()) call stop_on(status)
+        call merge_and_report(study, force)
+    end subroutine sweep_merge
+
+    !> The merged table as a sweep prints it, then what is missing or
+    !> failed and how to run those points again; exit 0 when every point
+    !> has its record (failed runs are rows, as in a serial sweep), 3 when
+    !> some have none (the table file is then not written).
+    subroutine merge_and_report(study, force)
+        type(study_input_t), intent(in) :: study
+        logical, intent(in) :: force
+        type(status_t) :: status
+        type(merged_t) :: merged
+        character(len=:), allocatable :: report
+        call merge_records(study, merged, status, force)
+        if (.not. status%ok()) call stop_on(status)
+        call print_runs(merged%runs, study)
+        if (merged%table_written) write (output_unit, '(a)') 'table: ' // study%table
+        write (output_unit, '(a)') 'records: ' // merged%folder
+        report = merge_report(merged, study, this_program())
+        write (output_unit, '(a)', advance='no') report
+        if (merged%complete()) call finish(exit_ok)
+        call say(study%path // ': ' // int_text(size(merged%missing)) // ' of ' // &
+            int_text(merged%npoints) // ' points have no current record (listed above); ' // &
+            'no table written')
+        call finish(exit_solver)
+    end subroutine merge_and_report
+
+    !> `sweep --slurm`: the job array and merge job scripts into the
+    !> results folder; submitted with --submit, else the commands shown.
+    subroutine sweep_slurm(path, options, submit, force)
+        character(len=*), intent(in) :: path
+        type(slurm_options_t), intent(in) :: options
+        logical, intent(in) :: submit, force
+        type(study_input_t) :: study
+        type(status_t) :: status
+        character(len=:), allocatable :: folder, array, merge, array_id, merge_id
+        integer :: npoints
+        call check_slurm_options(options, status)
+        if (status%ok()) call read_study(path, study, status)
+        if (status%ok()) call prepare_points(study, npoints, folder, status, force)
+        if (status%ok()) call write_slurm_scripts(study, this_program(), folder, npoints, &
+                                                  options, array, merge, status)
+        if (.not. status%ok()) call stop_on(status)
+        write (output_unit, '(a)') 'job array: ' // array // ' (' // int_text(npoints) // &
+            ' points in ' // int_text(array_task_count(npoints, options%chunk)) // ' tasks)', &
+            'merge job: ' // merge
+        if (.not. submit) then
+            write (output_unit, '(a)') 'submit with:', &
+                '  jobid=$(sbatch --parsable ' // shell_word(array) // ')', &
+                '  sbatch --dependency=afterany:$jobid ' // shell_word(merge)
+            call finish(exit_ok)
+        end if
+        call submit_study(array, merge, folder, array_id, merge_id, status)
+        if (.not. status%ok()) call stop_on(status)
+        write (output_unit, '(a)') 'submitted: array job ' // array_id // ', merge job ' // &
+            merge_id // ' (runs once the array has ended)'
+        call finish(exit_ok)
+    end subroutine sweep_slurm
+
+    !> This program's executable, absolute when the system says it.
+    function this_program() result(path)
+        character(len=:), allocatable :: path
+        path = executable_path()
+        if (len(path) == 0) path = argument(0)
+    end function this_program
 
     !> `columns FILE.h5 K...`: t and the components K of y at every record
     !> of a trajectory file, as text columns (for plots).
@@ -234,18 +404,20 @@ contains
         call finish(exit_ok)
     end subroutine columns
 
-    !> One point of a study's grid, as a record line (a parallel sweep's child).
+    !> One point of a study's grid (a parallel sweep's process, a Slurm
+    !> task): its record into the results folder, its line here.
     subroutine sweep_point(path, k)
         character(len=*), intent(in) :: path
         integer, intent(in) :: k
         type(study_input_t) :: study
         type(status_t) :: status
-        character(len=:), allocatable :: line
+        type(sweep_run_t) :: run
+        character(len=:), allocatable :: record
         call read_study(path, study, status)
         if (.not. status%ok()) call stop_on(status)
-        call run_sweep_point(study, k, line, status)
+        call run_sweep_point(study, k, run, record, status)
         if (.not. status%ok()) call stop_on(status)
-        write (output_unit, '(a)') line
+        write (output_unit, '(a)') run%summary, 'record: ' // record
         call finish(exit_ok)
     end subroutine sweep_point
 
@@ -357,7 +529,20 @@ contains
             '  flexmbs sweep STUDY.nml [-j N] [--quiet] [--force]', &
             '                                          run the study''s grid of solvers and', &
             '                                          tolerances, ERR against the reference;', &
-            '                                          -j N: N processes at a time', &
+            '                                          -j N: N processes at a time, each', &
+            '                                          point''s record kept in STUDY_points/', &
+            '  flexmbs sweep STUDY.nml --point K       run grid point K alone, its record', &
+            '                                          into the results folder', &
+            '  flexmbs sweep STUDY.nml --merge         the table from the records there;', &
+            '                                          lists the points missing or failed', &
+            '                                          and the commands that run only those', &
+            '  flexmbs sweep STUDY.nml --slurm [--chunk K] [--partition P] [--time T]', &
+            '                                [--mem M] [--submit]', &
+            '                                          write a Slurm job array (one task per', &
+            '                                          K points) and a merge job into the', &
+            '                                          results folder; --submit submits both', &
+            '                                          (the merge after the array), else the', &
+            '                                          sbatch commands are shown', &
             '  flexmbs columns FILE.h5 K [K ...]       t and components K of y of a', &
             '                                          trajectory, as text columns', &
             '  flexmbs --help                          show this text', &
@@ -377,8 +562,12 @@ contains
             'flexmbs''s own of that kind (an HDF5 result, a ParaView file, a table);', &
             '--force replaces anything else too.', &
             '', &
+            'The results folder of a study is <study name>_points/ beside its table, or', &
+            'beside the study file when it names no table (docs/studies_on_a_cluster.md).', &
+            '', &
             'exit codes: 0 success, 2 bad input (no output written),', &
-            '            3 solver failure (outputs kept), 4 I/O error,', &
+            '            3 solver failure (outputs kept); sweep --merge and -j: a point', &
+            '            has no current record (no table written), 4 I/O error,', &
             '            130 / 143 stopped by SIGINT / SIGTERM after the current step', &
             '            (outputs flushed and closed; a second signal ends it at once)'
     end subroutine usage

@@ -308,6 +308,105 @@ printf "&study scene = '%s/inputs/four_bar.nml', reference_file = 'none.h5' /\n"
 expect study-no-reference 2 "no reference file (make it with 'flexmbs reference' first)" \
     sweep no_reference.nml --quiet
 
+# Points alone, merges and Slurm scripts (docs/studies_on_a_cluster.md).
+# The -j 2 sweep above left every point's record in study_points/.
+if [ "$(ls study_points/point_*.rec 2>/dev/null | wc -l)" -eq 6 ] \
+    && grep -qx 'outcome = ok' study_points/point_6.rec; then pass sweep-records
+else fail sweep-records "study_points: $(ls study_points 2>&1)"; fi
+expect sweep-merge 0 "6 runs finished, 0 failed" sweep study.nml --merge
+"$exe" sweep study.nml --merge 2>&1 | grep '^|' | cut -d'|' -f1-9,11- > merged.txt
+if [ -s merged.txt ] && cmp -s serial.txt merged.txt; then pass sweep-merge-as-serial
+else fail sweep-merge-as-serial "tables differ: $(diff serial.txt merged.txt | head -5)"; fi
+expect sweep-point 0 "record: study_points/point_2.rec" sweep study.nml --point 2 --quiet
+expect sweep-point-beyond 2 "study.nml: --point 7: the grid has points 1 .. 6" \
+    sweep study.nml --point 7
+# a study without records: every point missing, the commands for each, exit 3
+cp study.nml empty.nml
+check sweep-merge-empty 3 "missing: 6 of 6 points have no current record in empty_points: 1-6" \
+    sweep empty.nml --merge
+for k in 1 2 3 4 5 6; do
+    [ -z "$problem" ] && ! grep -q -- "^resubmit: .* sweep $work/empty.nml --point $k\$" <<<"$output" \
+        && problem="no resubmit line for point $k: $output"
+done
+if [ -n "$problem" ]; then fail sweep-merge-empty "$problem"; else pass sweep-merge-empty; fi
+# a record of another text of the study (a comment changed) is stale, missing
+sed -i '1s/^/! another comment\n/' empty.nml
+mkdir -p empty_points && cp study_points/point_3.rec empty_points/point_3.rec
+expect sweep-merge-stale 3 "stale: point 3: computed from another text of the study file" \
+    sweep empty.nml --merge
+# options
+expect sweep-chunk-zero 2 "--chunk 0: needs a whole number >= 1" sweep study.nml --slurm --chunk 0
+expect sweep-chunk-text 2 "--chunk x: needs a whole number >= 1" sweep study.nml --slurm --chunk x
+expect sweep-time-bad 2 "--time '1:75': needs a Slurm time limit" sweep study.nml --slurm --time 1:75
+expect sweep-mem-bad 2 "--mem '2GB': needs a whole number" sweep study.nml --slurm --mem 2GB
+expect sweep-slurm-point 2 "sweep: --point --slurm: only one of" sweep study.nml --slurm --point 1
+expect sweep-slurm-jobs 2 "sweep: -j --slurm: only one of" sweep study.nml --slurm -j 2
+expect sweep-merge-jobs 2 "sweep: -j --merge: only one of" sweep study.nml --merge -j 2
+expect sweep-submit-alone 2 "--submit: only with --slurm" sweep study.nml --submit
+expect sweep-chunk-alone 2 "--chunk: only with --slurm" sweep study.nml --chunk 2
+expect sweep-slurm-unknown 2 "unknown option '--nodes'" sweep study.nml --slurm --nodes 2
+expect sweep-slurm-no-reference 2 "no reference file" sweep no_reference.nml --slurm
+# the scripts: 6 points in tasks of 4 are the array 1-6:4 (2 tasks)
+expect sweep-slurm-scripts 0 "(6 points in 2 tasks)" sweep study.nml --slurm --chunk 4 \
+    --time 0:10:00 --mem 1G --partition test
+a=study_points/array.sbatch
+if grep -qx '#SBATCH --array=1-6:4' $a && grep -qx '#SBATCH --cpus-per-task=1' $a \
+    && grep -qx '#SBATCH --time=0:10:00' $a && grep -qx '#SBATCH --mem=1G' $a \
+    && grep -qx '#SBATCH --partition=test' $a \
+    && grep -qx "#SBATCH --output=$work/study_points/slurm_%A_%a.out" $a \
+    && grep -qx "study='$work/study.nml'" $a && grep -qx "exe='$exe'" $a \
+    && grep -q -- ' --merge$' study_points/merge.sbatch; then pass sweep-slurm-array
+else fail sweep-slurm-array "$(cat $a study_points/merge.sbatch 2>&1)"; fi
+# its tasks' points: the script run by hand with a stand-in for flexmbs
+printf '#!/bin/sh\necho "$4" >> %s/ran.txt\n' "$work" > stand_in.sh && chmod +x stand_in.sh
+sed "s#^exe=.*#exe='$work/stand_in.sh'#" $a > stand_in.sbatch
+ran() { rm -f ran.txt; SLURM_ARRAY_TASK_ID=$1 bash stand_in.sbatch ${2:+"$2"}; tr '\n' ' ' < ran.txt; }
+got="$(ran 1)/$(ran 5)/$(ran 2 1)"
+if [ "$got" = "1 2 3 4 /5 6 /2 " ]; then pass sweep-slurm-task-points
+else fail sweep-slurm-task-points "tasks 1, 5 and 2 (alone) ran '$got'"; fi
+
+# SIGTERM or SIGINT to a parallel sweep: its points stop after their step,
+# no table, exit 143 / 130, no point left running. The points (MEXAX at
+# tight tolerances over 0.3 s) take far longer than the test waits.
+sed -e "s#'../five_body.nml'#'$root/inputs/five_body.nml'#" -e "s#t_end               = 0.05#t_end = 0.3#" \
+    -e "s#'../../build/five_body_quick_reference.h5'#'sig_reference.h5', table = 'sig.md'#" \
+    -e "s#reference_tolerance = 1.0e-9#reference_tolerance = 1e-4#" -e "s#check_solver        = 'ddassl'#check_solver = 'none'#" \
+    -e "s#solvers             = 'ddassl', 'radau5', 'mexax'#solvers = 'mexax'#" \
+    -e "s#tolerances          = 1.0e-4, 1.0e-6#tolerances = 1e-6, 1e-7#" \
+    "$root/inputs/paper/five_body_quick.nml" > sig.nml
+"$exe" reference sig.nml --quiet > /dev/null 2>&1 || fail sweep-signal-reference "$(cat sig.nml)"
+for sig in TERM INT; do
+    rm -rf sig_points sig.md
+    [ $sig = INT ] && set -m   # a job of its own: SIGINT not ignored, as at a terminal
+    "$exe" sweep sig.nml -j 2 --quiet > sig.out 2>&1 &
+    pid=$!
+    set +m
+    # until both points have computed for a second (they have caught the
+    # signals long before)
+    deadline=$(( $(date +%s) + 60 ))
+    until [ "$(date +%s)" -ge "$deadline" ]; do
+        busy=0
+        for c in $(pgrep -P $pid); do [ "$(ps -o times= -p "$c")" -ge 1 ] 2>/dev/null && busy=$((busy + 1)); done
+        [ $busy -eq 2 ] && break
+        sleep 0.1
+    done
+    kids=$(pgrep -P $pid)
+    if [ $sig = INT ]; then kill -INT -- -$pid; else kill -TERM $pid; fi
+    wait $pid
+    rc=$?
+    want=$([ $sig = INT ] && echo 130 || echo 143)
+    left=""
+    for c in $kids; do kill -0 "$c" 2>/dev/null && left="$left $c"; done
+    if [ "$rc" = "$want" ] && grep -q "stopped by SIG$sig" sig.out && [ ! -e sig.md ] \
+        && [ -z "$left" ] && ! compgen -G "sig_points/*.rec" > /dev/null \
+        && grep -q "point 1: stopped by SIG$sig; no record written" sig_points/point_1.log \
+        && grep -q "point 2: stopped by SIG$sig; no record written" sig_points/point_2.log; then
+        pass sweep-parallel-sig$sig
+    else
+        fail sweep-parallel-sig$sig "exit $rc (want $want), still running: '$left', $(ls sig_points 2>&1): $(cat sig.out sig_points/*.log)"
+    fi
+done
+
 # ParaView output of a flexible body beside a rigid one
 sed -e "s/t_end   = 0.5 /t_end   = 0.02 /" -e "s#^&output#\&output vtk = 'out/vis', file = 'none',#" \
     -e "s/n_output = 51/n_output = 3/" "$root/inputs/rigid_flexible_pendulum.nml" > vis.nml

@@ -8,7 +8,8 @@ module flexmbs_core_files
     implicit none
     private
     public :: read_text_file, read_first_lines, same_file, same_path, file_kind, &
-        make_scratch_folder
+        make_scratch_folder, write_file_atomically, make_folder, absolute_path, delete_file, &
+        error_text
 
     !> What a path names (file_kind).
     integer, parameter, public :: file_missing = 0, file_regular = 1, file_folder = 2, &
@@ -17,6 +18,23 @@ module flexmbs_core_files
     integer, parameter :: max_path = 4096
 
     interface
+        function c_write_atomically(path, text, n) bind(C, name='flexmbs_write_atomically') &
+            result(rc)
+            import :: c_char, c_int, c_long_long
+            character(kind=c_char), intent(in) :: path(*), text(*)
+            integer(c_long_long), value :: n
+            integer(c_int) :: rc
+        end function c_write_atomically
+        function c_make_folder(path) bind(C, name='flexmbs_make_folder') result(rc)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int) :: rc
+        end function c_make_folder
+        subroutine c_error_text(code, out, n) bind(C, name='flexmbs_error_text')
+            import :: c_char, c_int
+            integer(c_int), value :: code, n
+            character(kind=c_char), intent(out) :: out(*)
+        end subroutine c_error_text
         function c_same_file(a, b) bind(C, name='flexmbs_same_file') result(same)
             import :: c_char, c_int
             character(kind=c_char), intent(in) :: a(*), b(*)
@@ -142,6 +160,61 @@ contains
         end if
         path = buf(1:len(buf) - 1)
     end subroutine make_scratch_folder
+
+    !> `text` as the whole of the file `path`, or nothing: written to a new
+    !> file beside it, flushed, then renamed over it (flexmbs_write_atomically),
+    !> so that no reader and no process killed meanwhile sees a part of it.
+    subroutine write_file_atomically(path, text, status)
+        character(len=*), intent(in) :: path, text
+        type(status_t), intent(out) :: status
+        integer(c_int) :: rc
+        rc = c_write_atomically(path // c_null_char, text, int(len(text), c_long_long))
+        if (rc /= 0) call status%set(status_io_error, path // ': cannot write: ' // &
+            error_text(rc))
+    end subroutine write_file_atomically
+
+    !> The folder `path` (its parent must exist); nothing when it is one.
+    subroutine make_folder(path, status)
+        character(len=*), intent(in) :: path
+        type(status_t), intent(out) :: status
+        integer(c_int) :: rc
+        rc = c_make_folder(path // c_null_char)
+        if (rc /= 0) call status%set(status_io_error, path // ': cannot create the folder: ' &
+            // error_text(rc))
+    end subroutine make_folder
+
+    !> Remove the file `path` if there is one; false when it stays.
+    logical function delete_file(path)
+        character(len=*), intent(in) :: path
+        integer :: unit, ios
+        logical :: exists
+        inquire (file=path, exist=exists)
+        delete_file = .true.
+        if (.not. exists) return
+        open (newunit=unit, file=path, status='old', iostat=ios)
+        if (ios == 0) close (unit, status='delete', iostat=ios)
+        inquire (file=path, exist=exists)
+        delete_file = .not. exists
+    end function delete_file
+
+    !> The absolute path of `path`, links, '.' and '..' resolved (the
+    !> file's own when it exists, else its folder's and its name); '' when
+    !> its folder does not exist.
+    function absolute_path(path) result(absolute)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: absolute
+        absolute = resolved(path)
+    end function absolute_path
+
+    !> strerror(3) of an errno value.
+    function error_text(code) result(text)
+        integer(c_int), intent(in) :: code
+        character(len=:), allocatable :: text
+        character(kind=c_char, len=256) :: buf
+        buf = ''
+        call c_error_text(code, buf, int(len(buf), c_int))
+        text = buf(1:max(index(buf, c_null_char) - 1, 0))
+    end function error_text
 
     !> The first lines of a text file, as many as `lines` holds: `count` of
     !> them were read (fewer when the file is shorter or unreadable).

@@ -101,3 +101,65 @@ long long flexmbs_free_space(const char *folder)
     if (statvfs(folder, &s) != 0) return -1;
     return (long long)s.f_bavail * (long long)s.f_frsize;
 }
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+
+/* Write `n` bytes of `text` to `path` whole or not at all: into a new
+ * temporary file beside it (mkstemp), flushed to the disk, then renamed
+ * over `path` (rename(2) is atomic within a file system), so that a
+ * reader, or a process killed meanwhile, sees the old file or the new one
+ * and never a part. 0 on success, else the errno of the step that failed
+ * (the temporary file removed). */
+int flexmbs_write_atomically(const char *path, const char *text, long long n)
+{
+    size_t len = strlen(path);
+    char *tmp = malloc(len + 16);
+    int fd, rc = 0;
+    long long done = 0;
+    ssize_t wrote;
+    if (tmp == NULL) return ENOMEM;
+    memcpy(tmp, path, len);
+    strcpy(tmp + len, ".tmp.XXXXXX");
+    fd = mkstemp(tmp);
+    if (fd < 0) {
+        rc = errno;
+        free(tmp);
+        return rc;
+    }
+    while (done < n) {
+        wrote = write(fd, text + done, (size_t)(n - done));
+        if (wrote < 0) {
+            if (errno == EINTR) continue;
+            rc = errno;
+            break;
+        }
+        done += wrote;
+    }
+    if (rc == 0 && fchmod(fd, 0644) != 0) rc = errno;
+    if (rc == 0 && fsync(fd) != 0) rc = errno;
+    if (close(fd) != 0 && rc == 0) rc = errno;
+    if (rc == 0 && rename(tmp, path) != 0) rc = errno;
+    if (rc != 0) unlink(tmp);
+    free(tmp);
+    return rc;
+}
+
+/* mkdir(2) with mode 0777 (less the umask); 0 when made or already a
+ * folder, else errno. */
+int flexmbs_make_folder(const char *path)
+{
+    struct stat s;
+    int code;
+    if (mkdir(path, 0777) == 0) return 0;
+    code = errno;
+    if (code == EEXIST && stat(path, &s) == 0 && S_ISDIR(s.st_mode)) return 0;
+    return code;
+}
+
+/* The text of an errno value, in `out` (size n). */
+void flexmbs_error_text(int code, char *out, int n)
+{
+    snprintf(out, (size_t)n, "%s", strerror(code));
+}

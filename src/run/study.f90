@@ -17,15 +17,19 @@
 !> per tolerance ('projection'). A run that fails is a row with ERR '-' and
 !> the reason on its summary line. CPU in the table is normalised to the
 !> row `cpu_reference` (the paper's Tables 2 and 3 normalise to one run).
+!>
+!> A point of the grid can also run alone (`sweep --point K`, the process
+!> of a parallel sweep or a Slurm array task): its record goes into the
+!> study's results folder (run/study_results, run/study_record), and
+!> run/study_merge assembles the table from the records there.
 module flexmbs_run_study
     use hdf5
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input, status_io_error, &
         status_solver_failure, status_signal
-    use flexmbs_core_signals, only: signal_pending, caught_signal, signal_name, signal_number
+    use flexmbs_core_signals, only: signal_pending, caught_signal, signal_name
     use flexmbs_core_text, only: int_text, real_text
-    use flexmbs_core_files, only: make_scratch_folder
     use flexmbs_dae_error_measure, only: paper_error
     use flexmbs_run_catalogue, only: solver_projects, solver_pmax_grid, problem_stabilisations
     use flexmbs_io_namelist, only: study_input_t, scene_input_t, read_scene
@@ -35,25 +39,16 @@ module flexmbs_run_study
     use flexmbs_io_table, only: stats_row_t, new_stats_row, write_table
     use flexmbs_io_output_files, only: named_path_t, named_path, check_output_paths, &
         output_hdf5, output_table
+    use flexmbs_run_study_grid, only: sweep_point_t, sweep_points
+    use flexmbs_run_study_results, only: make_results_folder, record_path
+    use flexmbs_run_study_record, only: sweep_run_t, fingerprint_t, study_fingerprint, &
+        write_record
     implicit none
     private
 
-    !> One point of a sweep's grid.
-    type :: sweep_point_t
-        character(len=32) :: solver = '', stab = ''
-        real(wp) :: tol = 0.0_wp
-        integer :: pmax = 5
-        character(len=32) :: source = ''
-    end type sweep_point_t
-
-    !> One run of a sweep: its table row and a line for the log.
-    type, public :: sweep_run_t
-        type(stats_row_t) :: row
-        logical :: ok = .false.
-        character(len=:), allocatable :: summary
-    end type sweep_run_t
-
-    public :: make_reference, run_sweep, run_sweep_point, read_reference
+    public :: sweep_run_t
+    public :: make_reference, run_sweep, run_sweep_point, prepare_points, read_reference, &
+        read_study_scene, check_study_output
 
 contains
 
@@ -299,83 +294,40 @@ contains
         call h5fclose_f(file, err)
     end subroutine read_reference
 
-    !> The grid of a study, in the order of the table: solvers, then
-    !> stabilisations, tolerances, p_max (DDASSL), derivative sources.
-    subroutine sweep_points(study, base, points)
-        type(study_input_t), intent(in) :: study
-        type(scene_input_t), intent(in) :: base
-        type(sweep_point_t), allocatable, intent(out) :: points(:)
-        character(len=32), allocatable :: stabs(:), sources(:)
-        character(len=:), allocatable :: solver
-        integer :: is, ib, it, ip, id, np
-        stabs = [character(len=32) :: '-']
-        sources = [character(len=32) :: '']
-        if (problem_stabilisations(base%problem)) then
-            stabs = [character(len=32) :: study%stabilisations]
-            sources = [character(len=32) :: study%derivatives]
-        end if
-        allocate (points(0))
-        do is = 1, size(study%solvers)
-            solver = trim(study%solvers(is))
-            do ib = 1, size(stabs)
-                ! a solver that projects by itself (MEXAX): once per tolerance
-                if (solver_projects(solver) .and. ib > 1) exit
-                do it = 1, size(study%tolerances)
-                    np = merge(size(study%pmax), 1, solver_pmax_grid(solver))
-                    do ip = 1, np
-                        do id = 1, size(sources)
-                            points = [points, sweep_point_t(solver, stabs(ib), &
-                                study%tolerances(it), study%pmax(ip), sources(id))]
-                        end do
-                    end do
-                end do
-            end do
-        end do
-    end subroutine sweep_points
-
-    !> Every run of the study's grid against its reference (module header);
-    !> with jobs > 1, in that many processes of `exe` at a time (`exe sweep
-    !> STUDY --point K`, through xargs -P): the same rows, CPU apart.
-    subroutine run_sweep(study, quiet, runs, status, jobs, exe, force)
+    !> Every run of the study's grid against its reference (module header),
+    !> one after the other in this process; the table written when the
+    !> study names one. A parallel sweep runs the points in processes of
+    !> their own (app/) and merges their records (run/study_merge).
+    subroutine run_sweep(study, quiet, runs, status, force)
         type(study_input_t), intent(in) :: study
         logical, intent(in) :: quiet
         type(sweep_run_t), allocatable, intent(out) :: runs(:)
         type(status_t), intent(out) :: status
-        integer, intent(in), optional :: jobs
-        character(len=*), intent(in), optional :: exe
         !> replace a file at the table's path that is not flexmbs's own
         logical, intent(in), optional :: force
         type(scene_input_t) :: base
         type(sweep_point_t), allocatable :: points(:)
         type(stats_row_t), allocatable :: rows(:)
         real(wp), allocatable :: t_ref(:), y_ref(:, :)
-        integer :: k, njobs
+        integer :: k
 
         call prepare_sweep(study, base, t_ref, y_ref, points, status)
         if (.not. status%ok()) return
         if (len(study%table) > 0) call check_study_output(study, base, 'table', study%table, &
                                                           output_table, given(force), status)
         if (.not. status%ok()) return
-        njobs = 1
-        if (present(jobs)) njobs = jobs
         allocate (runs(size(points)))
-        if (njobs > 1 .and. present(exe)) then
-            call run_in_processes(study, exe, njobs, runs, status)
-            if (.not. status%ok()) then
-                deallocate (runs) ! none complete: what there is stays in the points' files
+        do k = 1, size(points)
+            runs(k) = point_run(base, points(k), t_ref, y_ref, quiet)
+            if (signal_pending()) then
+                ! the runs so far, the interrupted one last; no table
+                runs = runs(1:k)
+                call status%set(status_signal, study%path // ': stopped by ' // &
+                    signal_name(caught_signal()) // ' after ' // int_text(k) // ' of ' // &
+                    int_text(size(points)) // ' runs; no table written', caught_signal())
                 return
             end if
-        else
-            do k = 1, size(points)
-                runs(k) = point_run(base, points(k), t_ref, y_ref, quiet)
-                if (signal_pending()) then
-                    ! the runs so far, the interrupted one last; no table
-                    runs = runs(1:k)
-                    call stopped(int_text(k) // ' of ' // int_text(size(points)) // ' runs')
-                    return
-                end if
-            end do
-        end if
+        end do
         if (study%cpu_reference <= size(runs)) then
             if (runs(study%cpu_reference)%ok) runs%row%cpu_unit = &
                 runs(study%cpu_reference)%row%stats%cpu
@@ -383,15 +335,6 @@ contains
         rows = runs%row
         if (len(study%table) > 0) call write_table(study%table, rows, status, &
                                                    trim(study%layout))
-
-    contains
-
-        subroutine stopped(done)
-            character(len=*), intent(in) :: done
-            call status%set(status_signal, study%path // ': stopped by ' // &
-                signal_name(caught_signal()) // ' after ' // done // '; no table written', &
-                caught_signal())
-        end subroutine stopped
     end subroutine run_sweep
 
     !> What every sweep starts from: the study's scene with the sweep's step
@@ -410,16 +353,43 @@ contains
         call sweep_points(study, base, points)
     end subroutine prepare_sweep
 
-    !> Point k of the study's grid alone (the child of a parallel sweep):
-    !> `line` is its record (record_line).
-    subroutine run_sweep_point(study, k, line, status)
+    !> What a sweep whose points run elsewhere checks first, as a serial
+    !> sweep does before its first run (the scene, the reference, the
+    !> table's path), and the results folder, created when missing:
+    !> `npoints` points, their records to go into `folder`.
+    subroutine prepare_points(study, npoints, folder, status, force)
         type(study_input_t), intent(in) :: study
-        integer, intent(in) :: k
-        character(len=:), allocatable, intent(out) :: line
+        integer, intent(out) :: npoints
+        character(len=:), allocatable, intent(out) :: folder
         type(status_t), intent(out) :: status
+        logical, intent(in), optional :: force
         type(scene_input_t) :: base
         type(sweep_point_t), allocatable :: points(:)
         real(wp), allocatable :: t_ref(:), y_ref(:, :)
+        npoints = 0
+        call prepare_sweep(study, base, t_ref, y_ref, points, status)
+        if (.not. status%ok()) return
+        if (len(study%table) > 0) call check_study_output(study, base, 'table', study%table, &
+                                                          output_table, given(force), status)
+        if (.not. status%ok()) return
+        npoints = size(points)
+        call make_results_folder(study, folder, status)
+    end subroutine prepare_points
+
+    !> Point k of the study's grid alone (`sweep --point K`): its record
+    !> into the results folder (`record`, its path), written whole or not
+    !> at all; none when a signal stopped the run (status_signal).
+    subroutine run_sweep_point(study, k, run, record, status)
+        type(study_input_t), intent(in) :: study
+        integer, intent(in) :: k
+        type(sweep_run_t), intent(out) :: run
+        character(len=:), allocatable, intent(out) :: record
+        type(status_t), intent(out) :: status
+        type(scene_input_t) :: base
+        type(sweep_point_t), allocatable :: points(:)
+        type(fingerprint_t) :: print
+        real(wp), allocatable :: t_ref(:), y_ref(:, :)
+        character(len=:), allocatable :: folder
         call prepare_sweep(study, base, t_ref, y_ref, points, status)
         if (.not. status%ok()) return
         if (k < 1 .or. k > size(points)) then
@@ -427,94 +397,20 @@ contains
                 ': the grid has points 1 .. ' // int_text(size(points)))
             return
         end if
-        line = record_line(point_run(base, points(k), t_ref, y_ref, .true.))
-        if (signal_pending()) call status%set(status_signal, study%path // ': point ' // &
-            int_text(k) // ': stopped by ' // signal_name(caught_signal()), caught_signal())
-    end subroutine run_sweep_point
-
-    !> The points in processes: each writes its record to a file of a
-    !> scratch folder beside the reference; xargs -P keeps `jobs` running.
-    subroutine run_in_processes(study, exe, jobs, runs, status)
-        type(study_input_t), intent(in) :: study
-        character(len=*), intent(in) :: exe
-        integer, intent(in) :: jobs
-        type(sweep_run_t), intent(inout) :: runs(:)
-        type(status_t), intent(inout) :: status
-        character(len=:), allocatable :: dir, command, text
-        integer :: k, stat, unit, ios, signo
-        character(len=4096) :: buffer
-        ! a new folder beside the reference, so that nothing of anyone's is removed
-        call make_scratch_folder(study%reference_file // '.sweep.', dir, status)
+        ! the fingerprint of the files as they are before the run
+        call study_fingerprint(study, base, print, status)
+        if (status%ok()) call make_results_folder(study, folder, status)
         if (.not. status%ok()) return
-        ! SIGINT (Ctrl-C: the whole process group) and SIGTERM stop the running
-        ! points after their step (they catch the signals that the shell and
-        ! xargs ignore, so that these wait for them); a point so stopped
-        ! leaves the file 'stopped', and no later point starts.
-        command = 'trap '''' INT TERM && seq 1 ' // int_text(size(runs)) // ' | xargs -P ' // &
-            int_text(jobs) // ' -I{} sh -c ''[ -e "$2/stopped" ] && exit 0; "$0" sweep "$1" --point {} > ' // &
-            '"$2/{}.txt" 2>&1; rc=$?; [ $rc -gt 128 ] && : > "$2/stopped"; exit $rc'' "' // &
-            exe // '" "' // study%path // '" "' // dir // '"'
-        call execute_command_line(command, exitstat=stat)
-        ! This process ignores SIGINT until the command returns (system(3)):
-        ! the points say whether they were stopped.
-        signo = caught_signal()
-        if (signo == 0) signo = points_signal()
-        if (signo > 0) then
-            call status%set(status_signal, study%path // ': stopped by ' // &
-                signal_name(signo) // ': the sweep''s processes ended; no table written', signo)
+        record = record_path(folder, k)
+        run = point_run(base, points(k), t_ref, y_ref, .true.)
+        if (signal_pending()) then
+            call status%set(status_signal, study%path // ': point ' // int_text(k) // &
+                ': stopped by ' // signal_name(caught_signal()) // '; no record written', &
+                caught_signal())
             return
         end if
-        if (stat /= 0) then
-            call status%set(status_io_error, study%path // ': the sweep processes failed ' // &
-                '(exit ' // int_text(stat) // '): ' // command)
-            return
-        end if
-        do k = 1, size(runs)
-            open (newunit=unit, file=dir // '/' // int_text(k) // '.txt', action='read', &
-                  iostat=ios)
-            text = ''
-            if (ios == 0) then
-                do
-                    read (unit, '(a)', iostat=ios) buffer
-                    if (ios /= 0) exit
-                    if (buffer(1:7) == 'record ') text = trim(buffer)
-                end do
-                close (unit)
-            end if
-            if (len(text) == 0) then
-                call status%set(status_io_error, study%path // ': point ' // int_text(k) // &
-                    ' left no record in ' // dir)
-                return
-            end if
-            call parse_record(text, runs(k), status)
-            if (.not. status%ok()) return
-        end do
-        call execute_command_line('rm -rf "' // dir // '"')
-
-    contains
-
-        !> The signal that a point reports it was stopped by ('... stopped by
-        !> SIGINT' in its file), 0 when none was.
-        integer function points_signal() result(signo)
-            integer :: j, at, unit, ios
-            signo = 0
-            do j = 1, size(runs)
-                open (newunit=unit, file=dir // '/' // int_text(j) // '.txt', action='read', &
-                      iostat=ios)
-                if (ios /= 0) cycle
-                do
-                    read (unit, '(a)', iostat=ios) buffer
-                    if (ios /= 0) exit
-                    at = index(buffer, ': stopped by ')
-                    if (at == 0) cycle
-                    signo = signal_number(trim(buffer(at + 13:)))
-                    if (signo > 0) exit
-                end do
-                close (unit)
-                if (signo > 0) return
-            end do
-        end function points_signal
-    end subroutine run_in_processes
+        call write_record(record, k, points(k), print, run, status)
+    end subroutine run_sweep_point
 
     !> One point of the grid against the reference.
     function point_run(base, point, t_ref, y_ref, quiet) result(run)
@@ -558,6 +454,8 @@ contains
         end if
         run%row = new_stats_row(label, tol, stab_label, result%stats)
         run%row%err = err
+        run%reason = ''
+        if (.not. run%ok) run%reason = run_status%text()
         if (run%ok) then
             run%summary = label // ' ' // stab_label // ' TOL ' // real_text(tol) // ': ERR ' &
                 // real_text(err) // ' = ' // real_text(err / tol) // ' TOL, ' // &
@@ -570,50 +468,6 @@ contains
                 run_status%text() // '; ' // result%stats%summary()
         end if
     end function point_run
-
-    !> A run as one line: 'record', ok, ERR, tolerance, t reached, counters,
-    !> CPU, wall, last step (exact decimal forms), then label | stab | summary.
-    function record_line(run) result(line)
-        type(sweep_run_t), intent(in) :: run
-        character(len=:), allocatable :: line
-        character(len=1024) :: buf
-        associate (st => run%row%stats)
-            write (buf, '(a,l1,3es25.16e3,9(1x,i0),3es25.16e3)') 'record ', run%ok, &
-                run%row%err, run%row%tol, st%t_reached, st%nst, st%nac, st%nrj, st%nfe, &
-                st%nfe_jac, st%nje, st%ndec, st%nsol, st%nprj, st%cpu, st%wall, st%h_last
-        end associate
-        line = trim(buf) // ' | ' // run%row%solver // ' | ' // run%row%stab // ' | ' // &
-            run%summary
-    end function record_line
-
-    !> The run of a record_line.
-    subroutine parse_record(line, run, status)
-        character(len=*), intent(in) :: line
-        type(sweep_run_t), intent(inout) :: run
-        type(status_t), intent(inout) :: status
-        integer :: ios, b1, b2, b3
-        b1 = index(line, ' | ')
-        b2 = 0
-        b3 = 0
-        if (b1 > 0) b2 = b1 + 2 + index(line(b1 + 3:), ' | ')
-        if (b2 > b1 + 2) b3 = b2 + 2 + index(line(b2 + 3:), ' | ')
-        if (b1 == 0 .or. b2 <= b1 + 2 .or. b3 <= b2 + 2) then
-            call status%set(status_io_error, 'sweep: a point''s record is damaged: ' // line)
-            return
-        end if
-        associate (st => run%row%stats)
-            read (line(8:b1 - 1), *, iostat=ios) run%ok, run%row%err, run%row%tol, &
-                st%t_reached, st%nst, st%nac, st%nrj, st%nfe, st%nfe_jac, st%nje, st%ndec, &
-                st%nsol, st%nprj, st%cpu, st%wall, st%h_last
-        end associate
-        if (ios /= 0) then
-            call status%set(status_io_error, 'sweep: a point''s record is damaged: ' // line)
-            return
-        end if
-        run%row%solver = line(b1 + 3:b2 - 1)
-        run%row%stab = line(b2 + 3:b3 - 1)
-        run%summary = line(b3 + 3:)
-    end subroutine parse_record
 
     !> An optional flag's value, false when absent.
     pure logical function given(flag)

@@ -7,6 +7,12 @@
 #    while running (scancel JOB_3), and a job that depends on the array
 #    (afterany, as a merge job will) runs once all three have ended and
 #    sees which are missing;
+#  - the quick five-body study submitted by `flexmbs sweep --slurm --submit`
+#    (job array and merge job): its table equals `sweep -j 2`'s but for
+#    CPU; submitted again held, half of its tasks cancelled: `--merge`
+#    lists exactly those (exit 3), its printed sbatch command reruns only
+#    them, and the merge gives the same table; a changed study text makes
+#    every record stale;
 # then the daemons stop and leave nothing behind.
 #
 #   bash test/cluster/run.sh [path/to/flexmbs]
@@ -165,6 +171,81 @@ if [ "$(head -n 1 dep.txt 2>&1)" = "queue: []" ] && grep -qx done.1 dep.txt \
 else
     fail dependent-after-array "dep.txt: $(cat dep.txt 2>&1); $(cat dep.out 2>&1)"
 fi
+
+# A study on the cluster (docs/studies_on_a_cluster.md): the quick
+# five-body study (6 grid points) submitted by `sweep --slurm --submit` in
+# tasks of 2 points, its merge job, and the same study by `sweep -j 2`:
+# the same table but for CPU.
+study_from() {  # study_from DIR: the quick study in DIR, its paths absolute
+    mkdir -p "$1"
+    sed -e "s#'../five_body.nml'#'$root/inputs/five_body.nml'#" \
+        -e "s#'../../build/five_body_quick_reference.h5'#'$work/q_reference.h5', table = 'q.md'#" \
+        "$root/inputs/paper/five_body_quick.nml" > "$1/q.nml"
+}
+# table FILE: a table's rows without the CPU column
+table() { grep '^|' "$1" | cut -d'|' -f1-9,11-; }
+study_from "$work/s1"
+if "$exe" reference "$work/s1/q.nml" --quiet > reference.txt 2>&1; then pass study-reference; else
+    fail study-reference "$(cat reference.txt)"; fi
+submitted=$("$exe" sweep "$work/s1/q.nml" --slurm --chunk 2 --submit 2>&1)
+ids=$(sed -n 's/^submitted: array job \([0-9]*\), merge job \([0-9]*\) .*/\1 \2/p' <<<"$submitted")
+read -r arr mrg <<<"$ids"
+if [ -n "$mrg" ] && grep -q '(6 points in 3 tasks)' <<<"$submitted"; then pass study-submit; else
+    fail study-submit "$submitted"; fi
+if [ -n "$mrg" ] && cluster_wait 120 "$arr" "$mrg"; then pass "study-array-ended ($(($(date +%s) - t0)) s)"
+else fail study-array-ended "time limit or no jobs: $submitted"; fi
+for t in 1 3 5; do state "study-task-$t" "${arr}_$t" COMPLETED 0:0; done
+state study-merge-job "$mrg" COMPLETED 0:0
+merged_out=$work/s1/q_points/slurm_merge_$mrg.out
+if grep -q '^6 runs finished, 0 failed$' "$merged_out" 2>/dev/null && [ -s s1/q.md ]; then
+    pass study-merged; cp s1/q.md slurm_q.md
+else fail study-merged "$(cat "$merged_out" 2>&1)"; fi
+"$exe" sweep "$work/s1/q.nml" -j 2 --quiet > parallel.txt 2>&1
+if [ -s slurm_q.md ] && [ -n "$(table s1/q.md)" ] && [ "$(table slurm_q.md)" = "$(table s1/q.md)" ] \
+    && [ "$(table "$merged_out")" = "$(table parallel.txt)" ]; then pass study-slurm-as-parallel
+else fail study-slurm-as-parallel "$(diff <(table slurm_q.md) <(table s1/q.md)) $(cat parallel.txt)"; fi
+
+# Again in a fresh results folder, held, half of the tasks cancelled
+# before they run: --merge names exactly those, exits 3, and its command
+# for Slurm runs only them; the merge then gives the same table.
+study_from "$work/s2"
+"$exe" sweep "$work/s2/q.nml" --slurm > slurm2.txt 2>&1
+held=$(sbatch --parsable --hold "$work/s2/q_points/array.sbatch" 2>&1)
+scancel "${held}_2" "${held}_4" "${held}_6" && scontrol release "$held" > /dev/null 2>&1
+if [[ "$held" =~ ^[0-9]+$ ]] && cluster_wait 120 "$held"; then pass study-held-array-ended; else
+    fail study-held-array-ended "$held $(cat slurm2.txt)"; fi
+for t in 1 3 5; do state "study-held-task-$t" "${held}_$t" COMPLETED 0:0; done
+# a task cancelled while pending never ran: no output, no record
+never=""
+for t in 2 4 6; do
+    [ -e "s2/q_points/slurm_${held}_$t.out" ] || [ -e "s2/q_points/point_$t.rec" ] && never="$never $t"
+done
+if [ -z "$never" ] && [ -s s2/q_points/point_5.rec ]; then pass study-cancelled-never-ran; else
+    fail study-cancelled-never-ran "tasks$never ran: $(ls s2/q_points)"; fi
+(cd s2 && "$exe" sweep q.nml --merge > ../merge2.txt 2>&1)
+rc=$?
+if [ "$rc" = 3 ] && grep -q '^missing: 3 of 6 points have no current record in .*: 2,4,6$' merge2.txt \
+    && grep -q '^3 runs finished, 0 failed$' merge2.txt && [ ! -e s2/q.md ]; then pass study-merge-lists-missing
+else fail study-merge-lists-missing "exit $rc: $(cat merge2.txt)"; fi
+again=$(sed -n 's/^resubmit (Slurm): sbatch //p' merge2.txt)
+if [ "${again%% *}" = "--array=2,4,6" ]; then pass study-resubmit-command; else
+    fail study-resubmit-command "'$again' in: $(cat merge2.txt)"; fi
+# shellcheck disable=SC2086 # the printed command's words
+rerun=$(sbatch --parsable $again 2>&1)
+if [[ "$rerun" =~ ^[0-9]+$ ]] && cluster_wait 120 "$rerun"; then pass study-resubmitted-ended; else
+    fail study-resubmitted-ended "$rerun"; fi
+for t in 2 4 6; do state "study-resubmitted-$t" "${rerun}_$t" COMPLETED 0:0; done
+if "$exe" sweep "$work/s2/q.nml" --merge > merge3.txt 2>&1 \
+    && [ "$(table s2/q.md)" = "$(table s1/q.md)" ] && [ -n "$(table s2/q.md)" ]; then
+    pass study-resumed-as-parallel
+else fail study-resumed-as-parallel "$(cat merge3.txt; diff <(table s2/q.md) <(table s1/q.md))"; fi
+# another text of the study (a comment): every record is stale, none used
+echo "! the tolerances were checked" >> s2/q.nml
+"$exe" sweep "$work/s2/q.nml" --merge > merge4.txt 2>&1
+rc=$?
+if [ "$rc" = 3 ] && [ "$(grep -c '^stale: point [1-6]: computed from another text of the study file' merge4.txt)" = 6 ] \
+    && grep -q '^0 runs finished' merge4.txt; then pass study-stale-refused
+else fail study-stale-refused "exit $rc: $(cat merge4.txt)"; fi
 
 # the stop leaves no daemon and no folder (but with FLEXMBS_SLURM_KEEP=1)
 cd "$root" || exit 1
