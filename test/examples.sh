@@ -4,7 +4,9 @@
 # and no note on floating-point exceptions (LAPACK's IEEECK raises
 # divide-by-zero and invalid on purpose; linalg/lapack keeps the flags, and
 # app/ reports only invalid, divide-by-zero and overflow; a non-finite
-# value in a model or solver is a solver failure, exit 3, anyway).
+# value in a model or solver is a solver failure, exit 3, anyway). Then the
+# named series of every multibody result (/bodies, /joints, /drivers)
+# are checked against its /y (test/result_names.py).
 #
 #   bash test/examples.sh [path/to/flexmbs]
 #
@@ -39,6 +41,19 @@ for scene in "$root"/inputs/*.nml; do
     else
         pass "$name-clean-stderr"
     fi
+done
+
+# The named series of each multibody result against its /y
+# (test/result_names.py; h5py of the system's Python, see the Makefile).
+py=/usr/bin/python3
+[ -x "$py" ] || py=python3
+for h5 in *.h5; do
+    while read -r line; do
+        case $line in
+            pass\ *) pass "${line#pass result_names/}" ;;
+            FAIL\ *) fail "${line#FAIL result_names/}" "" ;;
+        esac
+    done < <("$py" "$root/test/result_names.py" "$h5" 2>&1 || echo "FAIL $h5: result_names.py failed")
 done
 
 echo "${passed} passed, ${failed} failed"

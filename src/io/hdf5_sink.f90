@@ -4,6 +4,9 @@
 !>   /time           (steps)        extendible, chunked
 !>   /y              (n, steps)     extendible, chunked: y(:, k) at time(k)
 !>   /<block>        (m, steps)     optional named slices of y (/q, /v, /lambda)
+!>   /<path>         (m, steps)     optional named series computed from each
+!>                                  record (add_series: /bodies/<name>/position
+!>                                  ...), with a `unit` attribute
 !>   attributes on / creator ('flexmbs 0.1.0'), input_text, solver, outcome,
 !>                   NST ... NPRJ, CPU, WALL, t_reached
 !> Each record is written and the file flushed at once, so a run that
@@ -19,6 +22,9 @@ module flexmbs_io_hdf5_sink
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_core_version, only: creator
+    use flexmbs_io_record_values, only: record_values_t
+    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_char, c_null_char, c_null_ptr, &
+        c_associated, c_f_pointer, c_size_t, c_int
     implicit none
     private
 
@@ -38,6 +44,15 @@ module flexmbs_io_hdf5_sink
         integer(hid_t) :: dset = -1
     end type block_t
 
+    !> A series computed from each record (add_series).
+    type :: series_t
+        character(len=:), allocatable :: path
+        integer :: rows = 0
+        integer(hid_t) :: dset = -1
+        class(record_values_t), allocatable :: source
+        real(wp), allocatable :: buffer(:)  !! one record's values
+    end type series_t
+
     type, extends(sink_t), public :: hdf5_sink_t
         character(len=:), allocatable :: path
         integer :: n = 0                 !! length of y
@@ -46,9 +61,13 @@ module flexmbs_io_hdf5_sink
         logical :: is_open = .false.
         integer(hid_t) :: file = -1, time_dset = -1, y_dset = -1
         type(block_t), allocatable :: blocks(:)
+        type(series_t), allocatable :: series(:)
     contains
         procedure :: create => sink_create
         procedure :: add_block => sink_add_block
+        procedure :: add_series => sink_add_series
+        procedure :: write_strings => sink_write_strings
+        procedure :: annotate => sink_annotate
         procedure :: output => sink_output
         procedure :: wants_steps => sink_wants_steps
         procedure :: step => sink_step
@@ -60,6 +79,19 @@ module flexmbs_io_hdf5_sink
     end type hdf5_sink_t
 
     logical, save :: library_open = .false.
+
+    interface
+        !> The length of a C string (a variable-length HDF5 string read back).
+        pure integer(c_size_t) function c_strlen(s) bind(C, name='strlen')
+            import :: c_ptr, c_size_t
+            type(c_ptr), value, intent(in) :: s
+        end function c_strlen
+        !> Memory the HDF5 library allocated (a variable-length string read).
+        integer(c_int) function h5_free_memory(buffer) bind(C, name='H5free_memory')
+            import :: c_ptr, c_int
+            type(c_ptr), value, intent(in) :: buffer
+        end function h5_free_memory
+    end interface
 
 contains
 
@@ -86,7 +118,7 @@ contains
         self%records = 0
         self%every_step = .false.
         if (present(every_step)) self%every_step = every_step
-        allocate (self%blocks(0))
+        allocate (self%blocks(0), self%series(0))
         call open_library(err)
         if (check(err, 'initialise the HDF5 library')) return
         call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%file, err)
@@ -179,6 +211,126 @@ contains
         if (.not. self%every_step) return
         call append(self, t, y, status)
     end subroutine sink_step
+
+    !> A named series beside /y: `rows` values per record at `path` (groups
+    !> created as needed, e.g. 'bodies/crank/position'), computed from each
+    !> record by `source`, with the string attributes `unit` (SI) and, when
+    !> given, `description`. Call before the first record.
+    subroutine sink_add_series(self, path, rows, unit, source, status, description)
+        class(hdf5_sink_t), intent(inout) :: self
+        character(len=*), intent(in) :: path, unit
+        integer, intent(in) :: rows
+        class(record_values_t), intent(in) :: source
+        type(status_t), intent(out) :: status
+        character(len=*), intent(in), optional :: description
+        type(series_t), allocatable :: grown(:)
+        integer :: err, k
+        if (.not. self%is_open .or. self%records > 0 .or. rows < 1) then
+            call status%set(status_bad_input, 'HDF5 sink: series /' // path // &
+                ' needs an open file without records and rows >= 1')
+            return
+        end if
+        allocate (grown(size(self%series) + 1))
+        do k = 1, size(self%series)
+            call move_series(self%series(k), grown(k))
+        end do
+        call move_alloc(grown, self%series)
+        k = size(self%series)
+        associate (s => self%series(k))
+            s%path = path
+            s%rows = rows
+            allocate (s%source, source=source)
+            allocate (s%buffer(rows))
+            call create_series(self%file, path, rows, &
+                max(1, min(time_chunk, chunk_bytes / (8 * rows))), s%dset, err, groups=.true.)
+            if (err >= 0) call write_string_attribute(s%dset, 'unit', unit, err)
+            if (err >= 0 .and. present(description)) &
+                call write_string_attribute(s%dset, 'description', description, err)
+        end associate
+        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot create /' // &
+                                     path)
+    end subroutine sink_add_series
+
+    !> A 1-D dataset of UTF-8 strings (variable length: h5py reads str) at
+    !> `path`, e.g. the label of every component of /y.
+    subroutine sink_write_strings(self, path, strings, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        character(len=*), intent(in) :: strings(:)
+        type(status_t), intent(out) :: status
+        character(kind=c_char, len=len(strings) + 1), allocatable, target :: text(:)
+        type(c_ptr), allocatable, target :: pointers(:)
+        integer(hid_t) :: str_type, space, dset, lcpl
+        integer(hsize_t) :: dims(1)
+        integer :: err, k, close_err
+        if (.not. self%is_open) then
+            call status%set(status_bad_input, 'HDF5 sink: write_strings before create')
+            return
+        end if
+        allocate (text(size(strings)), pointers(size(strings)))
+        do k = 1, size(strings)
+            text(k) = trim(strings(k)) // c_null_char
+            pointers(k) = c_loc(text(k)(1:1))
+        end do
+        dims = size(strings, kind=hsize_t)
+        call utf8_string_type(str_type, err)
+        if (err >= 0) call h5screate_simple_f(1, dims, space, err)
+        if (err >= 0) call group_creating(lcpl, err)
+        if (err >= 0) call h5dcreate_f(self%file, path, str_type, space, dset, err, &
+                                       lcpl_id=lcpl)
+        if (err >= 0) then
+            if (size(strings) > 0) call h5dwrite_f(dset, str_type, c_loc(pointers(1)), err)
+            call h5dclose_f(dset, close_err)
+        end if
+        call h5pclose_f(lcpl, close_err)
+        call h5sclose_f(space, close_err)
+        call h5tclose_f(str_type, close_err)
+        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write /' // &
+                                     path)
+    end subroutine sink_write_strings
+
+    !> A string attribute `name` = `text` of the dataset or group at `path`.
+    subroutine sink_annotate(self, path, name, text, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        character(len=*), intent(in) :: path, name, text
+        type(status_t), intent(out) :: status
+        integer(hid_t) :: obj
+        integer :: err, close_err
+        call h5oopen_f(self%file, path, obj, err)
+        if (err >= 0) then
+            call write_string_attribute(obj, name, text, err)
+            call h5oclose_f(obj, close_err)
+        end if
+        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot annotate /' &
+                                     // path)
+    end subroutine sink_annotate
+
+    !> Move a series (its source is polymorphic: no intrinsic assignment).
+    subroutine move_series(from, to)
+        type(series_t), intent(inout) :: from
+        type(series_t), intent(out) :: to
+        call move_alloc(from%path, to%path)
+        to%rows = from%rows
+        to%dset = from%dset
+        call move_alloc(from%source, to%source)
+        call move_alloc(from%buffer, to%buffer)
+    end subroutine move_series
+
+    !> A link-creation property list that creates missing groups of a path.
+    subroutine group_creating(lcpl, err)
+        integer(hid_t), intent(out) :: lcpl
+        integer, intent(out) :: err
+        call h5pcreate_f(H5P_LINK_CREATE_F, lcpl, err)
+        if (err >= 0) call h5pset_create_inter_group_f(lcpl, 1, err)
+    end subroutine group_creating
+
+    !> Variable-length UTF-8 strings.
+    subroutine utf8_string_type(str_type, err)
+        integer(hid_t), intent(out) :: str_type
+        integer, intent(out) :: err
+        call h5tcopy_f(H5T_STRING, str_type, err)
+        if (err >= 0) call h5tset_cset_f(str_type, H5T_CSET_UTF8_F, err)
+    end subroutine utf8_string_type
 
     !> Flush what is written; the file stays open for the statistics.
     subroutine sink_finish(self, status)
@@ -317,6 +469,14 @@ contains
                 worst = min(worst, err)
             end do
         end if
+        if (allocated(self%series)) then
+            do i = 1, size(self%series)
+                if (self%series(i)%dset < 0) cycle
+                call h5dclose_f(self%series(i)%dset, err)
+                worst = min(worst, err)
+            end do
+            deallocate (self%series)
+        end if
         err = 0
         if (self%y_dset >= 0) call h5dclose_f(self%y_dset, err)
         worst = min(worst, err)
@@ -370,7 +530,8 @@ contains
 
     ! ------------------------------------------------------------------
 
-    !> The text of a scalar string attribute of `obj`.
+    !> The text of a scalar string attribute of `obj`: variable-length (as
+    !> flexmbs writes them) or fixed-length (files of earlier versions).
     subroutine read_string_attribute(obj, name, text, err)
         integer(hid_t), intent(in) :: obj
         character(len=*), intent(in) :: name
@@ -379,31 +540,57 @@ contains
         integer(hid_t) :: attr, file_type, mem_type
         integer(size_t) :: length
         integer :: close_err, stat
+        logical :: variable
+        text = ''
         call h5aopen_f(obj, name, attr, err)
-        if (err < 0) then
-            text = ''
-            return
-        end if
+        if (err < 0) return
         call h5aget_type_f(attr, file_type, err)
-        if (err >= 0) call h5tget_size_f(file_type, length, err)
-        if (err >= 0) call string_type(int(length), mem_type, err)
-        if (err >= 0) then
-            ! the length is the file's word: a damaged one is a failed read
-            allocate (character(len=max(int(length), 1)) :: text, stat=stat)
-            if (stat /= 0) then
-                err = -1
+        if (err >= 0) call h5tis_variable_str_f(file_type, variable, err)
+        if (err >= 0 .and. variable) then
+            call read_variable(err)
+        else if (err >= 0) then
+            call h5tget_size_f(file_type, length, err)
+            if (err >= 0) call string_type(int(length), mem_type, err)
+            if (err >= 0) then
+                ! the length is the file's word: a damaged one is a failed read
+                deallocate (text)
+                allocate (character(len=max(int(length), 1)) :: text, stat=stat)
+                if (stat /= 0) err = -1
+                if (err >= 0) call h5aread_f(attr, mem_type, text, [1_hsize_t], err)
                 call h5tclose_f(mem_type, close_err)
+                if (err >= 0) text = trim(text)
             end if
         end if
-        if (err >= 0) then
-            call h5aread_f(attr, mem_type, text, [1_hsize_t], err)
-            call h5tclose_f(mem_type, close_err)
-            text = trim(text)
-        else
-            text = ''
-        end if
+        if (err < 0) text = ''
         call h5tclose_f(file_type, close_err)
         call h5aclose_f(attr, close_err)
+
+    contains
+
+        subroutine read_variable(err)
+            integer, intent(inout) :: err
+            type(c_ptr), target :: pointer(1)
+            type(c_ptr) :: buffer
+            character(kind=c_char), pointer :: chars(:)
+            integer :: n
+            call utf8_string_type(mem_type, err)
+            if (err < 0) return
+            pointer(1) = c_null_ptr
+            buffer = c_loc(pointer(1))
+            call h5aread_f(attr, mem_type, buffer, err)
+            call h5tclose_f(mem_type, close_err)
+            if (err < 0 .or. .not. c_associated(pointer(1))) return
+            n = int(c_strlen(pointer(1)))
+            call c_f_pointer(pointer(1), chars, [max(n, 1)])
+            deallocate (text)
+            allocate (character(len=n) :: text, stat=stat)
+            if (stat == 0) then
+                text = transfer(chars(1:n), text)
+            else
+                err = -1
+            end if
+            close_err = int(h5_free_memory(pointer(1)))
+        end subroutine read_variable
     end subroutine read_string_attribute
 
     !> Append one record: /y and the blocks first, /time last, then flush.
@@ -429,6 +616,14 @@ contains
                                   y(b%first:b%last), err)
             end associate
         end do
+        do i = 1, size(self%series)
+            if (err < 0) exit
+            associate (sr => self%series(i))
+                call sr%source%evaluate(t, y, sr%buffer, status)
+                if (.not. status%ok()) return
+                call write_column(sr%dset, sr%rows, self%records, sr%buffer, err)
+            end associate
+        end do
         if (err >= 0) call write_column(self%time_dset, 0, self%records, [t], err)
         if (err >= 0) call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, err)
         if (err < 0) then
@@ -439,15 +634,16 @@ contains
     end subroutine append
 
     !> An empty extendible dataset: (0) for m = 0, else (m, 0), chunked.
-    subroutine create_series(file, name, m, per_chunk, dset, err)
+    subroutine create_series(file, name, m, per_chunk, dset, err, groups)
         integer(hid_t), intent(in) :: file
         character(len=*), intent(in) :: name
         integer, intent(in) :: m, per_chunk
         integer(hid_t), intent(out) :: dset
         integer, intent(out) :: err
-        integer(hid_t) :: space, plist
+        logical, intent(in), optional :: groups !! create the groups of a path
+        integer(hid_t) :: space, plist, lcpl
         integer(hsize_t) :: dims(2), maxdims(2), chunk(2)
-        integer :: rank
+        integer :: rank, close_err
         if (m == 0) then
             rank = 1
             dims(1) = 0
@@ -464,7 +660,13 @@ contains
         if (err < 0) return
         call h5pcreate_f(H5P_DATASET_CREATE_F, plist, err)
         if (err >= 0) call h5pset_chunk_f(plist, rank, chunk(1:rank), err)
-        if (err >= 0) call h5dcreate_f(file, name, H5T_NATIVE_DOUBLE, space, dset, err, plist)
+        lcpl = H5P_DEFAULT_F
+        if (present(groups)) then
+            if (groups .and. err >= 0) call group_creating(lcpl, err)
+        end if
+        if (err >= 0) call h5dcreate_f(file, name, H5T_NATIVE_DOUBLE, space, dset, err, plist, &
+                                       lcpl_id=lcpl)
+        if (lcpl /= H5P_DEFAULT_F) call h5pclose_f(lcpl, close_err)
         if (err >= 0) call h5pclose_f(plist, err)
         if (err >= 0) call h5sclose_f(space, err)
     end subroutine create_series
@@ -513,21 +715,32 @@ contains
         if (err >= 0) call h5tset_size_f(str_type, int(max(n, 1), size_t), err)
     end subroutine string_type
 
+    !> A scalar string attribute, variable-length UTF-8 (h5py reads a str),
+    !> replacing one of that name.
     subroutine write_string_attribute(obj, name, text, err)
         integer(hid_t), intent(in) :: obj
         character(len=*), intent(in) :: name, text
         integer, intent(out) :: err
         integer(hid_t) :: str_type, space, attr
-        character(len=max(len(text), 1)) :: buf
-        buf = text
+        character(kind=c_char, len=len(text) + 1), target :: buf
+        type(c_ptr), target :: pointer(1)
+        integer :: close_err
+        buf = text // c_null_char
+        pointer(1) = c_loc(buf(1:1))
         call delete_attribute(obj, name, err)
-        if (err >= 0) call string_type(len(buf), str_type, err)
-        if (err >= 0) call h5screate_f(H5S_SCALAR_F, space, err)
-        if (err >= 0) call h5acreate_f(obj, name, str_type, space, attr, err)
-        if (err >= 0) call h5awrite_f(attr, str_type, buf, [1_hsize_t], err)
-        if (err >= 0) call h5aclose_f(attr, err)
-        if (err >= 0) call h5sclose_f(space, err)
-        if (err >= 0) call h5tclose_f(str_type, err)
+        if (err < 0) return
+        call utf8_string_type(str_type, err)
+        if (err < 0) return
+        call h5screate_f(H5S_SCALAR_F, space, err)
+        if (err >= 0) then
+            call h5acreate_f(obj, name, str_type, space, attr, err)
+            if (err >= 0) then
+                call h5awrite_f(attr, str_type, c_loc(pointer(1)), err)
+                call h5aclose_f(attr, close_err)
+            end if
+            call h5sclose_f(space, close_err)
+        end if
+        call h5tclose_f(str_type, close_err)
     end subroutine write_string_attribute
 
     subroutine delete_attribute(obj, name, err)

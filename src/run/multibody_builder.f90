@@ -41,13 +41,16 @@ module flexmbs_run_multibody_builder
 contains
 
     !> The system of the scene, q0 = (r, p) per body and v0 = (ṙ, ω′) per body.
-    subroutine build_multibody(scene, sys, q0, v0, status, joint_labels)
+    subroutine build_multibody(scene, sys, q0, v0, status, joint_labels, joint_names)
         type(scene_input_t), intent(in) :: scene
         type(mbs_system_t), intent(out) :: sys
         real(wp), allocatable, intent(out) :: q0(:), v0(:)
         type(status_t), intent(out) :: status
         !> per system joint, what the scene calls it ('&joint ''J''', ...)
         character(len=:), allocatable, intent(out), optional :: joint_labels(:)
+        !> per joint of the system (not the node frames): 'joints/NAME' or
+        !> 'drivers/NAME' ('joints/NAME (node N)' for the joints of an attach)
+        character(len=:), allocatable, intent(out), optional :: joint_names(:)
         type(rigid_body_t), allocatable :: bodies(:)
         type(marker_t), allocatable :: markers(:)
         type(mbs_joint_t), allocatable :: joints(:)
@@ -56,7 +59,7 @@ contains
         type(node_frame_t), allocatable :: frames(:)
         real(wp), allocatable :: qf(:), vf(:), qc(:), vc(:)
         integer, allocatable :: nodes(:), frame_of(:)
-        character(len=:), allocatable :: labels(:), frame_labels(:), defect
+        character(len=:), allocatable :: labels(:), frame_labels(:), defect, names(:)
         real(wp) :: p(4), r(3, 3), anchor(3)
         integer :: i, nb, k, n, b, mi
         ! node-set markers that a joint other than 'attach' or a driver uses
@@ -162,13 +165,14 @@ contains
             end associate
         end do
         allocate (joints(0))
-        allocate (character(len=80) :: labels(0))
+        allocate (character(len=80) :: labels(0), names(0))
         do i = 1, size(scene%joints)
             associate (jt => scene%joints(i))
                 if (jt%type /= 'attach') then
                     joints = [joints, mbs_joint_t(joint_kind(jt%type), &
                         marker_index(scene, jt%marker_i), marker_index(scene, jt%marker_j))]
                     labels = [character(len=80) :: labels, '&joint ''' // trim(jt%name) // '''']
+                    names = [character(len=80) :: names, 'joints/' // trim(jt%name)]
                     cycle
                 end if
                 ! 'attach': a spherical joint per node of the set, the rigid side's
@@ -201,6 +205,8 @@ contains
                                                   size(markers))]
                     labels = [character(len=80) :: labels, '&joint ''' // trim(jt%name) // &
                               ''' (node ' // int_text(nodes(n)) // ')']
+                    names = [character(len=80) :: names, 'joints/' // trim(jt%name) // &
+                             ' (node ' // int_text(nodes(n)) // ')']
                 end do
             end associate
         end do
@@ -211,6 +217,7 @@ contains
                     driver_kind(d%type), d%axis_i, d%axis_j, &
                     driver_t(d%coefficients, d%amplitude, d%frequency, d%phase))]
                 labels = [character(len=80) :: labels, '&driver ''' // trim(d%name) // '''']
+                names = [character(len=80) :: names, 'drivers/' // trim(d%name)]
             end associate
         end do
         sys = new_mbs_system(bodies, markers, joints, gravity=scene%multibody%gravity, &
@@ -222,6 +229,7 @@ contains
         end if
         call check_rank(scene, sys, q0, [character(len=80) :: labels, frame_labels], status)
         if (present(joint_labels)) joint_labels = [character(len=80) :: labels, frame_labels]
+        if (present(joint_names)) joint_names = names
 
     contains
 

@@ -35,6 +35,9 @@ module flexmbs_run_plan
         character(len=:), allocatable :: assembly
         !> the positions in y (block 'q'), all of y when there is none
         integer :: q_first = 0, q_last = 0
+        !> a multibody scene: per joint of the system, 'joints/NAME' or
+        !> 'drivers/NAME'
+        character(len=:), allocatable :: joint_names(:)
     contains
         procedure :: integrate => plan_integrate
     end type run_plan_t
@@ -52,7 +55,7 @@ contains
         class(linear_solver_t), allocatable :: linear_solver
         integer :: i
         call build_problem(scene, plan%problem, plan%y0, plan%blocks, status, &
-                           plan%mechanical, plan%assembly)
+                           plan%mechanical, plan%assembly, plan%joint_names)
         if (.not. status%ok()) return
         plan%q_first = 1
         plan%q_last = size(plan%y0)

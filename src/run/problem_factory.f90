@@ -54,7 +54,8 @@ contains
     !> its mechanical problem in `mechanical`, which the formulation in
     !> `problem` points to: it must stay in place while `problem` is used.
     !> Its y = (q, v, λ) is the layout MEXAX integrates.
-    subroutine build_problem(scene, problem, y0, blocks, status, mechanical, assembly)
+    subroutine build_problem(scene, problem, y0, blocks, status, mechanical, assembly, &
+                             joint_names)
         type(scene_input_t), intent(in) :: scene
         class(dae_problem_t), allocatable, intent(out) :: problem
         real(wp), allocatable, intent(out) :: y0(:)
@@ -63,7 +64,10 @@ contains
         class(mechanical_problem_t), allocatable, target, intent(inout), optional :: mechanical
         !> a multibody scene: how far the initial assembly moved each body
         character(len=:), allocatable, intent(out), optional :: assembly
-        character(len=:), allocatable :: labels(:), moves
+        !> a multibody scene: per joint of the system, its group and name
+        !> ('joints/NAME', 'drivers/NAME'; run/multibody_builder)
+        character(len=:), allocatable, intent(out), optional :: joint_names(:)
+        character(len=:), allocatable :: labels(:), moves, names(:)
         type(robertson_t) :: robertson
         type(pendulum_t) :: pendulum
         type(reaction_diffusion_t) :: bruss
@@ -147,7 +151,8 @@ contains
             massless = .false.
             select type (sys => mechanical)
             type is (mbs_system_t)
-                call build_multibody(scene, sys, q0, v0, status, labels)
+                call build_multibody(scene, sys, q0, v0, status, labels, names)
+                if (present(joint_names) .and. allocated(names)) joint_names = names
                 massless = size(sys%frames) > 0
             end select
             if (.not. status%ok()) return

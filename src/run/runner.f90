@@ -27,6 +27,7 @@ module flexmbs_run_runner
     use flexmbs_run_problem_factory, only: block_spec_t
     use flexmbs_run_plan, only: run_plan_t, make_plan, scene_stab
     use flexmbs_run_monitor_sink, only: monitor_sink_t
+    use flexmbs_run_named_output, only: add_named_output
     use flexmbs_run_body_builder, only: body_energies
     implicit none
     private
@@ -141,6 +142,8 @@ contains
                                   plan%blocks(i)%last, status)
                 if (.not. status%ok()) return
             end do
+            call add_named_output(h5, plan, scene, status)
+            if (.not. status%ok()) return
             call h5%write_text('problem', trim(scene%problem), status)
             if (status%ok()) call h5%write_text('title', trim(scene%title), status)
             if (status%ok()) call h5%write_text('input_file', scene%path, status)

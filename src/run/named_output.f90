@@ -1,0 +1,184 @@
+!> The named part of a multibody scene's HDF5 file: series beside /y that
+!> say what the numbers are, so that a reader needs no index arithmetic.
+!>
+!>   /bodies/<name>/position          (3)  m      the body's reference point
+!>   /bodies/<name>/orientation       (4)  1      unit quaternion (p0, p1, p2, p3)
+!>   /bodies/<name>/rotation_matrix   (9)  1      R, column by column (body to world)
+!>   /bodies/<name>/velocity          (3)  m/s
+!>   /bodies/<name>/angular_velocity  (3)  rad/s  in the world frame (R ω')
+!>   /joints/<name>/reaction_force    (3)  N      exerted by the joint on the body
+!>   /joints/<name>/reaction_torque   (3)  N m    of marker i, world frame, about
+!>                                                 the marker (also /drivers/<name>/)
+!>   /joints/<name>/reaction_force_j, reaction_torque_j: the same on marker j's body
+!>
+!> Python: `f['bodies/crank/position'][:, 2]` is the crank's z at every
+!> record of /time (h5py shows the series as records × rows).
+module flexmbs_run_named_output
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t
+    use flexmbs_mbs_rotation, only: rotation_matrix
+    use flexmbs_mbs_rigid_body, only: rigid_body_nq, rigid_body_nv
+    use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_mbs_formulation, only: formulation_t
+    use flexmbs_io_namelist, only: scene_input_t
+    use flexmbs_io_record_values, only: record_values_t
+    use flexmbs_io_hdf5_sink, only: hdf5_sink_t
+    use flexmbs_run_plan, only: run_plan_t
+    implicit none
+    private
+
+    integer, parameter :: body_position = 1, body_orientation = 2, body_rotation = 3, &
+        body_velocity = 4, body_angular_velocity = 5
+
+    !> A quantity of rigid body whose (r, p) start after y(iq), (ṙ, ω') after y(iv).
+    type, extends(record_values_t) :: body_values_t
+        integer :: what = 0, iq = 0, iv = 0
+    contains
+        procedure :: evaluate => body_evaluate
+    end type body_values_t
+
+    !> The reaction of joint `joint` of the system on the body of marker i
+    !> (side 1) or j (side 2): force (torque = .false.) or torque.
+    type, extends(record_values_t) :: reaction_values_t
+        type(mbs_system_t), pointer :: system => null()
+        integer :: joint = 0, side = 1, oq = 0, ol = 0
+        logical :: torque = .false.
+    contains
+        procedure :: evaluate => reaction_evaluate
+    end type reaction_values_t
+
+    public :: add_named_output
+
+contains
+
+    !> The named series of a multibody plan (module header); nothing for
+    !> other problems. Call before the first record.
+    subroutine add_named_output(h5, plan, scene, status)
+        type(hdf5_sink_t), intent(inout) :: h5
+        type(run_plan_t), intent(in), target :: plan
+        type(scene_input_t), intent(in) :: scene
+        type(status_t), intent(out) :: status
+        type(body_values_t) :: body
+        type(reaction_values_t) :: reaction
+        character(len=:), allocatable :: base
+        integer :: i, k
+        if (.not. allocated(plan%mechanical)) return
+        select type (sys => plan%mechanical)
+        type is (mbs_system_t)
+            select type (f => plan%problem)
+            type is (formulation_t)
+                do i = 1, size(scene%rigid_bodies)
+                    base = 'bodies/' // path_name(scene%rigid_bodies(i)%name) // '/'
+                    body%iq = f%oq + rigid_body_nq * (i - 1)
+                    body%iv = f%ov + rigid_body_nv * (i - 1)
+                    call add_body(body_position, 'position', 3, 'm', 'the body''s &
+                        &reference point (its centre of mass)')
+                    call add_body(body_orientation, 'orientation', 4, '1', 'unit quaternion &
+                        &(p0, p1, p2, p3) of the rotation body -> world')
+                    call add_body(body_rotation, 'rotation_matrix', 9, '1', 'R (body -> &
+                        &world), column by column: R(:,1), R(:,2), R(:,3)')
+                    call add_body(body_velocity, 'velocity', 3, 'm/s', 'of the reference point')
+                    call add_body(body_angular_velocity, 'angular_velocity', 3, 'rad/s', &
+                        'in the world frame')
+                    if (.not. status%ok()) return
+                end do
+                if (.not. allocated(plan%joint_names) .or. f%nc == 0) return
+                reaction%system => sys
+                reaction%oq = f%oq
+                reaction%ol = f%ol
+                do k = 1, min(size(plan%joint_names), size(sys%joints))
+                    reaction%joint = k
+                    base = group_path(plan%joint_names(k)) // '/'
+                    call add_reaction(1, .false., 'reaction_force', 'N', 'marker i')
+                    call add_reaction(1, .true., 'reaction_torque', 'N m', 'marker i')
+                    call add_reaction(2, .false., 'reaction_force_j', 'N', 'marker j')
+                    call add_reaction(2, .true., 'reaction_torque_j', 'N m', 'marker j')
+                    if (.not. status%ok()) return
+                end do
+            end select
+        end select
+
+    contains
+
+        subroutine add_body(what, name, rows, unit, description)
+            integer, intent(in) :: what, rows
+            character(len=*), intent(in) :: name, unit, description
+            if (.not. status%ok()) return
+            body%what = what
+            call h5%add_series(base // name, rows, unit, body, status, description)
+        end subroutine add_body
+
+        subroutine add_reaction(side, torque, name, unit, marker)
+            integer, intent(in) :: side
+            logical, intent(in) :: torque
+            character(len=*), intent(in) :: name, unit, marker
+            character(len=:), allocatable :: description
+            if (.not. status%ok()) return
+            reaction%side = side
+            reaction%torque = torque
+            description = 'exerted by the joint on the body of its ' // marker // ', world frame'
+            if (torque) description = description // ', about the marker'
+            call h5%add_series(base // name, 3, unit, reaction, status, description)
+        end subroutine add_reaction
+    end subroutine add_named_output
+
+    subroutine body_evaluate(self, t, y, values, status)
+        class(body_values_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: r(3, 3)
+        select case (self%what)
+        case (body_position)
+            values = y(self%iq + 1:self%iq + 3)
+        case (body_orientation)
+            values = y(self%iq + 4:self%iq + 7)
+        case (body_rotation)
+            r = rotation_matrix(y(self%iq + 4:self%iq + 7))
+            values = reshape(r, [9])
+        case (body_velocity)
+            values = y(self%iv + 1:self%iv + 3)
+        case (body_angular_velocity)
+            r = rotation_matrix(y(self%iq + 4:self%iq + 7))
+            values = matmul(r, y(self%iv + 4:self%iv + 6))
+        end select
+    end subroutine body_evaluate
+
+    subroutine reaction_evaluate(self, t, y, values, status)
+        class(reaction_values_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: force(3, 2), torque(3, 2)
+        associate (sys => self%system)
+            call sys%joint_reaction(self%joint, t, y(self%oq + 1:self%oq + sys%nq), &
+                                    y(self%ol + 1:self%ol + sys%nc), force, torque)
+        end associate
+        if (self%torque) then
+            values = torque(:, self%side)
+        else
+            values = force(:, self%side)
+        end if
+    end subroutine reaction_evaluate
+
+    !> A scene name as one HDF5 path component ('/' would open a group).
+    pure function path_name(name) result(part)
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable :: part
+        integer :: i
+        part = trim(name)
+        do i = 1, len(part)
+            if (part(i:i) == '/') part(i:i) = '_'
+        end do
+        if (part == '.' .or. len(part) == 0) part = '_' // part
+    end function path_name
+
+    !> 'joints/NAME' with NAME made one path component.
+    pure function group_path(joint_name) result(path)
+        character(len=*), intent(in) :: joint_name
+        character(len=:), allocatable :: path
+        integer :: slash
+        slash = index(joint_name, '/')
+        path = joint_name(1:slash) // path_name(joint_name(slash + 1:))
+    end function group_path
+end module flexmbs_run_named_output

@@ -1,0 +1,110 @@
+#!/usr/bin/env python3
+"""The named part of a multibody result (run/named_output) against /y.
+
+    python3 test/result_names.py RESULT.h5
+
+Every series under /bodies, /joints and /drivers has a `unit` and one row
+per record of /time. Each body's position and orientation are the
+7 coordinates (r, p) of one body in /q, its velocity and body-fixed angular
+velocity the matching 6 of /v (found, not assumed); the rotation matrix is
+that of the quaternion and orthogonal (up to |p|^2); the world angular velocity is
+R ω'; every joint's and driver's reaction force and torque on the body of
+marker i are among the per-joint columns of /reactions. Prints `pass` or
+`FAIL` lines and `N passed, M failed` last.
+"""
+import sys
+
+import h5py
+import numpy as np
+
+passed = failed = 0
+
+
+def report(name, problem):
+    global passed, failed
+    if problem:
+        failed += 1
+        print('FAIL result_names/%s: %s' % (name, problem))
+    else:
+        passed += 1
+        print('pass result_names/%s' % name)
+
+
+def rotation(p):
+    p0, e = p[0], p[1:]
+    skew = np.array([[0, -e[2], e[1]], [e[2], 0, -e[0]], [-e[1], e[0], 0]])
+    return (p0 * p0 - e @ e) * np.eye(3) + 2 * np.outer(e, e) + 2 * p0 * skew
+
+
+f = h5py.File(sys.argv[1], 'r')
+name = sys.argv[1].rsplit('/', 1)[-1]
+if f.attrs.get('problem') != 'multibody':
+    print('result_names: %s is not a multibody result: nothing named to check' % name)
+    print('0 passed, 0 failed')
+    sys.exit(0)
+records = len(f['time'])
+q, v = f['q'][:], f['v'][:]
+problems = []
+
+
+def series(group):
+    out = []
+    if group in f:
+        f[group].visititems(lambda n, o: out.append(group + '/' + n)
+                            if isinstance(o, h5py.Dataset) else None)
+    return out
+
+
+for path in series('bodies') + series('joints') + series('drivers'):
+    d = f[path]
+    if not isinstance(d.attrs.get('unit'), str):
+        problems.append('%s has no unit (a UTF-8 string)' % path)
+    if d.shape[0] != records:
+        problems.append('%s has %d records, /time %d' % (path, d.shape[0], records))
+report(name + '/units-and-records', '; '.join(problems[:5]))
+
+bodies = sorted(f['bodies']) if 'bodies' in f else []
+problems = []
+for body in bodies:
+    g = f['bodies'][body]
+    pose = np.hstack([g['position'][:], g['orientation'][:]])
+    at = [k for k in range(0, q.shape[1] - 6, 7) if np.array_equal(q[:, k:k + 7], pose)]
+    if len(at) != 1:
+        problems.append('%s: (position, orientation) is not one body of /q' % body)
+        continue
+    i = at[0] // 7
+    vel = np.hstack([g['velocity'][:], np.zeros((records, 3))])
+    omega_body = v[:, 6 * i + 3:6 * i + 6]
+    if not np.array_equal(v[:, 6 * i:6 * i + 3], g['velocity'][:]):
+        problems.append('%s: velocity is not /v of body %d' % (body, i + 1))
+    for k in range(records):
+        r = rotation(pose[k, 3:])
+        stored = g['rotation_matrix'][k].reshape(3, 3, order='F')
+        # R of a quaternion p is |p|^2 times a rotation (|p| drifts with the
+        # tolerance unless the run projects)
+        norm2 = pose[k, 3:] @ pose[k, 3:]
+        if np.max(np.abs(stored - r)) > 1e-12 or \
+                np.max(np.abs(r.T @ r - norm2 ** 2 * np.eye(3))) > 1e-12:
+            problems.append('%s: rotation_matrix at record %d' % (body, k))
+            break
+        if np.max(np.abs(g['angular_velocity'][k] - r @ omega_body[k])) > \
+                1e-12 * (1 + np.max(np.abs(omega_body[k]))):
+            problems.append('%s: angular_velocity at record %d is not R w\'' % (body, k))
+            break
+report(name + '/bodies-match-y (%d bodies)' % len(bodies), '; '.join(problems[:5]))
+
+problems = []
+joints = [p.rsplit('/', 1)[0] for p in series('joints') + series('drivers')
+          if p.endswith('/reaction_force')]
+if joints:
+    reactions = f['reactions'][:]
+    columns = [reactions[:, c:c + 6] for c in range(0, reactions.shape[1], 12)]
+    for joint in joints:
+        mine = np.hstack([f[joint + '/reaction_force'][:], f[joint + '/reaction_torque'][:]])
+        scale = 1 + np.max(np.abs(mine))
+        if not any(np.max(np.abs(c - mine)) <= 1e-9 * scale for c in columns):
+            problems.append('%s: reaction not among /reactions' % joint)
+report(name + '/reactions-match (%d joints and drivers)' % len(joints), '; '.join(problems[:5]))
+
+print('%d passed, %d failed' % (passed, failed))
+sys.exit(1 if failed else 0)
