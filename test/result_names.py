@@ -9,7 +9,9 @@ per record of /time. Each body's position and orientation are the
 velocity the matching 6 of /v (found, not assumed); the rotation matrix is
 that of the quaternion and orthogonal (up to |p|^2); the world angular velocity is
 R ω'; every joint's and driver's reaction force and torque on the body of
-marker i are among the per-joint columns of /reactions. Prints `pass` or
+marker i are among the per-joint columns of /reactions; each flexible
+body's reference nodes plus displacements, over the nodes that move, are
+one slice of /q, its node velocities one of /v. Prints `pass` or
 `FAIL` lines and `N passed, M failed` last.
 """
 import sys
@@ -38,8 +40,8 @@ def rotation(p):
 
 f = h5py.File(sys.argv[1], 'r')
 name = sys.argv[1].rsplit('/', 1)[-1]
-if f.attrs.get('problem') != 'multibody':
-    print('result_names: %s is not a multibody result: nothing named to check' % name)
+if f.attrs.get('problem') not in ('multibody', 'flexible_body'):
+    print('result_names: %s has no bodies: nothing named to check' % name)
     print('0 passed, 0 failed')
     sys.exit(0)
 records = len(f['time'])
@@ -55,7 +57,8 @@ def series(group):
     return out
 
 
-for path in series('bodies') + series('joints') + series('drivers'):
+for path in series('bodies') + series('joints') + series('drivers') + \
+        [p for p in series('flexible') if p.endswith(('/displacement', '/velocity'))]:
     d = f[path]
     if not isinstance(d.attrs.get('unit'), str):
         problems.append('%s has no unit (a UTF-8 string)' % path)
@@ -105,6 +108,32 @@ if joints:
         if not any(np.max(np.abs(c - mine)) <= 1e-9 * scale for c in columns):
             problems.append('%s: reaction not among /reactions' % joint)
 report(name + '/reactions-match (%d joints and drivers)' % len(joints), '; '.join(problems[:5]))
+
+problems = []
+flexible = sorted(f['flexible']) if 'flexible' in f else []
+for body in flexible:
+    g = f['flexible'][body]
+    x0 = g['reference_nodes'][:]                      # (nodes, 3)
+    u = g['displacement'][:]                          # (records, nodes, 3)
+    if u.shape[1:] != x0.shape or g['velocity'].shape != u.shape:
+        problems.append('%s: shapes %s, %s' % (body, x0.shape, u.shape))
+        continue
+    conn = g['connectivity'][:]
+    if conn.min() < 1 or conn.max() > x0.shape[0]:
+        problems.append('%s: connectivity outside nodes 1..%d' % (body, x0.shape[0]))
+    # the free coordinates, node by node, are one slice of /q (fixed nodes
+    # do not move: displacement 0)
+    moving = np.any(u != 0, axis=0).reshape(-1)
+    x = (x0[None, :, :] + u).reshape(records, -1)[:, moving]
+    m = x.shape[1]
+    at = [k for k in range(q.shape[1] - m + 1) if np.array_equal(q[:, k:k + m], x)]
+    if len(at) != 1:
+        problems.append('%s: the moving nodes\' positions are not one slice of /q' % body)
+        continue
+    vel = g['velocity'][:].reshape(records, -1)[:, moving]
+    if not any(np.array_equal(v[:, k:k + m], vel) for k in range(v.shape[1] - m + 1)):
+        problems.append('%s: the nodes\' velocities are not one slice of /v' % body)
+report(name + '/flexible-match-y (%d bodies)' % len(flexible), '; '.join(problems[:5]))
 
 print('%d passed, %d failed' % (passed, failed))
 sys.exit(1 if failed else 0)

@@ -47,7 +47,7 @@ module flexmbs_io_hdf5_sink
     !> A series computed from each record (add_series).
     type :: series_t
         character(len=:), allocatable :: path
-        integer :: rows = 0
+        integer :: rows = 0, columns = 1
         integer(hid_t) :: dset = -1
         class(record_values_t), allocatable :: source
         real(wp), allocatable :: buffer(:)  !! one record's values
@@ -75,6 +75,9 @@ module flexmbs_io_hdf5_sink
         procedure :: write_text => sink_write_text
         procedure :: write_statistics => sink_write_statistics
         procedure :: write_matrix => sink_write_matrix
+        procedure :: write_integer_matrix => sink_write_integers
+        procedure :: write_integer_list => sink_write_integer_list
+        generic :: write_integers => write_integer_matrix, write_integer_list
         procedure :: close => sink_close
     end type hdf5_sink_t
 
@@ -216,13 +219,16 @@ contains
     !> created as needed, e.g. 'bodies/crank/position'), computed from each
     !> record by `source`, with the string attributes `unit` (SI) and, when
     !> given, `description`. Call before the first record.
-    subroutine sink_add_series(self, path, rows, unit, source, status, description)
+    subroutine sink_add_series(self, path, rows, unit, source, status, description, columns)
         class(hdf5_sink_t), intent(inout) :: self
         character(len=*), intent(in) :: path, unit
         integer, intent(in) :: rows
         class(record_values_t), intent(in) :: source
         type(status_t), intent(out) :: status
         character(len=*), intent(in), optional :: description
+        !> a (rows, columns) matrix per record, e.g. (3, nodes): the dataset
+        !> is (rows, columns, records); the source gives rows x columns values
+        integer, intent(in), optional :: columns
         type(series_t), allocatable :: grown(:)
         integer :: err, k
         if (.not. self%is_open .or. self%records > 0 .or. rows < 1) then
@@ -239,10 +245,13 @@ contains
         associate (s => self%series(k))
             s%path = path
             s%rows = rows
+            s%columns = 1
+            if (present(columns)) s%columns = max(columns, 1)
             allocate (s%source, source=source)
-            allocate (s%buffer(rows))
-            call create_series(self%file, path, rows, &
-                max(1, min(time_chunk, chunk_bytes / (8 * rows))), s%dset, err, groups=.true.)
+            allocate (s%buffer(rows * s%columns))
+            call create_series(self%file, path, rows, max(1, min(time_chunk, &
+                chunk_bytes / (8 * rows * s%columns))), s%dset, err, groups=.true., &
+                columns=s%columns)
             if (err >= 0) call write_string_attribute(s%dset, 'unit', unit, err)
             if (err >= 0 .and. present(description)) &
                 call write_string_attribute(s%dset, 'description', description, err)
@@ -311,6 +320,7 @@ contains
         type(series_t), intent(out) :: to
         call move_alloc(from%path, to%path)
         to%rows = from%rows
+        to%columns = from%columns
         to%dset = from%dset
         call move_alloc(from%source, to%source)
         call move_alloc(from%buffer, to%buffer)
@@ -371,27 +381,82 @@ contains
         if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
     end subroutine sink_write_text
 
-    !> A 2-D real dataset /name (rows, columns), e.g. the monitor table.
+    !> A 2-D real dataset /name (rows, columns), e.g. the monitor table
+    !> (groups of a path created as needed).
     subroutine sink_write_matrix(self, name, values, status)
         class(hdf5_sink_t), intent(inout) :: self
         character(len=*), intent(in) :: name
         real(wp), intent(in) :: values(:, :)
         type(status_t), intent(out) :: status
-        integer(hid_t) :: space, dset
+        integer(hid_t) :: space, dset, lcpl
         integer(hsize_t) :: dims(2)
-        integer :: err
+        integer :: err, close_err
         if (.not. self%is_open) then
             call status%set(status_bad_input, 'HDF5 sink: write_matrix before create')
             return
         end if
         dims = shape(values, kind=hsize_t)
         call h5screate_simple_f(2, dims, space, err)
-        if (err >= 0) call h5dcreate_f(self%file, name, H5T_NATIVE_DOUBLE, space, dset, err)
+        if (err >= 0) call group_creating(lcpl, err)
+        if (err >= 0) call h5dcreate_f(self%file, name, H5T_NATIVE_DOUBLE, space, dset, err, &
+                                       lcpl_id=lcpl)
         if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, err)
         if (err >= 0) call h5dclose_f(dset, err)
         if (err >= 0) call h5sclose_f(space, err)
+        call h5pclose_f(lcpl, close_err)
         if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
     end subroutine sink_write_matrix
+
+    !> A 2-D integer dataset /name (rows, columns), e.g. a connectivity
+    !> (groups of a path created as needed).
+    subroutine sink_write_integers(self, name, values, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: values(:, :)
+        type(status_t), intent(out) :: status
+        integer(hid_t) :: space, dset, lcpl
+        integer(hsize_t) :: dims(2)
+        integer :: err, close_err
+        if (.not. self%is_open) then
+            call status%set(status_bad_input, 'HDF5 sink: write_integers before create')
+            return
+        end if
+        dims = shape(values, kind=hsize_t)
+        call h5screate_simple_f(2, dims, space, err)
+        if (err >= 0) call group_creating(lcpl, err)
+        if (err >= 0) call h5dcreate_f(self%file, name, H5T_NATIVE_INTEGER, space, dset, err, &
+                                       lcpl_id=lcpl)
+        if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_INTEGER, values, dims, err)
+        if (err >= 0) call h5dclose_f(dset, err)
+        if (err >= 0) call h5sclose_f(space, err)
+        call h5pclose_f(lcpl, close_err)
+        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
+    end subroutine sink_write_integers
+
+    !> A 1-D integer dataset /name, e.g. a node set.
+    subroutine sink_write_integer_list(self, name, values, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: values(:)
+        type(status_t), intent(out) :: status
+        integer(hid_t) :: space, dset, lcpl
+        integer(hsize_t) :: dims(1)
+        integer :: err, close_err
+        if (.not. self%is_open) then
+            call status%set(status_bad_input, 'HDF5 sink: write_integers before create')
+            return
+        end if
+        dims = size(values, kind=hsize_t)
+        call h5screate_simple_f(1, dims, space, err)
+        if (err >= 0) call group_creating(lcpl, err)
+        if (err >= 0) call h5dcreate_f(self%file, name, H5T_NATIVE_INTEGER, space, dset, err, &
+                                       lcpl_id=lcpl)
+        if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_INTEGER, values, dims, err)
+        if (err >= 0) call h5dclose_f(dset, err)
+        if (err >= 0) call h5sclose_f(space, err)
+        call h5pclose_f(lcpl, close_err)
+        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
+    end subroutine sink_write_integer_list
 
     !> Store the statistics (and optionally solver name and outcome) as
     !> attributes of '/'; call after the integration, before `close`.
@@ -621,7 +686,7 @@ contains
             associate (sr => self%series(i))
                 call sr%source%evaluate(t, y, sr%buffer, status)
                 if (.not. status%ok()) return
-                call write_column(sr%dset, sr%rows, self%records, sr%buffer, err)
+                call write_column(sr%dset, sr%rows, self%records, sr%buffer, err, sr%columns)
             end associate
         end do
         if (err >= 0) call write_column(self%time_dset, 0, self%records, [t], err)
@@ -634,26 +699,34 @@ contains
     end subroutine append
 
     !> An empty extendible dataset: (0) for m = 0, else (m, 0), chunked.
-    subroutine create_series(file, name, m, per_chunk, dset, err, groups)
+    subroutine create_series(file, name, m, per_chunk, dset, err, groups, columns)
         integer(hid_t), intent(in) :: file
         character(len=*), intent(in) :: name
         integer, intent(in) :: m, per_chunk
         integer(hid_t), intent(out) :: dset
         integer, intent(out) :: err
         logical, intent(in), optional :: groups !! create the groups of a path
+        integer, intent(in), optional :: columns !! > 1: (m, columns, records)
         integer(hid_t) :: space, plist, lcpl
-        integer(hsize_t) :: dims(2), maxdims(2), chunk(2)
-        integer :: rank, close_err
+        integer(hsize_t) :: dims(3), maxdims(3), chunk(3)
+        integer :: rank, close_err, nc
+        nc = 1
+        if (present(columns)) nc = columns
         if (m == 0) then
             rank = 1
             dims(1) = 0
             maxdims(1) = H5S_UNLIMITED_F
             chunk(1) = int(per_chunk, hsize_t)
+        else if (nc > 1) then
+            rank = 3
+            dims = [int(m, hsize_t), int(nc, hsize_t), 0_hsize_t]
+            maxdims = [int(m, hsize_t), int(nc, hsize_t), H5S_UNLIMITED_F]
+            chunk = [int(m, hsize_t), int(nc, hsize_t), int(per_chunk, hsize_t)]
         else
             rank = 2
-            dims = [int(m, hsize_t), 0_hsize_t]
-            maxdims = [int(m, hsize_t), H5S_UNLIMITED_F]
-            chunk = [int(m, hsize_t), int(per_chunk, hsize_t)]
+            dims(1:2) = [int(m, hsize_t), 0_hsize_t]
+            maxdims(1:2) = [int(m, hsize_t), H5S_UNLIMITED_F]
+            chunk(1:2) = [int(m, hsize_t), int(per_chunk, hsize_t)]
         end if
         dset = -1
         call h5screate_simple_f(rank, dims(1:rank), space, err, maxdims(1:rank))
@@ -672,24 +745,32 @@ contains
     end subroutine create_series
 
     !> Extend a series by one record at position `k` (0-based) and write it.
-    subroutine write_column(dset, m, k, values, err)
+    subroutine write_column(dset, m, k, values, err, columns)
         integer(hid_t), intent(in) :: dset
         integer, intent(in) :: m, k  !! m = 0 for the 1-D /time
         real(wp), intent(in) :: values(:)
         integer, intent(out) :: err
+        integer, intent(in), optional :: columns !! > 1: a (m, columns) record
         integer(hid_t) :: filespace, memspace
-        integer(hsize_t) :: size_new(2), offset(2), count(2)
-        integer :: rank
+        integer(hsize_t) :: size_new(3), offset(3), count(3)
+        integer :: rank, nc
+        nc = 1
+        if (present(columns)) nc = columns
         if (m == 0) then
             rank = 1
             size_new(1) = int(k + 1, hsize_t)
             offset(1) = int(k, hsize_t)
             count(1) = 1
+        else if (nc > 1) then
+            rank = 3
+            size_new = [int(m, hsize_t), int(nc, hsize_t), int(k + 1, hsize_t)]
+            offset = [0_hsize_t, 0_hsize_t, int(k, hsize_t)]
+            count = [int(m, hsize_t), int(nc, hsize_t), 1_hsize_t]
         else
             rank = 2
-            size_new = [int(m, hsize_t), int(k + 1, hsize_t)]
-            offset = [0_hsize_t, int(k, hsize_t)]
-            count = [int(m, hsize_t), 1_hsize_t]
+            size_new(1:2) = [int(m, hsize_t), int(k + 1, hsize_t)]
+            offset(1:2) = [0_hsize_t, int(k, hsize_t)]
+            count(1:2) = [int(m, hsize_t), 1_hsize_t]
         end if
         call h5dset_extent_f(dset, size_new(1:rank), err)
         if (err < 0) return

@@ -11,14 +11,21 @@
 !>                                                 the marker (also /drivers/<name>/)
 !>   /joints/<name>/reaction_force_j, reaction_torque_j: the same on marker j's body
 !>
+!>   /flexible/<name>/reference_nodes (3, nodes) m; connectivity (nodes of an
+!>                                  element, attribute element_type); node_sets/<set>
+!>   /flexible/<name>/displacement    (3, nodes) m    x - X of every node
+!>   /flexible/<name>/velocity        (3, nodes) m/s
+!>
 !> Python: `f['bodies/crank/position'][:, 2]` is the crank's z at every
-!> record of /time (h5py shows the series as records × rows).
+!> record of /time (h5py shows the series as records × rows), and
+!> `f['flexible/coupler/displacement'][:, k - 1, 0]` node k's x displacement.
 module flexmbs_run_named_output
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t
     use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_mbs_rigid_body, only: rigid_body_nq, rigid_body_nv
     use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_io_namelist, only: scene_input_t
     use flexmbs_io_record_values, only: record_values_t
@@ -47,6 +54,16 @@ module flexmbs_run_named_output
         procedure :: evaluate => reaction_evaluate
     end type reaction_values_t
 
+    !> Displacements (or velocities) of every node of a flexible body whose
+    !> free q start after y(oq), v after y(ov).
+    type, extends(record_values_t) :: node_values_t
+        type(flexible_body_t), pointer :: body => null()
+        integer :: oq = 0, ov = 0
+        logical :: velocity = .false.
+    contains
+        procedure :: evaluate => node_evaluate
+    end type node_values_t
+
     public :: add_named_output
 
 contains
@@ -64,6 +81,9 @@ contains
         integer :: i, k
         if (.not. allocated(plan%mechanical)) return
         select type (sys => plan%mechanical)
+        type is (flexible_body_t)
+            call add_standalone(sys)
+            return
         type is (mbs_system_t)
             select type (f => plan%problem)
             type is (formulation_t)
@@ -80,6 +100,11 @@ contains
                     call add_body(body_velocity, 'velocity', 3, 'm/s', 'of the reference point')
                     call add_body(body_angular_velocity, 'angular_velocity', 3, 'rad/s', &
                         'in the world frame')
+                    if (.not. status%ok()) return
+                end do
+                do i = 1, size(sys%flex)
+                    call add_flexible(h5, sys%flex(i), scene%body%name, f%oq + sys%flex_q(i), &
+                                      f%ov + sys%flex_v(i), status)
                     if (.not. status%ok()) return
                 end do
                 if (.not. allocated(plan%joint_names) .or. f%nc == 0) return
@@ -99,6 +124,15 @@ contains
         end select
 
     contains
+
+        !> A flexible body alone: its formulation's y = (q, v[, λ]).
+        subroutine add_standalone(b)
+            type(flexible_body_t), intent(in), target :: b
+            select type (f => plan%problem)
+            type is (formulation_t)
+                call add_flexible(h5, b, scene%body%name, f%oq, f%ov, status)
+            end select
+        end subroutine add_standalone
 
         subroutine add_body(what, name, rows, unit, description)
             integer, intent(in) :: what, rows
@@ -121,6 +155,73 @@ contains
             call h5%add_series(base // name, 3, unit, reaction, status, description)
         end subroutine add_reaction
     end subroutine add_named_output
+
+    !> /flexible/<name>/: the mesh (reference nodes, connectivity, element
+    !> type, node sets) and every node's displacement and velocity per
+    !> record, (3, nodes, records): node k of the mesh file is index k - 1
+    !> in Python, f['flexible/coupler/displacement'][:, k - 1, 0] its x.
+    subroutine add_flexible(h5, body, name, oq, ov, status)
+        type(hdf5_sink_t), intent(inout) :: h5
+        type(flexible_body_t), intent(in), target :: body
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: oq, ov  !! the body's free q and v start after y(oq), y(ov)
+        type(status_t), intent(out) :: status
+        type(node_values_t) :: nodes
+        character(len=:), allocatable :: base
+        integer :: k, nn
+        base = 'flexible/' // path_name(name) // '/'
+        nn = body%mesh%node_count()
+        call h5%write_matrix(base // 'reference_nodes', body%mesh%x, status)
+        if (status%ok()) call h5%annotate(base // 'reference_nodes', 'unit', 'm', status)
+        if (status%ok()) call h5%write_integers(base // 'connectivity', &
+                                                body%mesh%connectivity, status)
+        if (status%ok()) call h5%annotate(base // 'connectivity', 'description', 'the nodes &
+            &of each element (numbered from 1, as in the mesh file)', status)
+        if (status%ok()) call h5%annotate(base // 'connectivity', 'element_type', &
+            element_type(body%mesh%nnode_element), status)
+        if (allocated(body%mesh%node_sets)) then
+            do k = 1, size(body%mesh%node_sets)
+                if (.not. status%ok()) exit
+                associate (set => body%mesh%node_sets(k))
+                    call h5%write_integers(base // 'node_sets/' // path_name(set%name), &
+                                           set%nodes, status)
+                end associate
+            end do
+        end if
+        if (.not. status%ok()) return
+        nodes%body => body
+        nodes%oq = oq
+        nodes%ov = ov
+        nodes%velocity = .false.
+        call h5%add_series(base // 'displacement', 3, 'm', nodes, status, 'x - X of every &
+            &node (fixed ones 0), world frame', columns=nn)
+        if (.not. status%ok()) return
+        nodes%velocity = .true.
+        call h5%add_series(base // 'velocity', 3, 'm/s', nodes, status, 'of every node', &
+            columns=nn)
+    end subroutine add_flexible
+
+    subroutine node_evaluate(self, t, y, values, status)
+        class(node_values_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        integer :: i, j, d
+        associate (dof => self%body%dof)
+            do i = 1, size(dof, 2)
+                do j = 1, 3
+                    d = dof(j, i)
+                    if (d == 0) then
+                        values(3 * (i - 1) + j) = 0.0_wp
+                    else if (self%velocity) then
+                        values(3 * (i - 1) + j) = y(self%ov + d)
+                    else
+                        values(3 * (i - 1) + j) = y(self%oq + d) - self%body%mesh%x(j, i)
+                    end if
+                end do
+            end do
+        end associate
+    end subroutine node_evaluate
 
     subroutine body_evaluate(self, t, y, values, status)
         class(body_values_t), intent(inout) :: self
@@ -160,6 +261,13 @@ contains
             values = force(:, self%side)
         end if
     end subroutine reaction_evaluate
+
+    pure function element_type(nodes) result(name)
+        integer, intent(in) :: nodes
+        character(len=:), allocatable :: name
+        name = 'hex27'
+        if (nodes == 8) name = 'hex8'
+    end function element_type
 
     !> A scene name as one HDF5 path component ('/' would open a group).
     pure function path_name(name) result(part)
