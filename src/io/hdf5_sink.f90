@@ -23,8 +23,9 @@ module flexmbs_io_hdf5_sink
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_core_version, only: creator
     use flexmbs_io_record_values, only: record_values_t
-    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_char, c_null_char, c_null_ptr, &
-        c_associated, c_f_pointer, c_size_t, c_int
+    use flexmbs_io_hdf5_text, only: read_string_attribute, write_string_attribute, &
+        string_type, utf8_string_type, group_creating, delete_attribute
+    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_char, c_null_char
     implicit none
     private
 
@@ -84,17 +85,57 @@ module flexmbs_io_hdf5_sink
     logical, save :: library_open = .false.
 
     interface
-        !> The length of a C string (a variable-length HDF5 string read back).
-        pure integer(c_size_t) function c_strlen(s) bind(C, name='strlen')
-            import :: c_ptr, c_size_t
-            type(c_ptr), value, intent(in) :: s
-        end function c_strlen
-        !> Memory the HDF5 library allocated (a variable-length string read).
-        integer(c_int) function h5_free_memory(buffer) bind(C, name='H5free_memory')
-            import :: c_ptr, c_int
-            type(c_ptr), value, intent(in) :: buffer
-        end function h5_free_memory
+        !> Store a text as a string attribute of '/' (a scalar string dataset
+        !> when it is too large for an attribute), replacing an earlier one.
+        module subroutine sink_write_text(self, name, text, status)
+            class(hdf5_sink_t), intent(inout) :: self
+            character(len=*), intent(in) :: name, text
+            type(status_t), intent(out) :: status
+        end subroutine sink_write_text
+
+        !> A 2-D real dataset /name (rows, columns), e.g. the monitor table
+        !> (groups of a path created as needed).
+        module subroutine sink_write_matrix(self, name, values, status)
+            class(hdf5_sink_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            real(wp), intent(in) :: values(:, :)
+            type(status_t), intent(out) :: status
+        end subroutine sink_write_matrix
+
+        !> A 2-D integer dataset /name (rows, columns), e.g. a connectivity
+        !> (groups of a path created as needed).
+        module subroutine sink_write_integers(self, name, values, status)
+            class(hdf5_sink_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            integer, intent(in) :: values(:, :)
+            type(status_t), intent(out) :: status
+        end subroutine sink_write_integers
+
+        !> A 1-D integer dataset /name, e.g. a node set.
+        module subroutine sink_write_integer_list(self, name, values, status)
+            class(hdf5_sink_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            integer, intent(in) :: values(:)
+            type(status_t), intent(out) :: status
+        end subroutine sink_write_integer_list
+
+        !> A 1-D dataset of UTF-8 strings (variable length: h5py reads str) at
+        !> `path`, e.g. the label of every component of /y.
+        module subroutine sink_write_strings(self, path, strings, status)
+            class(hdf5_sink_t), intent(inout) :: self
+            character(len=*), intent(in) :: path
+            character(len=*), intent(in) :: strings(:)
+            type(status_t), intent(out) :: status
+        end subroutine sink_write_strings
+
+        !> A string attribute `name` = `text` of the dataset or group at `path`.
+        module subroutine sink_annotate(self, path, name, text, status)
+            class(hdf5_sink_t), intent(inout) :: self
+            character(len=*), intent(in) :: path, name, text
+            type(status_t), intent(out) :: status
+        end subroutine sink_annotate
     end interface
+
 
 contains
 
@@ -260,59 +301,7 @@ contains
                                      path)
     end subroutine sink_add_series
 
-    !> A 1-D dataset of UTF-8 strings (variable length: h5py reads str) at
-    !> `path`, e.g. the label of every component of /y.
-    subroutine sink_write_strings(self, path, strings, status)
-        class(hdf5_sink_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        character(len=*), intent(in) :: strings(:)
-        type(status_t), intent(out) :: status
-        character(kind=c_char, len=len(strings) + 1), allocatable, target :: text(:)
-        type(c_ptr), allocatable, target :: pointers(:)
-        integer(hid_t) :: str_type, space, dset, lcpl
-        integer(hsize_t) :: dims(1)
-        integer :: err, k, close_err
-        if (.not. self%is_open) then
-            call status%set(status_bad_input, 'HDF5 sink: write_strings before create')
-            return
-        end if
-        allocate (text(size(strings)), pointers(size(strings)))
-        do k = 1, size(strings)
-            text(k) = trim(strings(k)) // c_null_char
-            pointers(k) = c_loc(text(k)(1:1))
-        end do
-        dims = size(strings, kind=hsize_t)
-        call utf8_string_type(str_type, err)
-        if (err >= 0) call h5screate_simple_f(1, dims, space, err)
-        if (err >= 0) call group_creating(lcpl, err)
-        if (err >= 0) call h5dcreate_f(self%file, path, str_type, space, dset, err, &
-                                       lcpl_id=lcpl)
-        if (err >= 0) then
-            if (size(strings) > 0) call h5dwrite_f(dset, str_type, c_loc(pointers(1)), err)
-            call h5dclose_f(dset, close_err)
-        end if
-        call h5pclose_f(lcpl, close_err)
-        call h5sclose_f(space, close_err)
-        call h5tclose_f(str_type, close_err)
-        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write /' // &
-                                     path)
-    end subroutine sink_write_strings
 
-    !> A string attribute `name` = `text` of the dataset or group at `path`.
-    subroutine sink_annotate(self, path, name, text, status)
-        class(hdf5_sink_t), intent(inout) :: self
-        character(len=*), intent(in) :: path, name, text
-        type(status_t), intent(out) :: status
-        integer(hid_t) :: obj
-        integer :: err, close_err
-        call h5oopen_f(self%file, path, obj, err)
-        if (err >= 0) then
-            call write_string_attribute(obj, name, text, err)
-            call h5oclose_f(obj, close_err)
-        end if
-        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot annotate /' &
-                                     // path)
-    end subroutine sink_annotate
 
     !> Move a series (its source is polymorphic: no intrinsic assignment).
     subroutine move_series(from, to)
@@ -326,21 +315,7 @@ contains
         call move_alloc(from%buffer, to%buffer)
     end subroutine move_series
 
-    !> A link-creation property list that creates missing groups of a path.
-    subroutine group_creating(lcpl, err)
-        integer(hid_t), intent(out) :: lcpl
-        integer, intent(out) :: err
-        call h5pcreate_f(H5P_LINK_CREATE_F, lcpl, err)
-        if (err >= 0) call h5pset_create_inter_group_f(lcpl, 1, err)
-    end subroutine group_creating
 
-    !> Variable-length UTF-8 strings.
-    subroutine utf8_string_type(str_type, err)
-        integer(hid_t), intent(out) :: str_type
-        integer, intent(out) :: err
-        call h5tcopy_f(H5T_STRING, str_type, err)
-        if (err >= 0) call h5tset_cset_f(str_type, H5T_CSET_UTF8_F, err)
-    end subroutine utf8_string_type
 
     !> Flush what is written; the file stays open for the statistics.
     subroutine sink_finish(self, status)
@@ -353,110 +328,9 @@ contains
             call status%set(status_io_error, self%path // ': HDF5 cannot flush')
     end subroutine sink_finish
 
-    !> Store a text as a string attribute of '/' (a scalar string dataset
-    !> when it is too large for an attribute), replacing an earlier one.
-    subroutine sink_write_text(self, name, text, status)
-        class(hdf5_sink_t), intent(inout) :: self
-        character(len=*), intent(in) :: name, text
-        type(status_t), intent(out) :: status
-        integer(hid_t) :: str_type, space, dset
-        integer :: err
-        if (.not. self%is_open) then
-            call status%set(status_bad_input, 'HDF5 sink: write_text before create')
-            return
-        end if
-        if (len(text) <= max_attribute_text) then
-            call write_string_attribute(self%file, name, text, err)
-        else
-            call string_type(len(text), str_type, err)
-            if (err >= 0) call h5screate_f(H5S_SCALAR_F, space, err)
-            if (err >= 0) call h5dcreate_f(self%file, name, str_type, space, dset, err)
-            if (err >= 0) call h5dwrite_f(dset, str_type, text, [1_hsize_t], err)
-            if (err >= 0) call h5dclose_f(dset, err)
-            if (err >= 0) call h5sclose_f(space, err)
-            if (err >= 0) call h5tclose_f(str_type, err)
-            if (err >= 0) call write_string_attribute(self%file, name, &
-                'stored in dataset /' // name, err)
-        end if
-        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
-    end subroutine sink_write_text
 
-    !> A 2-D real dataset /name (rows, columns), e.g. the monitor table
-    !> (groups of a path created as needed).
-    subroutine sink_write_matrix(self, name, values, status)
-        class(hdf5_sink_t), intent(inout) :: self
-        character(len=*), intent(in) :: name
-        real(wp), intent(in) :: values(:, :)
-        type(status_t), intent(out) :: status
-        integer(hid_t) :: space, dset, lcpl
-        integer(hsize_t) :: dims(2)
-        integer :: err, close_err
-        if (.not. self%is_open) then
-            call status%set(status_bad_input, 'HDF5 sink: write_matrix before create')
-            return
-        end if
-        dims = shape(values, kind=hsize_t)
-        call h5screate_simple_f(2, dims, space, err)
-        if (err >= 0) call group_creating(lcpl, err)
-        if (err >= 0) call h5dcreate_f(self%file, name, H5T_NATIVE_DOUBLE, space, dset, err, &
-                                       lcpl_id=lcpl)
-        if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, err)
-        if (err >= 0) call h5dclose_f(dset, err)
-        if (err >= 0) call h5sclose_f(space, err)
-        call h5pclose_f(lcpl, close_err)
-        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
-    end subroutine sink_write_matrix
 
-    !> A 2-D integer dataset /name (rows, columns), e.g. a connectivity
-    !> (groups of a path created as needed).
-    subroutine sink_write_integers(self, name, values, status)
-        class(hdf5_sink_t), intent(inout) :: self
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: values(:, :)
-        type(status_t), intent(out) :: status
-        integer(hid_t) :: space, dset, lcpl
-        integer(hsize_t) :: dims(2)
-        integer :: err, close_err
-        if (.not. self%is_open) then
-            call status%set(status_bad_input, 'HDF5 sink: write_integers before create')
-            return
-        end if
-        dims = shape(values, kind=hsize_t)
-        call h5screate_simple_f(2, dims, space, err)
-        if (err >= 0) call group_creating(lcpl, err)
-        if (err >= 0) call h5dcreate_f(self%file, name, H5T_NATIVE_INTEGER, space, dset, err, &
-                                       lcpl_id=lcpl)
-        if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_INTEGER, values, dims, err)
-        if (err >= 0) call h5dclose_f(dset, err)
-        if (err >= 0) call h5sclose_f(space, err)
-        call h5pclose_f(lcpl, close_err)
-        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
-    end subroutine sink_write_integers
 
-    !> A 1-D integer dataset /name, e.g. a node set.
-    subroutine sink_write_integer_list(self, name, values, status)
-        class(hdf5_sink_t), intent(inout) :: self
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: values(:)
-        type(status_t), intent(out) :: status
-        integer(hid_t) :: space, dset, lcpl
-        integer(hsize_t) :: dims(1)
-        integer :: err, close_err
-        if (.not. self%is_open) then
-            call status%set(status_bad_input, 'HDF5 sink: write_integers before create')
-            return
-        end if
-        dims = size(values, kind=hsize_t)
-        call h5screate_simple_f(1, dims, space, err)
-        if (err >= 0) call group_creating(lcpl, err)
-        if (err >= 0) call h5dcreate_f(self%file, name, H5T_NATIVE_INTEGER, space, dset, err, &
-                                       lcpl_id=lcpl)
-        if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_INTEGER, values, dims, err)
-        if (err >= 0) call h5dclose_f(dset, err)
-        if (err >= 0) call h5sclose_f(space, err)
-        call h5pclose_f(lcpl, close_err)
-        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
-    end subroutine sink_write_integer_list
 
     !> Store the statistics (and optionally solver name and outcome) as
     !> attributes of '/'; call after the integration, before `close`.
@@ -595,68 +469,6 @@ contains
 
     ! ------------------------------------------------------------------
 
-    !> The text of a scalar string attribute of `obj`: variable-length (as
-    !> flexmbs writes them) or fixed-length (files of earlier versions).
-    subroutine read_string_attribute(obj, name, text, err)
-        integer(hid_t), intent(in) :: obj
-        character(len=*), intent(in) :: name
-        character(len=:), allocatable, intent(out) :: text
-        integer, intent(out) :: err
-        integer(hid_t) :: attr, file_type, mem_type
-        integer(size_t) :: length
-        integer :: close_err, stat
-        logical :: variable
-        text = ''
-        call h5aopen_f(obj, name, attr, err)
-        if (err < 0) return
-        call h5aget_type_f(attr, file_type, err)
-        if (err >= 0) call h5tis_variable_str_f(file_type, variable, err)
-        if (err >= 0 .and. variable) then
-            call read_variable(err)
-        else if (err >= 0) then
-            call h5tget_size_f(file_type, length, err)
-            if (err >= 0) call string_type(int(length), mem_type, err)
-            if (err >= 0) then
-                ! the length is the file's word: a damaged one is a failed read
-                deallocate (text)
-                allocate (character(len=max(int(length), 1)) :: text, stat=stat)
-                if (stat /= 0) err = -1
-                if (err >= 0) call h5aread_f(attr, mem_type, text, [1_hsize_t], err)
-                call h5tclose_f(mem_type, close_err)
-                if (err >= 0) text = trim(text)
-            end if
-        end if
-        if (err < 0) text = ''
-        call h5tclose_f(file_type, close_err)
-        call h5aclose_f(attr, close_err)
-
-    contains
-
-        subroutine read_variable(err)
-            integer, intent(inout) :: err
-            type(c_ptr), target :: pointer(1)
-            type(c_ptr) :: buffer
-            character(kind=c_char), pointer :: chars(:)
-            integer :: n
-            call utf8_string_type(mem_type, err)
-            if (err < 0) return
-            pointer(1) = c_null_ptr
-            buffer = c_loc(pointer(1))
-            call h5aread_f(attr, mem_type, buffer, err)
-            call h5tclose_f(mem_type, close_err)
-            if (err < 0 .or. .not. c_associated(pointer(1))) return
-            n = int(c_strlen(pointer(1)))
-            call c_f_pointer(pointer(1), chars, [max(n, 1)])
-            deallocate (text)
-            allocate (character(len=n) :: text, stat=stat)
-            if (stat == 0) then
-                text = transfer(chars(1:n), text)
-            else
-                err = -1
-            end if
-            close_err = int(h5_free_memory(pointer(1)))
-        end subroutine read_variable
-    end subroutine read_string_attribute
 
     !> Append one record: /y and the blocks first, /time last, then flush.
     subroutine append(self, t, y, status)
@@ -787,51 +599,8 @@ contains
         call h5sclose_f(filespace, err)
     end subroutine write_column
 
-    !> A fixed-length string type of `n` characters (at least 1).
-    subroutine string_type(n, str_type, err)
-        integer, intent(in) :: n
-        integer(hid_t), intent(out) :: str_type
-        integer, intent(out) :: err
-        call h5tcopy_f(H5T_FORTRAN_S1, str_type, err)
-        if (err >= 0) call h5tset_size_f(str_type, int(max(n, 1), size_t), err)
-    end subroutine string_type
 
-    !> A scalar string attribute, variable-length UTF-8 (h5py reads a str),
-    !> replacing one of that name.
-    subroutine write_string_attribute(obj, name, text, err)
-        integer(hid_t), intent(in) :: obj
-        character(len=*), intent(in) :: name, text
-        integer, intent(out) :: err
-        integer(hid_t) :: str_type, space, attr
-        character(kind=c_char, len=len(text) + 1), target :: buf
-        type(c_ptr), target :: pointer(1)
-        integer :: close_err
-        buf = text // c_null_char
-        pointer(1) = c_loc(buf(1:1))
-        call delete_attribute(obj, name, err)
-        if (err < 0) return
-        call utf8_string_type(str_type, err)
-        if (err < 0) return
-        call h5screate_f(H5S_SCALAR_F, space, err)
-        if (err >= 0) then
-            call h5acreate_f(obj, name, str_type, space, attr, err)
-            if (err >= 0) then
-                call h5awrite_f(attr, str_type, c_loc(pointer(1)), err)
-                call h5aclose_f(attr, close_err)
-            end if
-            call h5sclose_f(space, close_err)
-        end if
-        call h5tclose_f(str_type, close_err)
-    end subroutine write_string_attribute
 
-    subroutine delete_attribute(obj, name, err)
-        integer(hid_t), intent(in) :: obj
-        character(len=*), intent(in) :: name
-        integer, intent(out) :: err
-        logical :: exists
-        call h5aexists_f(obj, name, exists, err)
-        if (err >= 0 .and. exists) call h5adelete_f(obj, name, err)
-    end subroutine delete_attribute
 
     !> Initialise the Fortran HDF5 library once and silence its own error
     !> printing: every failure is reported through status_t instead.
