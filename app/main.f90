@@ -191,7 +191,7 @@ contains
         character(len=:), allocatable :: log
         call read_study(path, study, status)
         if (.not. status%ok()) call stop_on(status)
-        call make_reference(study, version, quiet, log, status, force)
+        call make_reference(study, quiet, log, status, force)
         if (.not. status%ok()) call stop_on(status)
         write (output_unit, '(a)', advance='no') log
         call finish(exit_ok)

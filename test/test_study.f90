@@ -114,7 +114,7 @@ contains
         call read_study(dir // 'fb.nml', study, status)
         call check(error, status%ok(), 'study: ' // status%text())
         if (allocated(error)) return
-        call make_reference(study, 'test', .true., log, status)
+        call make_reference(study, .true., log, status)
         call check(error, status%ok(), 'reference: ' // status%text())
         if (allocated(error)) return
         print '(a)', '    ' // log(1:index(log, nl) - 1)
@@ -203,7 +203,7 @@ contains
         call read_study('inputs/paper/five_body_quick.nml', study, status)
         call check(error, status%ok(), 'study: ' // status%text())
         if (allocated(error)) return
-        call make_reference(study, 'test', .true., log, status)
+        call make_reference(study, .true., log, status)
         call check(error, status%ok(), 'reference: ' // status%text())
         if (allocated(error)) return
         call run_sweep(study, .true., runs, status)

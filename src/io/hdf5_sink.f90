@@ -7,8 +7,9 @@
 !>   /<path>         (m, steps)     optional named series computed from each
 !>                                  record (add_series: /bodies/<name>/position
 !>                                  ...), with a `unit` attribute
-!>   attributes on / creator ('flexmbs 0.1.0'), input_text, solver, outcome,
-!>                   NST ... NPRJ, CPU, WALL, t_reached
+!>   attributes on / creator ('flexmbs 0.1.0'), flexmbs_version, created (ISO
+!>                   8601), input_text, solver, outcome, NST ... NPRJ, CPU,
+!>                   WALL, t_reached
 !> Each record is written and the file flushed at once, so a run that
 !> fails or is interrupted leaves a file that opens without repair; the
 !> number of complete records is the length of /time (written last).
@@ -21,7 +22,7 @@ module flexmbs_io_hdf5_sink
     use flexmbs_core_status, only: status_t, status_io_error, status_bad_input
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_stats, only: dae_stats_t
-    use flexmbs_core_version, only: creator
+    use flexmbs_core_version, only: creator, version
     use flexmbs_io_record_values, only: record_values_t
     use flexmbs_io_hdf5_text, only: read_string_attribute, write_string_attribute, &
         string_type, utf8_string_type, group_creating, delete_attribute
@@ -174,7 +175,9 @@ contains
         call create_series(self%file, 'y', n, per_chunk, self%y_dset, err)
         if (check(err, 'create /y')) return
         call write_string_attribute(self%file, 'creator', creator, err)
-        if (check(err, 'write the attribute creator')) return
+        if (err >= 0) call write_string_attribute(self%file, 'flexmbs_version', version, err)
+        if (err >= 0) call write_string_attribute(self%file, 'created', now(), err)
+        if (check(err, 'write the attributes creator, flexmbs_version, created')) return
         if (present(input_text)) then
             call self%write_text('input_text', input_text, status)
             if (.not. status%ok()) return
@@ -191,6 +194,18 @@ contains
             if (check) call status%set(status_io_error, path // ': HDF5 cannot ' // what)
         end function check
     end subroutine sink_create
+
+    !> The local date and time in ISO 8601 with the offset from UTC
+    !> (2026-11-26T11:08:53+00:00).
+    function now() result(text)
+        character(len=:), allocatable :: text
+        character(len=8) :: date
+        character(len=10) :: time
+        character(len=5) :: zone
+        call date_and_time(date, time, zone)
+        text = date(1:4) // '-' // date(5:6) // '-' // date(7:8) // 'T' // time(1:2) // ':' // &
+            time(3:4) // ':' // time(5:6) // zone(1:3) // ':' // zone(4:5)
+    end function now
 
     !> Also write y(first:last) as dataset /name (call before the first record).
     subroutine sink_add_block(self, name, first, last, status)

@@ -4,8 +4,8 @@
 !> = `reference_tolerance`, kept at the scene's output times in an HDF5
 !> trajectory file (/time, /y, /q) with its provenance: the study and scene
 !> files, the solver and tolerance, the cross-check (a second solver at
-!> `check_tolerance` and the ERR between the two), the flexmbs version and the
-!> date (text datasets).
+!> `check_tolerance` and the ERR between the two), and, as every result file,
+!> the flexmbs version and the date (attributes).
 !>
 !> A sweep runs the grid solvers × stabilisations × tolerances × p_max
 !> (DDASSL only) × derivative sources (multibody scenes only), each at
@@ -149,9 +149,8 @@ contains
 
     !> The reference of a study (module header); `log` gets one line per
     !> run. Nothing is written unless both runs succeed.
-    subroutine make_reference(study, version, quiet, log, status, force)
+    subroutine make_reference(study, quiet, log, status, force)
         type(study_input_t), intent(in) :: study
-        character(len=*), intent(in) :: version   !! flexmbs version, for the provenance
         logical, intent(in) :: quiet
         character(len=:), allocatable, intent(out) :: log
         type(status_t), intent(out) :: status
@@ -163,8 +162,6 @@ contains
         type(hdf5_sink_t) :: h5
         type(status_t) :: close_status
         character(len=:), allocatable :: check_text
-        character(len=8) :: date
-        character(len=10) :: time
         real(wp) :: err
         integer :: k
         character, parameter :: nl = new_line('a')
@@ -206,16 +203,12 @@ contains
             if (.not. status%ok()) exit
             call h5%output(rec%t(k), rec%y(:, k), status)
         end do
-        call date_and_time(date, time)
         if (status%ok()) call h5%write_text('study_file', study%path, status)
         if (status%ok()) call h5%write_text('scene_file', study%scene, status)
         if (status%ok()) call h5%write_text('reference_solver', ref%solver_name, status)
         if (status%ok()) call h5%write_text('reference_tolerance', &
                                             real_text(study%reference_tolerance), status)
         if (status%ok()) call h5%write_text('check', check_text, status)
-        if (status%ok()) call h5%write_text('flexmbs_version', version, status)
-        if (status%ok()) call h5%write_text('created', date(1:4) // '-' // date(5:6) // '-' // &
-            date(7:8) // ' ' // time(1:2) // ':' // time(3:4) // ':' // time(5:6), status)
         if (status%ok()) call h5%write_statistics(ref%stats, status, ref%solver_name, 'ok')
         call h5%close(close_status)
         if (status%ok()) status = close_status
