@@ -7,7 +7,8 @@
 !>   flexmbs sweep STUDY.nml --merge          the table from the records there
 !>   flexmbs sweep STUDY.nml --slurm [--chunk K] [--partition P] [--time T] [--mem M] [--submit]
 !>                                            a Slurm job array and merge job for the study
-!>   flexmbs columns FILE.h5 K [K ...]           t and y(K) of a trajectory as text
+!>   flexmbs columns FILE.h5 COLUMN [COLUMN ...]  t and columns of a result as text
+!>                                        (COLUMN: a number of /y, or rocker/position/z ...)
 !>   flexmbs --help | --version
 !>
 !> Exit codes: 0 success, 2 bad input (nothing written), 3 solver failure
@@ -32,6 +33,7 @@ program flexmbs_main
     use flexmbs_io_namelist, only: study_input_t, read_study
     use flexmbs_run_study, only: make_reference, run_sweep, run_sweep_point, sweep_run_t, &
         read_reference, prepare_points
+    use flexmbs_io_result_columns, only: read_column
     use flexmbs_run_study_grid, only: array_task_count
     use flexmbs_run_study_merge, only: merged_t, merge_records, merge_report
     use flexmbs_run_study_slurm, only: slurm_options_t, check_slurm_options, &
@@ -373,33 +375,35 @@ contains
         if (len(path) == 0) path = argument(0)
     end function this_program
 
-    !> `columns FILE.h5 K...`: t and the components K of y at every record
-    !> of a trajectory file, as text columns (for plots).
+
+    !> `columns FILE.h5 COLUMN...`: t and each column at every record of a
+    !> result, as text (for plots). A column is a component number of /y or
+    !> a name: rocker/position/z, motor/reaction_torque/z, coupler/node 23/x
+    !> (io/result_columns).
     subroutine columns()
         type(status_t) :: status
-        real(wp), allocatable :: t(:), y(:, :)
-        integer, allocatable :: k(:)
-        integer :: i, j, ios
-        character(len=:), allocatable :: value
-        if (nargs < 3) call fail_usage('columns needs a trajectory file and component numbers')
-        allocate (k(nargs - 2))
-        do i = 3, nargs
-            value = argument(i)
-            read (value, *, iostat=ios) k(i - 2)
-            if (ios /= 0) call fail_usage('columns: ''' // value // ''' is not a component &
-                &number')
-        end do
+        real(wp), allocatable :: t(:), values(:, :), column(:)
+        real(wp), allocatable :: y(:, :)
+        integer :: i, j
+        if (nargs < 3) call fail_usage('columns needs a result file and columns (numbers of &
+            &/y or names such as ''rocker/position/z'')')
         call read_reference(argument(2), t, y, status)
         if (.not. status%ok()) call stop_on(status)
-        do i = 1, size(k)
-            if (k(i) < 1 .or. k(i) > size(y, 1)) then
-                call status%set(status_bad_input, argument(2) // ': component ' // &
-                    argument(i + 2) // ' outside 1 .. ' // int_text(size(y, 1)))
+        deallocate (y)
+        allocate (values(size(t), nargs - 2))
+        do i = 3, nargs
+            call read_column(argument(2), argument(i), column, status)
+            if (.not. status%ok()) call stop_on(status)
+            if (size(column) < size(t)) then
+                call status%set(status_io_error, argument(2) // ': column ''' // argument(i) &
+                    // ''' has ' // int_text(size(column)) // ' records, /time ' // &
+                    int_text(size(t)))
                 call stop_on(status)
             end if
+            values(:, i - 2) = column(1:size(t))
         end do
         do j = 1, size(t)
-            write (output_unit, '(*(es24.15e3))') t(j), (y(k(i), j), i=1, size(k))
+            write (output_unit, '(*(es24.15e3))') t(j), values(j, :)
         end do
         call finish(exit_ok)
     end subroutine columns
@@ -543,8 +547,12 @@ contains
             '                                          results folder; --submit submits both', &
             '                                          (the merge after the array), else the', &
             '                                          sbatch commands are shown', &
-            '  flexmbs columns FILE.h5 K [K ...]       t and components K of y of a', &
-            '                                          trajectory, as text columns', &
+            '  flexmbs columns FILE.h5 COLUMN [COLUMN ...]', &
+            '                                          t and the columns of a result, as text:', &
+            '                                          K (component K of /y), BODY/QUANTITY/', &
+            '                                          COMPONENT (''rocker/position/z'',', &
+            '                                          ''motor/reaction_torque/z''), or a node', &
+            '                                          (''coupler/node 23/x'', ''.../velocity/x'')', &
             '  flexmbs --help                          show this text', &
             '  flexmbs --version                       show the version', &
             '', &

@@ -5,8 +5,9 @@
 # divide-by-zero and invalid on purpose; linalg/lapack keeps the flags, and
 # app/ reports only invalid, divide-by-zero and overflow; a non-finite
 # value in a model or solver is a solver failure, exit 3, anyway). Then the
-# named series of every multibody result (/bodies, /joints, /drivers)
-# are checked against its /y (test/result_names.py).
+# named series of every multibody result (/bodies, /joints, /drivers,
+# /flexible) are checked against its /y, and `flexmbs columns` by name
+# against them (test/result_names.py).
 #
 #   bash test/examples.sh [path/to/flexmbs]
 #
@@ -53,7 +54,8 @@ for h5 in *.h5; do
             pass\ *) pass "${line#pass result_names/}" ;;
             FAIL\ *) fail "${line#FAIL result_names/}" "" ;;
         esac
-    done < <("$py" "$root/test/result_names.py" "$h5" 2>&1 || echo "FAIL $h5: result_names.py failed")
+    done < <("$py" "$root/test/result_names.py" "$h5" "$exe" 2>&1 ||
+             echo "FAIL $h5: result_names.py failed")
 done
 
 echo "${passed} passed, ${failed} failed"

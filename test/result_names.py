@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The named part of a multibody result (run/named_output) against /y.
 
-    python3 test/result_names.py RESULT.h5
+    python3 test/result_names.py RESULT.h5 [FLEXMBS]
 
 Every series under /bodies, /joints and /drivers has a `unit` and one row
 per record of /time. Each body's position and orientation are the
@@ -11,7 +11,9 @@ that of the quaternion and orthogonal (up to |p|^2); the world angular velocity 
 R ω'; every joint's and driver's reaction force and torque on the body of
 marker i are among the per-joint columns of /reactions; each flexible
 body's reference nodes plus displacements, over the nodes that move, are
-one slice of /q, its node velocities one of /v. Prints `pass` or
+one slice of /q, its node velocities one of /v. With FLEXMBS, `flexmbs
+columns` by name (BODY/position/z, JOINT/reaction_force/x, BODY/node N/x
+and .../velocity/y) prints the same numbers as the datasets. Prints `pass` or
 `FAIL` lines and `N passed, M failed` last.
 """
 import sys
@@ -134,6 +136,38 @@ for body in flexible:
     if not any(np.array_equal(v[:, k:k + m], vel) for k in range(v.shape[1] - m + 1)):
         problems.append('%s: the nodes\' velocities are not one slice of /v' % body)
 report(name + '/flexible-match-y (%d bodies)' % len(flexible), '; '.join(problems[:5]))
+
+if len(sys.argv) > 2:
+    import subprocess
+    names, expected = [], []
+    for body in bodies[:2]:
+        names.append(body + '/position/z')
+        expected.append(f['bodies'][body]['position'][:, 2])
+    for joint in joints[:2]:
+        names.append(joint.split('/', 1)[1] + '/reaction_force/x')
+        expected.append(f[joint + '/reaction_force'][:, 0])
+    for body in flexible[:1]:
+        g = f['flexible'][body]
+        n = g['reference_nodes'].shape[0]
+        names += ['%s/node %d/x' % (body, n), '%s/node 1/velocity/y' % body]
+        expected += [g['reference_nodes'][n - 1, 0] + g['displacement'][:, n - 1, 0],
+                     g['velocity'][:, 0, 1]]
+    run = subprocess.run([sys.argv[2], 'columns', sys.argv[1]] + names,
+                         capture_output=True, text=True)
+    problem = ''
+    if run.returncode != 0:
+        problem = 'exit %d: %s' % (run.returncode, run.stderr.strip())
+    else:
+        table = np.loadtxt(run.stdout.splitlines(), ndmin=2)
+        if table.shape != (records, len(names) + 1):
+            problem = 'shape %s' % (table.shape,)
+        elif np.max(np.abs(table[:, 0] - f['time'][:])) > 1e-14:
+            problem = 'the times differ'
+        else:
+            for k, (column, want) in enumerate(zip(names, expected)):
+                if np.max(np.abs(table[:, k + 1] - want)) > 1e-13 * (1 + np.max(np.abs(want))):
+                    problem += '%s differs; ' % column
+    report(name + '/columns-by-name (%d)' % len(names), problem)
 
 print('%d passed, %d failed' % (passed, failed))
 sys.exit(1 if failed else 0)
