@@ -13,7 +13,10 @@ marker i are among the per-joint columns of /reactions; each flexible
 body's reference nodes plus displacements, over the nodes that move, are
 one slice of /q, its node velocities one of /v. With FLEXMBS, `flexmbs
 columns` by name (BODY/position/z, JOINT/reaction_force/x, BODY/node N/x
-and .../velocity/y) prints the same numbers as the datasets. Prints `pass` or
+and .../velocity/y) prints the same numbers as the datasets. Chain links:
+coordinate and rate are slices of /q and /v, the rotation orthonormal, and
+velocity and angular velocity the time derivatives (central differences)
+of position and rotation. Prints `pass` or
 `FAIL` lines and `N passed, M failed` last.
 """
 import sys
@@ -42,7 +45,7 @@ def rotation(p):
 
 f = h5py.File(sys.argv[1], 'r')
 name = sys.argv[1].rsplit('/', 1)[-1]
-if f.attrs.get('problem') not in ('multibody', 'flexible_body'):
+if f.attrs.get('problem') not in ('multibody', 'flexible_body', 'rigid_chain'):
     print('result_names: %s has no bodies: nothing named to check' % name)
     print('0 passed, 0 failed')
     sys.exit(0)
@@ -59,7 +62,7 @@ def series(group):
     return out
 
 
-for path in series('bodies') + series('joints') + series('drivers') + \
+for path in series('bodies') + series('joints') + series('drivers') + series('chains') + \
         [p for p in series('flexible') if p.endswith(('/displacement', '/velocity'))]:
     d = f[path]
     if not isinstance(d.attrs.get('unit'), str):
@@ -137,6 +140,37 @@ for body in flexible:
         problems.append('%s: the nodes\' velocities are not one slice of /v' % body)
 report(name + '/flexible-match-y (%d bodies)' % len(flexible), '; '.join(problems[:5]))
 
+problems = []
+links = sorted(f['chains']) if 'chains' in f else []
+t = f['time'][:]
+for link in links:
+    g = f['chains'][link]
+    coordinate, rate = g['coordinate'][:], g['rate'][:]
+    m, n = coordinate.shape[1], rate.shape[1]
+    if not any(np.array_equal(q[:, k:k + m], coordinate) for k in range(q.shape[1] - m + 1)):
+        problems.append('%s: coordinate is not a slice of /q' % link)
+    if not any(np.array_equal(v[:, k:k + n], rate) for k in range(v.shape[1] - n + 1)):
+        problems.append('%s: rate is not a slice of /v' % link)
+    r = g['rotation_matrix'][:].reshape(records, 3, 3, order='F')
+    if np.max(np.abs(np.einsum('kij,kil->kjl', r, r) - np.eye(3))) > 1e-12:
+        problems.append('%s: rotation_matrix not orthonormal' % link)
+    # the velocities are the time derivatives of the position and of R:
+    # central differences over the output times, second order accurate
+    x, vel, w = g['position'][:], g['velocity'][:], g['angular_velocity'][:]
+    dt = t[2:] - t[:-2]
+    dx = (x[2:] - x[:-2]) / dt[:, None]
+    dr = (r[2:] - r[:-2]) / dt[:, None, None]
+    w_skew = np.einsum('kij,klj->kil', dr, r[1:-1])          # dR R^T = [w]x
+    w_fd = np.stack([w_skew[:, 2, 1], w_skew[:, 0, 2], w_skew[:, 1, 0]], axis=1)
+    scale_v = 1e-3 + np.max(np.abs(vel))
+    scale_w = 1e-3 + np.max(np.abs(w))
+    if np.max(np.abs(dx - vel[1:-1])) > 2e-2 * scale_v:
+        problems.append('%s: velocity is not dx/dt (%.2e)' % (link, np.max(np.abs(dx - vel[1:-1]))))
+    if np.max(np.abs(w_fd - w[1:-1])) > 2e-2 * scale_w:
+        problems.append('%s: angular_velocity is not from dR/dt (%.2e)'
+                        % (link, np.max(np.abs(w_fd - w[1:-1]))))
+report(name + '/chains-consistent (%d links)' % len(links), '; '.join(problems[:5]))
+
 if len(sys.argv) > 2:
     import subprocess
     names, expected = [], []
@@ -146,6 +180,9 @@ if len(sys.argv) > 2:
     for joint in joints[:2]:
         names.append(joint.split('/', 1)[1] + '/reaction_force/x')
         expected.append(f[joint + '/reaction_force'][:, 0])
+    for link in links[:2]:
+        names.append(link + '/coordinate/1')
+        expected.append(f['chains'][link]['coordinate'][:, 0])
     for body in flexible[:1]:
         g = f['flexible'][body]
         n = g['reference_nodes'].shape[0]

@@ -2,6 +2,7 @@
 !> series of a run (run/named_output) hold, without index arithmetic.
 !>
 !>   rocker/position/z            /bodies/rocker/position, row z (x y z or 1..)
+!>   flail/coordinate/1           /chains/flail/coordinate: its joint's angle
 !>   motor/reaction_torque/z      /joints/... or /drivers/... likewise
 !>   coupler/node 23/x            node 23's x: reference_nodes + displacement
 !>   coupler/node 23/velocity/x   node 23's velocity (displacement likewise)
@@ -16,8 +17,8 @@ module flexmbs_io_result_columns
     private
 
     !> The groups a name's first part is looked up in, in this order.
-    character(len=*), parameter :: groups(4) = [character(len=8) :: 'bodies', 'joints', &
-        'drivers', 'flexible']
+    character(len=*), parameter :: groups(5) = [character(len=8) :: 'bodies', 'chains', &
+        'joints', 'drivers', 'flexible']
 
     public :: read_column
 
@@ -118,8 +119,8 @@ contains
             call link_exists(file, dataset, exists)
             if (exists) return
         end do
-        call status%set(status_bad_input, 'no dataset ' // name // ' under /bodies, /joints, &
-            &/drivers or /flexible')
+        call status%set(status_bad_input, 'no dataset ' // name // ' under /bodies, /chains, &
+            &/joints, /drivers or /flexible')
     end subroutine find_dataset
 
     !> Whether every link of `path` exists (H5Lexists checks the last only).

@@ -11,6 +11,9 @@
 !>                                                 the marker (also /drivers/<name>/)
 !>   /joints/<name>/reaction_force_j, reaction_torque_j: the same on marker j's body
 !>
+!>   /chains/<link>/position, rotation_matrix, velocity, angular_velocity: as
+!>                                  bodies; coordinate, rate: the joint to its
+!>                                  parent (rad or m; a spherical's quaternion)
 !>   /flexible/<name>/reference_nodes (3, nodes) m; connectivity (nodes of an
 !>                                  element, attribute element_type); node_sets/<set>
 !>   /flexible/<name>/displacement    (3, nodes) m    x - X of every node
@@ -26,6 +29,8 @@ module flexmbs_run_named_output
     use flexmbs_mbs_rigid_body, only: rigid_body_nq, rigid_body_nv
     use flexmbs_mbs_system, only: mbs_system_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
+    use flexmbs_mbs_rigid_chain, only: rigid_chain_t, chain_joint_prismatic, &
+        chain_joint_spherical
     use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_io_namelist, only: scene_input_t
     use flexmbs_io_record_values, only: record_values_t
@@ -64,6 +69,19 @@ module flexmbs_run_named_output
         procedure :: evaluate => node_evaluate
     end type node_values_t
 
+    integer, parameter :: link_position = 1, link_rotation = 2, link_velocity = 3, &
+        link_angular_velocity = 4, link_coordinate = 5, link_rate = 6
+
+    !> A quantity of link `link` of a chain whose q start after y(oq), v
+    !> after y(ov). The chain's workspace holds its frames: a pointer to
+    !> the plan's own chain (evaluations recompute them for their q).
+    type, extends(record_values_t) :: link_values_t
+        type(rigid_chain_t), pointer :: chain => null()
+        integer :: what = 0, link = 0, oq = 0, ov = 0
+    contains
+        procedure :: evaluate => link_evaluate
+    end type link_values_t
+
     public :: add_named_output
 
 contains
@@ -84,6 +102,12 @@ contains
         type is (flexible_body_t)
             call add_standalone(sys)
             return
+        type is (rigid_chain_t)
+            select type (f => plan%problem)
+            type is (formulation_t)
+                call add_chain(h5, sys, chain_names(), f%oq, f%ov, status)
+            end select
+            return
         type is (mbs_system_t)
             select type (f => plan%problem)
             type is (formulation_t)
@@ -100,6 +124,11 @@ contains
                     call add_body(body_velocity, 'velocity', 3, 'm/s', 'of the reference point')
                     call add_body(body_angular_velocity, 'angular_velocity', 3, 'rad/s', &
                         'in the world frame')
+                    if (.not. status%ok()) return
+                end do
+                do i = 1, size(sys%chains)
+                    call add_chain(h5, sys%chains(i), chain_names(), f%oq + sys%chain_q(i), &
+                                   f%ov + sys%chain_v(i), status)
                     if (.not. status%ok()) return
                 end do
                 do i = 1, size(sys%flex)
@@ -124,6 +153,12 @@ contains
         end select
 
     contains
+
+        !> The names of the scene's &rigid_chain links, in their order.
+        function chain_names() result(names)
+            character(len=len(scene%chain%name)), allocatable :: names(:)
+            names = scene%chain%name
+        end function chain_names
 
         !> A flexible body alone: its formulation's y = (q, v[, λ]).
         subroutine add_standalone(b)
@@ -222,6 +257,91 @@ contains
             end do
         end associate
     end subroutine node_evaluate
+
+    !> /chains/<link>/: each link of a rigid chain (relative coordinates)
+    !> whose q start after y(oq), v after y(ov); `names` in the chain's order.
+    subroutine add_chain(h5, chain, names, oq, ov, status)
+        type(hdf5_sink_t), intent(inout) :: h5
+        type(rigid_chain_t), intent(in), target :: chain
+        character(len=*), intent(in) :: names(:)
+        integer, intent(in) :: oq, ov
+        type(status_t), intent(out) :: status
+        type(link_values_t) :: link
+        character(len=:), allocatable :: base, unit, rate_unit
+        integer :: i, nc
+        link%chain => chain
+        link%oq = oq
+        link%ov = ov
+        do i = 1, min(size(names), size(chain%bodies))
+            base = 'chains/' // path_name(names(i)) // '/'
+            link%link = i
+            call add_link(link_position, 'position', 3, 'm', 'its centre of mass')
+            call add_link(link_rotation, 'rotation_matrix', 9, '1', 'R (link -> world), &
+                &column by column')
+            call add_link(link_velocity, 'velocity', 3, 'm/s', 'of its centre of mass')
+            call add_link(link_angular_velocity, 'angular_velocity', 3, 'rad/s', &
+                'in the world frame')
+            nc = chain%iq(i + 1) - chain%iq(i)
+            select case (chain%bodies(i)%joint)
+            case (chain_joint_prismatic)
+                unit = 'm'
+                rate_unit = 'm/s'
+            case (chain_joint_spherical)
+                unit = '1'
+                rate_unit = 'rad/s'
+            case default
+                unit = 'rad'
+                rate_unit = 'rad/s'
+            end select
+            call add_link(link_coordinate, 'coordinate', nc, unit, 'of the joint to its &
+                &parent (angle, displacement, or quaternion of a spherical joint)')
+            call add_link(link_rate, 'rate', chain%iv(i + 1) - chain%iv(i), rate_unit, &
+                'of the joint to its parent')
+            if (.not. status%ok()) return
+        end do
+
+    contains
+
+        subroutine add_link(what, name, rows, unit, description)
+            integer, intent(in) :: what, rows
+            character(len=*), intent(in) :: name, unit, description
+            if (.not. status%ok()) return
+            link%what = what
+            call h5%add_series(base // name, rows, unit, link, status, description)
+        end subroutine add_link
+    end subroutine add_chain
+
+    subroutine link_evaluate(self, t, y, values, status)
+        class(link_values_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: o(3), r(3, 3), vc(3), omega(3)
+        associate (chain => self%chain, i => self%link)
+            associate (q => y(self%oq + 1:self%oq + chain%nq), &
+                       v => y(self%ov + 1:self%ov + chain%nv))
+                select case (self%what)
+                case (link_position)
+                    call chain%body_frame(q, i, o, r)
+                    values = o + matmul(r, chain%bodies(i)%centre)
+                case (link_rotation)
+                    call chain%body_frame(q, i, o, r)
+                    values = reshape(r, [9])
+                case (link_velocity, link_angular_velocity)
+                    call chain%body_velocity(q, v, i, vc, omega)
+                    if (self%what == link_velocity) then
+                        values = vc
+                    else
+                        values = omega
+                    end if
+                case (link_coordinate)
+                    values = q(chain%iq(i) + 1:chain%iq(i + 1))
+                case (link_rate)
+                    values = v(chain%iv(i) + 1:chain%iv(i + 1))
+                end select
+            end associate
+        end associate
+    end subroutine link_evaluate
 
     subroutine body_evaluate(self, t, y, values, status)
         class(body_values_t), intent(inout) :: self
