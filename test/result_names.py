@@ -16,7 +16,8 @@ columns` by name (BODY/position/z, JOINT/reaction_force/x, BODY/node N/x
 and .../velocity/y) prints the same numbers as the datasets. Chain links:
 coordinate and rate are slices of /q and /v, the rotation orthonormal, and
 velocity and angular velocity the time derivatives (central differences)
-of position and rotation. Prints `pass` or
+of position and rotation. A revolute joint's angle changes as the body it
+holds to the ground turns. Prints `pass` or
 `FAIL` lines and `N passed, M failed` last.
 """
 import sys
@@ -171,6 +172,25 @@ for link in links:
                         % (link, np.max(np.abs(w_fd - w[1:-1]))))
 report(name + '/chains-consistent (%d links)' % len(links), '; '.join(problems[:5]))
 
+# a revolute joint's angle: a joint to the ground turns its body by the
+# change of the angle (the rotation angle of R(t) R(0)^T, the quaternion's
+# drift aside); at least one such joint and body in a file with angles
+# and no flexible body
+angles = [j for j in joints if j + '/angle' in f]
+matched = []
+for joint in angles:
+    delta = np.abs(f[joint + '/angle'][:, 0] - f[joint + '/angle'][0, 0])
+    for body in bodies:
+        r = f['bodies'][body]['rotation_matrix'][:].reshape(records, 3, 3, order='F')
+        rel = np.einsum('kij,lj->kil', r, r[0])
+        turn = np.arccos(np.clip((np.trace(rel, axis1=1, axis2=2) - 1) / 2, -1, 1))
+        if np.max(np.abs(turn - delta)) <= 1e-3 * np.max(delta) + 1e-7 and np.max(delta) > 0:
+            matched.append(joint)
+            break
+# (a hinge on a flexible body turns with the body's bending: no check there)
+report(name + '/joint-angles (%d of %d turn a body by them)' % (len(matched), len(angles)),
+       '' if not angles or matched or flexible else 'no joint angle is the turn of a body')
+
 if len(sys.argv) > 2:
     import subprocess
     names, expected = [], []
@@ -183,6 +203,9 @@ if len(sys.argv) > 2:
     for link in links[:2]:
         names.append(link + '/coordinate/1')
         expected.append(f['chains'][link]['coordinate'][:, 0])
+    for joint in angles[:1]:
+        names.append(joint.split('/', 1)[1] + '/angle')
+        expected.append(f[joint + '/angle'][:, 0])
     for body in flexible[:1]:
         g = f['flexible'][body]
         n = g['reference_nodes'].shape[0]

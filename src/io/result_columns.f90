@@ -3,6 +3,7 @@
 !>
 !>   rocker/position/z            /bodies/rocker/position, row z (x y z or 1..)
 !>   flail/coordinate/1           /chains/flail/coordinate: its joint's angle
+!>   rocker pivot/angle           /joints/rocker pivot/angle (one row: no component)
 !>   motor/reaction_torque/z      /joints/... or /drivers/... likewise
 !>   coupler/node 23/x            node 23's x: reference_nodes + displacement
 !>   coupler/node 23/velocity/x   node 23's velocity (displacement likewise)
@@ -46,11 +47,11 @@ contains
             call split(name, parts)
             if (size(parts) >= 2 .and. index(parts(min(2, size(parts))), 'node ') == 1) then
                 call node_column(file, parts, values, status)
-            else if (size(parts) == 3) then
+            else if (size(parts) == 3 .or. size(parts) == 2) then
                 call series_column(file, parts, values, status)
             else
-                call status%set(status_bad_input, 'a column is a number of /y or NAME/QUANTITY/&
-                    &COMPONENT (rocker/position/z, motor/reaction_torque/z, coupler/node 23/x)')
+                call status%set(status_bad_input, 'a column is a number of /y or NAME/QUANTITY[/&
+                    &COMPONENT] (rocker/position/z, rocker pivot/angle, coupler/node 23/x)')
             end if
         end if
         call h5fclose_f(file, close_err)
@@ -65,8 +66,11 @@ contains
         real(wp), allocatable, intent(out) :: values(:)
         type(status_t), intent(out) :: status
         character(len=:), allocatable :: dataset
+        integer :: row
+        row = 1   ! NAME/QUANTITY: a series of one row (a joint's angle)
+        if (size(parts) == 3) row = component(parts(3))
         call find_dataset(file, trim(parts(1)) // '/' // trim(parts(2)), dataset, status)
-        if (status%ok()) call read_row(file, dataset, component(parts(3)), values, status)
+        if (status%ok()) call read_row(file, dataset, row, values, status)
     end subroutine series_column
 
     !> BODY/node N/x (position), BODY/node N/displacement/x, .../velocity/x.

@@ -236,6 +236,7 @@ module flexmbs_mbs_system
             system_constraint_curvature_derivatives_sparse
         procedure :: joint_first_row => system_joint_first_row
         procedure :: joint_reaction => system_joint_reaction
+        procedure :: marker_pose => system_marker_pose
         procedure :: energy => system_energy
         procedure :: total_energy => system_total_energy
         procedure :: momenta => system_momenta
@@ -407,6 +408,13 @@ module flexmbs_mbs_system
             integer, intent(in) :: k
             logical, intent(in) :: position_space
         end function marker_columns
+        !> World position x and axes (columns) of marker k at positions q.
+        pure module subroutine system_marker_pose(self, k, q, x, axes)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: k
+            real(wp), intent(in) :: q(:)
+            real(wp), intent(out) :: x(3), axes(3, 3)
+        end subroutine system_marker_pose
         pure module subroutine marker_state(self, k, q, v, m)
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: k

@@ -74,6 +74,13 @@ contains
     end procedure marker_columns
 
     !> Real frame and motion of marker k at (q, v).
+    module procedure system_marker_pose
+        type(marker_state_t) :: m
+        call marker_state(self, k, q, self%zero_v, m)
+        x = m%x
+        axes = m%a
+    end procedure system_marker_pose
+
     module procedure marker_state
         integer :: b, iq, iv
         call marker_offsets(self, k, b, iq, iv)

@@ -10,6 +10,8 @@
 !>   /joints/<name>/reaction_torque   (3)  N m    of marker i, world frame, about
 !>                                                 the marker (also /drivers/<name>/)
 !>   /joints/<name>/reaction_force_j, reaction_torque_j: the same on marker j's body
+!>   /joints/<name>/angle             (1)  rad    revolute, cylindrical: x_j from x_i about z_i
+!>   /joints/<name>/displacement      (1)  m      prismatic, cylindrical: along z_i
 !>
 !>   /chains/<link>/position, rotation_matrix, velocity, angular_velocity: as
 !>                                  bodies; coordinate, rate: the joint to its
@@ -28,6 +30,7 @@ module flexmbs_run_named_output
     use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_mbs_rigid_body, only: rigid_body_nq, rigid_body_nv
     use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_mbs_joint, only: joint_revolute, joint_cylindrical, joint_prismatic
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, chain_joint_prismatic, &
         chain_joint_spherical
@@ -82,6 +85,20 @@ module flexmbs_run_named_output
         procedure :: evaluate => link_evaluate
     end type link_values_t
 
+    !> The coordinate of joint `joint` between its markers: the angle of a
+    !> revolute or cylindrical joint (marker j's x axis from marker i's,
+    !> about marker i's z, continued from record to record), or the
+    !> displacement of a prismatic or cylindrical one along marker i's z.
+    type, extends(record_values_t) :: coordinate_values_t
+        type(mbs_system_t), pointer :: system => null()
+        integer :: joint = 0, oq = 0
+        logical :: angle = .true.
+        logical :: started = .false.
+        real(wp) :: last = 0.0_wp
+    contains
+        procedure :: evaluate => coordinate_evaluate
+    end type coordinate_values_t
+
     public :: add_named_output
 
 contains
@@ -95,6 +112,7 @@ contains
         type(status_t), intent(out) :: status
         type(body_values_t) :: body
         type(reaction_values_t) :: reaction
+        type(coordinate_values_t) :: coordinate
         character(len=:), allocatable :: base
         integer :: i, k
         if (.not. allocated(plan%mechanical)) return
@@ -148,6 +166,7 @@ contains
                     call add_reaction(2, .false., 'reaction_force_j', 'N', 'marker j')
                     call add_reaction(2, .true., 'reaction_torque_j', 'N m', 'marker j')
                     if (.not. status%ok()) return
+                    call add_coordinates(sys%joints(k)%joint%kind)
                 end do
             end select
         end select
@@ -168,6 +187,27 @@ contains
                 call add_flexible(h5, b, scene%body%name, f%oq, f%ov, status)
             end select
         end subroutine add_standalone
+
+        !> angle and/or displacement of joint k of the kinds that have them
+        subroutine add_coordinates(kind)
+            integer, intent(in) :: kind
+            if (.not. status%ok()) return
+            coordinate%system => reaction%system
+            coordinate%joint = k
+            coordinate%oq = reaction%oq
+            if (kind == joint_revolute .or. kind == joint_cylindrical) then
+                coordinate%angle = .true.
+                call h5%add_series(base // 'angle', 1, 'rad', coordinate, status, 'marker &
+                    &j''s x axis from marker i''s, about marker i''s z axis (continued past &
+                    &+-pi)')
+            end if
+            if (.not. status%ok()) return
+            if (kind == joint_prismatic .or. kind == joint_cylindrical) then
+                coordinate%angle = .false.
+                call h5%add_series(base // 'displacement', 1, 'm', coordinate, status, &
+                    'of marker j from marker i along marker i''s z axis')
+            end if
+        end subroutine add_coordinates
 
         subroutine add_body(what, name, rows, unit, description)
             integer, intent(in) :: what, rows
@@ -342,6 +382,31 @@ contains
             end associate
         end associate
     end subroutine link_evaluate
+
+    subroutine coordinate_evaluate(self, t, y, values, status)
+        class(coordinate_values_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        real(wp) :: xi(3), xj(3), ai(3, 3), aj(3, 3), angle, c(3)
+        real(wp), parameter :: two_pi = 8.0_wp * atan(1.0_wp)
+        associate (sys => self%system, jt => self%system%joints(self%joint))
+            call sys%marker_pose(jt%marker_i, y(self%oq + 1:self%oq + sys%nq), xi, ai)
+            call sys%marker_pose(jt%marker_j, y(self%oq + 1:self%oq + sys%nq), xj, aj)
+        end associate
+        if (self%angle) then
+            ! the turn of x_j from x_i about z_i, continued past ±π
+            c = [ai(2, 1) * aj(3, 1) - ai(3, 1) * aj(2, 1), ai(3, 1) * aj(1, 1) - &
+                 ai(1, 1) * aj(3, 1), ai(1, 1) * aj(2, 1) - ai(2, 1) * aj(1, 1)]
+            angle = atan2(dot_product(c, ai(:, 3)), dot_product(ai(:, 1), aj(:, 1)))
+            if (self%started) angle = angle + two_pi * anint((self%last - angle) / two_pi)
+            self%last = angle
+            self%started = .true.
+            values(1) = angle
+        else
+            values(1) = dot_product(xj - xi, ai(:, 3))
+        end if
+    end subroutine coordinate_evaluate
 
     subroutine body_evaluate(self, t, y, values, status)
         class(body_values_t), intent(inout) :: self
