@@ -172,6 +172,15 @@ for link in links:
                         % (link, np.max(np.abs(w_fd - w[1:-1]))))
 report(name + '/chains-consistent (%d links)' % len(links), '; '.join(problems[:5]))
 
+problems = []
+if 'monitor' in f:
+    if 'energy' not in f or not np.array_equal(f['energy'][:], f['monitor'][:, 3]) or \
+            f['energy'].attrs.get('unit') != 'J':
+        problems.append('/energy is not the monitor\'s energy in J')
+    if 'drift' not in f or not np.array_equal(f['drift'][:], f['monitor'][:, 1:3]):
+        problems.append('/drift is not the monitor\'s drift')
+report(name + '/energy-and-drift', '; '.join(problems))
+
 # a revolute joint's angle: a joint to the ground turns its body by the
 # change of the angle (the rotation angle of R(t) R(0)^T, the quaternion's
 # drift aside); at least one such joint and body in a file with angles

@@ -77,6 +77,7 @@ module flexmbs_io_hdf5_sink
         procedure :: write_text => sink_write_text
         procedure :: write_statistics => sink_write_statistics
         procedure :: write_matrix => sink_write_matrix
+        procedure :: write_vector => sink_write_vector
         procedure :: write_integer_matrix => sink_write_integers
         procedure :: write_integer_list => sink_write_integer_list
         generic :: write_integers => write_integer_matrix, write_integer_list
@@ -102,6 +103,14 @@ module flexmbs_io_hdf5_sink
             real(wp), intent(in) :: values(:, :)
             type(status_t), intent(out) :: status
         end subroutine sink_write_matrix
+
+        !> A 1-D real dataset /name, e.g. the energy at each record.
+        module subroutine sink_write_vector(self, name, values, status)
+            class(hdf5_sink_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            real(wp), intent(in) :: values(:)
+            type(status_t), intent(out) :: status
+        end subroutine sink_write_vector
 
         !> A 2-D integer dataset /name (rows, columns), e.g. a connectivity
         !> (groups of a path created as needed).

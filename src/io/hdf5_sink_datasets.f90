@@ -60,6 +60,31 @@ contains
         if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
     end subroutine sink_write_matrix
 
+    !> A 1-D real dataset /name, e.g. the energy at each record.
+    module subroutine sink_write_vector(self, name, values, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        real(wp), intent(in) :: values(:)
+        type(status_t), intent(out) :: status
+        integer(hid_t) :: space, dset, lcpl
+        integer(hsize_t) :: dims(1)
+        integer :: err, close_err
+        if (.not. self%is_open) then
+            call status%set(status_bad_input, 'HDF5 sink: write_vector before create')
+            return
+        end if
+        dims = size(values, kind=hsize_t)
+        call h5screate_simple_f(1, dims, space, err)
+        if (err >= 0) call group_creating(lcpl, err)
+        if (err >= 0) call h5dcreate_f(self%file, name, H5T_NATIVE_DOUBLE, space, dset, err, &
+                                       lcpl_id=lcpl)
+        if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, err)
+        if (err >= 0) call h5dclose_f(dset, err)
+        if (err >= 0) call h5sclose_f(space, err)
+        call h5pclose_f(lcpl, close_err)
+        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
+    end subroutine sink_write_vector
+
     !> A 2-D integer dataset /name (rows, columns), e.g. a connectivity
     !> (groups of a path created as needed).
     module subroutine sink_write_integers(self, name, values, status)

@@ -195,6 +195,19 @@ contains
                 call h5%write_matrix('monitor', monitor%table(:, 1:monitor%records), io_status)
                 if (io_status%ok()) call h5%write_text('monitor_columns', &
                     't, |g|_inf, |G v + g_I|_inf, energy [J]', io_status)
+                ! the same by name, with units
+                if (io_status%ok()) call h5%write_vector('energy', &
+                    monitor%table(4, 1:monitor%records), io_status)
+                if (io_status%ok()) call h5%annotate('energy', 'unit', 'J', io_status)
+                if (io_status%ok()) call h5%annotate('energy', 'description', 'kinetic plus &
+                    &potential energy at each record of /time', io_status)
+                if (io_status%ok()) call h5%write_matrix('drift', &
+                    monitor%table(2:3, 1:monitor%records), io_status)
+                if (io_status%ok()) call h5%annotate('drift', 'unit', 'm or 1; m/s or rad/s', &
+                    io_status)
+                if (io_status%ok()) call h5%annotate('drift', 'description', '|g|_inf and &
+                    &|G v + g_I|_inf at each record (the rows of g are lengths or direction &
+                    &cosines)', io_status)
                 if (io_status%ok() .and. size(monitor%reactions, 1) > 0) then
                     call h5%write_matrix('reactions', &
                         monitor%reactions(:, 1:monitor%records), io_status)
