@@ -108,7 +108,7 @@ contains
         type(status_t) :: io_status
         integer :: i
         character(len=:), allocatable :: outcome
-        real(wp), allocatable :: y_start(:)
+        real(wp), allocatable :: y_start(:), energy(:), drift(:, :)
 
         call make_plan(scene, plan, status)
         if (.not. status%ok()) return
@@ -196,13 +196,14 @@ contains
                 if (io_status%ok()) call h5%write_text('monitor_columns', &
                     't, |g|_inf, |G v + g_I|_inf, energy [J]', io_status)
                 ! the same by name, with units
-                if (io_status%ok()) call h5%write_vector('energy', &
-                    monitor%table(4, 1:monitor%records), io_status)
+                ! contiguous copies: HDF5 writes whole arrays
+                energy = monitor%table(4, 1:monitor%records)
+                drift = monitor%table(2:3, 1:monitor%records)
+                if (io_status%ok()) call h5%write_vector('energy', energy, io_status)
                 if (io_status%ok()) call h5%annotate('energy', 'unit', 'J', io_status)
                 if (io_status%ok()) call h5%annotate('energy', 'description', 'kinetic plus &
                     &potential energy at each record of /time', io_status)
-                if (io_status%ok()) call h5%write_matrix('drift', &
-                    monitor%table(2:3, 1:monitor%records), io_status)
+                if (io_status%ok()) call h5%write_matrix('drift', drift, io_status)
                 if (io_status%ok()) call h5%annotate('drift', 'unit', 'm or 1; m/s or rad/s', &
                     io_status)
                 if (io_status%ok()) call h5%annotate('drift', 'description', '|g|_inf and &
