@@ -11,6 +11,7 @@ module test_io
     use flexmbs_io_table, only: stats_row_t, new_stats_row, table_text, table_format, &
         write_table, table_markdown, table_csv, table_latex
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
+    use flexmbs_io_hdf5_text, only: read_text_attribute => read_string_attribute
     use flexmbs_io_output_files, only: named_path_t, named_path, check_output_paths, &
         output_hdf5, output_table
     use flexmbs_core_version, only: version
@@ -537,26 +538,19 @@ contains
         call h5fclose_f(file, err)
     end subroutine read_series
 
+    !> A string attribute of the file's root, as flexmbs writes them
+    !> (variable-length UTF-8; io/hdf5_text reads both kinds).
     function read_string_attribute(path, name) result(text)
         character(len=*), intent(in) :: path, name
         character(len=:), allocatable :: text
-        integer(hid_t) :: file, attr, atype
-        integer(size_t) :: length
-        integer :: err
+        integer(hid_t) :: file
+        integer :: err, close_err
         text = '<unreadable>'
         call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
         if (err < 0) return
-        call h5aopen_f(file, name, attr, err)
-        if (err >= 0) then
-            call h5aget_type_f(attr, atype, err)
-            call h5tget_size_f(atype, length, err)
-            deallocate (text)
-            allocate (character(len=length) :: text)
-            call h5aread_f(attr, atype, text, [1_hsize_t], err)
-            call h5tclose_f(atype, err)
-            call h5aclose_f(attr, err)
-        end if
-        call h5fclose_f(file, err)
+        call read_text_attribute(file, name, text, err)
+        if (err < 0) text = '<unreadable>'
+        call h5fclose_f(file, close_err)
     end function read_string_attribute
 
     ! ------------------------------------------------------------------

@@ -167,8 +167,8 @@ contains
         else
             call h5sget_simple_extent_dims_f(space, dims, maxdims, err)
             if (row < 1 .or. row > dims(1)) then
-                call status%set(status_bad_input, 'row ' // int_text(row) // ' outside 1 .. ' &
-                    // int_text(int(dims(1))) // ' of /' // name)
+                call status%set(status_bad_input, 'component ' // int_text(row) // &
+                    ' outside 1 .. ' // int_text(int(dims(1))) // ' of /' // name)
             else
                 allocate (values(dims(2)), stat=stat)
                 if (stat /= 0) then
