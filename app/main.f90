@@ -1,6 +1,6 @@
 !> The flexmbs command line.
 !>
-!>   flexmbs run FILE.nml [--quiet] [--force]          run a scene
+!>   flexmbs run FILE.nml [--quiet] [--force] [--verbose]  run a scene
 !>   flexmbs reference STUDY.nml [--quiet] [--force]   a study's reference solution
 !>   flexmbs sweep STUDY.nml [-j N] [--quiet] [--force]  a study's grid of runs against it
 !>   flexmbs sweep STUDY.nml --point K        point K alone, its record into the results folder
@@ -51,7 +51,7 @@ program flexmbs_main
     integer, parameter :: max_printed = 12
 
     character(len=:), allocatable :: command, file, arg, value, slurm_only
-    logical :: quiet, force, merging, slurm, submit, jobs_given
+    logical :: quiet, force, merging, slurm, submit, jobs_given, verbose
     integer :: i, nargs, jobs, point, ios
     type(slurm_options_t) :: cluster
     !> the IEEE flags at the start, all quiet (finish)
@@ -74,6 +74,7 @@ program flexmbs_main
         call finish(exit_ok)
     case ('run', 'reference', 'sweep')
         quiet = .false.
+        verbose = .false.
         force = .false.
         file = ''
         jobs = 1
@@ -89,6 +90,8 @@ program flexmbs_main
             arg = argument(i)
             if (arg == '--quiet' .or. arg == '-q') then
                 quiet = .true.
+            else if (command == 'run' .and. (arg == '--verbose' .or. arg == '-v')) then
+                verbose = .true.
             else if (arg == '--force') then
                 force = .true.
             else if (command == 'sweep' .and. any(arg == [character(len=11) :: '-j', &
@@ -165,7 +168,7 @@ contains
             if (allocated(result%stats%warning)) &
                 write (error_unit, '(a)') 'flexmbs: warning: ' // result%stats%warning
             if (len_trim(scene%title) > 0) write (output_unit, '(a)') trim(scene%title)
-            call report(result, scene)
+            call report(result, scene, verbose)
             call finish(exit_ok)
         case (status_solver_failure, status_interrupted, status_signal)
             if (status%code == status_signal) then
@@ -425,21 +428,38 @@ contains
         call finish(exit_ok)
     end subroutine sweep_point
 
-    !> Statistics line and final state on standard output.
-    subroutine report(result, scene)
+    !> The run on standard output: the statistics line (with CPU and wall
+    !> seconds), the last time, then for a scene with bodies its bodies,
+    !> joints and flexible bodies there (run/summary), the energy and the
+    !> drift; the state itself for a problem without bodies, or with
+    !> --verbose.
+    subroutine report(result, scene, verbose)
         type(run_result_t), intent(in) :: result
         type(scene_input_t), intent(in) :: scene
+        logical, intent(in) :: verbose
         integer :: k, n
+        logical :: bodies
         write (output_unit, '(a)') result%solver_name // ': ' // result%stats%summary()
         n = size(result%y)
         write (output_unit, '(a,es23.15)') 't =', result%t
-        do k = 1, min(n, max_printed)
-            write (output_unit, '(a,i0,a,es23.15)') 'y(', k, ') =', result%y(k)
-        end do
-        if (n > max_printed) write (output_unit, '(a,i0,a)') '... (', n, &
-            ' components; all of them are in the HDF5 file)'
+        bodies = .false.
+        if (allocated(result%summary)) bodies = len(result%summary) > 0
+        if (bodies) write (output_unit, '(a)', advance='no') result%summary
+        if (verbose .or. .not. bodies) then
+            do k = 1, merge(n, min(n, max_printed), verbose)
+                write (output_unit, '(a,i0,a,es23.15)') 'y(', k, ') =', result%y(k)
+            end do
+            if (n > max_printed .and. .not. verbose) write (output_unit, '(a,i0,a)') '... (', &
+                n, ' components; all of them are in the HDF5 file; --verbose prints them)'
+        end if
         if (allocated(result%assembly)) write (output_unit, '(a)') &
             'initial assembly moved: ' // result%assembly
+        ! (a flexible body alone says more below: strain, kinetic, total)
+        if (result%has_monitor_energy .and. .not. result%has_energy) &
+            write (output_unit, '(a,es14.6,a,es14.6,a,es10.2,a)') &
+            'energy [J]: at t_start', result%monitor_energy(1), ', at t_end', &
+            result%monitor_energy(2), ' (change', result%monitor_energy(2) - &
+            result%monitor_energy(1), ')'
         if (result%has_drift .and. result%constraints > 0) then
             write (output_unit, '(a,2es11.3)') 'constraint drift at t_end: |g|, |G v + g_I|', &
                 result%drift_end
@@ -525,8 +545,9 @@ contains
             ' - flexible multibody dynamics and stiff DAE solvers', &
             '', &
             'usage:', &
-            '  flexmbs run FILE.nml [--quiet] [--force]', &
-            '                                          run the scene described by FILE.nml', &
+            '  flexmbs run FILE.nml [--quiet] [--force] [--verbose]', &
+            '                                          run the scene described by FILE.nml;', &
+            '                                          --verbose: the whole final state too', &
             '  flexmbs reference STUDY.nml [--quiet] [--force]', &
             '                                          integrate the study''s scene at tight', &
             '                                          tolerance, cross-check, keep in HDF5', &

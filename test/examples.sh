@@ -44,6 +44,23 @@ for scene in "$root"/inputs/*.nml; do
     fi
 done
 
+# The run summary for people: the five-body mechanism's bodies, joints
+# and coupler by name, not its 2268... components; --verbose adds them.
+out=$(cat five_body.out)
+if grep -q '^  rocker: at (' <<<"$out" && grep -q '^  rocker pivot: angle ' <<<"$out" &&
+    grep -q '^  flail: joint angle ' <<<"$out" &&
+    grep -q '^  coupler: largest displacement .* largest von Mises stress ' <<<"$out" &&
+    grep -q '^energy \[J\]: at t_start' <<<"$out" && ! grep -q '^y(1) =' <<<"$out"; then
+    pass summary-by-name
+else
+    fail summary-by-name "$out"
+fi
+if "$exe" run five_body.nml --quiet --verbose 2>&1 | grep -q '^y(1) ='; then
+    pass summary-verbose-state
+else
+    fail summary-verbose-state "--verbose printed no y(1)"
+fi
+
 # The named series of each multibody result against its /y
 # (test/result_names.py; h5py of the system's Python, see the Makefile).
 py=/usr/bin/python3

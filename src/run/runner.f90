@@ -28,6 +28,8 @@ module flexmbs_run_runner
     use flexmbs_run_plan, only: run_plan_t, make_plan, scene_stab
     use flexmbs_run_monitor_sink, only: monitor_sink_t
     use flexmbs_run_named_output, only: add_named_output
+    use flexmbs_run_summary, only: state_summary
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
     use flexmbs_run_body_builder, only: body_energies
     implicit none
     private
@@ -52,6 +54,13 @@ module flexmbs_run_runner
         character(len=:), allocatable :: assembly
         !> the positions in y (block 'q'), all of y when there is none
         integer :: q_first = 0, q_last = 0
+        !> a mechanical scene: its bodies and joints at the last time reached,
+        !> for people (run/summary); '' otherwise
+        character(len=:), allocatable :: summary
+        !> a formulated mechanical scene: the energy at the first and the
+        !> last record [J] (NaN where the model defines none)
+        logical :: has_monitor_energy = .false.
+        real(wp) :: monitor_energy(2) = 0.0_wp
     end type run_result_t
 
     public :: run_scene
@@ -189,7 +198,10 @@ contains
         if (monitor%records > 0) then
             result%has_drift = .true.
             result%drift_end = monitor%table(2:3, monitor%records)
+            result%monitor_energy = [monitor%table(4, 1), monitor%table(4, monitor%records)]
+            result%has_monitor_energy = .not. any(ieee_is_nan(result%monitor_energy))
         end if
+        result%summary = state_summary(plan, scene, result%y)
         if (h5%is_open) then
             if (monitor%records > 0) then
                 call h5%write_matrix('monitor', monitor%table(:, 1:monitor%records), io_status)

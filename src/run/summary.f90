@@ -1,0 +1,213 @@
+!> A run's end state for people: per rigid body its position and how far it
+!> has turned (degrees, about which axis), per chain link its joint
+!> coordinate, per revolute or prismatic joint its angle or displacement,
+!> per flexible body its largest displacement and von Mises stress. Lines
+!> of text, empty for problems without bodies (their state is short: the
+!> command line prints it instead).
+module flexmbs_run_summary
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t
+    use flexmbs_core_text, only: real_text, int_text
+    use flexmbs_mbs_rotation, only: rotation_matrix
+    use flexmbs_mbs_rigid_body, only: rigid_body_nq
+    use flexmbs_mbs_rigid_chain, only: rigid_chain_t, chain_joint_prismatic, &
+        chain_joint_spherical
+    use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_mbs_joint, only: joint_revolute, joint_cylindrical, joint_prismatic
+    use flexmbs_mbs_formulation, only: formulation_t
+    use flexmbs_fe_flexible_body, only: flexible_body_t
+    use flexmbs_io_namelist, only: scene_input_t
+    use flexmbs_run_plan, only: run_plan_t
+    implicit none
+    private
+
+    real(wp), parameter :: degrees = 45.0_wp / atan(1.0_wp)
+    character, parameter :: nl = new_line('a')
+
+    public :: state_summary
+
+contains
+
+    !> The summary of state y of the plan's model (module header).
+    function state_summary(plan, scene, y) result(text)
+        type(run_plan_t), intent(inout), target :: plan
+        type(scene_input_t), intent(in) :: scene
+        real(wp), intent(in) :: y(:)
+        character(len=:), allocatable :: text
+        integer :: i, k
+        text = ''
+        if (.not. allocated(plan%mechanical)) return
+        select type (f => plan%problem)
+        type is (formulation_t)
+            select type (m => plan%mechanical)
+            type is (mbs_system_t)
+                do i = 1, size(scene%rigid_bodies)
+                    text = text // body_line(trim(scene%rigid_bodies(i)%name), &
+                        y(f%oq + rigid_body_nq * (i - 1) + 1:f%oq + rigid_body_nq * i))
+                end do
+                do i = 1, size(m%chains)
+                    text = text // chain_lines(m%chains(i), y(f%oq + m%chain_q(i) + 1: &
+                        f%oq + m%chain_q(i) + m%chains(i)%nq))
+                end do
+                if (allocated(plan%joint_names)) then
+                    do k = 1, min(size(plan%joint_names), size(m%joints))
+                        text = text // joint_line(m, k, plan%joint_names(k), &
+                                                  y(f%oq + 1:f%oq + m%nq))
+                    end do
+                end if
+                do i = 1, size(m%flex)
+                    text = text // flexible_line(m%flex(i), trim(scene%body%name), &
+                        y(f%oq + m%flex_q(i) + 1:f%oq + m%flex_q(i) + m%flex(i)%nq), &
+                        y(f%ov + m%flex_v(i) + 1:f%ov + m%flex_v(i) + m%flex(i)%nv))
+                end do
+            type is (rigid_chain_t)
+                text = chain_lines(m, y(f%oq + 1:f%oq + m%nq))
+            type is (flexible_body_t)
+                text = flexible_line(m, trim(scene%body%name), y(f%oq + 1:f%oq + m%nq), &
+                                     y(f%ov + 1:f%ov + m%nv))
+            end select
+        end select
+
+    contains
+
+        !> the names of the chain's links, in order
+        function chain_lines(chain, q) result(lines)
+            type(rigid_chain_t), intent(in) :: chain
+            real(wp), intent(in) :: q(:)
+            character(len=:), allocatable :: lines
+            character(len=:), allocatable :: name
+            integer :: j
+            lines = ''
+            do j = 1, size(chain%bodies)
+                name = 'link ' // int_text(j)
+                if (j <= size(scene%chain)) name = trim(scene%chain(j)%name)
+                associate (c => q(chain%iq(j) + 1:chain%iq(j + 1)))
+                    select case (chain%bodies(j)%joint)
+                    case (chain_joint_prismatic)
+                        lines = lines // '  ' // name // ': joint displacement ' // &
+                            fixed(c(1), 4) // ' m' // nl
+                    case (chain_joint_spherical)
+                        lines = lines // '  ' // name // ': turned ' // &
+                            fixed(turn_angle(c) * degrees, 2) // ' deg about (' // &
+                            axis_text(c) // ') from its parent' // nl
+                    case default
+                        lines = lines // '  ' // name // ': joint angle ' // &
+                            fixed(c(1) * degrees, 2) // ' deg' // nl
+                    end select
+                end associate
+            end do
+        end function chain_lines
+    end function state_summary
+
+    !> 'crank: at (x, y, z) m, turned A deg about (ax, ay, az)'
+    function body_line(name, qb) result(line)
+        character(len=*), intent(in) :: name
+        real(wp), intent(in) :: qb(7)   !! r, p
+        character(len=:), allocatable :: line
+        line = '  ' // name // ': at (' // fixed(qb(1), 4) // ', ' // fixed(qb(2), 4) // ', ' &
+            // fixed(qb(3), 4) // ') m, turned ' // fixed(turn_angle(qb(4:7)) * degrees, 2) // &
+            ' deg about (' // axis_text(qb(4:7)) // ')' // nl
+    end function body_line
+
+    !> A revolute or cylindrical joint's angle, a prismatic one's displacement.
+    function joint_line(sys, k, group_name, q) result(line)
+        type(mbs_system_t), intent(in) :: sys
+        integer, intent(in) :: k
+        character(len=*), intent(in) :: group_name  !! 'joints/NAME' | 'drivers/NAME'
+        real(wp), intent(in) :: q(:)
+        character(len=:), allocatable :: line
+        real(wp) :: xi(3), xj(3), ai(3, 3), aj(3, 3), c(3)
+        character(len=:), allocatable :: name
+        line = ''
+        name = trim(group_name(index(group_name, '/') + 1:))
+        associate (jt => sys%joints(k))
+            select case (jt%joint%kind)
+            case (joint_revolute, joint_cylindrical, joint_prismatic)
+                call sys%marker_pose(jt%marker_i, q, xi, ai)
+                call sys%marker_pose(jt%marker_j, q, xj, aj)
+            case default
+                return
+            end select
+            if (jt%joint%kind /= joint_prismatic) then
+                c = [ai(2, 1) * aj(3, 1) - ai(3, 1) * aj(2, 1), ai(3, 1) * aj(1, 1) - &
+                     ai(1, 1) * aj(3, 1), ai(1, 1) * aj(2, 1) - ai(2, 1) * aj(1, 1)]
+                line = '  ' // name // ': angle ' // fixed(atan2(dot_product(c, ai(:, 3)), &
+                    dot_product(ai(:, 1), aj(:, 1))) * degrees, 2) // ' deg' // nl
+            end if
+            if (jt%joint%kind /= joint_revolute) line = line // '  ' // name // &
+                ': displacement ' // fixed(dot_product(xj - xi, ai(:, 3)), 4) // ' m' // nl
+        end associate
+    end function joint_line
+
+    !> 'coupler: largest displacement D m (node N), largest von Mises stress S Pa'
+    function flexible_line(body, name, q, v) result(line)
+        type(flexible_body_t), intent(inout) :: body
+        character(len=*), intent(in) :: name
+        real(wp), intent(in) :: q(:), v(:)
+        character(len=:), allocatable :: line
+        real(wp), allocatable :: sigma(:, :), mises(:)
+        real(wp) :: u(3), largest
+        type(status_t) :: status
+        integer :: i, j, at
+        largest = 0.0_wp
+        at = 0
+        do i = 1, size(body%dof, 2)
+            u = 0.0_wp
+            do j = 1, 3
+                if (body%dof(j, i) > 0) u(j) = q(body%dof(j, i)) - body%mesh%x(j, i)
+            end do
+            if (norm2(u) > largest .or. at == 0) then
+                largest = norm2(u)
+                at = i
+            end if
+        end do
+        line = '  ' // name // ': largest displacement ' // real_text(largest) // ' m (node ' &
+            // int_text(at) // ')'
+        allocate (sigma(6, body%mesh%element_count()), mises(body%mesh%element_count()))
+        call body%element_stress(q, v, sigma, mises, status)
+        if (status%ok() .and. size(mises) > 0) line = line // ', largest von Mises stress ' // &
+            real_text(maxval(mises)) // ' Pa (element ' // &
+            int_text(maxloc(mises, 1)) // ')'
+        line = line // nl
+    end function flexible_line
+
+    !> The rotation angle of quaternion p (normalised), in [0, π].
+    pure real(wp) function turn_angle(p) result(angle)
+        real(wp), intent(in) :: p(4)
+        real(wp) :: s
+        s = norm2(p(2:4))
+        angle = 2.0_wp * atan2(s, abs(p(1)))
+    end function turn_angle
+
+    !> The unit rotation axis of p, or (0, 0, 0) for no rotation.
+    function axis_text(p) result(text)
+        real(wp), intent(in) :: p(4)
+        character(len=:), allocatable :: text
+        real(wp) :: a(3)
+        a = 0.0_wp
+        if (norm2(p(2:4)) > 0.0_wp) a = sign(1.0_wp, p(1)) * p(2:4) / norm2(p(2:4))
+        text = fixed(a(1), 3) // ', ' // fixed(a(2), 3) // ', ' // fixed(a(3), 3)
+    end function axis_text
+
+    !> x with `digits` decimals, no blanks.
+    function fixed(x, digits) result(text)
+        real(wp), intent(in) :: x
+        integer, intent(in) :: digits
+        character(len=:), allocatable :: text
+        character(len=40) :: buffer
+        character(len=12) :: form
+        write (form, '(a,i0,a)') '(f0.', digits, ')'
+        ! no '-0.000': what rounds to zero is written as zero
+        if (abs(x) < 0.5_wp * 10.0_wp**(-digits)) then
+            write (buffer, form) 0.0_wp
+        else
+            write (buffer, form) x
+        end if
+        text = trim(adjustl(buffer))
+        if (text(1:1) == '.') text = '0' // text
+        if (len(text) > 1) then
+            if (text(1:2) == '-.') text = '-0' // text(2:)
+        end if
+        if (text(len(text):len(text)) == '.') text = text(1:len(text) - 1)
+    end function fixed
+end module flexmbs_run_summary
