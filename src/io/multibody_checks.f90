@@ -95,7 +95,7 @@ contains
         if (size(scene%rigid_bodies) + size(scene%chain) == 0) call errors%add('&simulation: &
             &problem = ''multibody'': needs at least one &rigid_body or &rigid_chain group', 0)
         ! each occurrence's own entries: linear in the number of groups
-        ranges = instance_ranges(entries, 'rigid_body', size(scene%rigid_bodies))
+        call instance_ranges(entries, 'rigid_body', size(scene%rigid_bodies), ranges)
         do i = 1, size(scene%rigid_bodies)
             associate (b => scene%rigid_bodies(i), own => entries(ranges(1, i):ranges(2, i)))
                 if (.not. has_entry(own, 'rigid_body', 'mass', i)) call required_error( &
@@ -114,11 +114,11 @@ contains
                     '''ground'' is reserved', i)
             end associate
         end do
-        ranges = instance_ranges(entries, 'marker', size(scene%markers))
+        call instance_ranges(entries, 'marker', size(scene%markers), ranges)
         do i = 1, size(scene%markers)
             call check_marker(i, entries(ranges(1, i):ranges(2, i)))
         end do
-        ranges = instance_ranges(entries, 'joint', size(scene%joints))
+        call instance_ranges(entries, 'joint', size(scene%joints), ranges)
         do i = 1, size(scene%joints)
             associate (jt => scene%joints(i), own => entries(ranges(1, i):ranges(2, i)))
                 if (.not. has_entry(own, 'joint', 'type', i)) then
@@ -135,7 +135,7 @@ contains
                 end if
             end associate
         end do
-        ranges = instance_ranges(entries, 'driver', size(scene%drivers))
+        call instance_ranges(entries, 'driver', size(scene%drivers), ranges)
         do i = 1, size(scene%drivers)
             associate (d => scene%drivers(i), own => entries(ranges(1, i):ranges(2, i)))
                 if (.not. has_entry(own, 'driver', 'type', i)) then

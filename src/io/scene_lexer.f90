@@ -512,12 +512,13 @@ contains
     !> entries in `entries` (1 and 0 for an occurrence without entries), in
     !> one pass: readers and checks look a variable up in its occurrence's
     !> slice, so that a scene of n groups is read in time linear in n.
-    pure function instance_ranges(entries, group, n) result(ranges)
+    pure subroutine instance_ranges(entries, group, n, ranges)
         type(entry_t), intent(in) :: entries(:)
         character(len=*), intent(in) :: group
         integer, intent(in) :: n
-        integer :: ranges(2, n)
+        integer, allocatable, intent(out) :: ranges(:, :)
         integer :: i, k
+        allocate (ranges(2, n))
         ranges(1, :) = huge(1)
         ranges(2, :) = 0
         do i = 1, size(entries)
@@ -528,7 +529,7 @@ contains
             ranges(2, k) = max(ranges(2, k), i)
         end do
         where (ranges(2, :) == 0) ranges(1, :) = 1
-    end function instance_ranges
+    end subroutine instance_ranges
 
     !> Whether `name` is given in `group` (in occurrence `instance` if present).
     pure logical function has_entry(entries, group, name, instance)

@@ -163,7 +163,7 @@ contains
             call get(e, g, 'formulation', b%formulation)
             b%formulation = lower(b%formulation)
         end associate
-        ranges = instance_ranges(e, 'material', size(scene%materials))
+        call instance_ranges(e, 'material', size(scene%materials), ranges)
         do i = 1, size(scene%materials)
             associate (m => scene%materials(i), ei => e(ranges(1, i):ranges(2, i)))
                 call get(ei, 'material', 'name', m%name, i)
@@ -191,7 +191,7 @@ contains
             call get(e, 'multibody', 'projection', mb%projection)
             call get(e, 'multibody', 'assembly_tolerance', mb%assembly_tolerance)
         end associate
-        ranges = instance_ranges(e, 'rigid_body', size(scene%rigid_bodies))
+        call instance_ranges(e, 'rigid_body', size(scene%rigid_bodies), ranges)
         do i = 1, size(scene%rigid_bodies)
             associate (b => scene%rigid_bodies(i), ei => e(ranges(1, i):ranges(2, i)))
                 call get(ei, 'rigid_body', 'name', b%name, i)
@@ -206,7 +206,7 @@ contains
                 call get(ei, 'rigid_body', 'angular_velocity', b%angular_velocity, i)
             end associate
         end do
-        ranges = instance_ranges(e, 'marker', size(scene%markers))
+        call instance_ranges(e, 'marker', size(scene%markers), ranges)
         do i = 1, size(scene%markers)
             associate (m => scene%markers(i), ei => e(ranges(1, i):ranges(2, i)))
                 call get(ei, 'marker', 'name', m%name, i)
@@ -219,7 +219,7 @@ contains
                 call get(ei, 'marker', 'node_set', m%node_set, i)
             end associate
         end do
-        ranges = instance_ranges(e, 'joint', size(scene%joints))
+        call instance_ranges(e, 'joint', size(scene%joints), ranges)
         do i = 1, size(scene%joints)
             associate (j => scene%joints(i), ei => e(ranges(1, i):ranges(2, i)))
                 call get(ei, 'joint', 'name', j%name, i)
@@ -230,7 +230,7 @@ contains
                 call get(ei, 'joint', 'marker_j', j%marker_j, i)
             end associate
         end do
-        ranges = instance_ranges(e, 'driver', size(scene%drivers))
+        call instance_ranges(e, 'driver', size(scene%drivers), ranges)
         do i = 1, size(scene%drivers)
             associate (d => scene%drivers(i), ei => e(ranges(1, i):ranges(2, i)))
                 call get(ei, 'driver', 'name', d%name, i)
@@ -247,7 +247,7 @@ contains
                 call get(ei, 'driver', 'phase', d%phase, i)
             end associate
         end do
-        ranges = instance_ranges(e, 'rigid_chain', size(scene%chain))
+        call instance_ranges(e, 'rigid_chain', size(scene%chain), ranges)
         do i = 1, size(scene%chain)
             associate (c => scene%chain(i), ei => e(ranges(1, i):ranges(2, i)))
                 call get(ei, 'rigid_chain', 'name', c%name, i)
