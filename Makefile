@@ -16,7 +16,8 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := run
 
 APT_PACKAGES := gfortran libsundials-dev libsundials-fortran-dev libsuitesparse-dev \
-                liblapack-dev libopenblas-dev libhdf5-dev libmumps-seq-dev python3-h5py pkgconf
+                liblapack-dev libopenblas-dev libhdf5-dev libmumps-seq-dev python3-h5py pkgconf \
+                python3-matplotlib
 BUILD        := $(CURDIR)/build
 VENV         := $(BUILD)/venv
 # One set of flags for every fpm call: changing them makes fpm rebuild everything.
@@ -105,7 +106,8 @@ run: build
 	$(FPM) run --profile release flexmbs -- run $(MAIN_INPUT)
 
 # Root suites, then the classic fixed-form drivers linked against the
-# installed library exactly as a user links them, the architecture's rules
+# installed library exactly as a user links them, the example programs of
+# examples/ built the same way and run (test/programs.sh), the architecture's rules
 # on the sources (test/layers.py), then the command-line
 # checks of test/cli.sh, the signals of test/kill.sh (python3-h5py reads
 # the files they leave), every example scene with empty standard error
@@ -118,6 +120,8 @@ test: deps
 	@$(MAKE) --no-print-directory legacy-test PREFIX_USED=$(PREFIX_DEBUG) PROFILE=debug \
 	    > $(BUILD)/test-legacy.log 2>&1; echo "exit $$?" >> $(BUILD)/test-legacy.log; \
 	    cat $(BUILD)/test-legacy.log
+	@set -o pipefail; bash test/programs.sh $(PREFIX_DEBUG) 2>&1 | tee $(BUILD)/test-programs.log; \
+	    echo "exit $$?" >> $(BUILD)/test-programs.log
 	@set -o pipefail; python3 test/layers.py 2>&1 | tee $(BUILD)/test-layers.log; \
 	    echo "exit $$?" >> $(BUILD)/test-layers.log
 	@set -o pipefail; FPM="$(FPM)" bash test/cli.sh 2>&1 | tee $(BUILD)/test-cli.log; \
@@ -129,7 +133,7 @@ test: deps
 	@set -o pipefail; FPM="$(FPM)" bash test/fuzz/run.sh 2>&1 | tee $(BUILD)/test-fuzz.log; \
 	    echo "exit $$?" >> $(BUILD)/test-fuzz.log
 	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log \
-	    $(BUILD)/test-layers.log $(BUILD)/test-cli.log $(BUILD)/test-kill.log \
+	    $(BUILD)/test-programs.log $(BUILD)/test-layers.log $(BUILD)/test-cli.log $(BUILD)/test-kill.log \
 	    $(BUILD)/test-examples.log $(BUILD)/test-fuzz.log
 
 PROFILE     ?= debug

@@ -41,6 +41,9 @@ module flexmbs
         chain_marker_t, chain_joint_revolute, chain_joint_prismatic
     use flexmbs_problems_mechanisms, only: new_mechanism, mechanism_slider_crank, &
         mechanism_four_bar
+    use flexmbs_problems_pendulum, only: pendulum_mechanical_t, new_pendulum_mechanical, &
+        pendulum_mechanical_initial, pendulum_angle_exact
+    use flexmbs_io_vtk_sink, only: vtk_sink_t
     use flexmbs_mbs_flexible_marker, only: flexible_marker_t, new_flexible_marker
     use flexmbs_mbs_joint, only: joint_spherical, joint_revolute, joint_cylindrical, &
         joint_prismatic, joint_universal, joint_fixed
