@@ -423,6 +423,19 @@ expect vtk-chain-run 0 "radau5: NST=" run chain_vtk.nml --quiet
 if grep -q 'NumberOfPoints="3" NumberOfCells="3"' out/chain_bodies_0001.vtu 2>/dev/null; then
     pass vtk-chain-links
 else fail vtk-chain-links "$(head -c 300 out/chain_bodies_0001.vtu 2>/dev/null)"; fi
+# the .pvd's times are the HDF5 file's /time to the last bit (17 digits)
+sed -e "s/t_end   = 0.5 /t_end   = 0.013 /" \
+    -e "s#^&output#\&output vtk = 'out/vt', file = 'out/vt.h5',#" \
+    -e "s/n_output = 51/n_output = 4/" "$root/inputs/rigid_flexible_pendulum.nml" > vt.nml
+expect vtk-times-run 0 "radau5: NST=" run vt.nml --quiet
+if /usr/bin/python3 - out/vt.pvd out/vt.h5 <<'PY'
+import re, sys, h5py
+pvd = sorted(set(float(x) for x in re.findall(r'timestep="([^"]+)"', open(sys.argv[1]).read())))
+t = list(h5py.File(sys.argv[2], 'r')['time'][:])
+sys.exit(0 if pvd == t and len(t) == 4 else 1)
+PY
+then pass vtk-times-are-hdf5-time
+else fail vtk-times-are-hdf5-time "$(grep -o 'timestep="[^"]*"' out/vt.pvd | head -4)"; fi
 sed -e "s#^&output#\&output vtk = 'vdp',#" "$root/inputs/van_der_pol.nml" > vdp_vtk.nml
 bad vtk-no-bodies "&output: vtk: problem = 'van_der_pol' has no bodies to draw" vdp_vtk.nml
 

@@ -288,7 +288,8 @@ contains
         write (unit, '(a)') '<VTKFile type="Collection" version="0.1">'
         write (unit, '(a)') '<Collection>'
         do k = 1, self%records
-            write (tbuf, '(es23.15e3)') self%times(k)
+            ! 17 significant digits: a reader gets back the HDF5 file's /time exactly
+            write (tbuf, '(es25.16e3)') self%times(k)
             if (associated(self%body)) write (unit, '(a)') '<DataSet timestep="' // &
                 trim(adjustl(tbuf)) // '" part="0" file="' // mesh_piece(base, k) // '"/>'
             if (self%bodies + links(self) > 0) write (unit, '(a)') '<DataSet timestep="' // &
