@@ -465,6 +465,8 @@ contains
             integrator_name = 'reference'
             solver_name = 'klu'
             npar = nx
+            max_steps = 1
+            rtol = 1.0e-6_wp
             call make_plan_for(trim(problem_name))
             jac%storage = storage_sparse
             jac%n = plan%problem%n
