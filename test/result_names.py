@@ -181,6 +181,33 @@ if 'monitor' in f:
         problems.append('/drift is not the monitor\'s drift')
 report(name + '/energy-and-drift', '; '.join(problems))
 
+# /y_labels and /y_units: every component named once, with a unit; the
+# labelled columns of /y are the named series
+problems = []
+labels = [x.decode() if isinstance(x, bytes) else x for x in f['y_labels'][:]]
+units = [x.decode() if isinstance(x, bytes) else x for x in f['y_units'][:]]
+y = f['y'][:]
+if len(labels) != y.shape[1] or len(units) != y.shape[1]:
+    problems.append('%d labels, %d units for %d components' % (len(labels), len(units),
+                                                              y.shape[1]))
+elif len(set(labels)) != len(labels) or any(not u for u in units):
+    problems.append('labels not unique or units missing')
+else:
+    column = {label: k for k, label in enumerate(labels)}
+    for body in bodies:
+        for k, axis in enumerate('xyz'):
+            at = column.get('%s/position/%s' % (body, axis))
+            if at is None or not np.array_equal(y[:, at], f['bodies'][body]['position'][:, k]):
+                problems.append('%s/position/%s is not its named column' % (body, axis))
+    for body in flexible:
+        g = f['flexible'][body]
+        for node in (1, g['reference_nodes'].shape[0]):
+            at = column.get('%s/node %d/x' % (body, node))
+            if at is not None and np.max(np.abs(y[:, at] - g['reference_nodes'][node - 1, 0]
+                                                - g['displacement'][:, node - 1, 0])) > 1e-15:
+                problems.append('%s/node %d/x is not reference + displacement' % (body, node))
+report(name + '/y-labels-and-units (%d)' % len(labels), '; '.join(problems[:5]))
+
 # a revolute joint's angle: a joint to the ground turns its body by the
 # change of the angle (the rotation angle of R(t) R(0)^T, the quaternion's
 # drift aside); at least one such joint and body in a file with angles

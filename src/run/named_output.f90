@@ -21,6 +21,8 @@
 !>   /flexible/<name>/displacement    (3, nodes) m    x - X of every node
 !>   /flexible/<name>/velocity        (3, nodes) m/s
 !>
+!>   /y_labels, /y_units               every component of y by name, and its unit
+!>
 !> Python: `f['bodies/crank/position'][:, 2]` is the crank's z at every
 !> record of /time (h5py shows the series as records × rows), and
 !> `f['flexible/coupler/displacement'][:, k - 1, 0]` node k's x displacement.
@@ -31,6 +33,9 @@ module flexmbs_run_named_output
     use flexmbs_mbs_rigid_body, only: rigid_body_nq, rigid_body_nv
     use flexmbs_mbs_system, only: mbs_system_t
     use flexmbs_mbs_joint, only: joint_revolute, joint_cylindrical, joint_prismatic
+    use flexmbs_mbs_primitive_kinds, only: primitive_rows, primitive_dot1, &
+        primitive_angle_driver, primitive_distance
+    use flexmbs_core_text, only: int_text
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, chain_joint_prismatic, &
         chain_joint_spherical
@@ -115,6 +120,8 @@ contains
         type(coordinate_values_t) :: coordinate
         character(len=:), allocatable :: base
         integer :: i, k
+        call add_labels(h5, plan, scene, status)
+        if (.not. status%ok()) return
         if (.not. allocated(plan%mechanical)) return
         select type (sys => plan%mechanical)
         type is (flexible_body_t)
@@ -230,6 +237,191 @@ contains
             call h5%add_series(base // name, 3, unit, reaction, status, description)
         end subroutine add_reaction
     end subroutine add_named_output
+
+    !> /y_labels and /y_units: every component of y by name and SI unit
+    !> ('crank/position/x' m, 'coupler/node 23/velocity/z' m/s,
+    !> 'joints/pivot/lambda 4' N m, ...). GGL's μ has no physical unit: '-'.
+    subroutine add_labels(h5, plan, scene, status)
+        type(hdf5_sink_t), intent(inout) :: h5
+        type(run_plan_t), intent(in), target :: plan
+        type(scene_input_t), intent(in) :: scene
+        type(status_t), intent(out) :: status
+        character(len=120), allocatable :: labels(:)
+        character(len=12), allocatable :: units(:)
+        integer :: n, k
+        n = plan%problem%n
+        allocate (labels(n), units(n))
+        do k = 1, n
+            write (labels(k), '(a,i0,a)') 'y(', k, ')'
+        end do
+        units = ''
+        if (allocated(plan%mechanical)) then
+            select type (f => plan%problem)
+            type is (formulation_t)
+                select type (m => plan%mechanical)
+                type is (mbs_system_t)
+                    call system_labels(m, f)
+                type is (rigid_chain_t)
+                    call chain_labels(m, f%oq, f%ov, accelerations(f))
+                type is (flexible_body_t)
+                    call flexible_labels(m, trim(scene%body%name), f%oq, f%ov, accelerations(f))
+                end select
+                if (f%nc > 0 .and. f%n > f%om) then   ! GGL: μ after λ
+                    do k = 1, f%nc
+                        labels(f%om + k) = trim(labels(f%ol + k)) // ' (mu)'
+                        units(f%om + k) = '-'
+                    end do
+                end if
+            end select
+        end if
+        call h5%write_strings('y_labels', labels, status)
+        if (status%ok()) call h5%write_strings('y_units', units, status)
+
+    contains
+
+        subroutine system_labels(sys, f)
+            type(mbs_system_t), intent(in) :: sys
+            type(formulation_t), intent(in) :: f
+            character(len=:), allocatable :: name
+            integer :: i, j, r, row
+            do i = 1, size(sys%rigid%bodies)
+                if (i <= size(scene%rigid_bodies)) then
+                    name = trim(scene%rigid_bodies(i)%name)
+                else
+                    name = 'node frame ' // int_text(i - size(scene%rigid_bodies))
+                end if
+                call put3(f%oq + 7 * (i - 1), name // '/position', 'm')
+                do j = 1, 4
+                    labels(f%oq + 7 * (i - 1) + 3 + j) = name // '/orientation/p' // &
+                        int_text(j - 1)
+                    units(f%oq + 7 * (i - 1) + 3 + j) = '1'
+                end do
+                call put3(f%ov + 6 * (i - 1), name // '/velocity', 'm/s')
+                call put3(f%ov + 6 * (i - 1) + 3, name // '/angular_velocity (body)', 'rad/s')
+                if (f%accelerations) then
+                    call put3(f%oa + 6 * (i - 1), name // '/acceleration', 'm/s^2')
+                    call put3(f%oa + 6 * (i - 1) + 3, name // '/angular_acceleration (body)', &
+                              'rad/s^2')
+                end if
+            end do
+            do i = 1, size(sys%chains)
+                call chain_labels(sys%chains(i), f%oq + sys%chain_q(i), f%ov + sys%chain_v(i), &
+                    merge(f%oa + sys%chain_v(i), -1, f%accelerations))
+            end do
+            do i = 1, size(sys%flex)
+                call flexible_labels(sys%flex(i), trim(scene%body%name), f%oq + sys%flex_q(i), &
+                    f%ov + sys%flex_v(i), merge(f%oa + sys%flex_v(i), -1, f%accelerations))
+            end do
+            ! multipliers: a row's unit is the force its constraint exerts
+            do i = 1, size(sys%joints)
+                name = 'joint ' // int_text(i)
+                if (allocated(plan%joint_names)) then
+                    if (i <= size(plan%joint_names)) name = trim(plan%joint_names(i))
+                end if
+                row = sys%joints(i)%row0
+                do j = 1, sys%joints(i)%joint%nprimitives
+                    do r = 1, primitive_rows(sys%joints(i)%joint%primitive(j))
+                        row = row + 1
+                        if (row > f%nc) exit
+                        labels(f%ol + row) = name // '/lambda ' // int_text(row - &
+                                                                          sys%joints(i)%row0)
+                        units(f%ol + row) = multiplier_unit(sys%joints(i)%joint%primitive(j))
+                    end do
+                end do
+            end do
+            do i = 1, size(sys%frames)
+                do r = 1, 6
+                    row = sys%frames(i)%row0 + r
+                    if (row > f%nc) exit
+                    labels(f%ol + row) = 'node frame ' // int_text(i) // '/lambda ' // int_text(r)
+                    units(f%ol + row) = merge('N  ', 'N m', r <= 3)
+                end do
+            end do
+        end subroutine system_labels
+
+        subroutine chain_labels(chain, oq, ov, oa)
+            type(rigid_chain_t), intent(in) :: chain
+            integer, intent(in) :: oq, ov, oa   !! oa < 0: no accelerations in y
+            character(len=:), allocatable :: name, unit
+            integer :: i, j
+            do i = 1, size(chain%bodies)
+                name = 'link ' // int_text(i)
+                if (i <= size(scene%chain)) name = trim(scene%chain(i)%name)
+                unit = 'rad'
+                if (chain%bodies(i)%joint == chain_joint_prismatic) unit = 'm'
+                if (chain%bodies(i)%joint == chain_joint_spherical) unit = '1'
+                do j = chain%iq(i) + 1, chain%iq(i + 1)
+                    labels(oq + j) = name // '/coordinate ' // int_text(j - chain%iq(i))
+                    units(oq + j) = unit
+                end do
+                if (unit == '1') unit = 'rad'
+                do j = chain%iv(i) + 1, chain%iv(i + 1)
+                    labels(ov + j) = name // '/rate ' // int_text(j - chain%iv(i))
+                    units(ov + j) = unit // '/s'
+                    if (oa >= 0) then
+                        labels(oa + j) = name // '/rate derivative ' // int_text(j - chain%iv(i))
+                        units(oa + j) = unit // '/s^2'
+                    end if
+                end do
+            end do
+        end subroutine chain_labels
+
+        subroutine flexible_labels(body, name, oq, ov, oa)
+            type(flexible_body_t), intent(in) :: body
+            character(len=*), intent(in) :: name
+            integer, intent(in) :: oq, ov, oa   !! oa < 0: no accelerations in y
+            character(len=1), parameter :: xyz(3) = ['x', 'y', 'z']
+            integer :: i, j, d
+            do i = 1, size(body%dof, 2)
+                do j = 1, 3
+                    d = body%dof(j, i)
+                    if (d == 0) cycle
+                    labels(oq + d) = name // '/node ' // int_text(i) // '/' // xyz(j)
+                    units(oq + d) = 'm'
+                    labels(ov + d) = name // '/node ' // int_text(i) // '/velocity/' // xyz(j)
+                    units(ov + d) = 'm/s'
+                    if (oa >= 0) then
+                        labels(oa + d) = name // '/node ' // int_text(i) // '/acceleration/' // &
+                            xyz(j)
+                        units(oa + d) = 'm/s^2'
+                    end if
+                end do
+            end do
+        end subroutine flexible_labels
+
+        subroutine put3(offset, base, unit)
+            integer, intent(in) :: offset
+            character(len=*), intent(in) :: base, unit
+            character(len=1), parameter :: xyz(3) = ['x', 'y', 'z']
+            integer :: j
+            do j = 1, 3
+                labels(offset + j) = base // '/' // xyz(j)
+                units(offset + j) = unit
+            end do
+        end subroutine put3
+    end subroutine add_labels
+
+    !> Where the accelerations start in y, -1 when y has none.
+    pure integer function accelerations(f) result(oa)
+        type(formulation_t), intent(in) :: f
+        oa = -1
+        if (f%accelerations) oa = f%oa
+    end function accelerations
+
+    !> The unit of the multiplier of a constraint row of primitive `kind`:
+    !> the generalised force of a position (m) or direction (1) constraint.
+    pure function multiplier_unit(kind) result(unit)
+        integer, intent(in) :: kind
+        character(len=12) :: unit
+        select case (kind)
+        case (primitive_dot1, primitive_angle_driver)
+            unit = 'N m'      ! a direction or angle: a torque
+        case (primitive_distance)
+            unit = 'N/m'      ! |d|^2 - s^2 (m^2)
+        case default
+            unit = 'N'        ! a position (spherical, dot2, translation)
+        end select
+    end function multiplier_unit
 
     !> /flexible/<name>/: the mesh (reference nodes, connectivity, element
     !> type, node sets) and every node's displacement and velocity per
