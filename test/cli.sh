@@ -423,6 +423,12 @@ expect vtk-chain-run 0 "radau5: NST=" run chain_vtk.nml --quiet
 if grep -q 'NumberOfPoints="3" NumberOfCells="3"' out/chain_bodies_0001.vtu 2>/dev/null; then
     pass vtk-chain-links
 else fail vtk-chain-links "$(head -c 300 out/chain_bodies_0001.vtu 2>/dev/null)"; fi
+# the bodies by name: field data body_names (a VTK string array: character
+# codes, 0 after each name) and point data body_id; 'link' is 108 105 110 107
+if grep -q 'Name="body_names" NumberOfTuples="1"' out/vis_bodies_0002.vtu 2>/dev/null &&
+    grep -qx ' 108 105 110 107 0' out/vis_bodies_0002.vtu && grep -q 'Name="body_id"' \
+    out/vis_bodies_0002.vtu; then pass vtk-bodies-named
+else fail vtk-bodies-named "$(grep -A2 FieldData out/vis_bodies_0002.vtu 2>/dev/null)"; fi
 # the .pvd's times are the HDF5 file's /time to the last bit (17 digits: at t_end =
 # 0.011 and 4 outputs, 0.0036666666666666666 needs all of them)
 sed -e "s/t_end   = 0.5 /t_end   = 0.011 /" \

@@ -30,6 +30,9 @@ module flexmbs_io_vtk_sink
         integer :: bodies = 0         !! rigid bodies: (r, p) at y(7 b − 6 : 7 b)
         type(rigid_chain_t), pointer :: chain => null() !! its links after them
         integer :: chain_q = 0        !! the chain's coordinates in y
+        !> the names of the rigid bodies, then of the chain's links (a point
+        !> each in the bodies' files: field data body_names, point data body_id)
+        character(len=32), allocatable :: names(:)
         integer :: records = 0
         real(wp), allocatable :: times(:)
     contains
@@ -233,7 +236,23 @@ contains
             write (unit, '(3es24.15e3)') (axes(:, k, b), b=1, n)
             write (unit, '(a)') '</DataArray>'
         end do
+        ! which body a point is: its number, and the names in the field data
+        write (unit, '(a)') '<DataArray type="Int32" Name="body_id" format="ascii">'
+        write (unit, '(*(1x,i0))') (b, b=1, n)
+        write (unit, '(a)') '</DataArray>'
         write (unit, '(a)') '</PointData>'
+        if (allocated(self%names)) then
+            if (size(self%names) >= n) then
+                ! a VTK string array in ASCII: each name's character codes, then 0
+                write (unit, '(a)') '<FieldData><DataArray type="String" Name="body_names" ' &
+                    // 'NumberOfTuples="' // int_text(n) // '" format="ascii">'
+                do b = 1, n
+                    write (unit, '(*(1x,i0))') (iachar(self%names(b)(k:k)), &
+                        k=1, len_trim(self%names(b))), 0
+                end do
+                write (unit, '(a)') '</DataArray></FieldData>'
+            end if
+        end if
         write (unit, '(a)') '</Piece></UnstructuredGrid></VTKFile>'
         close (unit, iostat=ios)
         if (ios /= 0) call status%set(status_io_error, path // ': cannot close')

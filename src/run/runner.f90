@@ -16,6 +16,7 @@ module flexmbs_run_runner
     use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_mbs_system, only: mbs_system_t
     use flexmbs_io_namelist, only: scene_input_t
+    use flexmbs_io_scene_schema, only: len_name
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_progress, only: progress_t, new_progress
     use flexmbs_io_multi_sink, only: multi_sink_t
@@ -266,6 +267,7 @@ contains
                 vtk%ov = m%nq
             type is (mbs_system_t)
                 vtk%bodies = size(m%rigid%bodies)
+                vtk%names = body_names(size(m%rigid%bodies))
                 if (size(m%chains) > 0) then
                     vtk%chain => m%chains(1)
                     vtk%chain_q = m%chain_q(1)
@@ -285,6 +287,25 @@ contains
                     // trim(scene%problem) // ''' has no bodies to draw')
             end select
         end subroutine setup_vtk
+
+        !> The scene's rigid bodies, the node frames after them, then the
+        !> chain's links, by name (the ParaView bodies' names).
+        function body_names(n) result(names)
+            integer, intent(in) :: n  !! rigid bodies, node frames included
+            character(len=len_name), allocatable :: names(:)
+            integer :: i
+            allocate (names(n + size(scene%chain)))
+            do i = 1, n
+                if (i <= size(scene%rigid_bodies)) then
+                    names(i) = scene%rigid_bodies(i)%name
+                else
+                    names(i) = 'node frame ' // int_text(i - size(scene%rigid_bodies))
+                end if
+            end do
+            do i = 1, size(scene%chain)
+                names(n + i) = scene%chain(i)%name
+            end do
+        end function body_names
 
         logical function force_given()
             force_given = .false.
