@@ -41,23 +41,13 @@ contains
         character(len=*), intent(in) :: name
         real(wp), intent(in) :: values(:, :)
         type(status_t), intent(out) :: status
-        integer(hid_t) :: space, dset, lcpl
         integer(hsize_t) :: dims(2)
-        integer :: err, close_err
-        if (.not. self%is_open) then
-            call status%set(status_bad_input, 'HDF5 sink: write_matrix before create')
-            return
-        end if
+        integer(hid_t) :: dset
+        integer :: err
         dims = shape(values, kind=hsize_t)
-        call h5screate_simple_f(2, dims, space, err)
-        if (err >= 0) call group_creating(lcpl, err)
-        if (err >= 0) call h5dcreate_f(self%file, name, H5T_NATIVE_DOUBLE, space, dset, err, &
-                                       lcpl_id=lcpl)
+        call new_dataset(self, name, H5T_NATIVE_DOUBLE, dims, dset, err, status)
         if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, err)
-        if (err >= 0) call h5dclose_f(dset, err)
-        if (err >= 0) call h5sclose_f(space, err)
-        call h5pclose_f(lcpl, close_err)
-        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
+        call close_dataset(self, name, dset, err, status)
     end subroutine sink_write_matrix
 
     !> A 1-D real dataset /name, e.g. the energy at each record.
@@ -66,23 +56,13 @@ contains
         character(len=*), intent(in) :: name
         real(wp), intent(in) :: values(:)
         type(status_t), intent(out) :: status
-        integer(hid_t) :: space, dset, lcpl
         integer(hsize_t) :: dims(1)
-        integer :: err, close_err
-        if (.not. self%is_open) then
-            call status%set(status_bad_input, 'HDF5 sink: write_vector before create')
-            return
-        end if
-        dims = size(values, kind=hsize_t)
-        call h5screate_simple_f(1, dims, space, err)
-        if (err >= 0) call group_creating(lcpl, err)
-        if (err >= 0) call h5dcreate_f(self%file, name, H5T_NATIVE_DOUBLE, space, dset, err, &
-                                       lcpl_id=lcpl)
+        integer(hid_t) :: dset
+        integer :: err
+        dims = [size(values, kind=hsize_t)]
+        call new_dataset(self, name, H5T_NATIVE_DOUBLE, dims, dset, err, status)
         if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, err)
-        if (err >= 0) call h5dclose_f(dset, err)
-        if (err >= 0) call h5sclose_f(space, err)
-        call h5pclose_f(lcpl, close_err)
-        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
+        call close_dataset(self, name, dset, err, status)
     end subroutine sink_write_vector
 
     !> A 2-D integer dataset /name (rows, columns), e.g. a connectivity
@@ -92,23 +72,13 @@ contains
         character(len=*), intent(in) :: name
         integer, intent(in) :: values(:, :)
         type(status_t), intent(out) :: status
-        integer(hid_t) :: space, dset, lcpl
         integer(hsize_t) :: dims(2)
-        integer :: err, close_err
-        if (.not. self%is_open) then
-            call status%set(status_bad_input, 'HDF5 sink: write_integers before create')
-            return
-        end if
+        integer(hid_t) :: dset
+        integer :: err
         dims = shape(values, kind=hsize_t)
-        call h5screate_simple_f(2, dims, space, err)
-        if (err >= 0) call group_creating(lcpl, err)
-        if (err >= 0) call h5dcreate_f(self%file, name, H5T_NATIVE_INTEGER, space, dset, err, &
-                                       lcpl_id=lcpl)
+        call new_dataset(self, name, H5T_NATIVE_INTEGER, dims, dset, err, status)
         if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_INTEGER, values, dims, err)
-        if (err >= 0) call h5dclose_f(dset, err)
-        if (err >= 0) call h5sclose_f(space, err)
-        call h5pclose_f(lcpl, close_err)
-        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
+        call close_dataset(self, name, dset, err, status)
     end subroutine sink_write_integers
 
     !> A 1-D integer dataset /name, e.g. a node set.
@@ -117,23 +87,13 @@ contains
         character(len=*), intent(in) :: name
         integer, intent(in) :: values(:)
         type(status_t), intent(out) :: status
-        integer(hid_t) :: space, dset, lcpl
         integer(hsize_t) :: dims(1)
-        integer :: err, close_err
-        if (.not. self%is_open) then
-            call status%set(status_bad_input, 'HDF5 sink: write_integers before create')
-            return
-        end if
-        dims = size(values, kind=hsize_t)
-        call h5screate_simple_f(1, dims, space, err)
-        if (err >= 0) call group_creating(lcpl, err)
-        if (err >= 0) call h5dcreate_f(self%file, name, H5T_NATIVE_INTEGER, space, dset, err, &
-                                       lcpl_id=lcpl)
+        integer(hid_t) :: dset
+        integer :: err
+        dims = [size(values, kind=hsize_t)]
+        call new_dataset(self, name, H5T_NATIVE_INTEGER, dims, dset, err, status)
         if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_INTEGER, values, dims, err)
-        if (err >= 0) call h5dclose_f(dset, err)
-        if (err >= 0) call h5sclose_f(space, err)
-        call h5pclose_f(lcpl, close_err)
-        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
+        call close_dataset(self, name, dset, err, status)
     end subroutine sink_write_integer_list
 
     !> A 1-D dataset of UTF-8 strings (variable length: h5py reads str) at
@@ -145,33 +105,20 @@ contains
         type(status_t), intent(out) :: status
         character(kind=c_char, len=len(strings) + 1), allocatable, target :: text(:)
         type(c_ptr), allocatable, target :: pointers(:)
-        integer(hid_t) :: str_type, space, dset, lcpl
-        integer(hsize_t) :: dims(1)
+        integer(hid_t) :: str_type, dset
         integer :: err, k, close_err
-        if (.not. self%is_open) then
-            call status%set(status_bad_input, 'HDF5 sink: write_strings before create')
-            return
-        end if
         allocate (text(size(strings)), pointers(size(strings)))
         do k = 1, size(strings)
             text(k) = trim(strings(k)) // c_null_char
             pointers(k) = c_loc(text(k)(1:1))
         end do
-        dims = size(strings, kind=hsize_t)
         call utf8_string_type(str_type, err)
-        if (err >= 0) call h5screate_simple_f(1, dims, space, err)
-        if (err >= 0) call group_creating(lcpl, err)
-        if (err >= 0) call h5dcreate_f(self%file, path, str_type, space, dset, err, &
-                                       lcpl_id=lcpl)
-        if (err >= 0) then
-            if (size(strings) > 0) call h5dwrite_f(dset, str_type, c_loc(pointers(1)), err)
-            call h5dclose_f(dset, close_err)
-        end if
-        call h5pclose_f(lcpl, close_err)
-        call h5sclose_f(space, close_err)
+        if (err >= 0) call new_dataset(self, path, str_type, [size(strings, kind=hsize_t)], &
+                                       dset, err, status)
+        if (err >= 0 .and. size(strings) > 0) &
+            call h5dwrite_f(dset, str_type, c_loc(pointers(1)), err)
+        call close_dataset(self, path, dset, err, status)
         call h5tclose_f(str_type, close_err)
-        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write /' // &
-                                     path)
     end subroutine sink_write_strings
 
     !> A string attribute `name` = `text` of the dataset or group at `path`.
@@ -189,4 +136,48 @@ contains
         if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot annotate /' &
                                      // path)
     end subroutine sink_annotate
+
+    !> A new dataset `name` of type `dtype` and shape `dims`, the groups of
+    !> its path made as needed; err < 0 (and `status` says why when the file
+    !> is not open) when it cannot be.
+    subroutine new_dataset(self, name, dtype, dims, dset, err, status)
+        class(hdf5_sink_t), intent(in) :: self
+        character(len=*), intent(in) :: name
+        integer(hid_t), intent(in) :: dtype
+        integer(hsize_t), intent(in) :: dims(:)
+        integer(hid_t), intent(out) :: dset
+        integer, intent(out) :: err
+        type(status_t), intent(inout) :: status
+        integer(hid_t) :: space, lcpl
+        integer :: close_err
+        dset = -1
+        err = -1
+        if (.not. self%is_open) then
+            call status%set(status_bad_input, 'HDF5 sink: /' // name // ' before create')
+            return
+        end if
+        call h5screate_simple_f(size(dims), dims, space, err)
+        if (err < 0) return
+        call group_creating(lcpl, err)
+        if (err >= 0) call h5dcreate_f(self%file, name, dtype, space, dset, err, lcpl_id=lcpl)
+        call h5pclose_f(lcpl, close_err)
+        call h5sclose_f(space, close_err)
+    end subroutine new_dataset
+
+    !> Close a dataset new_dataset made; an HDF5 failure (err < 0) on an
+    !> open file is an I/O error naming it.
+    subroutine close_dataset(self, name, dset, err, status)
+        class(hdf5_sink_t), intent(in) :: self
+        character(len=*), intent(in) :: name
+        integer(hid_t), intent(in) :: dset
+        integer, intent(inout) :: err
+        type(status_t), intent(inout) :: status
+        integer :: close_err
+        if (dset >= 0) then
+            call h5dclose_f(dset, close_err)
+            if (close_err < 0) err = close_err
+        end if
+        if (err < 0 .and. status%ok()) call status%set(status_io_error, self%path // &
+            ': HDF5 cannot write /' // name)
+    end subroutine close_dataset
 end submodule flexmbs_io_hdf5_sink_datasets

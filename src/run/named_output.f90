@@ -104,7 +104,7 @@ module flexmbs_run_named_output
         procedure :: evaluate => coordinate_evaluate
     end type coordinate_values_t
 
-    public :: add_named_output
+    public :: add_named_output, joint_angle
 
 contains
 
@@ -401,6 +401,16 @@ contains
         end subroutine put3
     end subroutine add_labels
 
+    !> The angle of marker j's x axis from marker i's, about marker i's z
+    !> axis (axes as columns), in (-π, π].
+    pure real(wp) function joint_angle(ai, aj) result(angle)
+        real(wp), intent(in) :: ai(3, 3), aj(3, 3)
+        real(wp) :: c(3)
+        c = [ai(2, 1) * aj(3, 1) - ai(3, 1) * aj(2, 1), ai(3, 1) * aj(1, 1) - &
+             ai(1, 1) * aj(3, 1), ai(1, 1) * aj(2, 1) - ai(2, 1) * aj(1, 1)]
+        angle = atan2(dot_product(c, ai(:, 3)), dot_product(ai(:, 1), aj(:, 1)))
+    end function joint_angle
+
     !> Where the accelerations start in y, -1 when y has none.
     pure integer function accelerations(f) result(oa)
         type(formulation_t), intent(in) :: f
@@ -580,17 +590,15 @@ contains
         real(wp), intent(in) :: t, y(:)
         real(wp), intent(out) :: values(:)
         type(status_t), intent(inout) :: status
-        real(wp) :: xi(3), xj(3), ai(3, 3), aj(3, 3), angle, c(3)
+        real(wp) :: xi(3), xj(3), ai(3, 3), aj(3, 3), angle
         real(wp), parameter :: two_pi = 8.0_wp * atan(1.0_wp)
         associate (sys => self%system, jt => self%system%joints(self%joint))
             call sys%marker_pose(jt%marker_i, y(self%oq + 1:self%oq + sys%nq), xi, ai)
             call sys%marker_pose(jt%marker_j, y(self%oq + 1:self%oq + sys%nq), xj, aj)
         end associate
         if (self%angle) then
-            ! the turn of x_j from x_i about z_i, continued past ±π
-            c = [ai(2, 1) * aj(3, 1) - ai(3, 1) * aj(2, 1), ai(3, 1) * aj(1, 1) - &
-                 ai(1, 1) * aj(3, 1), ai(1, 1) * aj(2, 1) - ai(2, 1) * aj(1, 1)]
-            angle = atan2(dot_product(c, ai(:, 3)), dot_product(ai(:, 1), aj(:, 1)))
+            ! continued past ±π from the record before
+            angle = joint_angle(ai, aj)
             if (self%started) angle = angle + two_pi * anint((self%last - angle) / two_pi)
             self%last = angle
             self%started = .true.

@@ -8,7 +8,6 @@ module flexmbs_run_summary
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t
     use flexmbs_core_text, only: real_text, int_text
-    use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_mbs_rigid_body, only: rigid_body_nq
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, chain_joint_prismatic, &
         chain_joint_spherical
@@ -18,6 +17,7 @@ module flexmbs_run_summary
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_io_namelist, only: scene_input_t
     use flexmbs_run_plan, only: run_plan_t
+    use flexmbs_run_named_output, only: joint_angle
     implicit none
     private
 
@@ -116,7 +116,7 @@ contains
         character(len=*), intent(in) :: group_name  !! 'joints/NAME' | 'drivers/NAME'
         real(wp), intent(in) :: q(:)
         character(len=:), allocatable :: line
-        real(wp) :: xi(3), xj(3), ai(3, 3), aj(3, 3), c(3)
+        real(wp) :: xi(3), xj(3), ai(3, 3), aj(3, 3)
         character(len=:), allocatable :: name
         line = ''
         name = trim(group_name(index(group_name, '/') + 1:))
@@ -128,12 +128,8 @@ contains
             case default
                 return
             end select
-            if (jt%joint%kind /= joint_prismatic) then
-                c = [ai(2, 1) * aj(3, 1) - ai(3, 1) * aj(2, 1), ai(3, 1) * aj(1, 1) - &
-                     ai(1, 1) * aj(3, 1), ai(1, 1) * aj(2, 1) - ai(2, 1) * aj(1, 1)]
-                line = '  ' // name // ': angle ' // fixed(atan2(dot_product(c, ai(:, 3)), &
-                    dot_product(ai(:, 1), aj(:, 1))) * degrees, 2) // ' deg' // nl
-            end if
+            if (jt%joint%kind /= joint_prismatic) line = '  ' // name // ': angle ' // &
+                fixed(joint_angle(ai, aj) * degrees, 2) // ' deg' // nl
             if (jt%joint%kind /= joint_revolute) line = line // '  ' // name // &
                 ': displacement ' // fixed(dot_product(xj - xi, ai(:, 3)), 4) // ' m' // nl
         end associate
