@@ -43,7 +43,7 @@ FPM          = $(shell command -v fpm 2>/dev/null || echo $(VENV)/bin/fpm)
 PREFIX_DEBUG   := $(BUILD)/prefix-debug
 PREFIX_RELEASE := $(BUILD)/prefix-release
 PREFIX       ?= /usr/local
-# The link line a user needs after the flexmbs library (see README).
+# The link line a user needs after the flexmbs library (docs/library.md).
 SYSLIBS      := -lsundials_fida_mod -lsundials_fnvecserial_mod \
                 -lsundials_fsunmatrixdense_mod -lsundials_fsunmatrixsparse_mod \
                 -lsundials_fsunlinsoldense_mod -lsundials_fsunlinsolklu_mod \
@@ -109,7 +109,8 @@ run: build
 # installed library exactly as a user links them, the example programs of
 # examples/ built the same way and run (test/programs.sh), the architecture's rules
 # on the sources (test/layers.py), then the command-line
-# checks of test/cli.sh, the signals of test/kill.sh (python3-h5py reads
+# checks of test/cli.sh, the documentation's links and generated scene
+# reference (test/docs.py), the signals of test/kill.sh (python3-h5py reads
 # the files they leave), every example scene with empty standard error
 # (test/examples.sh) and the fuzzer of the scene input (test/fuzz, about
 # a thousand mutated scenes, two at a time); one summary line last.
@@ -126,6 +127,9 @@ test: deps
 	    echo "exit $$?" >> $(BUILD)/test-layers.log
 	@set -o pipefail; FPM="$(FPM)" bash test/cli.sh 2>&1 | tee $(BUILD)/test-cli.log; \
 	    echo "exit $$?" >> $(BUILD)/test-cli.log
+	@set -o pipefail; python3 test/docs.py \
+	    "$$($(FPM) run --profile debug --runner echo flexmbs 2>/dev/null | tail -n 1)" 2>&1 \
+	    | tee $(BUILD)/test-docs.log; echo "exit $$?" >> $(BUILD)/test-docs.log
 	@set -o pipefail; FPM="$(FPM)" bash test/kill.sh 2>&1 | tee $(BUILD)/test-kill.log; \
 	    echo "exit $$?" >> $(BUILD)/test-kill.log
 	@set -o pipefail; FPM="$(FPM)" bash test/examples.sh 2>&1 | tee $(BUILD)/test-examples.log; \
@@ -133,7 +137,8 @@ test: deps
 	@set -o pipefail; FPM="$(FPM)" bash test/fuzz/run.sh 2>&1 | tee $(BUILD)/test-fuzz.log; \
 	    echo "exit $$?" >> $(BUILD)/test-fuzz.log
 	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log \
-	    $(BUILD)/test-programs.log $(BUILD)/test-layers.log $(BUILD)/test-cli.log $(BUILD)/test-kill.log \
+	    $(BUILD)/test-programs.log $(BUILD)/test-layers.log $(BUILD)/test-cli.log $(BUILD)/test-docs.log \
+	    $(BUILD)/test-kill.log \
 	    $(BUILD)/test-examples.log $(BUILD)/test-fuzz.log
 
 PROFILE     ?= debug

@@ -9,6 +9,7 @@
 !>                                            a Slurm job array and merge job for the study
 !>   flexmbs columns FILE.h5 COLUMN [COLUMN ...]  t and columns of a result as text
 !>                                        (COLUMN: a number of /y, or rocker/position/z ...)
+!>   flexmbs scene-reference                  every group and variable of a scene, as Markdown
 !>   flexmbs --help | --version
 !>
 !> Exit codes: 0 success, 2 bad input (nothing written), 3 solver failure
@@ -34,6 +35,7 @@ program flexmbs_main
     use flexmbs_run_study, only: make_reference, run_sweep, run_sweep_point, sweep_run_t, &
         read_reference, prepare_points
     use flexmbs_io_result_columns, only: read_column
+    use flexmbs_io_scene_reference, only: scene_reference_lines
     use flexmbs_run_study_grid, only: array_task_count
     use flexmbs_run_study_merge, only: merged_t, merge_records, merge_report
     use flexmbs_run_study_slurm, only: slurm_options_t, check_slurm_options, &
@@ -147,6 +149,9 @@ program flexmbs_main
         end select
     case ('columns')
         call columns()
+    case ('scene-reference')
+        if (nargs > 1) call fail_usage('scene-reference takes no arguments')
+        call scene_reference()
     case default
         call fail_usage('unknown command ''' // command // '''')
     end select
@@ -574,6 +579,9 @@ contains
             '                                          COMPONENT (''rocker/position/z'',', &
             '                                          ''motor/reaction_torque/z''), or a node', &
             '                                          (''coupler/node 23/x'', ''.../velocity/x'')', &
+            '  flexmbs scene-reference                 every group and variable of a scene', &
+            '                                          file: type, unit, default, range, as', &
+            '                                          Markdown (docs/scene_reference.md)', &
             '  flexmbs --help                          show this text', &
             '  flexmbs --version                       show the version', &
             '', &
@@ -581,7 +589,8 @@ contains
             'and for a flexible body &flexible_body with one or more &material;', &
             'for rigid bodies and joints &multibody, &rigid_body, &marker, &joint, &driver;', &
             'for a chain in relative coordinates &rigid_chain', &
-            '(see README.md for every variable, its type, unit and default).', &
+            '(docs/scene_reference.md or flexmbs scene-reference: every variable,', &
+            'its type, unit and default; docs/user_guide.md: how to use them).', &
             'STUDY.nml holds one &study group naming a scene file and the grid.', &
             'Paths in a scene or study file are relative to that file''s folder;', &
             'every error of a file is listed, one per line.', &
@@ -600,6 +609,17 @@ contains
             '            130 / 143 stopped by SIGINT / SIGTERM after the current step', &
             '            (outputs flushed and closed; a second signal ends it at once)'
     end subroutine usage
+
+    !> The scene reference on standard output.
+    subroutine scene_reference()
+        character(len=:), allocatable :: lines(:)
+        integer :: k
+        call scene_reference_lines(lines)
+        do k = 1, size(lines)
+            write (output_unit, '(a)') trim(lines(k))
+        end do
+        call finish(exit_ok)
+    end subroutine scene_reference
 
     function argument(i) result(value)
         integer, intent(in) :: i

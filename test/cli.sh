@@ -168,7 +168,16 @@ kept success-statistics 0 "radau5: NST=275 NAC=238" out/run.h5 run ok.nml --quie
 printf '%s\n&solver name = '"'ida'"', rtol = 1e-8, atol = 1e-8 /\n%s\n' "$sim" "$out" > ida.nml
 kept success-ida 0 "y(1) =  1.70616" out/run.h5 run ida.nml --quiet
 
-# DDASSL on the index-3 pendulum: accepted, with a warning (ALGORITHMS.md §6)
+# the BDF codes refuse coordinate projection before anything is written
+# (IDA used to leave it out silently: NPRJ = 0)
+for solver in ddassl ida; do
+    sed -e "s/formulation = 'ggl'/formulation = 'index2', projection = .true./" \
+        -e "s/^\( *name *= *\)'radau5'/\1'$solver'/" "$root/inputs/four_bar.nml" \
+        > "projection_$solver.nml"
+    bad "$solver-refuses-projection" "$solver: projection is refused" "projection_$solver.nml"
+done
+
+# DDASSL on the index-3 pendulum: accepted, with a warning (docs/theory.md, 3.6)
 printf "&simulation problem = 'pendulum', pendulum_formulation = 'index3', t_end = 1 /\n&solver name = 'ddassl', rtol = 1e-5, atol = 1e-5 /\n%s\n" "$out" > index3.nml
 kept ddassl-index3-warning 0 "warning: ddassl: the problem has index-3 components" out/run.h5 \
     run index3.nml --quiet

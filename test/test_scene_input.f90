@@ -230,18 +230,18 @@ contains
                    scene%output_file)
     end subroutine test_relative_paths
 
-    !> Every variable of the schema is in the README's scene reference.
+    !> Every variable of the schema is in the scene reference of docs/.
     subroutine test_schema_documented(error)
         type(error_t), allocatable, intent(out) :: error
         type(status_t) :: status
         character(len=:), allocatable :: readme
         integer :: i
-        call read_text_file('README.md', readme, status)
-        call check(error, status%ok(), 'README.md: ' // status%text())
+        call read_text_file('docs/scene_reference.md', readme, status)
+        call check(error, status%ok(), 'docs/scene_reference.md: ' // status%text())
         if (allocated(error)) return
         do i = 1, size(schema)
             call check(error, index(readme, '`' // trim(schema(i)%name) // '`') > 0, &
-                       'README lacks &' // trim(schema(i)%group) // ' ' // trim(schema(i)%name))
+                       'docs/scene_reference.md lacks &' // trim(schema(i)%group) // ' ' // trim(schema(i)%name))
         end do
     end subroutine test_schema_documented
 

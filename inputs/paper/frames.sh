@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Frames of the five-body mechanism (README, like the paper's Figure 4):
+# Frames of the five-body mechanism (docs/paper.md, like the paper's Figure 4):
 # the reference trajectory at t = 0, 0.5 and 1 s drawn by gnuplot.
 #   frames.sh FLEXMBS REFERENCE.h5 OUT.png
 # y of inputs/five_body.nml: rocker r 1-3, slider r 8-10, the node frames'

@@ -256,7 +256,7 @@ contains
 
         if (problem%has_projection()) then
             call status%set(status_bad_input, 'ddassl: projection is refused, it disturbs ' // &
-                'the BDF history (ALGORITHMS.md §6); use radau5 or switch projection off')
+                'the BDF history (docs/theory.md, section 3.5); use radau5 or switch projection off')
             return
         end if
         if (problem%n <= 0 .or. size(y) /= problem%n) then

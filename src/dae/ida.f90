@@ -162,6 +162,14 @@ contains
         stats%t_reached = t
         self%native = ida_native_t()
         self%linear_solver_used = ''
+        ! IDA has no hook after a step: a projection asked for would be
+        ! silently left out (as for DDASSL, it would disturb the BDF history)
+        if (problem%has_projection()) then
+            call status%set(status_bad_input, 'ida: projection is refused, it disturbs ' // &
+                'the BDF history (docs/theory.md, section 3.5); use radau5 or switch &
+                &projection off')
+            return
+        end if
         if (size(y) /= problem%n .or. problem%n <= 0) then
             call status%set(status_bad_input, 'ida: size of y differs from problem%n')
             return

@@ -18,7 +18,7 @@ module flexmbs_linalg_linear_solver
     !> 20, 5.3 at 60, 18 at 100, 256 at 1000; below ~20 the two are equal
     !> within noise and dense is the more robust choice. Band LU is never
     !> chosen: on the same banded problem it is 10-20 % slower than KLU at
-    !> n = 1e2..1e5 (README, Benchmarks).
+    !> n = 1e2..1e5 (docs/benchmarks.md).
     integer, parameter, public :: auto_sparse_threshold = 20
 
     !> For `linear_solver = 'auto'` with a sparse J of order n >=
