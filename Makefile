@@ -9,6 +9,7 @@
 #   make check-memory  install valgrind if missing, build (debug), run the numerical
 #                suites and every scene of inputs/ (cut to a few steps) under valgrind
 #   make install PREFIX=...   install library, modules and the classic faces
+#   make docs    the API documentation (FORD, in a virtual environment) into build/docs/api/
 #   OPENMP=1     (with any of them) thread the finite-element assembly
 #   LTO=1        (with any of them) link-time optimisation
 
@@ -17,9 +18,11 @@ SHELL := /bin/bash
 
 APT_PACKAGES := gfortran libsundials-dev libsundials-fortran-dev libsuitesparse-dev \
                 liblapack-dev libopenblas-dev libhdf5-dev libmumps-seq-dev python3-h5py pkgconf \
-                python3-matplotlib
+                python3-matplotlib python3-venv
 BUILD        := $(CURDIR)/build
 VENV         := $(BUILD)/venv
+FORD_VERSION := 7.0.13
+FORD_VENV    := $(BUILD)/ford-venv
 # One set of flags for every fpm call: changing them makes fpm rebuild everything.
 # MUMPS's Fortran headers (dmumps_struc.h, ...) are in /usr/include, which
 # gfortran does not search for INCLUDE lines; the sequential library's
@@ -68,11 +71,11 @@ define write_pkgconfig
 endef
 
 .PHONY: run test bench paper extremes check-memory deps build build-debug install legacy-test \
-        clean help
+        docs clean help
 
 help:
 	@echo "make run | make test | make bench | make paper | make check-memory |" \
-	    "make install PREFIX=dir | make clean"
+	    "make install PREFIX=dir | make docs | make clean"
 
 # Install the system packages and fpm when they are missing (make paper
 # adds gnuplot for its plots, make check-memory valgrind).
@@ -248,6 +251,28 @@ bench: deps
 	$(FPM) build --profile release
 	bash bench/run.sh
 	bash bench/sparse.sh
+
+# The API documentation: FORD $(FORD_VERSION) from PyPI in its own virtual
+# environment (installed once), its settings in fpm.toml's [extra.ford]
+# (sources src/, app/ and legacy/src/; the .F90 files through gfortran's
+# preprocessor), HTML into build/docs/api/. FORD reads [extra.ford] from the
+# folder of its project file: the project file is standard input, so that
+# folder is this one, and the front page is the settings' summary. Any
+# warning of FORD fails the target; its output is in build/docs/ford.log.
+docs: deps
+	@if ! $(FORD_VENV)/bin/ford --version 2>/dev/null | grep -qx "ford version $(FORD_VERSION)"; then \
+	    echo "installing FORD $(FORD_VERSION) into $(FORD_VENV)"; \
+	    /usr/bin/python3 -m venv $(FORD_VENV) && \
+	    $(FORD_VENV)/bin/pip install --quiet ford==$(FORD_VERSION) \
+	        || { echo "could not install FORD $(FORD_VERSION)" >&2; exit 1; }; \
+	fi
+	@mkdir -p $(BUILD)/docs
+	@$(FORD_VENV)/bin/ford - < /dev/null > $(BUILD)/docs/ford.log 2>&1 \
+	    || { cat $(BUILD)/docs/ford.log; echo "make docs: FORD failed" >&2; exit 1; }
+	@if grep -q 'Warning' $(BUILD)/docs/ford.log; then \
+	    cat $(BUILD)/docs/ford.log; echo "make docs: FORD warned (above)" >&2; exit 1; \
+	fi
+	@echo "API documentation: $(BUILD)/docs/api/index.html"
 
 clean:
 	rm -rf $(BUILD) legacy/build

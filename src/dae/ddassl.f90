@@ -1,4 +1,4 @@
-!> DDASSL: variable-order, variable-step BDF for G(t, y, y') = 0.
+!> `DDASSL`: variable-order, variable-step BDF for G(t, y, y') = 0.
 !>
 !> Implemented from [BCP89, ch. 5] as specified in ALGORITHMS.md §2:
 !> fixed-leading-coefficient BDF of orders 1..pmax in modified divided

@@ -818,7 +818,7 @@ contains
     ! The N_Vector arguments are intent(inout) only because FN_VGetArrayPointer
     ! declares its argument so; y and y' are read, never written.
 
-    !> IDAResFn: r = M y' − F(t, y). Failures and non-finite values are
+    !> `IDAResFn`: r = M y' − F(t, y). Failures and non-finite values are
     !> recoverable (1): IDA retries with a smaller step.
     integer(c_int) function ida_residual(t, nv_y, nv_yp, nv_r, user_data) result(ierr) &
         bind(C, name='flexmbs_ida_residual')

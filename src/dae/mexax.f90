@@ -1,4 +1,4 @@
-!> MEXAX: half-explicit extrapolation for constrained mechanical systems
+!> `MEXAX`: half-explicit extrapolation for constrained mechanical systems
 !> (ALGORITHMS.md §3; [Lub91], [LNPE95], [HW96 VII.6], ODEX control of
 !> [HNW93 II.9]).
 !>
@@ -285,8 +285,8 @@ contains
         type(dae_stats_t), intent(out) :: stats
         type(status_t), intent(out) :: status
         class(sink_t), intent(inout), optional :: sink
-        real(wp), intent(inout), optional :: lambda(:) !! out: λ at t (size nc)
-        real(wp), intent(inout), optional :: accel(:)  !! out: a = v' at t (size nv)
+        real(wp), intent(inout), optional :: lambda(:) !! on exit: λ at t (size nc)
+        real(wp), intent(inout), optional :: accel(:)  !! on exit: a = v' at t (size nv)
 
         type(workspace_t) :: w
         type(timer_t) :: timer

@@ -1,4 +1,4 @@
-!> RADAU5: the 3-stage Radau IIA method of order 5 for M y' = F(t, y).
+!> `RADAU5`: the 3-stage Radau IIA method of order 5 for M y' = F(t, y).
 !>
 !> Implemented from the published algorithm [HW96 IV.8, HW99] as specified
 !> in ALGORITHMS.md §1: simplified Newton on the stage equations in the
@@ -731,7 +731,7 @@ contains
             end do
         end subroutine compute_scal
 
-        !> R8: h/2 after Newton failure, singular matrix or non-finite value.
+        !> §1.10 R8: h/2 after Newton failure, singular matrix or non-finite value.
         !> Take back the step just accepted and retry with h/2, counted like R8.
         subroutine undo_step()
             y = cont

@@ -90,7 +90,7 @@ contains
         classes = 1
     end subroutine residual_index_classes
 
-    !> Default: no. A problem that computes PD = ∂G/∂y + cj ∂G/∂y' itself
+    !> By default, no. A problem that computes PD = ∂G/∂y + cj ∂G/∂y' itself
     !> (the classic DDASSL JAC) says yes and gives `setup_partials` B in
     !> dense storage; the solver then factors PD as it stands.
     logical function residual_has_iteration_matrix(self)

@@ -117,7 +117,7 @@ contains
         text = text // ' (known: ' // excerpt(list) // ')'
     end function known_sets
 
-    !> Consistency: 8 or 27 nodes per element, connectivity within the nodes
+    !> Consistency checks: 8 or 27 nodes per element, connectivity within the nodes
     !> and without repeats, set members in range, set names unique per kind.
     subroutine mesh_check(self, status)
         class(mesh_t), intent(in) :: self

@@ -167,7 +167,7 @@ module flexmbs_io_scene_input
         logical :: exclude_index23 !! DDASSL: index-2/3 out of the error test
         logical :: netlib !! DDASSL: later netlib revision
         integer :: max_extrapolation !! MEXAX: extrapolation columns (KDMAX), 2..12
-        character(len=len_name) :: mexax_base !! MEXAX: 'midpoint' | 'euler'
+        character(len=len_name) :: mexax_base !! MEXAX's base method: 'midpoint' | 'euler'
         ! &output
         !> HDF5 file; '' = none. Derived from the input name when not given.
         character(len=:), allocatable :: output_file

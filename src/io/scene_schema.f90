@@ -29,7 +29,7 @@ module flexmbs_io_scene_schema
         character(len=16) :: group = ''
         character(len=24) :: name = ''
         integer :: kind = kind_real
-        !> values: 1 for a scalar; an array of reals or integers takes
+        !> Number of values: 1 for a scalar; an array of reals or integers takes
         !> exactly `count`, an array of strings 1..count
         integer :: count = 1
         !> a list: 1..count values of any kind

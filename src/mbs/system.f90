@@ -79,13 +79,13 @@ module flexmbs_mbs_system
     implicit none
     private
 
-    !> constraint_derivatives: hand-coded first derivatives of the joint rows.
+    !> `constraint_derivatives`: hand-coded first derivatives of the joint rows.
     integer, parameter, public :: constraint_derivatives_analytic = 1
-    !> constraint_derivatives: AD of the joints' vector relations on the
+    !> `constraint_derivatives`: AD of the joints' vector relations on the
     !> marker frames (dual numbers seeded with the markers' Jacobians; jets
     !> along the markers' motion for γ).
     integer, parameter, public :: constraint_derivatives_ad = 2
-    !> constraint_derivatives: AD through the body coordinates (quaternions,
+    !> `constraint_derivatives`: AD through the body coordinates (quaternions,
     !> chain angles) as well: slower, verifies the markers' Jacobians too.
     integer, parameter, public :: constraint_derivatives_ad_full = 3
 

@@ -11,7 +11,7 @@ contains
         system_has_sparse = .true.
     end procedure system_has_sparse
 
-    !> M: per body m I₃ (3 slots) and the full 3 × 3 inertia block, in the
+    !> Pattern of M: per body m I₃ (3 slots) and the full 3 × 3 inertia block, in the
     !> triplet order mass_sparse fills.
     module procedure system_mass_pattern
         integer, allocatable :: rows(:), cols(:)
@@ -106,7 +106,7 @@ contains
         end do
     end procedure system_mass_sparse
 
-    !> G: joint k's rows times the 6 velocity columns of each of its
+    !> Pattern of G: joint k's rows times the 6 velocity columns of each of its
     !> markers' bodies (none for the ground), joint by joint.
     module procedure system_constraint_jacobian_pattern
         integer, allocatable :: rows(:), cols(:)
@@ -288,7 +288,7 @@ contains
         end do
     end procedure system_derivative_patterns
 
-    !> T: I₃ and L(p)ᵀ/2 per rigid body, the chains' columns T e_l, I for
+    !> Values of T: I₃ and L(p)ᵀ/2 per rigid body, the chains' columns T e_l, I for
     !> flexible bodies.
     module procedure system_kinematics_sparse
         real(wp) :: e(rigid_body_nq), rate(rigid_body_nq), l(3, 4)

@@ -27,9 +27,9 @@ module flexmbs_problems_mechanisms
 
     real(wp), parameter, public :: mechanism_omega = 6.283185307179586_wp !! rad/s
     real(wp), parameter, public :: mechanism_theta0 = 0.3_wp             !! rad at t = 0
-    !> slider-crank: crank r, rod l
+    !> Slider-crank lengths: crank r, rod l
     real(wp), parameter, public :: crank_r = 0.1_wp, rod_l = 0.3_wp
-    !> four-bar: crank a, coupler b, rocker c, ground d (0.1 + 0.4 < 0.3 + 0.35)
+    !> Four-bar lengths: crank a, coupler b, rocker c, ground d (0.1 + 0.4 < 0.3 + 0.35)
     real(wp), parameter, public :: bar_a = 0.1_wp, bar_b = 0.4_wp, bar_c = 0.3_wp, &
         bar_d = 0.35_wp
 
@@ -51,7 +51,7 @@ contains
         crank_angle = mechanism_theta0 + mechanism_omega * t
     end function crank_angle
 
-    !> Slider-crank: crank pin B, slider C = (s, 0, 0), rod angle φ.
+    !> Slider-crank exact solution: crank pin B, slider C = (s, 0, 0), rod angle φ.
     pure subroutine slider_crank_exact(theta, b, c, phi)
         real(wp), intent(in) :: theta
         real(wp), intent(out) :: b(3), c(3), phi
@@ -60,7 +60,7 @@ contains
         phi = atan2(c(2) - b(2), c(1) - b(1))
     end subroutine slider_crank_exact
 
-    !> Four-bar: crank pin B and coupler–rocker pin C, the intersection of
+    !> Four-bar exact solution: crank pin B and coupler–rocker pin C, the intersection of
     !> |C − B| = b and |C − D| = c in the assembly mode above the ground line.
     pure subroutine four_bar_exact(theta, b, c)
         real(wp), intent(in) :: theta

@@ -13,7 +13,7 @@ module flexmbs_legacy_ddassl_interface
     public :: ddassl_res_i, ddassl_jac_i, ddassl
 
     abstract interface
-        !> RES: delta = G(t, y, y'). Set ires = -1 for an illegal y (the step
+        !> `RES`: delta = G(t, y, y'). Set ires = -1 for an illegal y (the step
         !> is retried smaller), ires = -2 to stop the integration (IDID -11).
         subroutine ddassl_res_i(t, y, yprime, delta, ires, rpar, ipar)
             import :: wp
@@ -26,7 +26,7 @@ module flexmbs_legacy_ddassl_interface
             integer, intent(inout) :: ipar(*)    !! user data, passed through
         end subroutine ddassl_res_i
 
-        !> JAC: pd = ∂G/∂y + cj ∂G/∂y', zeroed before the call; full
+        !> `JAC`: pd = ∂G/∂y + cj ∂G/∂y', zeroed before the call; full
         !> pd(i, j) with leading dimension NEQ, or banded pd(i - j + ML + MU + 1, j)
         !> with leading dimension 2 ML + MU + 1.
         subroutine ddassl_jac_i(t, y, yprime, pd, cj, rpar, ipar)

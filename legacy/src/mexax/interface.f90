@@ -14,7 +14,7 @@ module flexmbs_legacy_mexax_interface
     public :: mexax_fprob_i, mexax_solout_i, mexax, mexx
 
     abstract interface
-        !> FPROB: evaluate exactly the items whose flag is set (§3.9):
+        !> `FPROB`: evaluate exactly the items whose flag is set (§3.9):
         !> QFLAG(1) AM = M; (2) GP = G (LDG = NL); (3) GP = C = g_p T (LDG = NG);
         !> (4) F = f; (5) PDOT = T(t, p) v; (6) UDOT = d; (7) G = g; (8) GI = g_I;
         !> (9) FL = ∂f/∂λ. Set IFAIL ≠ 0 to stop the run (IERR −17 / −18).
@@ -38,7 +38,7 @@ module flexmbs_legacy_mexax_interface
             integer, intent(inout) :: ifail           !! 0 on entry; ≠ 0 stops the run
         end subroutine mexax_fprob_i
 
-        !> SOLOUT: called at T0 and after every accepted step when MXJOB(30) = 1.
+        !> `SOLOUT`: called at T0 and after every accepted step when MXJOB(30) = 1.
         !> INFO(1) is the number of the output (1 at T0); set IRTRN < 0 to stop
         !> the integration (IERR 1).
         subroutine mexax_solout_i(np, nv, nu, nl, t, p, v, u, a, rlam, info, irtrn)

@@ -393,7 +393,7 @@ contains
         end subroutine reject
     end subroutine radau5_classic
 
-    !> CONTR5: component i at s of the dense output of the latest SOLOUT
+    !> `CONTR5`: component i at s of the dense output of the latest SOLOUT
     !> call; NaN when there is none or i is out of range.
     real(wp) function contr5_value(i, s) result(value)
         integer, intent(in) :: i
@@ -592,7 +592,7 @@ contains
         end do
     end subroutine full_differences
 
-    !> Banded: columns j ≡ g (mod MLJAC+MUJAC+1) of one block perturbed
+    !> Banded Jacobian: columns j ≡ g (mod MLJAC+MUJAC+1) of one block perturbed
     !> together, one FCN call per group; only in-band entries kept.
     subroutine banded_differences(self, t, y)
         class(classic_problem_t), intent(inout) :: self

@@ -14,7 +14,7 @@ module flexmbs_legacy_radau5_interface
     public :: radau5, contr5
 
     abstract interface
-        !> FCN: the right-hand side f(x, y) of M y' = f(x, y).
+        !> `FCN`: the right-hand side f(x, y) of M y' = f(x, y).
         subroutine radau5_fcn_i(n, x, y, f, rpar, ipar)
             import :: wp
             integer, intent(in) :: n             !! dimension
@@ -25,7 +25,7 @@ module flexmbs_legacy_radau5_interface
             integer, intent(inout) :: ipar(*)    !! user data, passed through
         end subroutine radau5_fcn_i
 
-        !> JAC: dfy(i, j) = ∂f_i/∂y_j (full), or dfy(i - j + mujac + 1, j)
+        !> `JAC`: dfy(i, j) = ∂f_i/∂y_j (full), or dfy(i - j + mujac + 1, j)
         !> (banded); with M1 > 0 only the rows M1+1..n, as rows 1..n-M1.
         subroutine radau5_jac_i(n, x, y, dfy, ldfy, rpar, ipar)
             import :: wp
@@ -38,7 +38,7 @@ module flexmbs_legacy_radau5_interface
             integer, intent(inout) :: ipar(*)    !! user data, passed through
         end subroutine radau5_jac_i
 
-        !> MAS: the constant mass matrix, full am(i, j) or banded
+        !> `MAS`: the constant mass matrix, full am(i, j) or banded
         !> am(i - j + mumas + 1, j); with M1 > 0 its lower-right block of
         !> order n - M1, which is then the `n` passed.
         subroutine radau5_mas_i(n, am, lmas, rpar, ipar)
@@ -50,7 +50,7 @@ module flexmbs_legacy_radau5_interface
             integer, intent(inout) :: ipar(*)    !! user data, passed through
         end subroutine radau5_mas_i
 
-        !> SOLOUT: called at x0 (nr = 1) and after every accepted step;
+        !> `SOLOUT`: called at x0 (nr = 1) and after every accepted step;
         !> CONTR5 evaluates the step's dense output on [xold, x].
         subroutine radau5_solout_i(nr, xold, x, y, cont, lrc, n, rpar, ipar, irtrn)
             import :: wp
