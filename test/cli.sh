@@ -420,8 +420,8 @@ done
 sed -e "s/t_end   = 0.5 /t_end   = 0.02 /" -e "s#^&output#\&output vtk = 'out/vis', file = 'none',#" \
     -e "s/n_output = 51/n_output = 3/" "$root/inputs/rigid_flexible_pendulum.nml" > vis.nml
 expect vtk-run 0 "radau5: NST=" run vis.nml --quiet
-if [ -f out/vis_0002.vtu ] && [ -f out/vis_bodies_0002.vtu ] && \
-   [ "$(grep -c '<DataSet' out/vis.pvd)" -eq 6 ] && \
+if [ -f out/vis_0002.vtu ] && [ -f out/vis_bodies_0002.vtu ] && [ -f out/vis_joints_0002.vtu ] && \
+   [ "$(grep -c '<DataSet' out/vis.pvd)" -eq 9 ] && \
    grep -q 'NumberOfPoints="20" NumberOfCells="4"' out/vis_0002.vtu && \
    grep -q 'Name="von_mises"' out/vis_0002.vtu; then pass vtk-files
 else fail vtk-files "$(ls out; head -c 400 out/vis.pvd 2>/dev/null)"; fi
@@ -452,6 +452,70 @@ sys.exit(0 if pvd == t and len(t) == 4 else 1)
 PY
 then pass vtk-times-are-hdf5-time
 else fail vtk-times-are-hdf5-time "$(grep -o 'timestep="[^"]*"' out/vt.pvd | head -4)"; fi
+# the joints (part 2): the four-bar's four joints and its driver, a point each at
+# marker i, by name; the points against the markers computed from the HDF5 file's
+# bodies (position + R s), the fixed pivots, the reactions against /joints
+sed -e "s/t_end   = 1.0 /t_end   = 0.2 /" \
+    -e "s#^&output#\&output vtk = 'out/fbj', file = 'out/fbj.h5',#" \
+    -e "s/n_output = 101/n_output = 3/" "$root/inputs/four_bar.nml" > fbj.nml
+expect vtk-joints-run 0 "radau5: NST=" run fbj.nml --quiet
+if problem=$(/usr/bin/python3 - out/fbj.pvd out/fbj.h5 2>&1 <<'PY'
+import sys, re, h5py, numpy as np
+import xml.etree.ElementTree as ET
+pvd = open(sys.argv[1]).read()
+f = h5py.File(sys.argv[2], 'r')
+files = re.findall(r'part="2" file="([^"]+)"', pvd)
+assert files == ['fbj_joints_%04d.vtu' % k for k in range(3)], files
+def arrays(node):
+    return {a.get('Name'): a for a in node.iter('DataArray') if a.get('Name')}
+def values(a):
+    return np.array(a.text.split(), float)
+def strings(a):
+    codes = [int(c) for c in a.text.split()]
+    out, word = [], ''
+    for c in codes:
+        if c == 0:
+            out.append(word)
+            word = ''
+        else:
+            word += chr(c)
+    return out
+def rotation(body, k):
+    return f['bodies/%s/rotation_matrix' % body][k].reshape(3, 3).T   # column by column
+names = ['joints/crank pivot', 'joints/crank pin', 'joints/rocker pin', 'joints/rocker pivot',
+         'drivers/motor']
+for k, name in enumerate(files):
+    grid = ET.parse('out/' + name).getroot().find('UnstructuredGrid')
+    piece = grid.find('Piece')
+    assert piece.get('NumberOfPoints') == '5', piece.attrib
+    # field data belongs to the data set: VTK reads none inside a piece
+    field = arrays(grid.find('FieldData'))
+    assert strings(field['joint_names']) == names, strings(field['joint_names'])
+    assert strings(field['joint_types']) == ['revolute', 'spherical', 'universal', 'revolute',
+                                            'angle driver'], strings(field['joint_types'])
+    x = values(piece.find('Points/DataArray')).reshape(5, 3)
+    point = arrays(piece.find('PointData'))
+    assert list(values(point['joint_id'])) == [1, 2, 3, 4, 5]
+    assert list(values(point['joint_type'])) == [2, 1, 5, 2, 7]
+    crank, coupler = f['bodies/crank/position'][k], f['bodies/coupler/position'][k]
+    want = np.array([[0, 0, 0],                                          # A on the ground
+                     crank + rotation('crank', k) @ [0.05, 0, 0],        # B1 on the crank
+                     coupler + rotation('coupler', k) @ [0.2, 0, 0],     # C2 on the coupler
+                     [0.35, 0, 0],                                       # D on the ground
+                     [0, 0, 0]])                                         # the motor's A
+    assert np.abs(x - want).max() < 1e-12, (k, x, want)
+    axis = values(point['axis']).reshape(5, 3)
+    assert np.abs(axis[2] - rotation('coupler', k) @ [0, 1, 0]).max() < 1e-12, axis[2]
+    force = values(point['reaction_force']).reshape(5, 3)
+    assert np.abs(force[1] - f['joints/crank pin/reaction_force'][k]).max() < 1e-12
+    force_j = values(point['reaction_force_j']).reshape(5, 3)
+    assert np.abs(force_j[3] - f['joints/rocker pivot/reaction_force_j'][k]).max() < 1e-12
+    assert np.abs(force[1]).max() > 0.1, force                           # not all zero
+bodies = ET.parse('out/fbj_bodies_0002.vtu').getroot().find('UnstructuredGrid')
+assert strings(arrays(bodies.find('FieldData'))['body_names']) == ['crank', 'coupler', 'rocker']
+PY
+); then pass vtk-joints-at-markers
+else fail vtk-joints-at-markers "$problem"; fi
 sed -e "s#^&output#\&output vtk = 'vdp',#" "$root/inputs/van_der_pol.nml" > vdp_vtk.nml
 bad vtk-no-bodies "&output: vtk: problem = 'van_der_pol' has no bodies to draw" vdp_vtk.nml
 
@@ -521,6 +585,10 @@ expect vtk-rerun 0 "radau5: NST=" run vis.nml --quiet
 echo "<VTKFile/>" > out/vis_0001.vtu
 untouched vtk-foreign-piece "&output: vtk: 'out/vis_0001.vtu' exists and is not a ParaView file written by flexmbs" \
     out/vis_0001.vtu run vis.nml --quiet
+rm -f out/vis_0001.vtu
+echo "<VTKFile/>" > out/vis_joints_0001.vtu
+untouched vtk-foreign-joints-piece "&output: vtk: 'out/vis_joints_0001.vtu' exists and is not a ParaView file written by flexmbs" \
+    out/vis_joints_0001.vtu run vis.nml --quiet
 echo "notes" > study_reference.h5
 untouched study-reference-foreign "&study: reference_file: 'study_reference.h5' exists and is not an HDF5 file" \
     study_reference.h5 reference study.nml --quiet

@@ -9,7 +9,7 @@ module test_chain_coupling
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_radau5, only: radau5_t
-    use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle
+    use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle, cross
     use flexmbs_mbs_rigid_body, only: rigid_body_t
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, new_rigid_chain, chain_body_t, &
         chain_joint_revolute, chain_joint_spherical
@@ -37,7 +37,8 @@ contains
         tests = [new_test('chain_markers_ad_vs_analytic', test_ad), &
                  new_test('formulation_jacobian_fd', test_jacobian), &
                  new_test('four_bar_with_chain_closed_form', test_closed_form), &
-                 new_test('spherical_chain_in_system', test_spherical)]
+                 new_test('spherical_chain_in_system', test_spherical), &
+                 new_test('chain_joint_reactions_balance', test_reactions)]
     end function collect_chain_coupling
 
     subroutine make(derivatives, sys, q0, status)
@@ -238,6 +239,62 @@ contains
             abs(e1 - e0) / abs(e0)
         call check(error, abs(e1 - e0) <= 1.0e-5_wp * abs(e0), 'energy drift')
     end subroutine test_spherical
+
+    !> A joint's rows do not change when both its markers move as one rigid
+    !> body, so what it exerts on its two sides balances: F_i + F_j = 0 and
+    !> n_i + n_j + (x_i − x_j) × F_i = 0 (torques about each marker). Checked
+    !> for joints between a chain link and a rigid body (the pair's spherical
+    !> joint, assembled, whose rows turn with the bodies; the four-bar's two
+    !> dot-2 rows, scalars) at perturbed positions and
+    !> random multipliers: a chain side's force is a force, not the chain's
+    !> generalised forces.
+    subroutine test_reactions(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(mbs_system_t) :: pair, four
+        type(status_t) :: status
+        real(wp) :: q0(12), q4(9), worst
+        integer(i8) :: seed
+        integer :: trial
+        call make_pair('analytic', pair, q0, status)
+        if (status%ok()) call make('analytic', four, q4, status)
+        call check(error, status%ok(), 'systems: ' // status%text())
+        if (allocated(error)) return
+        seed = 33_i8
+        worst = 0.0_wp
+        do trial = 1, 4
+            worst = max(worst, imbalance(pair, q0, 1), imbalance(four, q4, 2), &
+                        imbalance(four, q4, 3))
+        end do
+        print '(4x,a,es9.2)', 'chain joint reactions: largest imbalance ', worst
+        call check(error, worst <= 1.0e-12_wp, 'reactions on a chain link and a body do &
+                   &not balance')
+    contains
+        real(wp) function imbalance(sys, q0, k) result(d)
+            type(mbs_system_t), intent(in) :: sys
+            real(wp), intent(in) :: q0(:)
+            integer, intent(in) :: k
+            real(wp) :: q(size(q0)), lambda(sys%nc), force(3, 2), torque(3, 2), &
+                xi(3), xj(3), a(3, 3)
+            call fill_random(q, seed, -0.1_wp, 0.1_wp)
+            q = q0 + q
+            q(4:7) = q(4:7) / norm2(q(4:7))
+            if (size(q) == 12) then
+                ! the ball joint's rows are a vector: assembled, the body put
+                ! where its marker meets the chain's
+                q(8:11) = q(8:11) / norm2(q(8:11))
+                call sys%marker_pose(sys%joints(k)%marker_i, q, xi, a)
+                q(1:3) = xi - matmul(rotation_matrix(q(4:7)), sys%markers(2)%position)
+            end if
+            call fill_random(lambda, seed, -2.0_wp, 2.0_wp)
+            call sys%joint_reaction(k, 0.3_wp, q, lambda, force, torque)
+            call sys%marker_pose(sys%joints(k)%marker_i, q, xi, a)
+            call sys%marker_pose(sys%joints(k)%marker_j, q, xj, a)
+            d = max(maxval(abs(force(:, 1) + force(:, 2))), &
+                    maxval(abs(torque(:, 1) + torque(:, 2) + cross(xi - xj, force(:, 1)))))
+            ! a side that takes nothing balances trivially
+            if (norm2(force(:, 1)) + norm2(torque(:, 1)) < 1.0e-3_wp) d = huge(1.0_wp)
+        end function imbalance
+    end subroutine test_reactions
 
     !> The pair: rigid body (q 1:7), chain (ball quaternion 8:11, hinge 12).
     subroutine make_pair(derivatives, sys, q0, status)

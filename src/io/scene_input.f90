@@ -175,7 +175,8 @@ module flexmbs_io_scene_input
         logical :: every_step
         character(len=len_path) :: table
         logical :: progress
-        !> ParaView files PREFIX_NNNN.vtu and PREFIX.pvd ('' = none)
+        !> ParaView files PREFIX_NNNN.vtu, PREFIX_bodies_NNNN.vtu, PREFIX_joints_NNNN.vtu and
+        !> PREFIX.pvd ('' = none; flexmbs_io_vtk_sink)
         character(len=len_path) :: vtk
         ! &flexible_body and &material
         logical :: has_body = .false.                 !! a &flexible_body group was given

@@ -128,7 +128,7 @@ module flexmbs_io_scene_schema
         var_spec_t('output', 'progress', kind_logical, default='.true.', &
             doc='progress display on standard error'), &
         var_spec_t('output', 'vtk', kind_string, &
-            doc='ParaView files PREFIX_NNNN.vtu and PREFIX.pvd'), &
+            doc='ParaView files PREFIX.pvd, PREFIX_NNNN.vtu, PREFIX_bodies|joints_NNNN.vtu'), &
         var_spec_t('flexible_body', 'name', kind_string, default='body', &
             doc='name of the flexible body'), &
         var_spec_t('flexible_body', 'element', kind_string, default='hex8', &

@@ -2,13 +2,29 @@
 !> XML unstructured grid (`PREFIX_NNNN.vtu`: current node positions, the
 !> hexahedra in VTK order — hex8 cell type 12, hex27 type 29 —, point data
 !> displacement and velocity, cell data Cauchy stress (xx, yy, zz, xy, yz,
-!> xz) and its von Mises value) and the rigid bodies (`PREFIX_bodies_NNNN.vtu`:
+!> xz) and its von Mises value), the rigid bodies (`PREFIX_bodies_NNNN.vtu`:
 !> one vertex per body at its centre of mass, the bodies in absolute
 !> coordinates first, then a chain's links; point data the body's three
-!> axes), listed with their times in `PREFIX.pvd` (part 0 the mesh, part 1
-!> the bodies). The .pvd is rewritten after every record, so a run that
-!> stops keeps a collection ParaView opens. Every file's second line is the
-!> comment '<!-- written by flexmbs 0.1.0 -->' (vtk_file_ours).
+!> axes and body_id, field data body_names) and a multibody system's joints
+!> and drivers (`PREFIX_joints_NNNN.vtu`: one vertex per joint at its marker
+!> i, wherever that sits — a body, a chain link, a node frame, a node, the
+!> ground; point data joint_id, joint_type (flexmbs_mbs_joint: 1 spherical,
+!> 2 revolute, 3 cylindrical, 4 prismatic, 5 universal, 6 fixed, 7 one
+!> primitive: drivers, distances), axis (world: marker i's z axis, the joint
+!> axis; an angle driver's turning axis, a translation driver's direction),
+!> marker_j_offset x_j − x_i (zero for a satisfied spherical, revolute,
+!> universal or fixed joint; a prismatic joint's stroke, a distance's rod)
+!> and, with the multipliers in y, reaction_force and reaction_torque on
+!> marker i's body, reaction_force_j and reaction_torque_j on marker j's
+!> (as the HDF5 file's /joints; zero on the ground); field data joint_names
+!> — 'joints/NAME', 'joints/NAME (node N)' for an attached node, or
+!> 'drivers/NAME', the HDF5 groups — and joint_types). Field data belongs to
+!> the data set, before its piece: VTK reads none inside a piece.
+!> The files are listed with their times in `PREFIX.pvd` (part 0 the mesh, part
+!> 1 the bodies, part 2 the joints). The .pvd is rewritten after every
+!> record, so a run that stops keeps a collection ParaView opens. Every
+!> file's second line is the comment '<!-- written by flexmbs 0.1.0 -->'
+!> (vtk_file_ours).
 module flexmbs_io_vtk_sink
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_resources, only: out_of_memory
@@ -20,6 +36,10 @@ module flexmbs_io_vtk_sink
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
+    use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_mbs_joint, only: joint_primitive, joint_name
+    use flexmbs_mbs_primitive_kinds, only: primitive_name, primitive_angle_driver, &
+        primitive_translation_driver, primitive_dot2
     implicit none
     private
 
@@ -33,6 +53,12 @@ module flexmbs_io_vtk_sink
         !> the names of the rigid bodies, then of the chain's links (a point
         !> each in the bodies' files: field data body_names, point data body_id)
         character(len=32), allocatable :: names(:)
+        !> a multibody system's joints and drivers (a point each in the
+        !> joints' files): its q after y(system_q), its multipliers after
+        !> y(system_l) (0: none in y, no reactions)
+        type(mbs_system_t), pointer :: system => null()
+        integer :: system_q = 0, system_l = 0
+        character(len=80), allocatable :: joint_names(:) !! 'joints/NAME', 'drivers/NAME'
         integer :: records = 0
         real(wp), allocatable :: times(:)
     contains
@@ -56,6 +82,8 @@ contains
         n = 0
         if (associated(self%body)) n = n + records
         if (self%bodies + links(self) > 0) n = n + records
+        if (joints(self) > 0) n = n + records
+        ! '_joints_' is as long as '_bodies_'
         width = len(self%prefix) + len('_bodies_') + len(digits(records)) + len('.vtu')
         allocate (character(len=width) :: paths(n))
         n = 0
@@ -67,6 +95,10 @@ contains
             if (self%bodies + links(self) > 0) then
                 n = n + 1
                 paths(n) = bodies_piece(self%prefix, k)
+            end if
+            if (joints(self) > 0) then
+                n = n + 1
+                paths(n) = joints_piece(self%prefix, k)
             end if
         end do
     end function vtk_pieces
@@ -98,6 +130,14 @@ contains
         path = prefix // '_bodies_' // digits(k - 1) // '.vtu'
     end function bodies_piece
 
+    !> PREFIX_joints_NNNN.vtu, the joints at record k
+    pure function joints_piece(prefix, k) result(path)
+        character(len=*), intent(in) :: prefix
+        integer, intent(in) :: k
+        character(len=:), allocatable :: path
+        path = prefix // '_joints_' // digits(k - 1) // '.vtu'
+    end function joints_piece
+
     subroutine vtk_output(self, t, y, status)
         class(vtk_sink_t), intent(inout) :: self
         real(wp), intent(in) :: t, y(:)
@@ -109,6 +149,8 @@ contains
             mesh_piece(self%prefix, self%records), status)
         if (status%ok() .and. self%bodies + links(self) > 0) call write_bodies(self, y, &
             bodies_piece(self%prefix, self%records), status)
+        if (status%ok() .and. joints(self) > 0) call write_joints(self, t, y, &
+            joints_piece(self%prefix, self%records), status)
         if (.not. status%ok()) return
         if (.not. allocated(self%times)) allocate (self%times(0))
         tt = [self%times, t]
@@ -131,7 +173,7 @@ contains
         type(status_t), intent(inout) :: status
         real(wp), allocatable :: x(:, :), v(:, :), sigma(:, :), mises(:)
         type(status_t) :: stress_status
-        integer :: unit, ios, n, ne, nn, i, j, celltype, stat
+        integer :: unit, n, ne, nn, i, j, celltype, stat
         associate (body => self%body, mesh => self%body%mesh)
             n = mesh%node_count()
             ne = mesh%element_count()
@@ -159,8 +201,9 @@ contains
                 mises = 0.0_wp
             end if
             celltype = merge(12, 29, nn == 8)
-            call open_grid(path, n, ne, unit, status)
+            call open_grid(path, unit, status)
             if (.not. status%ok()) return
+            call begin_piece(unit, n, ne)
             write (unit, '(3es24.15e3)') x
             write (unit, '(a)') '</DataArray></Points>'
             write (unit, '(a)') '<Cells><DataArray type="Int64" Name="connectivity" ' // &
@@ -176,14 +219,9 @@ contains
             write (unit, '(*(1x,i0))') (celltype, i=1, ne)
             write (unit, '(a)') '</DataArray></Cells>'
             write (unit, '(a)') '<PointData Vectors="displacement">'
-            write (unit, '(a)') '<DataArray type="Float64" Name="displacement" ' // &
-                'NumberOfComponents="3" format="ascii">'
-            write (unit, '(3es24.15e3)') x - mesh%x
-            write (unit, '(a)') '</DataArray>'
-            write (unit, '(a)') '<DataArray type="Float64" Name="velocity" ' // &
-                'NumberOfComponents="3" format="ascii">'
-            write (unit, '(3es24.15e3)') v
-            write (unit, '(a)') '</DataArray></PointData>'
+            call write_vectors(unit, 'displacement', x - mesh%x)
+            call write_vectors(unit, 'velocity', v)
+            write (unit, '(a)') '</PointData>'
             write (unit, '(a)') '<CellData Scalars="von_mises">'
             write (unit, '(a)') '<DataArray type="Float64" Name="stress" ' // &
                 'NumberOfComponents="6" format="ascii">'
@@ -192,9 +230,7 @@ contains
             write (unit, '(a)') '<DataArray type="Float64" Name="von_mises" format="ascii">'
             write (unit, '(es24.15e3)') mises
             write (unit, '(a)') '</DataArray></CellData>'
-            write (unit, '(a)') '</Piece></UnstructuredGrid></VTKFile>'
-            close (unit, iostat=ios)
-            if (ios /= 0) call status%set(status_io_error, path // ': cannot close')
+            call close_grid(unit, path, status)
         end associate
     end subroutine write_mesh
 
@@ -205,7 +241,7 @@ contains
         type(status_t), intent(inout) :: status
         real(wp) :: a(3, 3), centre(3, self%bodies + links(self)), &
             axes(3, 3, self%bodies + links(self))
-        integer :: unit, ios, b, k, n
+        integer :: unit, b, k, n
         n = self%bodies + links(self)
         do b = 1, self%bodies
             centre(:, b) = y(7 * b - 6:7 * b - 4)
@@ -218,9 +254,111 @@ contains
                 axes(:, :, self%bodies + b) = a
             end associate
         end do
-        call open_grid(path, n, n, unit, status)
+        call open_grid(path, unit, status)
         if (.not. status%ok()) return
+        ! the names: field data of the data set (VTK reads none in a piece)
+        if (allocated(self%names)) then
+            if (size(self%names) >= n) then
+                write (unit, '(a)') '<FieldData>'
+                call write_strings(unit, 'body_names', self%names(1:n))
+                write (unit, '(a)') '</FieldData>'
+            end if
+        end if
+        call begin_piece(unit, n, n)
         write (unit, '(3es24.15e3)') centre
+        call write_vertices(unit, n)
+        write (unit, '(a)') '<PointData>'
+        do k = 1, 3
+            call write_vectors(unit, 'axis_' // achar(iachar('x') + k - 1), axes(:, k, :))
+        end do
+        ! which body a point is: its number, and the names in the field data
+        call write_integers(unit, 'body_id', [(b, b=1, n)])
+        write (unit, '(a)') '</PointData>'
+        call close_grid(unit, path, status)
+    end subroutine write_bodies
+
+    !> The joints' file (module header): a vertex per joint at marker i.
+    subroutine write_joints(self, t, y, path, status)
+        class(vtk_sink_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        character(len=*), intent(in) :: path
+        type(status_t), intent(inout) :: status
+        real(wp) :: xi(3, joints(self)), offset(3, joints(self)), axis(3, joints(self)), &
+            force(3, 2, joints(self)), torque(3, 2, joints(self)), xj(3), ai(3, 3), aj(3, 3)
+        character(len=32) :: types(joints(self))
+        character(len=80) :: names(joints(self))
+        integer :: unit, k, n
+        n = joints(self)
+        associate (sys => self%system, q => y(self%system_q + 1:self%system_q + self%system%nq))
+            do k = 1, n
+                associate (jt => sys%joints(k))
+                    call sys%marker_pose(jt%marker_i, q, xi(:, k), ai)
+                    call sys%marker_pose(jt%marker_j, q, xj, aj)
+                    offset(:, k) = xj - xi(:, k)
+                    axis(:, k) = ai(:, joint_axis(jt%joint%kind, jt%joint%primitive(1), &
+                                                  jt%joint%axis_i(1)))
+                    types(k) = joint_name(jt%joint%kind)
+                    if (jt%joint%kind == joint_primitive) types(k) = &
+                        primitive_name(jt%joint%primitive(1))
+                    if (self%system_l > 0) call sys%joint_reaction(k, t, q, &
+                        y(self%system_l + 1:self%system_l + sys%nc), force(:, :, k), &
+                        torque(:, :, k))
+                end associate
+                names(k) = 'joint ' // int_text(k)
+                if (allocated(self%joint_names)) then
+                    if (k <= size(self%joint_names)) names(k) = self%joint_names(k)
+                end if
+            end do
+        end associate
+        call open_grid(path, unit, status)
+        if (.not. status%ok()) return
+        write (unit, '(a)') '<FieldData>'
+        call write_strings(unit, 'joint_names', names)
+        call write_strings(unit, 'joint_types', types)
+        write (unit, '(a)') '</FieldData>'
+        call begin_piece(unit, n, n)
+        write (unit, '(3es24.15e3)') xi
+        call write_vertices(unit, n)
+        write (unit, '(a)') '<PointData Vectors="axis">'
+        call write_integers(unit, 'joint_id', [(k, k=1, n)])
+        call write_integers(unit, 'joint_type', [(self%system%joints(k)%joint%kind, k=1, n)])
+        call write_vectors(unit, 'axis', axis)
+        call write_vectors(unit, 'marker_j_offset', offset)
+        if (self%system_l > 0) then
+            call write_vectors(unit, 'reaction_force', force(:, 1, :))
+            call write_vectors(unit, 'reaction_torque', torque(:, 1, :))
+            call write_vectors(unit, 'reaction_force_j', force(:, 2, :))
+            call write_vectors(unit, 'reaction_torque_j', torque(:, 2, :))
+        end if
+        write (unit, '(a)') '</PointData>'
+        call close_grid(unit, path, status)
+    end subroutine write_joints
+
+    !> Which of marker i's axes is a joint's axis: z (flexmbs_mbs_joint's
+    !> convention), for a single primitive the axis it acts about or along.
+    pure integer function joint_axis(kind, primitive, axis_i) result(k)
+        integer, intent(in) :: kind, primitive, axis_i
+        k = 3
+        if (kind /= joint_primitive) return
+        select case (primitive)
+        case (primitive_angle_driver)
+            k = mod(axis_i + 1, 3) + 1   ! about axis k + 2 (cyclic)
+        case (primitive_translation_driver, primitive_dot2)
+            k = axis_i
+        end select
+    end function joint_axis
+
+    !> Joints of the system (none without one).
+    pure integer function joints(self)
+        class(vtk_sink_t), intent(in) :: self
+        joints = 0
+        if (associated(self%system)) joints = size(self%system%joints)
+    end function joints
+
+    !> The cells of n points, a vertex (type 1) each, after the points.
+    subroutine write_vertices(unit, n)
+        integer, intent(in) :: unit, n
+        integer :: b
         write (unit, '(a)') '</DataArray></Points>'
         write (unit, '(a)') '<Cells><DataArray type="Int64" Name="connectivity" format="ascii">'
         write (unit, '(*(1x,i0))') (b - 1, b=1, n)
@@ -229,34 +367,50 @@ contains
         write (unit, '(a)') '</DataArray><DataArray type="UInt8" Name="types" format="ascii">'
         write (unit, '(*(1x,i0))') (1, b=1, n)
         write (unit, '(a)') '</DataArray></Cells>'
-        write (unit, '(a)') '<PointData>'
-        do k = 1, 3
-            write (unit, '(a)') '<DataArray type="Float64" Name="axis_' // &
-                achar(iachar('x') + k - 1) // '" NumberOfComponents="3" format="ascii">'
-            write (unit, '(3es24.15e3)') (axes(:, k, b), b=1, n)
-            write (unit, '(a)') '</DataArray>'
-        end do
-        ! which body a point is: its number, and the names in the field data
-        write (unit, '(a)') '<DataArray type="Int32" Name="body_id" format="ascii">'
-        write (unit, '(*(1x,i0))') (b, b=1, n)
+    end subroutine write_vertices
+
+    subroutine write_integers(unit, name, values)
+        integer, intent(in) :: unit, values(:)
+        character(len=*), intent(in) :: name
+        write (unit, '(a)') '<DataArray type="Int32" Name="' // name // '" format="ascii">'
+        write (unit, '(*(1x,i0))') values
         write (unit, '(a)') '</DataArray>'
-        write (unit, '(a)') '</PointData>'
-        if (allocated(self%names)) then
-            if (size(self%names) >= n) then
-                ! a VTK string array in ASCII: each name's character codes, then 0
-                write (unit, '(a)') '<FieldData><DataArray type="String" Name="body_names" ' &
-                    // 'NumberOfTuples="' // int_text(n) // '" format="ascii">'
-                do b = 1, n
-                    write (unit, '(*(1x,i0))') (iachar(self%names(b)(k:k)), &
-                        k=1, len_trim(self%names(b))), 0
-                end do
-                write (unit, '(a)') '</DataArray></FieldData>'
-            end if
-        end if
+    end subroutine write_integers
+
+    !> A vector per point (the columns of `values`).
+    subroutine write_vectors(unit, name, values)
+        integer, intent(in) :: unit
+        character(len=*), intent(in) :: name
+        real(wp), intent(in) :: values(:, :)
+        write (unit, '(a)') '<DataArray type="Float64" Name="' // name // &
+            '" NumberOfComponents="3" format="ascii">'
+        write (unit, '(3es24.15e3)') values
+        write (unit, '(a)') '</DataArray>'
+    end subroutine write_vectors
+
+    !> A VTK string array in ASCII: each name's character codes, then 0.
+    subroutine write_strings(unit, name, names)
+        integer, intent(in) :: unit
+        character(len=*), intent(in) :: name, names(:)
+        integer :: b, k
+        write (unit, '(a)') '<DataArray type="String" Name="' // name // &
+            '" NumberOfTuples="' // int_text(size(names)) // '" format="ascii">'
+        do b = 1, size(names)
+            write (unit, '(*(1x,i0))') (iachar(names(b)(k:k)), k=1, len_trim(names(b))), 0
+        end do
+        write (unit, '(a)') '</DataArray>'
+    end subroutine write_strings
+
+    !> The end of a piece's file.
+    subroutine close_grid(unit, path, status)
+        integer, intent(in) :: unit
+        character(len=*), intent(in) :: path
+        type(status_t), intent(inout) :: status
+        integer :: ios
         write (unit, '(a)') '</Piece></UnstructuredGrid></VTKFile>'
         close (unit, iostat=ios)
         if (ios /= 0) call status%set(status_io_error, path // ': cannot close')
-    end subroutine write_bodies
+    end subroutine close_grid
 
     !> Links of the chain (none without one).
     pure integer function links(self)
@@ -265,10 +419,10 @@ contains
         if (associated(self%chain)) links = size(self%chain%bodies)
     end function links
 
-    !> Open an unstructured-grid file and write up to its points' values.
-    subroutine open_grid(path, npoints, ncells, unit, status)
+    !> Open an unstructured-grid file and write up to its data set's field
+    !> data (begin_piece follows).
+    subroutine open_grid(path, unit, status)
         character(len=*), intent(in) :: path
-        integer, intent(in) :: npoints, ncells
         integer, intent(out) :: unit
         type(status_t), intent(inout) :: status
         integer :: ios
@@ -282,11 +436,16 @@ contains
         write (unit, '(a)') '<VTKFile type="UnstructuredGrid" version="0.1" ' // &
             'byte_order="LittleEndian">'
         write (unit, '(a)') '<UnstructuredGrid>'
+    end subroutine open_grid
+
+    !> The piece's opening, up to its points' values.
+    subroutine begin_piece(unit, npoints, ncells)
+        integer, intent(in) :: unit, npoints, ncells
         write (unit, '(a)') '<Piece NumberOfPoints="' // int_text(npoints) // &
             '" NumberOfCells="' // int_text(ncells) // '">'
         write (unit, '(a)') '<Points><DataArray type="Float64" NumberOfComponents="3" ' // &
             'format="ascii">'
-    end subroutine open_grid
+    end subroutine begin_piece
 
     !> PREFIX.pvd: every record so far, file names relative to the .pvd.
     subroutine write_collection(self, status)
@@ -313,6 +472,8 @@ contains
                 trim(adjustl(tbuf)) // '" part="0" file="' // mesh_piece(base, k) // '"/>'
             if (self%bodies + links(self) > 0) write (unit, '(a)') '<DataSet timestep="' // &
                 trim(adjustl(tbuf)) // '" part="1" file="' // bodies_piece(base, k) // '"/>'
+            if (joints(self) > 0) write (unit, '(a)') '<DataSet timestep="' // &
+                trim(adjustl(tbuf)) // '" part="2" file="' // joints_piece(base, k) // '"/>'
         end do
         write (unit, '(a)') '</Collection>'
         write (unit, '(a)') '</VTKFile>'

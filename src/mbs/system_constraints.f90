@@ -210,7 +210,10 @@ contains
     !> marker's origin: the generalised force −C_bᵀλ_k of the equations of
     !> motion M v' = f − Gᵀλ (module header). A ground side reports zeros
     !> (the ground's share is the opposite of the body's for joints whose
-    !> markers' origins coincide).
+    !> markers' origins coincide). A chain link's share is the generalised
+    !> force along the marker's own displacement and rotation
+    !> (marker_frame_reaction), since its columns of G are the chain's joint
+    !> coordinates.
     module procedure system_joint_reaction
         real(wp) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq), ct(max_rows)
         real(wp) :: gen(6), a(3, 3)
@@ -225,6 +228,12 @@ contains
                 mk = merge(jt%marker_i, jt%marker_j, side == 1)
                 call marker_offsets(self, mk, b, iq, iv)
                 if (b == 0) cycle
+                if (self%markers(mk)%chain > 0) then
+                    gen = marker_frame_reaction(self, k, t, q, lambda(r0 + 1:r0 + nr), side)
+                    force(:, side) = gen(1:3)
+                    torque(:, side) = gen(4:6)
+                    cycle
+                end if
                 if (b < 0) then
                     ! a node takes the force only
                     if (side == 1) force(:, side) = -matmul(lambda(r0 + 1:r0 + nr), ci(1:nr, 1:3))
@@ -244,4 +253,44 @@ contains
             end do
         end associate
     end procedure system_joint_reaction
+
+    !> −C_mᵀλ of joint k for the marker of `side` (1: i, 2: j), C_m the rows'
+    !> derivatives along the marker's displacement δx and its rotation δθ
+    !> (global; δa = δθ × a for each axis a): the force and the torque about
+    !> the marker's origin that the joint exerts there, whatever carries it.
+    function marker_frame_reaction(self, k, t, q, lambda, side) result(gen)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k, side
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(in) :: lambda(:) !! joint k's multipliers
+        real(wp) :: gen(6)
+        type(marker_state_t) :: mi, mj
+        real(wp) :: jxi(3, 6), jai(3, 6, 3), jxj(3, 6), jaj(3, 6, 3), c(max_rows, 6, 2)
+        integer :: nr
+        associate (jt => self%joints(k))
+            nr = jt%joint%nrows
+            call marker_state(self, jt%marker_i, q, self%zero_v, mi)
+            call marker_state(self, jt%marker_j, q, self%zero_v, mj)
+            call frame_tangents(mi, jxi, jai)
+            call frame_tangents(mj, jxj, jaj)
+            call joint_jacobian(jt%joint, mi, jxi, jai, mj, jxj, jaj, joint_driver(self, k, t), &
+                                c(1:nr, :, 1), c(1:nr, :, 2))
+            gen = -matmul(lambda, c(1:nr, :, side))
+        end associate
+    end function marker_frame_reaction
+
+    !> A marker frame's tangents along (δx, δθ): x' = δx, a' = δθ × a.
+    pure subroutine frame_tangents(m, jx, ja)
+        type(marker_state_t), intent(in) :: m
+        real(wp), intent(out) :: jx(3, 6), ja(3, 6, 3)
+        integer :: l, a
+        jx = 0.0_wp
+        ja = 0.0_wp
+        do l = 1, 3
+            jx(l, l) = 1.0_wp
+            do a = 1, 3
+                ja(:, 3 + l, a) = cross(identity3(:, l), m%a(:, a))
+            end do
+        end do
+    end subroutine frame_tangents
 end submodule flexmbs_mbs_system_constraints

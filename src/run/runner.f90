@@ -251,8 +251,9 @@ contains
 
     contains
 
-        !> ParaView output of the flexible body and the rigid bodies (y starts
-        !> with q in every layout: the bodies' (r, p), then v behind q).
+        !> ParaView output of the flexible body, the rigid bodies and the
+        !> joints (y starts with q in every layout: the bodies' (r, p), then v
+        !> behind q).
         subroutine setup_vtk()
             vtk%prefix = trim(scene%vtk)
             if (.not. allocated(plan%mechanical)) then
@@ -280,6 +281,16 @@ contains
                     type is (formulation_t)
                         vtk%oq = p%oq + m%flex_q(1)
                         vtk%ov = p%ov + m%flex_v(1)
+                    end select
+                end if
+                if (size(m%joints) > 0) then
+                    vtk%system => m
+                    if (allocated(plan%joint_names)) vtk%joint_names = plan%joint_names
+                    ! the reactions need the multipliers, which formulations hold
+                    select type (p => plan%problem)
+                    type is (formulation_t)
+                        vtk%system_q = p%oq
+                        if (p%nc > 0) vtk%system_l = p%ol
                     end select
                 end if
             class default
