@@ -452,6 +452,28 @@ sys.exit(0 if pvd == t and len(t) == 4 else 1)
 PY
 then pass vtk-times-are-hdf5-time
 else fail vtk-times-are-hdf5-time "$(grep -o 'timestep="[^"]*"' out/vt.pvd | head -4)"; fi
+# node numbers: VTK's point k - 1 is flexmbs's node k (point data node_id), at
+# the HDF5 file's reference_nodes + displacement of node k; cell k - 1 element k
+if problem=$(/usr/bin/python3 - out/vt.h5 out/vt_0003.vtu 2>&1 <<'PY'
+import sys, h5py, numpy as np
+import xml.etree.ElementTree as ET
+f = h5py.File(sys.argv[1], 'r')
+body = f['flexible/' + sorted(f['flexible'])[0]]
+x_h5 = body['reference_nodes'][:] + body['displacement'][3]            # (nodes, 3)
+piece = ET.parse(sys.argv[2]).getroot().find('UnstructuredGrid/Piece')
+arrays = {a.get('Name'): a for a in piece.iter('DataArray') if a.get('Name')}
+x = np.array(piece.find('Points/DataArray').text.split(), float).reshape(-1, 3)
+ids = [int(v) for v in arrays['node_id'].text.split()]
+assert ids == list(range(1, len(x) + 1)), ids
+assert np.abs(x - x_h5).max() < 1e-12, np.abs(x - x_h5).max()
+assert np.abs(body['displacement'][3]).max() > 0, 'no motion to compare'
+cells = np.array(arrays['connectivity'].text.split(), int).reshape(-1, 8)
+assert (cells + 1 == body['connectivity'][:]).all(), 'connectivity'
+elements = [int(v) for v in arrays['element_id'].text.split()]
+assert elements == list(range(1, len(cells) + 1)), elements
+PY
+); then pass vtk-node-ids-are-hdf5-nodes
+else fail vtk-node-ids-are-hdf5-nodes "$problem"; fi
 # the joints (part 2): the four-bar's four joints and its driver, a point each at
 # marker i, by name; the points against the markers computed from the HDF5 file's
 # bodies (position + R s), the fixed pivots, the reactions against /joints

@@ -1,8 +1,9 @@
 !> ParaView output: at every output time, the flexible body's mesh as an
 !> XML unstructured grid (`PREFIX_NNNN.vtu`: current node positions, the
 !> hexahedra in VTK order — hex8 cell type 12, hex27 type 29 —, point data
-!> displacement and velocity, cell data Cauchy stress (xx, yy, zz, xy, yz,
-!> xz) and its von Mises value), the rigid bodies (`PREFIX_bodies_NNNN.vtu`:
+!> displacement, velocity and node_id (flexmbs's node number, from 1: VTK's
+!> point k - 1 is node k), cell data Cauchy stress (xx, yy, zz, xy, yz, xz),
+!> its von Mises value and element_id), the rigid bodies (`PREFIX_bodies_NNNN.vtu`:
 !> one vertex per body at its centre of mass, the bodies in absolute
 !> coordinates first, then a chain's links; point data the body's three
 !> axes and body_id, field data body_names) and a multibody system's joints
@@ -221,6 +222,8 @@ contains
             write (unit, '(a)') '<PointData Vectors="displacement">'
             call write_vectors(unit, 'displacement', x - mesh%x)
             call write_vectors(unit, 'velocity', v)
+            ! flexmbs's node and element numbers (from 1), beside VTK's ids (from 0)
+            call write_integers(unit, 'node_id', [(i, i=1, n)])
             write (unit, '(a)') '</PointData>'
             write (unit, '(a)') '<CellData Scalars="von_mises">'
             write (unit, '(a)') '<DataArray type="Float64" Name="stress" ' // &
@@ -229,7 +232,9 @@ contains
             write (unit, '(a)') '</DataArray>'
             write (unit, '(a)') '<DataArray type="Float64" Name="von_mises" format="ascii">'
             write (unit, '(es24.15e3)') mises
-            write (unit, '(a)') '</DataArray></CellData>'
+            write (unit, '(a)') '</DataArray>'
+            call write_integers(unit, 'element_id', [(i, i=1, ne)])
+            write (unit, '(a)') '</CellData>'
             call close_grid(unit, path, status)
         end associate
     end subroutine write_mesh
