@@ -262,7 +262,8 @@ contains
             stats%t_reached = t
             call status%set(status_bad_input, 'mexax: y has ' // int_text(size(y)) // &
                 ' components; the mechanical problem''s (q, v, lambda) has ' // &
-                int_text(nq + nv + nc))
+                int_text(nq + nv + nc) // ': give it the state of the index-2 formulation &
+                &with constant mass (formulation_index2, constant_mass = .true.)')
             return
         end if
         call self%integrate_mechanical(mechanical, t, y(1:nq), y(nq + 1:nq + nv), t_end, &
