@@ -8,7 +8,8 @@
 #   make extremes  every solver at extreme tolerances, materials and times
 #   make check-memory  install valgrind if missing, build (debug), run the numerical
 #                suites and every scene of inputs/ (cut to a few steps) under valgrind
-#   make install PREFIX=...   install library, modules and the classic faces
+#   make install PREFIX=...   install library (static and shared), modules, the classic
+#                faces and pkg-config files (docs/packaging.md)
 #   make docs    the API documentation (FORD, in a virtual environment) into build/docs/api/
 #   OPENMP=1     (with any of them) thread the finite-element assembly
 #   LTO=1        (with any of them) link-time optimisation
@@ -29,7 +30,9 @@ FORD_VENV    := $(BUILD)/ford-venv
 # mpif.h is in /usr/include/mumps_seq.
 export FPM_FFLAGS := -I/usr/include/hdf5/serial -I/usr/include/sundials/fortran \
                      -I/usr/include -I/usr/include/mumps_seq
-export FPM_CFLAGS := -I/usr/include/suitesparse
+# -fPIC: the C shims go into libflexmbs.so as well (fpm compiles every
+# Fortran object with -fPIC already, in both profiles).
+export FPM_CFLAGS := -I/usr/include/suitesparse -fPIC
 # LTO=1 adds link-time optimisation (inlines the dual-number operators of
 # the AD mode across modules; fat objects keep the library linkable without it).
 ifeq ($(LTO),1)
@@ -60,14 +63,28 @@ MAIN_INPUT   := inputs/five_body.nml
 VERSION      := $(shell sed -n 's/^version *= *"\(.*\)"/\1/p' fpm.toml)
 
 # pkg-config files of an install under $(1) (pkgconfig/*.pc.in): then
-# `gfortran prog.f90 $$(pkg-config --cflags --libs flexmbs)` builds a program.
+# `gfortran prog.f90 $$(pkg-config --cflags --libs flexmbs)` builds a program
+# (static: libflexmbs.a), flexmbs-shared links libflexmbs.so (docs/packaging.md).
 define write_pkgconfig
 	@mkdir -p $(1)/lib/pkgconfig
-	@for pc in flexmbs flexmbs-legacy; do \
+	@for pc in flexmbs flexmbs-shared flexmbs-legacy; do \
 	    sed -e 's#@PREFIX@#$(1)#' -e 's#@VERSION@#$(VERSION)#' \
 	        -e 's#@SYSLIBS@#$(strip $(OMP_LINK) $(SYSLIBS))#' \
 	        pkgconfig/$$pc.pc.in > $(1)/lib/pkgconfig/$$pc.pc || exit 1; \
 	done
+endef
+
+# libflexmbs.so beside libflexmbs.a under $(1)/lib: the archive's objects
+# (all -fPIC) linked whole into a shared library that names the system
+# libraries it needs, so that a program links it with -lflexmbs alone
+# (--no-undefined: none is missing). The soname is the full version: the
+# module files, and so the ABI, change from one version to the next.
+define install_shared_library
+	@gfortran -shared -o $(1)/lib/libflexmbs.so.$(VERSION) \
+	    -Wl,-soname,libflexmbs.so.$(VERSION) -Wl,--no-undefined \
+	    -Wl,--whole-archive $(1)/lib/libflexmbs.a -Wl,--no-whole-archive \
+	    $(FPM_LDFLAGS) $(SYSLIBS)
+	@ln -sf libflexmbs.so.$(VERSION) $(1)/lib/libflexmbs.so
 endef
 
 .PHONY: run test bench paper extremes check-memory deps build build-debug install legacy-test \
@@ -110,7 +127,9 @@ run: build
 
 # Root suites, then the classic fixed-form drivers linked against the
 # installed library exactly as a user links them, the example programs of
-# examples/ built the same way and run (test/programs.sh), the architecture's rules
+# examples/ built the same way and run, one also against the shared library
+# (test/programs.sh), a project depending on flexmbs through fpm
+# (test/dependency.sh, test/fpm_dependency/), the architecture's rules
 # on the sources (test/layers.py), then the command-line
 # checks of test/cli.sh, the documentation's links and generated scene
 # reference (test/docs.py), the signals of test/kill.sh (python3-h5py reads
@@ -126,6 +145,8 @@ test: deps
 	    cat $(BUILD)/test-legacy.log
 	@set -o pipefail; bash test/programs.sh $(PREFIX_DEBUG) 2>&1 | tee $(BUILD)/test-programs.log; \
 	    echo "exit $$?" >> $(BUILD)/test-programs.log
+	@set -o pipefail; FPM="$(FPM)" bash test/dependency.sh 2>&1 | tee $(BUILD)/test-dependency.log; \
+	    echo "exit $$?" >> $(BUILD)/test-dependency.log
 	@set -o pipefail; python3 test/layers.py 2>&1 | tee $(BUILD)/test-layers.log; \
 	    echo "exit $$?" >> $(BUILD)/test-layers.log
 	@set -o pipefail; FPM="$(FPM)" bash test/cli.sh 2>&1 | tee $(BUILD)/test-cli.log; \
@@ -140,8 +161,8 @@ test: deps
 	@set -o pipefail; FPM="$(FPM)" bash test/fuzz/run.sh 2>&1 | tee $(BUILD)/test-fuzz.log; \
 	    echo "exit $$?" >> $(BUILD)/test-fuzz.log
 	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log \
-	    $(BUILD)/test-programs.log $(BUILD)/test-layers.log $(BUILD)/test-cli.log $(BUILD)/test-docs.log \
-	    $(BUILD)/test-kill.log \
+	    $(BUILD)/test-programs.log $(BUILD)/test-dependency.log $(BUILD)/test-layers.log \
+	    $(BUILD)/test-cli.log $(BUILD)/test-docs.log $(BUILD)/test-kill.log \
 	    $(BUILD)/test-examples.log $(BUILD)/test-fuzz.log
 
 PROFILE     ?= debug
@@ -152,11 +173,13 @@ LEGACY_MODERN  := $(wildcard legacy/test/*.f90)
 # Classic drivers: plain `gfortran -std=legacy`, linked against the install
 # with the link line of its pkg-config file (flexmbs-legacy.pc); modern
 # callers (*.f90) use the installed interface modules. The root is installed
-# too (--no-prune: the whole library), for `-lflexmbs`.
+# too (--no-prune: the whole library), for `-lflexmbs`, with its shared
+# library as `make install` makes it (test/programs.sh links one).
 legacy-test:
 	@$(FPM) install --no-prune --profile $(PROFILE) --prefix $(PREFIX_USED) >/dev/null
 	@cd legacy && $(FPM) install --profile $(PROFILE) --prefix $(PREFIX_USED) >/dev/null
 	$(call write_pkgconfig,$(PREFIX_USED))
+	$(call install_shared_library,$(PREFIX_USED))
 	@mkdir -p $(BUILD)/legacy-test
 	@for src in $(LEGACY_DRIVERS) $(LEGACY_MODERN); do \
 	    name=$$(basename $$src); exe=$(BUILD)/legacy-test/$${name%.*}; \
@@ -177,6 +200,7 @@ install: deps
 	$(FPM) install --no-prune --profile release --prefix $(PREFIX)
 	cd legacy && $(FPM) install --profile release --prefix $(PREFIX)
 	$(call write_pkgconfig,$(abspath $(PREFIX)))
+	$(call install_shared_library,$(abspath $(PREFIX)))
 
 # The paper's studies (inputs/paper/five_body_*.nml) into results/, on the
 # coarse and on the fine coupler mesh: the references (two at a time), then
@@ -275,4 +299,4 @@ docs: deps
 	@echo "API documentation: $(BUILD)/docs/api/index.html"
 
 clean:
-	rm -rf $(BUILD) legacy/build
+	rm -rf $(BUILD) legacy/build test/fpm_dependency/build

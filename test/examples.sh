@@ -7,7 +7,8 @@
 # value in a model or solver is a solver failure, exit 3, anyway). Then the
 # named series of every multibody result (/bodies, /joints, /drivers,
 # /flexible) are checked against its /y, and `flexmbs columns` by name
-# against them (test/result_names.py).
+# against them (test/result_names.py), and the five-body result read by
+# name and unit (test/five_body_names.py).
 #
 #   bash test/examples.sh [path/to/flexmbs]
 #
@@ -60,6 +61,19 @@ if "$exe" run five_body.nml --quiet --verbose 2>&1 | grep -q '^y(1) ='; then
 else
     fail summary-verbose-state "--verbose printed no y(1)"
 fi
+
+# The five-body result as a user reads it, by name and unit, against /y
+# (test/five_body_names.py: the rocker pivot's angle, coupler node 23's x,
+# the rocker pivot's reaction)
+py=/usr/bin/python3
+[ -x "$py" ] || py=python3
+while read -r line; do
+    case $line in
+        pass\ *) pass "${line#pass }" ;;
+        FAIL\ *) fail "${line#FAIL }" "" ;;
+    esac
+done < <("$py" "$root/test/five_body_names.py" five_body.h5 2>&1 ||
+         echo "FAIL five_body_names: test/five_body_names.py failed")
 
 # The named series of each multibody result against its /y
 # (test/result_names.py; h5py of the system's Python, see the Makefile).

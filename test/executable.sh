@@ -9,7 +9,7 @@ if [ $# -ge 2 ]; then
 else
     # the Makefile's flags: other flags would make fpm rebuild everything
     export FPM_FFLAGS=${FPM_FFLAGS:-"-I/usr/include/hdf5/serial -I/usr/include/sundials/fortran -I/usr/include -I/usr/include/mumps_seq"}
-    export FPM_CFLAGS=${FPM_CFLAGS:-"-I/usr/include/suitesparse"}
+    export FPM_CFLAGS=${FPM_CFLAGS:-"-I/usr/include/suitesparse -fPIC"}
     exe=$(cd "$root" && ${FPM:-fpm} run --profile debug --runner echo flexmbs 2>/dev/null | tail -n 1)
     [ -n "$exe" ] && exe="$root/$exe"
 fi

@@ -43,7 +43,7 @@ fi
 
 # the Makefile's flags: other flags would make fpm rebuild everything
 export FPM_FFLAGS=${FPM_FFLAGS:-"-I/usr/include/hdf5/serial -I/usr/include/sundials/fortran -I/usr/include -I/usr/include/mumps_seq"}
-export FPM_CFLAGS=${FPM_CFLAGS:-"-I/usr/include/suitesparse"}
+export FPM_CFLAGS=${FPM_CFLAGS:-"-I/usr/include/suitesparse -fPIC"}
 fpm=${FPM:-fpm}
 # `fpm test` builds the library, the tests and the executable in one go;
 # after a plain `fpm build` it leaves the tests linked against the old

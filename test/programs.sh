@@ -1,9 +1,14 @@
 #!/usr/bin/env bash
 # The example programs of examples/, built as a user builds them against
-# an installed flexmbs (pkg-config's flags) and run: the pendulum through
-# every solver (exits non-zero when an angle is off), a scene run from a
-# program, and the Python script that plots its result by name (h5py and
-# matplotlib of the system's Python).
+# an installed flexmbs (pkg-config's flags: flexmbs-legacy for classic_*.f90,
+# the classic faces; flexmbs for the others) and run, each with an empty
+# standard error: the pendulum through every solver (exits non-zero when an
+# angle is off), the rigid-flexible system built through the API with every
+# solver (energy and joints), the classic RADAU5 driver (van der Pol against
+# its reference), a scene run from a program and the Python script that
+# plots its result by name (h5py and matplotlib of the system's Python).
+# Last, the rigid-flexible system linked against libflexmbs.so
+# (flexmbs-shared) and run from the install.
 #
 #   bash test/programs.sh PREFIX
 #
@@ -21,24 +26,48 @@ failed=0
 pass() { passed=$((passed + 1)); echo "pass programs/$1"; }
 fail() { failed=$((failed + 1)); echo "FAIL programs/$1: $2"; }
 
-flags=$(pkg-config --cflags --libs flexmbs) || { echo "FAIL programs: no flexmbs.pc in $prefix"; echo "0 passed, 1 failed"; exit 1; }
+# run NAME PATTERN COMMAND...: passes when COMMAND exits 0 with nothing on
+# standard error and its standard output has a line matching PATTERN.
+run() {
+    local name=$1 pattern=$2 out
+    shift 2
+    out=$("$@" 2>"$work/stderr")
+    local rc=$?
+    if [ "$rc" -ne 0 ]; then
+        fail "$name" "exit $rc: $out $(cat "$work/stderr")"
+    elif [ -s "$work/stderr" ]; then
+        fail "$name" "standard error: $(cat "$work/stderr")"
+    elif ! grep -qE "$pattern" <<<"$out"; then
+        fail "$name" "no line matching '$pattern' in: $out"
+    else
+        pass "$name"
+    fi
+}
+
+for pc in flexmbs flexmbs-legacy flexmbs-shared; do
+    pkg-config --exists "$pc" || { fail "pkg-config-$pc" "no $pc.pc in $prefix/lib/pkgconfig"; }
+done
 for src in examples/*.f90; do
     name=$(basename "$src" .f90)
-    if out=$(gfortran -J "$work" -o "$work/$name" "$src" $flags 2>&1); then
+    case $name in
+        classic_*) pc=flexmbs-legacy ;;
+        *) pc=flexmbs ;;
+    esac
+    if out=$(gfortran -J "$work" -o "$work/$name" "$src" $(pkg-config --cflags --libs $pc) 2>&1)
+    then
         pass "$name-builds"
     else
         fail "$name-builds" "$out"
     fi
 done
 
-if out=$("$work/pendulum" 2>&1); then pass "pendulum-every-solver"
-else fail "pendulum-every-solver" "$out"; fi
-if out=$("$work/run_scene" inputs/rigid_flexible_pendulum.nml "$work/rigid_flexible.h5" 2>&1) &&
-    grep -q '^  link: at (' <<<"$out"; then
-    pass "run-scene-from-a-program"
-else
-    fail "run-scene-from-a-program" "$out"
-fi
+run pendulum-every-solver '^   mexax: angle' "$work/pendulum"
+for solver in radau5 ddassl ida mexax; do
+    run "rigid-flexible-$solver" '^energy drift' "$work/rigid_flexible" $solver
+done
+run classic-radau5-van-der-pol '^IDID = 1,' "$work/classic_radau5"
+run run-scene-from-a-program '^  link: at \(' \
+    "$work/run_scene" inputs/rigid_flexible_pendulum.nml "$work/rigid_flexible.h5"
 py=/usr/bin/python3
 [ -x "$py" ] || py=python3
 if out=$("$py" examples/plot_result.py "$work/rigid_flexible.h5" "$work/plot.png" 2>&1) &&
@@ -46,6 +75,20 @@ if out=$("$py" examples/plot_result.py "$work/rigid_flexible.h5" "$work/plot.png
     pass "plot-by-name"
 else
     fail "plot-by-name" "$out"
+fi
+
+# The shared library: the program names libflexmbs.so (not the archive's
+# objects) and finds it in the install through the rpath of flexmbs-shared.
+if out=$(gfortran -J "$work" -o "$work/rigid_flexible_shared" examples/rigid_flexible.f90 \
+        $(pkg-config --cflags --libs flexmbs-shared) 2>&1); then
+    if readelf -d "$work/rigid_flexible_shared" | grep -q 'NEEDED.*\[libflexmbs\.so'; then
+        run shared-library '^energy drift' "$work/rigid_flexible_shared"
+    else
+        fail shared-library "the program does not name libflexmbs.so: $(readelf -d \
+            "$work/rigid_flexible_shared" | grep NEEDED)"
+    fi
+else
+    fail shared-library "$out"
 fi
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

@@ -1,4 +1,4 @@
-!> SIGINT and SIGTERM as a request to stop (DESIGN.md, Errors and failure).
+!> SIGINT and SIGTERM as a request to stop (docs/user_guide.md, exit codes).
 !>
 !> The application installs the handlers once (`install_signals`); the
 !> run checks `signal_pending` after every accepted step (io/signal_sink)

@@ -1,4 +1,4 @@
-!> How many threads the BLAS uses (DESIGN.md, Scale; docs/performance.md).
+!> How many threads the BLAS uses (docs/linear_algebra.md).
 !>
 !> OpenBLAS starts as many threads as there are cores. flexmbs's dense
 !> factorisations are small (the classic faces, small scenes, MUMPS's

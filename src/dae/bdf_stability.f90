@@ -1,4 +1,4 @@
-!> Stability angles of the BDF methods (ALGORITHMS.md §5, the paper's Table 1).
+!> Stability angles of the BDF methods (docs/theory.md §10, the paper's Table 1).
 !>
 !> BDF-k applied to y' = λy with μ = hλ is stable outside the bounded region
 !> enclosed by the boundary locus μ(θ) = Σ_{j=1}^{k} (1 − e^{−iθ})^j / j,

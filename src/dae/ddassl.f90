@@ -1,6 +1,6 @@
 !> `DDASSL`: variable-order, variable-step BDF for G(t, y, y') = 0.
 !>
-!> Implemented from [BCP89, ch. 5] as specified in ALGORITHMS.md §2:
+!> Implemented from [BCP89, ch. 5] as specified in docs/theory.md §6:
 !> fixed-leading-coefficient BDF of orders 1..pmax in modified divided
 !> differences, a modified Newton corrector with iteration matrix
 !> PD = ∂G/∂y + cj ∂G/∂y' reused across steps, error estimates at orders
@@ -96,7 +96,7 @@ module flexmbs_dae_ddassl
     !> the iteration matrix and its factors. It lives in `ddassl_t%work`
     !> between calls, so that a driver can stop after any step and resume
     !> (the classic face's INFO(3) and continuation calls); the names are
-    !> those of ALGORITHMS.md §2.
+    !> those of docs/theory.md §6.
     type, public :: ddassl_work_t
         logical :: ready = .false.       !! begin succeeded; step may be called
         integer :: n = 0, pmax = 0
@@ -219,7 +219,7 @@ contains
         end do
     end subroutine interpolate_history
 
-    !> Integrate M y' = F(t, y) as G = M y' − F = 0 (ALGORITHMS.md §2.1).
+    !> Integrate M y' = F(t, y) as G = M y' − F = 0 (docs/theory.md §6).
     !> Without yp, y' comes from `problem%consistent_initial` or, when the
     !> problem offers none or `initial_derivative` is set, from DDAINI.
     subroutine ddassl_integrate(self, problem, t, y, t_end, options, stats, status, sink, yp)
@@ -299,7 +299,7 @@ contains
         nullify (res%problem)
     end subroutine run_dae
 
-    !> Integrate G(t, y, y') = 0 from (t, y, yp) to t_end (ALGORITHMS.md §2).
+    !> Integrate G(t, y, y') = 0 from (t, y, yp) to t_end (docs/theory.md §6).
     !> On return t, y, yp hold the last point reached (t_end on success).
     subroutine ddassl_integrate_residual(self, res, t, y, yp, t_end, options, stats, status, &
                                          sink, initial_derivative)
@@ -440,7 +440,7 @@ contains
 
     contains
 
-        !> Common statistics from the native counters (ALGORITHMS.md §4.1).
+        !> Common statistics from the native counters (docs/solvers.md).
         subroutine finish()
             type(status_t) :: sink_status
             stats%nst = self%native%nst + self%native%netf + self%native%ncfn
@@ -537,7 +537,7 @@ contains
 
     !> The machinery of begin and step. The state lives in self%work between
     !> calls and in locals (moved, not copied) during one, so that the
-    !> procedures below read as the algorithm does in ALGORITHMS.md §2.
+    !> procedures below read as the algorithm does in docs/theory.md §6.
     subroutine ddassl_engine(self, res, action, t, y, yp, tout, status, options, ddaini, &
                              limited, tlimit)
         class(ddassl_t), intent(inout) :: self

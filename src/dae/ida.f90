@@ -6,7 +6,7 @@
 !> state). The iteration matrix ∂G/∂y + c_j ∂G/∂y' = c_j M − ∂F/∂y is a
 !> dense SUNMatrix (SUNDIALS' dense LU) or a CSC SUNMatrix with KLU, whose
 !> pattern (the union of the patterns of ∂F/∂y and M) is built once.
-!> Statistics map onto `dae_stats_t` as DESIGN.md says: NST = nst + netf +
+!> Statistics map onto `dae_stats_t` as docs/solvers.md says: NST = nst + netf +
 !> ncfn, NAC = nst, NFE = nre, NFE_JAC = nreLS, NJE = nje, NDEC = nsetups,
 !> NSOL = nni.
 module flexmbs_dae_ida
@@ -769,7 +769,7 @@ contains
             if (FIDAGetLastOrder(mem, order) == 0) self%native%last_order = int(order(1))
             h = 0.0_wp
             if (FIDAGetLastStep(mem, h) == 0) self%native%last_step = h(1)
-            ! DESIGN.md, "The DAE interface".
+            ! docs/architecture.md, the DAE contract.
             stats%nst = self%native%nst + self%native%netf + self%native%ncfn
             stats%nac = self%native%nst
             stats%nrj = stats%nst - stats%nac

@@ -1,5 +1,5 @@
 !> `MEXAX`: half-explicit extrapolation for constrained mechanical systems
-!> (ALGORITHMS.md §3; [Lub91], [LNPE95], [HW96 VII.6], ODEX control of
+!> (docs/theory.md §7; [Lub91], [LNPE95], [HW96 VII.6], ODEX control of
 !> [HNW93 II.9]).
 !>
 !> For q' = T(t,q) v, M(t,q) v' = f(t,q,v) − G(t,q)ᵀλ, 0 = G v + g_I, with
@@ -221,7 +221,7 @@ contains
         y = h00 * self%y0 + h10 * h * self%d0 + h01 * self%y1 + h11 * h * self%d1
     end subroutine dense_evaluate
 
-    !> MEXAX takes mechanical problems only (ALGORITHMS.md §6).
+    !> MEXAX takes mechanical problems only (docs/theory.md §3).
     subroutine mexax_integrate(self, problem, t, y, t_end, options, stats, status, sink, yp)
         class(mexax_t), intent(inout) :: self
         class(dae_problem_t), intent(inout) :: problem
@@ -262,7 +262,8 @@ contains
             stats%t_reached = t
             call status%set(status_bad_input, 'mexax: y has ' // int_text(size(y)) // &
                 ' components; the mechanical problem''s (q, v, lambda) has ' // &
-                int_text(nq + nv + nc))
+                int_text(nq + nv + nc) // ': give it the state of the index-2 formulation &
+                &with constant mass (formulation_index2, constant_mass = .true.)')
             return
         end if
         call self%integrate_mechanical(mechanical, t, y(1:nq), y(nq + 1:nq + nv), t_end, &
@@ -715,7 +716,7 @@ contains
                 self%dense, stop_requested, status)
         end subroutine emit_outputs
 
-        !> Common statistics from the native counters (ALGORITHMS.md §4.1).
+        !> Common statistics from the native counters (docs/solvers.md).
         subroutine finish()
             type(status_t) :: sink_status
             stats%nst = self%native%nstep

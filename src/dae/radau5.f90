@@ -1,12 +1,12 @@
 !> `RADAU5`: the 3-stage Radau IIA method of order 5 for M y' = F(t, y).
 !>
 !> Implemented from the published algorithm [HW96 IV.8, HW99] as specified
-!> in ALGORITHMS.md §1: simplified Newton on the stage equations in the
+!> in docs/theory.md §5: simplified Newton on the stage equations in the
 !> variables W = (T⁻¹ ⊗ I) Z, which decouple into a real system with
 !> E1 = (γ/h) M − J and a complex one with E2 = ((α + iβ)/h) M − J; the
 !> embedded error estimate; Gustafsson's predictive step-size controller;
 !> index-2/3 weight scaling; collocation dense output. The control flow
-!> R0…R8 of ALGORITHMS.md §1.10 decides every counter and is followed
+!> R0…R8 of the control flow (docs/theory.md §5.5) decides every counter and is followed
 !> literally, so the native counters are those of the classic code.
 module flexmbs_dae_radau5
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -31,7 +31,7 @@ module flexmbs_dae_radau5
     implicit none
     private
 
-    ! Method constants (ALGORITHMS.md §1.2), r6 = sqrt(6).
+    ! Method constants (docs/theory.md §5.1), r6 = sqrt(6).
     real(wp), parameter :: sq6 = sqrt(6.0_wp)
     real(wp), parameter :: c1 = (4.0_wp - sq6) / 10.0_wp
     real(wp), parameter :: c2 = (4.0_wp + sq6) / 10.0_wp
@@ -157,7 +157,7 @@ contains
             + (sigma - c1m1) * self%cont(i, 3)))
     end function dense_component
 
-    !> Integrate M y' = F(t, y) from (t, y) to t_end (ALGORITHMS.md §1.10).
+    !> Integrate M y' = F(t, y) from (t, y) to t_end (docs/theory.md §5.5).
     subroutine radau5_integrate(self, problem, t, y, t_end, options, stats, status, sink, yp)
         class(radau5_t), intent(inout) :: self
         class(dae_problem_t), intent(inout) :: problem
@@ -696,7 +696,7 @@ contains
             call finish()
         end subroutine interrupted
 
-        !> Common statistics from the native counters (ALGORITHMS.md §4.1).
+        !> Common statistics from the native counters (docs/solvers.md).
         subroutine finish()
             type(status_t) :: sink_status
             stats%nst = self%native%nstep

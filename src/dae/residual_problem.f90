@@ -3,7 +3,7 @@
 !> The iteration matrix ∂G/∂y + c ∂G/∂y' is handed to the linear solvers,
 !> which factor c*A − B, as the pair A = ∂G/∂y' and B = −∂G/∂y. Any
 !> `dae_problem_t` becomes a residual problem through `dae_residual_t`:
-!> G = M y' − F(t, y), so A = M (constant) and B = J = ∂F/∂y (DESIGN.md).
+!> G = M y' − F(t, y), so A = M (constant) and B = J = ∂F/∂y (docs/theory.md §1).
 module flexmbs_dae_residual_problem
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_resources, only: out_of_memory

@@ -1,4 +1,4 @@
-!> Common solver statistics, one meaning for every solver (DESIGN.md).
+!> Common solver statistics, one meaning for every solver (docs/solvers.md).
 module flexmbs_dae_stats
     use flexmbs_core_kinds, only: wp
     implicit none
@@ -50,7 +50,7 @@ contains
         line = trim(buf)
     end function stats_summary
 
-    !> The warning for index-3 components given to a BDF code (ALGORITHMS.md §6).
+    !> The warning for index-3 components given to a BDF code (docs/theory.md §3).
     pure function index3_warning(solver) result(text)
         character(len=*), intent(in) :: solver
         character(len=:), allocatable :: text

@@ -1,4 +1,4 @@
-!> The paper's material (PAPER.md, "The material law behind the paper"):
+!> The paper's material (docs/theory.md §2.4):
 !> compressible neo-Hookean elasticity with Kelvin–Voigt damping on the scaled
 !> strain rate (Kübler, Eberhard & Geisler 2003).
 !>

@@ -1,4 +1,4 @@
-!> Which files a run may write (DESIGN.md, Errors and failure), checked
+!> Which files a run may write (docs/user_guide.md, exit codes), checked
 !> before anything is computed: an output is never an input of the run,
 !> two outputs of a run are never one file, and a file already there is
 !> replaced only when it is a result of the same kind written by flexmbs —

@@ -1,7 +1,7 @@
-!> The formulations of ALGORITHMS.md §6: any `mechanical_problem_t` turned
+!> The formulations of docs/theory.md §3: any `mechanical_problem_t` turned
 !> into the linearly implicit DAE `M y' = F(t, y)` of `dae_problem_t`.
 !>
-!> Mechanical system (DESIGN.md, our sign of λ): q' = T(q) v,
+!> Mechanical system (docs/theory.md §2.1, our sign of λ): q' = T(q) v,
 !> M(q) v' = f(t,q,v) - Gᵀλ, constraints g(t,q) = 0, G = g_q T,
 !> velocity constraint G v + g_I = 0, acceleration constraint G a + γ = 0.
 !>
@@ -35,7 +35,7 @@
 !> (mechanical_problem.f90) otherwise.
 !>
 !> Coordinate projection (eqs. 11-12), the post-step hook: positions by the
-!> simplified Newton iteration of ALGORITHMS.md §3.6 step 1 with
+!> simplified Newton iteration of docs/theory.md §7.4 step 1 with
 !> K = [M Gᵀ; G 0] at the step's q̃, q ← q + T(q̃) δ, converged when the
 !> weighted RMS norm of the correction is ≤ EPSREQ; then velocities by one
 !> solve with K at the projected q, every `velocity_interval` calls. Before
@@ -67,7 +67,7 @@ module flexmbs_mbs_formulation
     integer, parameter, public :: formulation_index3 = 3
     integer, parameter, public :: formulation_ggl = 4
 
-    ! ALGORITHMS.md §3.6: convergence bound and iteration limit of the
+    ! docs/theory.md §7.4: convergence bound and iteration limit of the
     ! position projection.
     real(wp), parameter :: projection_epsreq = 1.0e-2_wp
     integer, parameter :: projection_itmax = 10
@@ -602,7 +602,7 @@ contains
         end if
     end subroutine formulation_mass_dense
 
-    !> ALGORITHMS.md §6.
+    !> docs/theory.md §3.
     subroutine formulation_index_classes(self, classes)
         class(formulation_t), intent(in) :: self
         integer, intent(out) :: classes(:)

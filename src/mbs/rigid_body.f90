@@ -1,4 +1,4 @@
-!> Rigid bodies in absolute coordinates (DESIGN.md, the mechanical model).
+!> Rigid bodies in absolute coordinates (docs/theory.md §2).
 !>
 !> Body i has positions q_i = (r, p): centre of mass r (global) and a unit
 !> quaternion p (scalar first, body to global A(p), flexmbs_mbs_rotation),

@@ -1,4 +1,4 @@
-!> Rigid chains: loop-free substructures in relative coordinates (DESIGN.md,
+!> Rigid chains: loop-free substructures in relative coordinates (docs/theory.md §2.3,
 !> the paper's rigid substructures). Body i hangs from its parent (0 = the
 !> ground) by a revolute or prismatic joint (one coordinate q_i, rate v_i,
 !> q_i' = v_i) or a spherical joint (a unit quaternion p_i of the relative

@@ -1,4 +1,4 @@
-!> The assembled multibody system (DESIGN.md, the mechanical model): rigid
+!> The assembled multibody system (docs/theory.md §2): rigid
 !> bodies in absolute coordinates and joints between markers on them (or on
 !> the ground), as one `mechanical_problem_t`.
 !>
@@ -31,7 +31,7 @@
 !> is the revolute plus an angle driver on the same markers, axes 1 and 1:
 !> the angle from x_i to x_j about z_i.
 !>
-!> Joint reactions (`joint_reaction`), our sign of λ (DESIGN.md: M v' =
+!> Joint reactions (`joint_reaction`), our sign of λ (docs/theory.md §2.1: M v' =
 !> f − Gᵀλ): the generalised force of joint k on a body is −C_bᵀλ_k, C_b
 !> the joint's columns of G for that body; it is reported as the force F
 !> (global) and the torque n (global) about the marker's origin that the

@@ -1,6 +1,6 @@
 !> The planar pendulum in Cartesian coordinates, the reference problem of
 !> every solver: a point mass m on a massless rod of length L, gravity g in
-!> -y, written by hand in the four formulations of ALGORITHMS.md §6.
+!> -y, written by hand in the four formulations of docs/theory.md §3.
 !>
 !> Position invariant and constraint Jacobian (one scaling used throughout,
 !> so that G = g_q and the velocity constraint is G v):
@@ -391,7 +391,7 @@ contains
         if (status%ok()) m%values = [1.0_wp, 1.0_wp, self%point_mass, self%point_mass]
     end subroutine pendulum_mass_sparse
 
-    !> ALGORITHMS.md §6 with constant M and y = (q, v, λ[, μ]).
+    !> docs/theory.md §3 with constant M and y = (q, v, λ[, μ]).
     subroutine pendulum_index_classes(self, classes)
         class(pendulum_t), intent(in) :: self
         integer, intent(out) :: classes(:)

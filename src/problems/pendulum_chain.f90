@@ -1,4 +1,4 @@
-!> The planar chain of NB rigid bars of ALGORITHMS.md §8 (the MEXAX anchor
+!> The planar chain of NB rigid bars of docs/solvers.md (the MEXAX anchor
 !> problem) as a mechanical problem in absolute coordinates.
 !>
 !> Body i has q = (x_i, y_i, φ_i) (centre and angle from the downward

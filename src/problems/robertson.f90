@@ -8,7 +8,7 @@
 !> k1 = 0.04, k2 = 3e7, k3 = 1e4, M = diag(1, 1, 0), y0 = (1, 0, 0). The
 !> algebraic equation is the conservation law that the ODE form
 !> (y3' = k2 y2²) keeps, so d/dt (y1 + y2 + y3) = 0. It is the DDASSL anchor
-!> of ALGORITHMS.md §8. The Jacobian is reported dense or as CSC (full 3x3
+!> of docs/solvers.md. The Jacobian is reported dense or as CSC (full 3x3
 !> pattern), the mass matrix dense or as CSC.
 module flexmbs_problems_robertson
     use flexmbs_core_kinds, only: wp

@@ -1,7 +1,7 @@
 !> Van der Pol's equation in the scaled stiff form of [HW96, IV.1]:
 !>   y1' = y2,  y2' = ((1 - y1²) y2 - y1) / ε.
 !> With ε = 1e-6, y0 = (2, -0.66), x in [0, 2] it is the RADAU5 anchor of
-!> ALGORITHMS.md §8.
+!> docs/solvers.md.
 module flexmbs_problems_van_der_pol
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t

@@ -1169,7 +1169,7 @@ def find_exe():
     env = dict(os.environ)
     env.setdefault('FPM_FFLAGS', '-I/usr/include/hdf5/serial -I/usr/include/sundials/fortran '
                    '-I/usr/include -I/usr/include/mumps_seq')
-    env.setdefault('FPM_CFLAGS', '-I/usr/include/suitesparse')
+    env.setdefault('FPM_CFLAGS', '-I/usr/include/suitesparse -fPIC')
     fpm = os.environ.get('FPM', 'fpm')
     try:
         out = subprocess.run([fpm, 'run', '--profile', 'debug', '--runner', 'echo', 'flexmbs'],

@@ -1,7 +1,7 @@
 !> The classic DDASSL face over the modern core `flexmbs_dae_ddassl`.
 !>
 !> `ddassl_classic` reads INFO, RTOL/ATOL and the option slots
-!> (ALGORITHMS.md §2.11), validates them (IDID -33), wraps RES, JAC and
+!> (docs/solvers.md, DDASSL), validates them (IDID -33), wraps RES, JAC and
 !> RPAR/IPAR in a `residual_problem_t`, and plays the driver of §2.7 over
 !> the core's begin/step/interpolate: output at TOUT by interpolation or
 !> after every step (INFO(3)), TSTOP (INFO(4)), 500 steps a call (IDID -1)
@@ -501,7 +501,7 @@ contains
         case (17); text = 'ML = IWORK(1) not in 0..NEQ-1'
         case (18); text = 'MU = IWORK(2) not in 0..NEQ-1'
         case (19); text = 'TOUT = T'
-        case default; text = 'see ALGORITHMS.md §2.11'
+        case default; text = 'see docs/solvers.md, DDASSL'
         end select
     end function illegal_text
 

@@ -1,4 +1,4 @@
-!> The classic external entry point DDASSL (ALGORITHMS.md §2.11).
+!> The classic external entry point DDASSL (docs/solvers.md, DDASSL).
 !>
 !> Not in a module, so that programs written for the original link
 !> unchanged: `gfortran -std=legacy prog.f -lflexmbs-legacy -lflexmbs ...`.

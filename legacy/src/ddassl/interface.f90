@@ -1,7 +1,7 @@
 !> Explicit interfaces of the classic DDASSL face for modern callers.
 !>
 !> `use flexmbs_legacy_ddassl_interface` gives `DDASSL` and the abstract
-!> interfaces of the user routines RES and JAC (ALGORITHMS.md §2.11). As in
+!> interfaces of the user routines RES and JAC (docs/solvers.md, DDASSL). As in
 !> the original, RES and JAC do not receive NEQ: their arrays are
 !> assumed-size. Fixed-form programs call the same external procedure
 !> without this module.
@@ -42,7 +42,7 @@ module flexmbs_legacy_ddassl_interface
     end interface
 
     interface
-        !> The classic DDASSL calling sequence (ALGORITHMS.md §2.11).
+        !> The classic DDASSL calling sequence (docs/solvers.md, DDASSL).
         subroutine ddassl(res, neq, t, y, yprime, tout, info, rtol, atol, idid, rwork, lrw, &
             iwork, liw, rpar, ipar, jac)
             import :: wp, ddassl_res_i, ddassl_jac_i

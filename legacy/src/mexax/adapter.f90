@@ -1,7 +1,7 @@
 !> The classic MEXAX face over the modern core `flexmbs_dae_mexax`.
 !>
 !> `mexax_classic` validates the dimensions, MXJOB options and workspace
-!> lengths (ALGORITHMS.md §3.9, IERR −2 … −135), wraps FPROB in a
+!> lengths (docs/solvers.md, MEXAX, IERR −2 … −135), wraps FPROB in a
 !> `mechanical_problem_t` (one FPROB call, one flag, per item the core
 !> needs), runs the core from T to TFIN with the half-explicit Euler base
 !> unless MXJOB(29) = 1, and returns the state, the proposed step, the
@@ -247,7 +247,7 @@ contains
             if (k /= 0) then
                 code = ierr_mxjob - k
                 call message('MXJOB(' // int_text(k) // ') = ' // int_text(mxjob(k)) // &
-                    ': not a value this face accepts (ALGORITHMS.md §3.9)')
+                    ': not a value this face accepts (docs/solvers.md, MEXAX)')
                 return
             end if
             kdmax = mxjob(slot_kdmax)
@@ -308,7 +308,7 @@ contains
         end function status_ierr
     end subroutine mexax_classic
 
-    !> One line on the standard error unit (ALGORITHMS.md §0).
+    !> One line on the standard error unit (docs/theory.md §4).
     subroutine message(text)
         character(len=*), intent(in) :: text
         write (error_unit, '(a)') 'MEXAX: ' // text

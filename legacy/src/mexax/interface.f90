@@ -2,7 +2,7 @@
 !>
 !> `use flexmbs_legacy_mexax_interface` gives `MEXAX`, its alias `MEXX`, and
 !> the abstract interfaces of the user routines FPROB and SOLOUT
-!> (ALGORITHMS.md §3.9). DENOUT and FSWIT are passed but never called (the
+!> (docs/solvers.md, MEXAX). DENOUT and FSWIT are passed but never called (the
 !> face rejects dense output and root finding), so they have no interface
 !> here: any external subroutine will do. Fixed-form programs call the same
 !> external procedures without this module.
@@ -53,7 +53,7 @@ module flexmbs_legacy_mexax_interface
     end interface
 
     interface
-        !> The classic MEXAX calling sequence (ALGORITHMS.md §3.9).
+        !> The classic MEXAX calling sequence (docs/solvers.md, MEXAX).
         subroutine mexax(np, nv, nl, ng, nu, fprob, t, tfin, p, v, u, a, rlam, itol, rtol, &
             atol, h, mxjob, ierr, liwk, iwk, lrwk, rwk, solout, denout, fswit)
             import :: wp, mexax_fprob_i, mexax_solout_i

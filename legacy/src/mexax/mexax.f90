@@ -1,4 +1,4 @@
-!> The classic external entry points MEXAX and MEXX (ALGORITHMS.md §3.9).
+!> The classic external entry points MEXAX and MEXX (docs/solvers.md, MEXAX).
 !>
 !> Not in a module, so that programs written for the original link
 !> unchanged: `gfortran -std=legacy prog.f -lflexmbs-legacy -lflexmbs ...`.

@@ -1,7 +1,7 @@
 !> The classic RADAU5 face over the modern core `flexmbs_dae_radau5`.
 !>
 !> `radau5_classic` reads the classic arguments and option slots
-!> (ALGORITHMS.md §1.13), validates them (IDID = -1), wraps FCN/JAC/MAS and
+!> (docs/solvers.md, RADAU5), validates them (IDID = -1), wraps FCN/JAC/MAS and
 !> RPAR/IPAR in a `dae_problem_t` and SOLOUT in a `sink_t`, runs the core,
 !> and writes back X, Y, H, IDID and the statistics IWORK(14..20). Banded
 !> Jacobians and masses become CSC matrices; the M1/M2 structure is expanded
@@ -31,7 +31,7 @@ module flexmbs_legacy_radau5_adapter
 
     public :: radau5_classic, contr5_value
 
-    ! Defaults of the option slots (ALGORITHMS.md §1.13) that are not
+    ! Defaults of the option slots (docs/solvers.md, RADAU5) that are not
     ! RADAU5's own settings; those (a zero slot) come from radau5_t.
     real(wp), parameter :: uround_default = 1.0e-16_wp
     integer, parameter :: nmax_default = 100000

@@ -2,7 +2,7 @@
 !>
 !> `use flexmbs_legacy_radau5_interface` gives `RADAU5`, `CONTR5` and the
 !> abstract interfaces of the user routines FCN, JAC, MAS and SOLOUT
-!> (ALGORITHMS.md §1.13). A modern caller writes its callbacks with exactly
+!> (docs/solvers.md, RADAU5). A modern caller writes its callbacks with exactly
 !> these characteristics (the intents included) and gets its call checked;
 !> fixed-form programs call the same external procedures without it.
 module flexmbs_legacy_radau5_interface
@@ -68,7 +68,7 @@ module flexmbs_legacy_radau5_interface
     end interface
 
     interface
-        !> The classic RADAU5 calling sequence (ALGORITHMS.md §1.13).
+        !> The classic RADAU5 calling sequence (docs/solvers.md, RADAU5).
         subroutine radau5(n, fcn, x, y, xend, h, rtol, atol, itol, jac, ijac, mljac, mujac, &
             mas, imas, mlmas, mumas, solout, iout, work, lwork, iwork, liwork, rpar, ipar, idid)
             import :: wp, radau5_fcn_i, radau5_jac_i, radau5_mas_i, radau5_solout_i

@@ -1,4 +1,4 @@
-!> The classic external entry points RADAU5 and CONTR5 (ALGORITHMS.md §1.13).
+!> The classic external entry points RADAU5 and CONTR5 (docs/solvers.md, RADAU5).
 !>
 !> Not in a module, so that programs written for the original link
 !> unchanged: `gfortran -std=legacy prog.f -lflexmbs-legacy -lflexmbs ...`.

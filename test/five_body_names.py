@@ -1,0 +1,79 @@
+#!/usr/bin/env python3
+"""The five-body result read as a user reads it: by name, with units, and no
+index arithmetic; each value checked against /y, found by its label.
+
+    python3 test/five_body_names.py five_body.h5
+
+- the rocker pivot's angle (rad) is the rocker's turn about the world x
+  axis, 2 atan2(p1, p0) of its quaternion in /y (the pivot's markers have
+  z along x and start aligned);
+- coupler node 23's x (m) is its reference position plus its displacement,
+  and equals /y's column 'coupler/node 23/x';
+- the rocker pivot's reaction force on the rocker (N) is minus the
+  joint's first three multipliers in /y (a revolute joint's point
+  constraint x_j - x_i = 0 in world coordinates, our sign of lambda), and
+  on the ground side it is zero.
+Prints `pass`/`FAIL` lines and `N passed, M failed` last.
+"""
+import sys
+
+import h5py
+import numpy as np
+
+passed = failed = 0
+
+
+def report(name, problem):
+    global passed, failed
+    if problem:
+        failed += 1
+        print('FAIL five_body_names/%s: %s' % (name, problem))
+    else:
+        passed += 1
+        print('pass five_body_names/%s' % name)
+
+
+def text(value):
+    return value.decode() if isinstance(value, bytes) else value
+
+
+with h5py.File(sys.argv[1], 'r') as f:
+    labels = [text(s) for s in f['y_labels'][:]]
+    units = [text(s) for s in f['y_units'][:]]
+    y = f['y'][:]
+
+    def column(label):
+        return y[:, labels.index(label)], units[labels.index(label)]
+
+    angle = f['joints/rocker pivot/angle']
+    p0, _ = column('rocker/orientation/p0')
+    p1, _ = column('rocker/orientation/p1')
+    turn = 2.0 * np.arctan2(p1, p0)
+    report('rocker-pivot-angle',
+           None if text(angle.attrs['unit']) == 'rad'
+           and np.abs(angle[:, 0] - turn).max() < 1e-12
+           and np.abs(turn).max() > 1e-5 else
+           'angle %s %s against %s' % (angle[-1], text(angle.attrs['unit']), turn[-1]))
+
+    node = 23
+    reference = f['flexible/coupler/reference_nodes']
+    displacement = f['flexible/coupler/displacement']
+    x = reference[node - 1, 0] + displacement[:, node - 1, 0]
+    x_y, unit = column('coupler/node %d/x' % node)
+    report('coupler-node-x',
+           None if text(reference.attrs['unit']) == 'm' == text(displacement.attrs['unit'])
+           and unit == 'm' and np.abs(x - x_y).max() < 1e-15
+           and np.abs(displacement[:, node - 1, 0]).max() > 0 else
+           'x %s against /y %s' % (x[-1], x_y[-1]))
+
+    force = f['joints/rocker pivot/reaction_force_j']
+    ground = f['joints/rocker pivot/reaction_force']
+    lam = np.array([column('joints/rocker pivot/lambda %d' % k)[0] for k in (1, 2, 3)]).T
+    report('rocker-pivot-reaction',
+           None if text(force.attrs['unit']) == 'N'
+           and column('joints/rocker pivot/lambda 1')[1] == 'N'
+           and np.abs(force[:] + lam).max() < 1e-12 * max(1.0, np.abs(lam).max())
+           and np.abs(ground[:]).max() == 0.0 and np.abs(lam).max() > 0.1 else
+           'force %s against -lambda %s' % (force[-1], -lam[-1]))
+print('%d passed, %d failed' % (passed, failed))
+sys.exit(1 if failed else 0)
