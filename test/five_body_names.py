@@ -2,7 +2,7 @@
 """The five-body result read as a user reads it: by name, with units, and no
 index arithmetic; each value checked against /y, found by its label.
 
-    python3 test/five_body_names.py five_body.h5
+    python3 test/five_body_names.py five_body.h5 [five_body.out]
 
 - the rocker pivot's angle (rad) is the rocker's turn about the world x
   axis, 2 atan2(p1, p0) of its quaternion in /y (the pivot's markers have
@@ -12,9 +12,13 @@ index arithmetic; each value checked against /y, found by its label.
 - the rocker pivot's reaction force on the rocker (N) is minus the
   joint's first three multipliers in /y (a revolute joint's point
   constraint x_j - x_i = 0 in world coordinates, our sign of lambda), and
-  on the ground side it is zero.
+  on the ground side it is zero;
+- the coupler's von Mises stress per element is that of its Cauchy stress
+  (Pa), and with the run's summary (five_body.out) the largest at t_end is
+  the one the summary names, in the same element.
 Prints `pass`/`FAIL` lines and `N passed, M failed` last.
 """
+import re
 import sys
 
 import h5py
@@ -75,5 +79,25 @@ with h5py.File(sys.argv[1], 'r') as f:
            and np.abs(force[:] + lam).max() < 1e-12 * max(1.0, np.abs(lam).max())
            and np.abs(ground[:]).max() == 0.0 and np.abs(lam).max() > 0.1 else
            'force %s against -lambda %s' % (force[-1], -lam[-1]))
+    stress = f['flexible/coupler/stress']
+    mises = f['flexible/coupler/von_mises']
+    xx, yy, zz, xy, yz, xz = np.moveaxis(stress[:], 2, 0)
+    from_stress = np.sqrt(0.5 * ((xx - yy)**2 + (yy - zz)**2 + (zz - xx)**2)
+                          + 3.0 * (xy**2 + yz**2 + xz**2))
+    report('coupler-von-mises',
+           None if text(stress.attrs['unit']) == 'Pa' == text(mises.attrs['unit'])
+           and mises.shape == from_stress.shape
+           and np.abs(mises[:] - from_stress).max() <= 1e-12 * np.abs(from_stress).max()
+           and np.abs(from_stress).max() > 0 else
+           'von Mises %s against %s' % (mises[-1], from_stress[-1]))
+    if len(sys.argv) > 2:
+        summary = open(sys.argv[2]).read()
+        m = re.search(r'coupler: .*largest von Mises stress (\S+) Pa \(element (\d+)\)', summary)
+        last = mises[-1]
+        report('coupler-von-mises-as-summary',
+               None if m and abs(float(m.group(1)) - last.max()) <= 1e-6 * last.max()
+               and int(m.group(2)) == int(np.argmax(last)) + 1 else
+               'summary %s against %s in element %d'
+               % (m.group(0) if m else '(no line)', last.max(), np.argmax(last) + 1))
 print('%d passed, %d failed' % (passed, failed))
 sys.exit(1 if failed else 0)

@@ -17,9 +17,12 @@
 !>                                  bodies; coordinate, rate: the joint to its
 !>                                  parent (rad or m; a spherical's quaternion)
 !>   /flexible/<name>/reference_nodes (3, nodes) m; connectivity (nodes of an
-!>                                  element, attribute element_type); node_sets/<set>
+!>                                  element, attribute element_type); node_sets/<set>,
+!>                                  element_sets/<set>
 !>   /flexible/<name>/displacement    (3, nodes) m    x - X of every node
 !>   /flexible/<name>/velocity        (3, nodes) m/s
+!>   /flexible/<name>/stress          (6, elements) Pa  Cauchy, mean over the element
+!>   /flexible/<name>/von_mises       (elements)    Pa
 !>
 !>   /y_labels, /y_units               every component of y by name, and its unit
 !>
@@ -27,8 +30,9 @@
 !> record of /time (h5py shows the series as records × rows), and
 !> `f['flexible/coupler/displacement'][:, k - 1, 0]` node k's x displacement.
 module flexmbs_run_named_output
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_mbs_rigid_body, only: rigid_body_nq, rigid_body_nv
     use flexmbs_mbs_system, only: mbs_system_t
@@ -76,6 +80,19 @@ module flexmbs_run_named_output
     contains
         procedure :: evaluate => node_evaluate
     end type node_values_t
+
+    !> The Cauchy stress of every element (the mean over its quadrature
+    !> points, as ParaView shows it), or its von Mises value, of a flexible
+    !> body whose q start after y(oq), v after y(ov). The work arrays are
+    !> allocated when the series is added, not per record.
+    type, extends(record_values_t) :: stress_values_t
+        type(flexible_body_t), pointer :: body => null()
+        integer :: oq = 0, ov = 0
+        logical :: von_mises = .false.
+        real(wp), allocatable :: sigma(:, :), mises(:)
+    contains
+        procedure :: evaluate => stress_evaluate
+    end type stress_values_t
 
     integer, parameter :: link_position = 1, link_rotation = 2, link_velocity = 3, &
         link_angular_velocity = 4, link_coordinate = 5, link_rate = 6
@@ -444,8 +461,9 @@ contains
         integer, intent(in) :: oq, ov  !! the body's free q and v start after y(oq), y(ov)
         type(status_t), intent(out) :: status
         type(node_values_t) :: nodes
+        type(stress_values_t) :: stress
         character(len=:), allocatable :: base
-        integer :: k, nn
+        integer :: k, nn, ne, stat
         base = 'flexible/' // path_name(name) // '/'
         nn = body%mesh%node_count()
         call h5%write_matrix(base // 'reference_nodes', body%mesh%x, status)
@@ -465,6 +483,15 @@ contains
                 end associate
             end do
         end if
+        if (allocated(body%mesh%element_sets)) then
+            do k = 1, size(body%mesh%element_sets)
+                if (.not. status%ok()) exit
+                associate (set => body%mesh%element_sets(k))
+                    call h5%write_integers(base // 'element_sets/' // path_name(set%name), &
+                                           set%elements, status)
+                end associate
+            end do
+        end if
         if (.not. status%ok()) return
         nodes%body => body
         nodes%oq = oq
@@ -476,7 +503,45 @@ contains
         nodes%velocity = .true.
         call h5%add_series(base // 'velocity', 3, 'm/s', nodes, status, 'of every node', &
             columns=nn)
+        if (.not. status%ok()) return
+        ne = body%mesh%element_count()
+        allocate (stress%sigma(6, ne), stress%mises(ne), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'the elements'' stress for the HDF5 file', &
+                7_i8 * ne, 8)
+            return
+        end if
+        stress%body => body
+        stress%oq = oq
+        stress%ov = ov
+        call h5%add_series(base // 'stress', 6, 'Pa', stress, status, 'Cauchy stress of &
+            &every element, mean over its quadrature points: xx, yy, zz, xy, yz, xz', &
+            columns=ne)
+        if (.not. status%ok()) return
+        stress%von_mises = .true.
+        call h5%add_series(base // 'von_mises', ne, 'Pa', stress, status, 'von Mises &
+            &stress of every element, from its mean Cauchy stress')
     end subroutine add_flexible
+
+    subroutine stress_evaluate(self, t, y, values, status)
+        class(stress_values_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        integer :: el
+        associate (body => self%body)
+            call body%element_stress(y(self%oq + 1:self%oq + body%nq), &
+                                     y(self%ov + 1:self%ov + body%nv), self%sigma, &
+                                     self%mises, status)
+        end associate
+        if (self%von_mises) then
+            values = self%mises
+        else
+            do el = 1, size(self%sigma, 2)
+                values(6 * el - 5:6 * el) = self%sigma(:, el)
+            end do
+        end if
+    end subroutine stress_evaluate
 
     subroutine node_evaluate(self, t, y, values, status)
         class(node_values_t), intent(inout) :: self
