@@ -165,6 +165,28 @@ expect unknown-option 2 "unknown option '--loud'" run x.nml --loud
 printf '%s\n&solver rtol = 1e-4, atol = 1e-4, h0 = 1e-6 /\n%s\n' "$sim" "$out" > ok.nml
 kept success 0 "y(1) =  1.7061611" out/run.h5 run ok.nml --quiet
 kept success-statistics 0 "radau5: NST=275 NAC=238" out/run.h5 run ok.nml --quiet
+# NRJ by cause on the statistics line, in the HDF5 attributes and, asked
+# for, in the table (docs/solvers.md, Rejection causes)
+kept success-causes 0 "NRJ=37 (error test 8, Newton slow 29) NFE=2218" out/run.h5 \
+    run ok.nml --quiet
+if problem=$(/usr/bin/python3 - out/run.h5 2>&1 <<'PY'
+import sys, h5py
+a = h5py.File(sys.argv[1], 'r').attrs
+causes = ['NRJ_ERROR_TEST', 'NRJ_NEWTON_DIVERGED', 'NRJ_NEWTON_SLOW', 'NRJ_SINGULAR',
+          'NRJ_REFUSED', 'NRJ_PROJECTION', 'NRJ_UNSTABLE']
+values = [int(a[c]) for c in causes]
+assert sum(values) == int(a['NRJ']) == 37, values
+assert values == [8, 0, 29, 0, 0, 0, 0], values
+assert 'refusal' not in a
+PY
+); then pass hdf5-rejection-causes; else fail hdf5-rejection-causes "$problem"; fi
+printf '%s\n&solver rtol = 1e-4, atol = 1e-4, h0 = 1e-6 /\n%s\n' "$sim" \
+    "&output file = 'out/run.h5', table = 'out/run.csv', reasons = .true. /" > reasons.nml
+kept table-rejection-causes 0 "radau5: NST=275" out/run.csv run reasons.nml --quiet
+if ! grep -q '^solver,.*,NSOL,error test,Newton diverged,Newton slow,singular,refused,projection,unstable$' out/run.csv \
+    || ! grep -q ',37,248,.*,8,0,29,0,0,0,0$' out/run.csv; then
+    fail table-rejection-columns "$(cat out/run.csv)"
+else pass table-rejection-columns; fi
 printf '%s\n&solver name = '"'ida'"', rtol = 1e-8, atol = 1e-8 /\n%s\n' "$sim" "$out" > ida.nml
 kept success-ida 0 "y(1) =  1.70616" out/run.h5 run ida.nml --quiet
 
