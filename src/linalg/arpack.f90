@@ -30,7 +30,8 @@ module flexmbs_linalg_arpack
     !> Arnoldi basis size for nev wanted values: ARPACK's guide recommends
     !> ncv ≥ 2 nev + 1; a floor of 20 keeps restarts rare for small nev.
     integer, parameter :: min_basis = 20
-    !> Restart limit (iparam(3)); the tests converge in well under 50.
+    !> Restart limit (iparam(3)); when it is reached, the eigenvalues that
+    !> converged come back (fewer than asked for).
     integer, parameter :: default_max_restarts = 500
 
     interface
