@@ -18,8 +18,8 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := run
 
 APT_PACKAGES := gfortran libsundials-dev libsundials-fortran-dev libsuitesparse-dev \
-                liblapack-dev libopenblas-dev libhdf5-dev libmumps-seq-dev python3-h5py pkgconf \
-                python3-matplotlib python3-venv
+                liblapack-dev libopenblas-dev libhdf5-dev libmumps-seq-dev libarpack2-dev \
+                python3-h5py pkgconf python3-matplotlib python3-venv
 BUILD        := $(CURDIR)/build
 VENV         := $(BUILD)/venv
 FORD_VERSION := 7.0.13
@@ -58,7 +58,7 @@ SYSLIBS      := -lsundials_fida_mod -lsundials_fnvecserial_mod \
                 -lsundials_generic \
                 -lklu -lcholmod -lamd -lcolamd -lbtf -lsuitesparseconfig \
                 -ldmumps_seq -lzmumps_seq -lmumps_common_seq -lmpiseq_seq -lpord_seq \
-                -lhdf5_serial_fortran -lhdf5_serial -llapack -lblas
+                -lhdf5_serial_fortran -lhdf5_serial -larpack -llapack -lblas
 MAIN_INPUT   := inputs/five_body.nml
 VERSION      := $(shell sed -n 's/^version *= *"\(.*\)"/\1/p' fpm.toml)
 

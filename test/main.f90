@@ -44,6 +44,7 @@ program flexmbs_tests
     use test_chain_coupling, only: collect_chain_coupling
     use test_sparse_formulation, only: collect_sparse_formulation
     use test_out_of_memory, only: collect_out_of_memory
+    use test_modes, only: collect_modes
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -94,6 +95,7 @@ program flexmbs_tests
     call run_suite('sparse_formulation', collect_sparse_formulation(), filter, npassed, &
                    nfailed)
     call run_suite('out_of_memory', collect_out_of_memory(), filter, npassed, nfailed)
+    call run_suite('modes', collect_modes(), filter, npassed, nfailed)
     call run_suite('node_frame', collect_node_frame(), filter, npassed, nfailed)
     call run_suite('study', collect_study(), filter, npassed, nfailed)
     call run_suite('run', collect_run(), filter, npassed, nfailed)

@@ -74,6 +74,7 @@ module flexmbs_dae_ddassl
     contains
         procedure :: evaluate => dense_evaluate
         procedure :: interpolate => dense_interpolate
+        procedure :: order => dense_order
     end type ddassl_dense_t
 
     !> The classic code's counters, IWORK(11..15).
@@ -188,6 +189,12 @@ contains
         real(wp), intent(out) :: y(:)
         call interpolate_history(self%phi, self%psi, self%kold, self%tn, s, y)
     end subroutine dense_evaluate
+
+    !> The BDF order of the last accepted step.
+    integer function dense_order(self)
+        class(ddassl_dense_t), intent(in) :: self
+        dense_order = self%kold
+    end function dense_order
 
     !> y(s) and y'(s).
     subroutine dense_interpolate(self, s, y, yp)

@@ -47,7 +47,7 @@ module flexmbs_dae_ida
     use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_identity, storage_dense, &
         storage_sparse
     use flexmbs_linalg_linear_solver, only: auto_sparse_threshold
-    use flexmbs_dae_problem, only: dae_problem_t
+    use flexmbs_dae_problem, only: dae_problem_t, problem_mass_matrix
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t, index3_warning
     use flexmbs_dae_rejections, only: refusal_len, cause_model_refused
@@ -408,22 +408,8 @@ contains
         subroutine setup_matrices(st)
             type(status_t), intent(inout) :: st
             integer :: storage
-            data%mass%n = n
-            data%mass%storage = problem%mass_storage()
-            select case (data%mass%storage)
-            case (storage_dense)
-                allocate (data%mass%dense(n, n), stat=stat)
-                if (stat /= 0) then
-                    call out_of_memory(st, 'ida dense mass matrix', int(n, i8) * n, 8)
-                    return
-                end if
-                call problem%mass_dense(data%mass%dense)
-            case (storage_sparse)
-                call problem%mass_sparse(data%mass%csc, st)
-                if (.not. st%ok()) return
-            case default
-                data%mass%storage = storage_identity
-            end select
+            call problem_mass_matrix(problem, data%mass, st, 'ida')
+            if (.not. st%ok()) return
             storage = problem%jacobian_storage()
             if (options%jacobian == 'fd') storage = storage_none
             select case (storage)

@@ -23,7 +23,7 @@ module flexmbs_dae_radau5
         storage_sparse
     use flexmbs_linalg_linear_solver, only: linear_solver_t
     use flexmbs_linalg_factory, only: new_linear_solver
-    use flexmbs_dae_problem, only: dae_problem_t
+    use flexmbs_dae_problem, only: dae_problem_t, problem_mass_matrix
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_rejections, only: cause_error_test, cause_newton_diverged, &
@@ -898,21 +898,7 @@ contains
                     return
                 end if
             end select
-            mass%n = n
-            mass%storage = problem%mass_storage()
-            select case (mass%storage)
-            case (storage_dense)
-                allocate (mass%dense(n, n), stat=stat)
-                if (stat /= 0) then
-                    call out_of_memory(st, 'radau5 dense mass matrix', int(n, i8) * n, 8)
-                    return
-                end if
-                call problem%mass_dense(mass%dense)
-            case (storage_sparse)
-                call problem%mass_sparse(mass%csc, st)
-            case default
-                mass%storage = storage_identity
-            end select
+            call problem_mass_matrix(problem, mass, st, 'radau5')
         end subroutine setup_matrices
 
         !> J at (x, y): analytic, or by forward differences (§1.12; these
