@@ -47,6 +47,11 @@ OMP_LINK := -fopenmp
 endif
 FPM          = $(shell command -v fpm 2>/dev/null || echo $(VENV)/bin/fpm)
 PREFIX_DEBUG   := $(BUILD)/prefix-debug
+# The umbrella module (src/flexmbs.f90) is compiled only by --no-prune
+# installs, and fpm does not rebuild its object when a module it uses
+# changes: a stale one gave the examples a mismatched `use flexmbs` (they
+# crashed). Removed before every install, it is rebuilt in a second.
+UMBRELLA_OBJECTS = $(wildcard $(BUILD)/gfortran_*/flexmbs/src_flexmbs.f90.o*)
 PREFIX_RELEASE := $(BUILD)/prefix-release
 PREFIX       ?= /usr/local
 # The link line a user needs after the flexmbs library (docs/library.md).
@@ -176,6 +181,7 @@ LEGACY_MODERN  := $(wildcard legacy/test/*.f90)
 # too (--no-prune: the whole library), for `-lflexmbs`, with its shared
 # library as `make install` makes it (test/programs.sh links one).
 legacy-test:
+	@rm -f $(UMBRELLA_OBJECTS)
 	@$(FPM) install --no-prune --profile $(PROFILE) --prefix $(PREFIX_USED) >/dev/null
 	@cd legacy && $(FPM) install --profile $(PROFILE) --prefix $(PREFIX_USED) >/dev/null
 	$(call write_pkgconfig,$(PREFIX_USED))
@@ -197,6 +203,7 @@ legacy-test:
 
 # libflexmbs.a needs --no-prune: fpm would otherwise keep only what app/ uses.
 install: deps
+	@rm -f $(UMBRELLA_OBJECTS)
 	$(FPM) install --no-prune --profile release --prefix $(PREFIX)
 	cd legacy && $(FPM) install --profile release --prefix $(PREFIX)
 	$(call write_pkgconfig,$(abspath $(PREFIX)))
