@@ -386,7 +386,7 @@ contains
         end function before
     end subroutine sort_by_modulus
 
-    !> Modes: each eigenvalue with Im λ ≥ 0 above the zero bound, in order;
+    !> The modes: each eigenvalue with Im λ ≥ 0 above the zero bound, in order;
     !> one with Im λ < 0 takes the number of its conjugate (equal to
     !> round-off), or a number of its own when the conjugate is missing (an
     !> ARPACK list cut between the two).
