@@ -62,31 +62,31 @@ else
     fail summary-verbose-state "--verbose printed no y(1)"
 fi
 
+# The Python checks below print pass and FAIL lines: counted here, the
+# prefix PREFIX taken off their names (h5py of the system's Python, see the
+# Makefile).
+py=/usr/bin/python3
+[ -x "$py" ] || py=python3
+relay() {  # PREFIX < lines
+    local line
+    while read -r line; do
+        case $line in
+            pass\ *) pass "${line#pass $1}" ;;
+            FAIL\ *) fail "${line#FAIL $1}" "" ;;
+        esac
+    done
+}
+
 # The five-body result as a user reads it, by name and unit, against /y
 # (test/five_body_names.py: the rocker pivot's angle, coupler node 23's x,
 # the rocker pivot's reaction, the coupler's stress against the summary)
-py=/usr/bin/python3
-[ -x "$py" ] || py=python3
-while read -r line; do
-    case $line in
-        pass\ *) pass "${line#pass }" ;;
-        FAIL\ *) fail "${line#FAIL }" "" ;;
-    esac
-done < <("$py" "$root/test/five_body_names.py" five_body.h5 five_body.out 2>&1 ||
-         echo "FAIL five_body_names: test/five_body_names.py failed")
+relay "" < <("$py" "$root/test/five_body_names.py" five_body.h5 five_body.out 2>&1 ||
+             echo "FAIL five_body_names: test/five_body_names.py failed")
 
-# The named series of each multibody result against its /y
-# (test/result_names.py; h5py of the system's Python, see the Makefile).
-py=/usr/bin/python3
-[ -x "$py" ] || py=python3
+# The named series of each multibody result against its /y (test/result_names.py)
 for h5 in *.h5; do
-    while read -r line; do
-        case $line in
-            pass\ *) pass "${line#pass result_names/}" ;;
-            FAIL\ *) fail "${line#FAIL result_names/}" "" ;;
-        esac
-    done < <("$py" "$root/test/result_names.py" "$h5" "$exe" 2>&1 ||
-             echo "FAIL $h5: result_names.py failed")
+    relay result_names/ < <("$py" "$root/test/result_names.py" "$h5" "$exe" 2>&1 ||
+                            echo "FAIL $h5: result_names.py failed")
 done
 
 echo "${passed} passed, ${failed} failed"

@@ -22,7 +22,7 @@ module flexmbs_dae_ddassl
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_residual_problem, only: residual_problem_t, dae_residual_t
     use flexmbs_dae_options, only: dae_options_t
-    use flexmbs_dae_stats, only: dae_stats_t, index3_warning
+    use flexmbs_dae_stats, only: dae_stats_t, index3_warning, projection_refusal
     use flexmbs_dae_rejections, only: rejections_t, cause_error_test, cause_newton_diverged, &
         cause_newton_slow, cause_singular_matrix, cause_model_refused
     use flexmbs_dae_sink, only: sink_t, dense_output_t
@@ -265,8 +265,7 @@ contains
         integer :: stat
 
         if (problem%has_projection()) then
-            call status%set(status_bad_input, 'ddassl: projection is refused, it disturbs ' // &
-                'the BDF history (docs/theory.md, section 3.5); use radau5 or switch projection off')
+            call status%set(status_bad_input, projection_refusal('ddassl', 'radau5'))
             return
         end if
         if (problem%n <= 0 .or. size(y) /= problem%n) then

@@ -49,7 +49,7 @@ module flexmbs_dae_ida
     use flexmbs_linalg_linear_solver, only: auto_sparse_threshold
     use flexmbs_dae_problem, only: dae_problem_t, problem_mass_matrix
     use flexmbs_dae_options, only: dae_options_t
-    use flexmbs_dae_stats, only: dae_stats_t, index3_warning
+    use flexmbs_dae_stats, only: dae_stats_t, index3_warning, projection_refusal
     use flexmbs_dae_rejections, only: refusal_len, cause_model_refused
     use flexmbs_dae_ida_observer, only: observer_attach, observer_refused, observer_free, &
         observed_rejections
@@ -175,9 +175,7 @@ contains
         ! IDA has no hook after a step: a projection asked for would be
         ! silently left out (as for DDASSL, it would disturb the BDF history)
         if (problem%has_projection()) then
-            call status%set(status_bad_input, 'ida: projection is refused, it disturbs ' // &
-                'the BDF history (docs/theory.md, section 3.5); use radau5 or switch &
-                &projection off')
+            call status%set(status_bad_input, projection_refusal('ida', 'radau5'))
             return
         end if
         if (size(y) /= problem%n .or. problem%n <= 0) then

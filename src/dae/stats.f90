@@ -5,7 +5,7 @@ module flexmbs_dae_stats
     implicit none
     private
 
-    public :: index3_warning
+    public :: index3_warning, projection_refusal
 
     type, public :: dae_stats_t
         integer :: nst = 0     !! attempted steps (accepted + rejected + failed)
@@ -67,4 +67,13 @@ contains
             'index 3 (they are left out of the error test, else it fails at t = 0): ' // &
             'prefer the index-2 or GGL formulation'
     end function index3_warning
+
+    !> Why a BDF code refuses a formulation with coordinate projection, and
+    !> the solver that takes one.
+    pure function projection_refusal(solver, instead) result(text)
+        character(len=*), intent(in) :: solver, instead
+        character(len=:), allocatable :: text
+        text = solver // ': projection is refused, it disturbs the BDF history ' // &
+            '(docs/theory.md, section 3.5); use ' // instead // ' or switch projection off'
+    end function projection_refusal
 end module flexmbs_dae_stats
