@@ -102,10 +102,10 @@ module flexmbs_dae_ida
         integer(i8), allocatable :: colptr(:), rowind(:) !! its pattern
         integer(i8), allocatable :: jac_slot(:), mass_slot(:) !! entry -> its slot
         real(wp), allocatable :: f(:), rtol(:), atol(:)
-        !> suppressed correction components (GGL's μ): weights divided by |h|,
-        !> so that their Newton corrections count as h δ (dae_problem_t%
-        !> correction_flags)
-        logical, allocatable :: scaled(:)
+        !> suppressed components of index k (out of the error test): weights
+        !> divided by |h|^(k-1), so that their Newton corrections count as
+        !> h^(k-1) δ (ida_weights)
+        integer, allocatable :: newton_power(:)
         real(wp) :: h_start = 0.0_wp   !! |h| before the first step (IDA's rule)
         type(c_ptr) :: mem = c_null_ptr
         type(status_t) :: failure               !! first failing callback
@@ -240,7 +240,7 @@ contains
         data%problem => problem
         data%n = n
         allocate (data%f(n), data%rtol(n), data%atol(n), yw(n), ypw(n), atolw(n), idw(n), &
-            dkyw(n), classes(n), flags(n), data%scaled(n), stat=stat)
+            dkyw(n), classes(n), flags(n), data%newton_power(n), stat=stat)
         if (stat /= 0) then
             call out_of_memory(status, 'ida vectors', 11_i8 * n, 8)
             return
@@ -250,8 +250,8 @@ contains
         call problem%index_classes(classes)
         call problem%differential_flags(flags)
         suppress = self%suppress_alg .and. any(classes > 1)
-        call problem%correction_flags(data%scaled)
-        data%scaled = data%scaled .and. suppress .and. classes > 1
+        data%newton_power = 0
+        if (suppress) where (classes > 1) data%newton_power = classes - 1
         if (any(classes >= 3)) stats%warning = index3_warning('ida')
 
         run: block
@@ -560,7 +560,7 @@ contains
             type(status_t), intent(inout) :: st
             logical :: ok
             if (.not. st%ok()) return
-            if (any(data%scaled)) then
+            if (any(data%newton_power > 0)) then
                 ok = check(FIDAWFtolerances(mem, c_funloc(ida_weights)), 'IDAWFtolerances')
                 return
             end if
@@ -967,13 +967,14 @@ contains
             ierr = -1
             return
         end if
-        ! correction components (out of the error test) count as h δ in the
-        ! Newton test, as in DDASSL's (dae_problem_t%correction_flags)
-        if (allocated(data%scaled) .and. c_associated(data%mem)) then
-            if (any(data%scaled)) then
+        ! components out of the error test (index k = 2, 3) count as h^(k-1) δ
+        ! in the Newton test, as in DDASSL's newton_norm: with them out of the
+        ! error test, these weights serve the Newton test alone
+        if (allocated(data%newton_power) .and. c_associated(data%mem)) then
+            if (any(data%newton_power > 0)) then
                 if (FIDAGetCurrentStep(data%mem, hcur) /= 0) hcur = 0.0_wp
                 if (hcur(1) == 0.0_wp) hcur = data%h_start
-                if (hcur(1) /= 0.0_wp) where (data%scaled) w = w / abs(hcur(1))
+                if (hcur(1) /= 0.0_wp) w = w / abs(hcur(1))**data%newton_power
             end if
         end if
         w = 1.0_wp / w

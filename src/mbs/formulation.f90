@@ -111,7 +111,6 @@ module flexmbs_mbs_formulation
         procedure :: is_sparse => formulation_is_sparse
         procedure :: index_classes => formulation_index_classes
         procedure :: differential_flags => formulation_differential_flags
-        procedure :: correction_flags => formulation_correction_flags
         procedure :: has_projection => formulation_has_projection
         procedure :: project => formulation_project
         procedure :: consistent_initial => formulation_consistent_initial
@@ -617,14 +616,6 @@ contains
     end subroutine formulation_index_classes
 
     !> q and v differential, a, λ, μ algebraic.
-    !> GGL's μ: zero on the exact solution, acting on q as h T Gᵀμ.
-    subroutine formulation_correction_flags(self, flags)
-        class(formulation_t), intent(in) :: self
-        logical, intent(out) :: flags(:)
-        flags = .false.
-        if (self%form == formulation_ggl) flags(self%om + 1:self%om + self%nc) = .true.
-    end subroutine formulation_correction_flags
-
     subroutine formulation_differential_flags(self, flags)
         class(formulation_t), intent(in) :: self
         logical, intent(out) :: flags(:)
