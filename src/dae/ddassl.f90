@@ -35,6 +35,8 @@ module flexmbs_dae_ddassl
     real(wp), parameter :: s_fresh = 100.0_wp         !! §2.3: s = 100 with a new PD or cj
     real(wp), parameter :: rate_max = 0.9_wp          !! §2.3: ρ > 0.9 fails
     real(wp), parameter :: conv_tol = 0.33_wp         !! §2.3: s·d ≤ 0.33 converges
+    !> The same with components of index 2 or 3 measured as h^(k-1) δ
+    real(wp), parameter :: conv_tol_scaled = 0.033_wp
     integer, parameter :: max_iter = 4                !! §2.3: m ≥ 4 fails
     real(wp), parameter :: cj_ratio_low = 0.6_wp      !! §2.3: (1 − 0.25)/(1 + 0.25)
     real(wp), parameter :: roundoff_conv = 100.0_wp   !! §2.3: d ≤ 100·uround·pnorm
@@ -1052,7 +1054,7 @@ contains
                     if (rate > rate_max) return
                     s = rate / (1.0_wp - rate)
                 end if
-                if (s * d <= conv_tol) then
+                if (s * d <= merge(conv_tol_scaled, conv_tol, any(newton_power > 0))) then
                     converged = .true.
                     return
                 end if

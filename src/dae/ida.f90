@@ -26,7 +26,7 @@ module flexmbs_dae_ida
     use fida_mod, only: FIDACreate, FIDAInit, FIDAFree, FIDASStolerances, FIDASVtolerances, &
         FIDAWFtolerances, FIDASetUserData, FIDASetErrHandlerFn, FIDASetMaxOrd, &
         FIDASetMaxNumSteps, FIDASetInitStep, FIDASetMaxStep, FIDASetStopTime, FIDASetId, &
-        FIDASetSuppressAlg, FIDASetLinearSolver, FIDASetJacFn, FIDACalcIC, &
+        FIDASetSuppressAlg, FIDASetNonlinConvCoef, FIDASetLinearSolver, FIDASetJacFn, FIDACalcIC, &
         FIDAGetConsistentIC, FIDASolve, FIDAGetDky, FIDAGetNumSteps, FIDAGetNumResEvals, &
         FIDAGetNumLinResEvals, FIDAGetNumJacEvals, FIDAGetNumLinSolvSetups, &
         FIDAGetNumNonlinSolvIters, FIDAGetNumErrTestFails, FIDAGetNumNonlinSolvConvFails, &
@@ -55,6 +55,9 @@ module flexmbs_dae_ida
 
     integer, parameter :: ida_max_order = 5    !! IDA's BDF orders are 1…5
     integer, parameter :: max_message = 1000   !! longest IDA message kept
+    !> IDA's Newton-test coefficient (its default 0.33) when the components of
+    !> index 2 or 3 count as h^(k-1) δ: ten times tighter, as DDASSL's
+    real(c_double), parameter :: newton_coefficient_scaled = 0.033_c_double
 
     ! How the iteration matrix is formed.
     integer, parameter :: jac_quotients = 0    !! IDA's difference quotients (dense)
@@ -325,6 +328,12 @@ contains
                 idw = merge(1.0_wp, 0.0_wp, classes == 1)
                 if (.not. check(FIDASetId(mem, nv_id), 'IDASetId')) exit run
                 if (.not. check(FIDASetSuppressAlg(mem, 1_c_int), 'IDASetSuppressAlg')) exit run
+                ! their Newton corrections count as h^(k-1) δ (ida_weights): the
+                ! Newton test is ten times tighter, as in DDASSL's
+                if (any(data%newton_power > 0)) then
+                    if (.not. check(FIDASetNonlinConvCoef(mem, newton_coefficient_scaled), &
+                                    'IDASetNonlinConvCoef')) exit run
+                end if
             end if
 
             dense%mem = mem
