@@ -560,6 +560,7 @@ contains
         logical, allocatable :: in_test(:)
         !> correction components (GGL's μ) in the Newton test as h δ (§2.10)
         integer, allocatable :: newton_power(:)
+        logical, allocatable :: multiplier(:)
         real(wp) :: psi(mx), alpha(mx), beta(mx), gamma(mx), sigma(mx)
         type(matrix_t), allocatable :: amat, bmat
         class(linear_solver_t), allocatable :: ls
@@ -626,7 +627,7 @@ contains
                 return
             end if
             allocate (rtol(n), atol(n), wt(n), in_test(n), classes(n), newton_power(n), &
-                      stat=stat)
+                      multiplier(n), stat=stat)
             if (stat /= 0) then
                 call out_of_memory(status, 'ddassl weights and index classes', 6_i8 * n, 8)
                 return
@@ -637,7 +638,8 @@ contains
             newton_power = 0
             if (self%exclude_index23) then
                 in_test = classes < 2
-                where (.not. in_test) newton_power = classes - 1
+                call res%multiplier_flags(multiplier)
+                where (multiplier .and. .not. in_test) newton_power = classes - 1
             end if
             if (any(classes >= 3)) self%warning = index3_warning('ddassl')
             dir = sign(1.0_wp, tout - t)
@@ -1036,12 +1038,6 @@ contains
                 e = e - delta
                 yp = yp - cj * delta
                 d = newton_norm(delta)
-                block
-                    integer :: imax
-                    imax = maxloc(abs(delta / wt), 1)
-                    write (0, '(a,i3,a,es10.3,a,es10.3,a,i4,a,es10.3,a,es10.3,a,es10.3)') 'm', m, ' h', h, &
-                        ' d', d, ' i', imax, ' delta', delta(imax), ' wt', wt(imax), ' y', y(imax)
-                end block
                 if (.not. ieee_is_finite(d)) return
                 if (d <= roundoff_conv * uround * pnorm .and. (.not. self%netlib .or. m == 0)) then
                     converged = .true.

@@ -251,10 +251,11 @@ contains
         call options%tolerances(data%rtol, data%atol)
         yw = y
         call problem%index_classes(classes)
-        call problem%differential_flags(flags)
         suppress = self%suppress_alg .and. any(classes > 1)
+        call problem%multiplier_flags(flags)
         data%newton_power = 0
-        if (suppress) where (classes > 1) data%newton_power = classes - 1
+        if (suppress) where (flags .and. classes > 1) data%newton_power = classes - 1
+        call problem%differential_flags(flags)
         if (any(classes >= 3)) stats%warning = index3_warning('ida')
 
         run: block

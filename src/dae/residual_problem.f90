@@ -22,6 +22,7 @@ module flexmbs_dae_residual_problem
         procedure(partials_i), deferred :: partials
         procedure :: index_classes => residual_index_classes
         procedure :: differential_flags => residual_differential_flags
+        procedure :: multiplier_flags => residual_multiplier_flags
         procedure :: has_iteration_matrix => residual_has_iteration_matrix
         procedure :: iteration_matrix => residual_iteration_matrix
         procedure :: admissible => residual_admissible
@@ -67,6 +68,7 @@ module flexmbs_dae_residual_problem
         procedure :: partials => wrapper_partials
         procedure :: index_classes => wrapper_index_classes
         procedure :: differential_flags => wrapper_differential_flags
+        procedure :: multiplier_flags => wrapper_multiplier_flags
         procedure :: admissible => wrapper_admissible
     end type dae_residual_t
 
@@ -113,6 +115,12 @@ contains
         flags = .true.
     end subroutine residual_differential_flags
 
+    !> Default: no multipliers (see dae_problem_t%multiplier_flags).
+    subroutine residual_multiplier_flags(self, flags)
+        class(residual_problem_t), intent(in) :: self
+        logical, intent(out) :: flags(:)
+        flags = .false.
+    end subroutine residual_multiplier_flags
 
     subroutine wrapper_residual(self, t, y, yp, g, status)
         class(dae_residual_t), intent(inout) :: self
@@ -208,6 +216,11 @@ contains
         call self%problem%differential_flags(flags)
     end subroutine wrapper_differential_flags
 
+    subroutine wrapper_multiplier_flags(self, flags)
+        class(dae_residual_t), intent(in) :: self
+        logical, intent(out) :: flags(:)
+        call self%problem%multiplier_flags(flags)
+    end subroutine wrapper_multiplier_flags
 
     subroutine wrapper_admissible(self, t, y, status)
         class(dae_residual_t), intent(inout) :: self
