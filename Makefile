@@ -18,8 +18,8 @@ SHELL := /bin/bash
 .DEFAULT_GOAL := run
 
 APT_PACKAGES := gfortran libsundials-dev libsundials-fortran-dev libsuitesparse-dev \
-                liblapack-dev libopenblas-dev libhdf5-dev libmumps-seq-dev python3-h5py pkgconf \
-                python3-matplotlib python3-venv
+                liblapack-dev libopenblas-dev libhdf5-dev libmumps-seq-dev libarpack2-dev \
+                python3-h5py pkgconf python3-matplotlib python3-venv
 BUILD        := $(CURDIR)/build
 VENV         := $(BUILD)/venv
 FORD_VERSION := 7.0.13
@@ -47,6 +47,11 @@ OMP_LINK := -fopenmp
 endif
 FPM          = $(shell command -v fpm 2>/dev/null || echo $(VENV)/bin/fpm)
 PREFIX_DEBUG   := $(BUILD)/prefix-debug
+# The umbrella module (src/flexmbs.f90) is compiled only by --no-prune
+# installs, and fpm does not rebuild its object when a module it uses
+# changes: a stale one gave the examples a mismatched `use flexmbs` (they
+# crashed). Removed before every install, it is rebuilt in a second.
+UMBRELLA_OBJECTS = $(wildcard $(BUILD)/gfortran_*/flexmbs/src_flexmbs.f90.o*)
 PREFIX_RELEASE := $(BUILD)/prefix-release
 PREFIX       ?= /usr/local
 # The link line a user needs after the flexmbs library (docs/library.md).
@@ -58,7 +63,7 @@ SYSLIBS      := -lsundials_fida_mod -lsundials_fnvecserial_mod \
                 -lsundials_generic \
                 -lklu -lcholmod -lamd -lcolamd -lbtf -lsuitesparseconfig \
                 -ldmumps_seq -lzmumps_seq -lmumps_common_seq -lmpiseq_seq -lpord_seq \
-                -lhdf5_serial_fortran -lhdf5_serial -llapack -lblas
+                -lhdf5_serial_fortran -lhdf5_serial -larpack -llapack -lblas
 MAIN_INPUT   := inputs/five_body.nml
 VERSION      := $(shell sed -n 's/^version *= *"\(.*\)"/\1/p' fpm.toml)
 
@@ -176,6 +181,7 @@ LEGACY_MODERN  := $(wildcard legacy/test/*.f90)
 # too (--no-prune: the whole library), for `-lflexmbs`, with its shared
 # library as `make install` makes it (test/programs.sh links one).
 legacy-test:
+	@rm -f $(UMBRELLA_OBJECTS)
 	@$(FPM) install --no-prune --profile $(PROFILE) --prefix $(PREFIX_USED) >/dev/null
 	@cd legacy && $(FPM) install --profile $(PROFILE) --prefix $(PREFIX_USED) >/dev/null
 	$(call write_pkgconfig,$(PREFIX_USED))
@@ -197,6 +203,7 @@ legacy-test:
 
 # libflexmbs.a needs --no-prune: fpm would otherwise keep only what app/ uses.
 install: deps
+	@rm -f $(UMBRELLA_OBJECTS)
 	$(FPM) install --no-prune --profile release --prefix $(PREFIX)
 	cd legacy && $(FPM) install --profile release --prefix $(PREFIX)
 	$(call write_pkgconfig,$(abspath $(PREFIX)))

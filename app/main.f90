@@ -9,6 +9,9 @@
 !>                                            a Slurm job array and merge job for the study
 !>   flexmbs columns FILE.h5 COLUMN [COLUMN ...]  t and columns of a result as text
 !>                                        (COLUMN: a number of /y, or rocker/position/z ...)
+!>   flexmbs modes FILE.nml [--time T] [--count K] [--shift S] [--method M] [--output P]
+!>                 [--no-run] [--force]        eigenvalues of the linearised scene and the
+!>                                            BDF sectors at the step sizes of a BDF run
 !>   flexmbs scene-reference                  every group and variable of a scene, as Markdown
 !>   flexmbs --help | --version
 !>
@@ -43,6 +46,8 @@ program flexmbs_main
     use flexmbs_io_table, only: layout_text, table_markdown, stats_row_t
     use flexmbs_app_parallel_sweep, only: run_points_in_processes
     use flexmbs_app_slurm_submit, only: submit_study
+    use flexmbs_app_modes_command, only: modes_command
+    use flexmbs_run_modes, only: modes_options_t
     implicit none
 
     integer, parameter :: exit_ok = 0, exit_bad_input = 2, exit_solver = 3, exit_io = 4
@@ -147,6 +152,8 @@ program flexmbs_main
                 call sweep(file, quiet, force)
             end if
         end select
+    case ('modes')
+        call modes()
     case ('columns')
         call columns()
     case ('scene-reference')
@@ -384,6 +391,75 @@ contains
     end function this_program
 
 
+    !> `modes FILE.nml [options]`: the eigen-analysis (app/modes_command).
+    subroutine modes()
+        type(modes_options_t) :: options
+        type(status_t) :: status
+        character(len=:), allocatable :: prefix
+        logical :: run_failed
+        file = ''
+        prefix = ''
+        force = .false.
+        i = 1
+        do while (i < nargs)
+            i = i + 1
+            arg = argument(i)
+            select case (arg)
+            case ('--help', '-h')
+                call usage(output_unit)
+                call finish(exit_ok)
+            case ('--force')
+                force = .true.
+            case ('--no-run')
+                options%run_bdf = .false.
+            case ('--time', '--count', '--shift', '--method', '--output')
+                if (i == nargs) call fail_usage(arg // ' needs a value')
+                i = i + 1
+                value = argument(i)
+                call modes_option(options, arg, value, prefix)
+            case default
+                if (arg(1:min(1, len(arg))) == '-') call fail_usage('unknown option ''' // &
+                    arg // '''')
+                if (len(file) > 0) call fail_usage('modes takes one file, got ''' // file // &
+                    ''' and ''' // arg // '''')
+                file = arg
+            end select
+        end do
+        if (len(file) == 0) call fail_usage('modes needs a scene file')
+        call modes_command(file, options, prefix, force, status, run_failed)
+        if (.not. status%ok()) call stop_on(status)
+        if (run_failed) call finish(exit_solver)
+        call finish(exit_ok)
+    end subroutine modes
+
+    !> A value of a `modes` option, checked as a number where it is one.
+    subroutine modes_option(options, arg, value, prefix)
+        type(modes_options_t), intent(inout) :: options
+        character(len=*), intent(in) :: arg, value
+        character(len=:), allocatable, intent(inout) :: prefix
+        select case (arg)
+        case ('--time')
+            read (value, *, iostat=ios) options%time
+            if (ios /= 0) call fail_usage('--time ' // value // ': needs a number (s)')
+            options%at_time = .true.
+        case ('--count')
+            read (value, *, iostat=ios) options%count
+            if (ios /= 0 .or. verify(trim(adjustl(value)), '+0123456789') /= 0 .or. &
+                options%count < 1) call fail_usage('--count ' // value // &
+                ': needs a whole number >= 1')
+        case ('--shift')
+            read (value, *, iostat=ios) options%shift
+            if (ios /= 0) call fail_usage('--shift ' // value // ': needs a number (1/s)')
+        case ('--method')
+            if (all(value /= [character(len=6) :: 'auto', 'dense', 'arpack'])) call &
+                fail_usage('--method ' // value // ': use auto, dense or arpack')
+            options%method = value
+        case ('--output')
+            if (len(value) == 0) call fail_usage('--output needs a path prefix')
+            prefix = value
+        end select
+    end subroutine modes_option
+
     !> `columns FILE.h5 COLUMN...`: t and each column at every record of a
     !> result, as text (for plots). A column is a component number of /y or
     !> a name: rocker/position/z, motor/reaction_torque/z, coupler/node 23/x
@@ -579,6 +655,21 @@ contains
             '                                          COMPONENT (''rocker/position/z'',', &
             '                                          ''motor/reaction_torque/z''), or a node', &
             '                                          (''coupler/node 23/x'', ''.../velocity/x'')', &
+            '  flexmbs modes FILE.nml [--time T] [--count K] [--shift S]', &
+            '                         [--method auto|dense|arpack] [--output P] [--no-run]', &
+            '                                          eigenvalues of the scene''s DAE pencil', &
+            '                                          (dF/dy, M) linearised at t_start (or', &
+            '                                          T): the K lowest modes (default 10)', &
+            '                                          with frequency and damping, and per', &
+            '                                          BDF order the stiff modes outside its', &
+            '                                          A(alpha) sector at the step sizes a', &
+            '                                          BDF run of the scene took at that order', &
+            '                                          (--no-run: no run); every eigenvalue in', &
+            '                                          P.csv, a plot in P.png (gnuplot); P is', &
+            '                                          the scene without .nml, then _modes;', &
+            '                                          dense QZ up to 2000 unknowns, else', &
+            '                                          ARPACK around the shift S (default', &
+            '                                          -1 1/s) (docs/modes.md)', &
             '  flexmbs scene-reference                 every group and variable of a scene', &
             '                                          file: type, unit, default, range, as', &
             '                                          Markdown (docs/scene_reference.md)', &

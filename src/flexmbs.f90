@@ -15,6 +15,9 @@ module flexmbs
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_rejections, only: rejections_t, cause_error_test, cause_newton_diverged, &
+        cause_newton_slow, cause_singular_matrix, cause_model_refused, cause_projection, &
+        cause_unstable, cause_count, cause_keys, cause_labels
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_solver, only: dae_solver_t
     use flexmbs_dae_radau5, only: radau5_t, radau5_dense_t, radau5_native_t

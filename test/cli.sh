@@ -2,7 +2,8 @@
 # Command-line tests of the flexmbs executable: bad input gives exit 2, a
 # message naming file, group, variable and reason, and no output file;
 # --help and --version exit 0; a solver failure exits 3 and keeps its HDF5
-# file; an unwritable output exits 4.
+# file; an unwritable output exits 4; `flexmbs modes` reports its table
+# with nothing on standard error, with or without gnuplot.
 #
 #   bash test/cli.sh [path/to/flexmbs]
 #
@@ -165,6 +166,28 @@ expect unknown-option 2 "unknown option '--loud'" run x.nml --loud
 printf '%s\n&solver rtol = 1e-4, atol = 1e-4, h0 = 1e-6 /\n%s\n' "$sim" "$out" > ok.nml
 kept success 0 "y(1) =  1.7061611" out/run.h5 run ok.nml --quiet
 kept success-statistics 0 "radau5: NST=275 NAC=238" out/run.h5 run ok.nml --quiet
+# NRJ by cause on the statistics line, in the HDF5 attributes and, asked
+# for, in the table (docs/solvers.md, Rejection causes)
+kept success-causes 0 "NRJ=37 (error test 8, Newton slow 29) NFE=2218" out/run.h5 \
+    run ok.nml --quiet
+if problem=$(/usr/bin/python3 - out/run.h5 2>&1 <<'PY'
+import sys, h5py
+a = h5py.File(sys.argv[1], 'r').attrs
+causes = ['NRJ_ERROR_TEST', 'NRJ_NEWTON_DIVERGED', 'NRJ_NEWTON_SLOW', 'NRJ_SINGULAR',
+          'NRJ_REFUSED', 'NRJ_PROJECTION', 'NRJ_UNSTABLE']
+values = [int(a[c]) for c in causes]
+assert sum(values) == int(a['NRJ']) == 37, values
+assert values == [8, 0, 29, 0, 0, 0, 0], values
+assert 'refusal' not in a
+PY
+); then pass hdf5-rejection-causes; else fail hdf5-rejection-causes "$problem"; fi
+printf '%s\n&solver rtol = 1e-4, atol = 1e-4, h0 = 1e-6 /\n%s\n' "$sim" \
+    "&output file = 'out/run.h5', table = 'out/run.csv', reasons = .true. /" > reasons.nml
+kept table-rejection-causes 0 "radau5: NST=275" out/run.csv run reasons.nml --quiet
+if ! grep -q '^solver,.*,NSOL,error test,Newton diverged,Newton slow,singular,refused,projection,unstable$' out/run.csv \
+    || ! grep -q ',37,248,.*,8,0,29,0,0,0,0$' out/run.csv; then
+    fail table-rejection-columns "$(cat out/run.csv)"
+else pass table-rejection-columns; fi
 printf '%s\n&solver name = '"'ida'"', rtol = 1e-8, atol = 1e-8 /\n%s\n' "$sim" "$out" > ida.nml
 kept success-ida 0 "y(1) =  1.70616" out/run.h5 run ida.nml --quiet
 
@@ -655,6 +678,85 @@ printf '%s\n' "&simulation problem = 'flexible_body', t_end = 1e-3 /" \
 expect mesh-relative-to-scene 0 "radau5: NST=" run scenes/m/bar.nml --quiet
 if [ -s scenes/m/r.h5 ]; then pass output-relative-to-scene
 else fail output-relative-to-scene "scenes/m/r.h5 was not written: $(ls scenes/m)"; fi
+
+# flexmbs modes (docs/modes.md): the eigen-analysis of a scene on standard
+# output with nothing on standard error, the spectrum table, the plot when
+# gnuplot is there and a note when it is not; bad options exit 2
+expect help-modes 0 "flexmbs modes FILE.nml" --help
+mkdir -p m
+# modes_run NAME ARGS...: exit 0, empty standard error; output in m/NAME.out
+modes_run() {
+    local name=$1
+    shift
+    "$exe" modes "$@" > "m/$name.out" 2> "m/$name.err"
+    local rc=$?
+    problem=""
+    if [ "$rc" -ne 0 ]; then problem="exit $rc: $(head -c 400 "m/$name.err")"
+    elif [ -s "m/$name.err" ]; then problem="standard error: $(head -c 400 "m/$name.err")"
+    fi
+}
+modes_run five_body "$root/inputs/five_body.nml" --count 5 --output m/five_body
+if [ -z "$problem" ]; then
+    out=$(cat m/five_body.out)
+    rows=$(grep -cE '^ +[1-5] +-?[0-9]\.[0-9]{10}E[+-][0-9]{2} +-?[0-9]\.[0-9]{10}E[+-][0-9]{2} +[0-9]\.[0-9]{6}E[+-][0-9]{2} +[0-9]\.[0-9]{6}E[+-][0-9]{2} +-?[0-9]+\.[0-9]{4} +[0-9]+\.[0-9]{4}$' <<<"$out")
+    for line in "^modes of 'five-body mechanism \(damped\)' \(.*/inputs/five_body.nml\) at t = 0.000000E\+00 s$" \
+        "^linearised: formulation 'ggl' as ddassl integrates it, n = 547 unknowns; dense QZ" \
+        "^eigenvalues: 266 finite, 281 infinite" "^expected finite: 266 = 2 x 131 " \
+        "^  mode   Re\(lambda\) \[1/s\]   Im\(lambda\) \[1/s\]  omega \[rad/s\]      f \[Hz\]     zeta  angle \[deg\]$" \
+        "^ddassl on the same scene \(rtol 1.000000E-06, atol 1.000000E-06, p_max 5\): NST=" \
+        "^accepted steps: [0-9]+, h from " "^  BDF-5      51.8398 " "^spectrum: m/five_body.csv$" \
+        "^plot: "; do
+        grep -qE -- "$line" <<<"$out" || { problem="no line '$line' in: $out"; break; }
+    done
+    [ -z "$problem" ] && [ "$rows" -ne 5 ] && problem="$rows mode rows, not 5: $out"
+    [ -z "$problem" ] && [ "$(head -1 m/five_body.csv)" != "# written by flexmbs $("$exe" --version | cut -d' ' -f2)" ] &&
+        problem="m/five_body.csv: first line $(head -1 m/five_body.csv)"
+    [ -z "$problem" ] && [ "$(grep -vc '^#' m/five_body.csv)" -ne 266 ] &&
+        problem="m/five_body.csv: $(grep -vc '^#' m/five_body.csv) rows, not 266"
+    if [ -z "$problem" ] && command -v gnuplot > /dev/null; then
+        grep -q '^plot: m/five_body.png$' <<<"$out" || problem="no plot: $out"
+        [ -z "$problem" ] && [ "$(head -c 4 m/five_body.png | tail -c 3)" != "PNG" ] &&
+            problem="m/five_body.png is not a PNG"
+    fi
+fi
+if [ -n "$problem" ]; then fail modes-five-body "$problem"; else pass modes-five-body; fi
+# the driven four-bar has no degree of freedom: 3 finite eigenvalues (its
+# quaternions' lengths), the rest infinite
+modes_run four_bar "$root/inputs/four_bar.nml" --output m/four_bar --no-run
+if [ -z "$problem" ] && ! grep -q '^eigenvalues: 3 finite, 72 infinite' m/four_bar.out; then
+    problem="$(cat m/four_bar.out)"
+fi
+if [ -n "$problem" ]; then fail modes-four-bar "$problem"; else pass modes-four-bar; fi
+# no gnuplot on PATH: said, no PNG, exit 0
+PATH=/nonexistent "$exe" modes "$root/inputs/five_body.nml" --output m/five_body --no-run \
+    > m/no_gnuplot.out 2> m/no_gnuplot.err
+rc=$?
+if [ "$rc" -ne 0 ] || [ -s m/no_gnuplot.err ] ||
+    ! grep -q '^plot: skipped (gnuplot not found on PATH' m/no_gnuplot.out || [ -e m/five_body.png ]; then
+    fail modes-without-gnuplot "exit $rc, $(cat m/no_gnuplot.err m/no_gnuplot.out | tail -3)"
+else
+    pass modes-without-gnuplot
+fi
+# ARPACK: the five lowest modes as the dense QZ has them
+modes_run arpack "$root/inputs/five_body.nml" --output m/arpack --no-run --method arpack --count 5
+if [ -z "$problem" ]; then
+    grep -q 'ARPACK shift-invert around sigma = -1.000000E+00' m/arpack.out ||
+        problem="$(cat m/arpack.out)"
+    lowest() { grep -E '^ +[1-5] ' "$1" | awk '{ printf "%d %.6e %.6e\n", $1, $2, $3 }'; }
+    [ -z "$problem" ] && [ "$(lowest m/arpack.out)" != "$(lowest m/five_body.out)" ] &&
+        problem="ARPACK's modes differ from QZ's: $(grep -E '^ +[1-5] ' m/arpack.out)"
+fi
+if [ -n "$problem" ]; then fail modes-arpack "$problem"; else pass modes-arpack; fi
+expect modes-time-outside 2 "five_body.nml: --time 2.000000E+00: outside the scene's [t_start, t_end]" \
+    modes "$root/inputs/five_body.nml" --time 2 --output m/x
+expect modes-count-word 2 "--count ten: needs a whole number >= 1" \
+    modes "$root/inputs/five_body.nml" --count ten
+expect modes-method 2 "--method qz: use auto, dense or arpack" \
+    modes "$root/inputs/five_body.nml" --method qz
+expect modes-no-scene 2 "modes needs a scene file" modes --count 3
+echo "my picture" > m/foreign.png
+untouched modes-foreign-png "modes: plot: 'm/foreign.png' exists and is not a plot written by flexmbs" \
+    m/foreign.png modes "$root/inputs/four_bar.nml" --output m/foreign --no-run
 
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

@@ -40,9 +40,11 @@ program flexmbs_tests
     use test_node_frame, only: collect_node_frame
     use test_study, only: collect_study
     use test_run, only: collect_run
+    use test_rejections, only: collect_rejections
     use test_chain_coupling, only: collect_chain_coupling
     use test_sparse_formulation, only: collect_sparse_formulation
     use test_out_of_memory, only: collect_out_of_memory
+    use test_modes, only: collect_modes
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -93,9 +95,11 @@ program flexmbs_tests
     call run_suite('sparse_formulation', collect_sparse_formulation(), filter, npassed, &
                    nfailed)
     call run_suite('out_of_memory', collect_out_of_memory(), filter, npassed, nfailed)
+    call run_suite('modes', collect_modes(), filter, npassed, nfailed)
     call run_suite('node_frame', collect_node_frame(), filter, npassed, nfailed)
     call run_suite('study', collect_study(), filter, npassed, nfailed)
     call run_suite('run', collect_run(), filter, npassed, nfailed)
+    call run_suite('rejections', collect_rejections(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1
 end program flexmbs_tests

@@ -9,7 +9,8 @@ module test_io
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_io_namelist, only: scene_input_t, read_scene, parse_scene, scene_dae_options
     use flexmbs_io_table, only: stats_row_t, new_stats_row, table_text, table_format, &
-        write_table, table_markdown, table_csv, table_latex
+        write_table, table_markdown, table_csv, table_latex, layout_text
+    use flexmbs_dae_rejections, only: cause_count
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_hdf5_text, only: read_text_attribute => read_string_attribute
     use flexmbs_io_output_files, only: named_path_t, named_path, check_output_paths, &
@@ -56,6 +57,7 @@ contains
                  new_test('unknown_group', test_unknown_group), &
                  new_test('other_bad_text', test_other_bad_text), &
                  new_test('table_formats', test_table_formats), &
+                 new_test('table_rejection_causes', test_table_reasons), &
                  new_test('hdf5_round_trip', test_hdf5_round_trip), &
                  new_test('hdf5_every_step', test_hdf5_every_step), &
                  new_test('hdf5_unwritable_path', test_hdf5_unwritable), &
@@ -341,6 +343,41 @@ contains
         call write_table(scratch('table.txt'), rows, status)
         call check(error, status%code == status_bad_input, 'write_table unknown format')
     end subroutine test_table_formats
+
+    !> `reasons`: NRJ by cause after the paper's columns (Table 3) or below
+    !> its rows (Table 2); without it the paper's layouts are unchanged.
+    subroutine test_table_reasons(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(stats_row_t) :: rows(1)
+        type(dae_stats_t) :: stats
+        character(len=:), allocatable :: text
+        integer :: counts(cause_count)
+        stats%nst = 275
+        stats%nac = 238
+        stats%nrj = 37
+        counts = 0
+        counts(1) = 8
+        counts(3) = 29
+        call stats%rejections%restore(counts, '')
+        rows(1) = new_stats_row('radau5', 1.0e-4_wp, '-', stats)
+        call check(error, table_text(rows, table_csv) == table_text(rows, table_csv, &
+                   reasons=.false.), 'reasons = .false. changed the table')
+        call check(error, index(table_text(rows, table_csv), 'Newton') == 0, &
+                   'causes without reasons')
+        text = table_text(rows, table_csv, reasons=.true.)
+        call check(error, index(text, 'solver,TOL,stab.,ERR,NST,NAC,NFE,NJE,CPU,NRJ,NDEC,' // &
+                   'NSOL,error test,Newton diverged,Newton slow,singular,refused,' // &
+                   'projection,unstable' // nl) == 1, 'csv header with causes: ' // text)
+        call check(error, index(text, ',37,0,0,8,0,29,0,0,0,0' // nl) > 0, &
+                   'csv row with causes: ' // text)
+        text = layout_text(rows, table_markdown, 'table2')
+        call check(error, index(text, 'rejected/NST') > 0 .and. index(text, 'Newton') == 0, &
+                   'table2 without causes: ' // text)
+        text = layout_text(rows, table_markdown, 'table2', reasons=.true.)
+        call check(error, index(text, '| Newton slow     |     29 |') > 0 .and. &
+                   index(text, '| error test      |      8 |') > 0, 'table2 rows of causes: ' &
+                   // text)
+    end subroutine test_table_reasons
 
     !> Which files a run may replace: flexmbs's own HDF5 result and table,
     !> not a file of anyone else unless forced; never an input; never two

@@ -188,7 +188,9 @@ contains
             a%stats%nfe_jac == b%stats%nfe_jac .and. a%stats%nje == b%stats%nje .and. &
             a%stats%ndec == b%stats%ndec .and. a%stats%nsol == b%stats%nsol .and. &
             a%stats%nprj == b%stats%nprj .and. a%stats%t_reached == b%stats%t_reached .and. &
-            a%stats%h_last == b%stats%h_last
+            a%stats%h_last == b%stats%h_last .and. &
+            all(a%stats%rejections%counts_by_cause() == b%stats%rejections%counts_by_cause()) &
+            .and. a%stats%rejections%refusal_reason() == b%stats%rejections%refusal_reason()
     end function same_row
     !> The quick variant of the paper's studies (inputs/paper/five_body_quick.nml:
     !> the five-body mechanism over 0.05 s): the reference's cross-check
@@ -265,6 +267,9 @@ contains
         run%row%stats%ndec = 9; run%row%stats%nsol = 10; run%row%stats%nprj = 11
         run%row%stats%cpu = 2.0_wp / 3.0_wp; run%row%stats%wall = 1.0_wp / 7.0_wp
         run%row%stats%t_reached = 0.1_wp; run%row%stats%h_last = 1.0e-3_wp / 9.0_wp
+        ! NRJ = 23 by cause, with a refusal whose reason holds ' = '
+        call run%row%stats%rejections%restore([12, 1, 2, 0, 8, 0, 0], &
+                                              'flexible body: element 17: det F = -1.0E-02')
         call write_record(path, 2, point, print, run, status)
         call check(error, status%ok(), 'write: ' // status%text())
         call read_record(path, 2, point, print, back, state, note)

@@ -10,7 +10,7 @@ module flexmbs_dae_bdf_stability
     use flexmbs_core_kinds, only: wp
     implicit none
     private
-    public :: bdf_boundary_locus, bdf_stability_angle
+    public :: bdf_boundary_locus, bdf_stability_angle, sector_angle
 
     real(wp), parameter :: pi = acos(-1.0_wp)
     !> Samples of (0, π] for the coarse search; the minimiser is then refined.
@@ -87,6 +87,14 @@ contains
         if (present(theta_min)) theta_min = theta
         alpha_deg = best * 180.0_wp / pi
     end function bdf_stability_angle
+
+    !> |arg(−z)| in degrees, the angle of z from the negative real axis: 0
+    !> there, 90 on the imaginary axis, above 90 in the right half-plane.
+    !> h·λ (h > 0) lies in BDF-k's sector when sector_angle(λ) ≤ α_k.
+    elemental real(wp) function sector_angle(z)
+        complex(wp), intent(in) :: z
+        sector_angle = abs(atan2(-aimag(z), -real(z, wp))) * 180.0_wp / pi
+    end function sector_angle
 
     !> π − |arg μ(θ)|: angle between the locus point and the negative axis.
     pure real(wp) function sector_gap(k, theta)

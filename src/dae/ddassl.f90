@@ -23,6 +23,8 @@ module flexmbs_dae_ddassl
     use flexmbs_dae_residual_problem, only: residual_problem_t, dae_residual_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t, index3_warning
+    use flexmbs_dae_rejections, only: rejections_t, cause_error_test, cause_newton_diverged, &
+        cause_newton_slow, cause_singular_matrix, cause_model_refused
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_solver, only: dae_solver_t
     implicit none
@@ -74,6 +76,7 @@ module flexmbs_dae_ddassl
     contains
         procedure :: evaluate => dense_evaluate
         procedure :: interpolate => dense_interpolate
+        procedure :: order => dense_order
     end type ddassl_dense_t
 
     !> The classic code's counters, IWORK(11..15).
@@ -150,6 +153,7 @@ module flexmbs_dae_ddassl
         integer :: ndec = 0          !! successful PD factorisations
         integer :: nsol = 0          !! solves (corrector and DDAINI)
         integer :: nfe_jac = 0       !! residual calls of difference PDs
+        type(rejections_t) :: rejections !! the NETF + NCFN failed attempts by cause
         character(len=:), allocatable :: warning !! for stats%warning (§6: index 3)
         integer :: k_last = 0        !! order of the last step (IWORK(8))
         integer :: k_next = 0        !! order for the next step (IWORK(7))
@@ -188,6 +192,12 @@ contains
         real(wp), intent(out) :: y(:)
         call interpolate_history(self%phi, self%psi, self%kold, self%tn, s, y)
     end subroutine dense_evaluate
+
+    !> The BDF order of the last accepted step.
+    integer function dense_order(self)
+        class(ddassl_dense_t), intent(in) :: self
+        dense_order = self%kold
+    end function dense_order
 
     !> y(s) and y'(s).
     subroutine dense_interpolate(self, s, y, yp)
@@ -454,6 +464,8 @@ contains
             stats%nje = self%native%nje
             stats%ndec = self%ndec
             stats%nsol = self%nsol
+            stats%rejections = self%rejections
+            call stats%rejections%annotate(status)
             stats%t_reached = t
             if (allocated(self%warning)) stats%warning = self%warning
             self%k_last = self%work%kold
@@ -567,6 +579,7 @@ contains
         type(status_t) :: st
         type(status_t) :: model_failure !! the model's last refusal in this step
         integer :: n, pmax, k, kold, ns, iphase, jcalc, nef, ncf, nsf, knew, stat
+        logical :: pd_refused !! the last PD failed in the model, not in the LU
         real(wp) :: tn, h, hold, cj, cjlast, cjold, s, hmin, hmax, dir, uround
         real(wp) :: t0, h_fixed, est, erkm1, terkm1, terk, r
         logical :: fd, ires_stop, direct
@@ -590,6 +603,7 @@ contains
             self%work = ddassl_work_t()
             if (allocated(self%warning)) deallocate (self%warning)
             self%native = ddassl_native_t()
+            self%rejections = rejections_t()
             self%ndec = 0
             self%nsol = 0
             self%nfe_jac = 0
@@ -946,7 +960,8 @@ contains
             integer :: j
             real(wp) :: del, ysafe, ypsafe, squr
             type(status_t) :: fst
-            singular = .false.
+            singular = .true.
+            pd_refused = .true.
             if (fd) then
                 ! §2.3: column j = (G(y + δ_j e_j, y' + cj δ_j e_j) − δ)/δ_j; held as −PD.
                 squr = sqrt(uround)
@@ -963,20 +978,22 @@ contains
                     y(j) = ysafe
                     yp(j) = ypsafe
                     if (.not. fst%ok()) then
-                        singular = .true.
+                        model_failure = fst
                         return
                     end if
                     bmat%dense(:, j) = -(yptmp - delta) / del
                 end do
                 if (.not. all(ieee_is_finite(bmat%dense))) then
-                    singular = .true.
+                    call model_failure%set(status_solver_failure, 'non-finite residual in ' // &
+                        'the difference iteration matrix at t = ' // real_text(tn), &
+                        reason_non_finite)
                     return
                 end if
                 call ls%factor_real(0.0_wp, amat, bmat, fst)
             else if (direct) then
                 call res%iteration_matrix(tn, y, yp, cj, bmat%dense, fst)
                 if (.not. fst%ok()) then
-                    singular = .true.
+                    model_failure = fst
                     return
                 end if
                 bmat%dense = -bmat%dense
@@ -984,36 +1001,49 @@ contains
             else
                 call res%partials(tn, y, yp, amat, bmat, fst)
                 if (.not. fst%ok()) then
-                    singular = .true.
+                    model_failure = fst
                     return
                 end if
                 call ls%factor_real(cj, amat, bmat, fst)
             end if
+            pd_refused = .false.
             singular = .not. fst%ok()
             if (.not. singular) self%ndec = self%ndec + 1
         end subroutine form_pd
 
-        !> g = G(tn, y, yp) into delta; false on failure or non-finite values.
+        !> g = G(tn, y, yp) into delta; false on failure or non-finite values
+        !> (both the model's refusal, kept in model_failure).
         logical function residual_ok()
             type(status_t) :: fst
+            integer :: j
             self%native%nre = self%native%nre + 1
             call res%residual(tn, y, yp, delta, fst)
             ! IRES = −2 of the classic code: the residual asks to stop.
             if (fst%code == status_interrupted) ires_stop = .true.
             if (.not. fst%ok()) model_failure = fst
             residual_ok = fst%ok()
-            if (residual_ok) residual_ok = all(ieee_is_finite(delta))
+            if (.not. residual_ok) return
+            do j = 1, n
+                if (ieee_is_finite(delta(j))) cycle
+                call model_failure%set(status_solver_failure, 'non-finite residual in ' // &
+                    'component ' // int_text(j) // ' at t = ' // real_text(tn), reason_non_finite)
+                residual_ok = .false.
+                return
+            end do
         end function residual_ok
 
-        !> §2.3: the corrector iteration from the predictor in (y, yp).
-        subroutine corrector(pnorm, converged, singular, early)
+        !> §2.3: the corrector iteration from the predictor in (y, yp); `why`
+        !> is the cause (cause_*) of a failure.
+        subroutine corrector(pnorm, converged, singular, early, why)
             real(wp), intent(in) :: pnorm
             logical, intent(out) :: converged, singular, early
+            integer, intent(out) :: why
             integer :: m
             real(wp) :: d, d0, rate
             converged = .false.
             singular = .false.
             early = .false.
+            why = cause_model_refused
             if (.not. residual_ok()) then
                 early = .true.
                 return
@@ -1024,9 +1054,11 @@ contains
                 call form_pd(singular)
                 cjold = cj
                 s = s_fresh
+                if (singular .and. .not. pd_refused) why = cause_singular_matrix
                 if (singular) return
                 nsf = 0
             end if
+            why = cause_newton_diverged
             e = 0.0_wp
             m = 0
             d0 = 0.0_wp
@@ -1055,8 +1087,11 @@ contains
                     return
                 end if
                 m = m + 1
+                why = cause_newton_slow
                 if (m >= max_iter) return
+                why = cause_model_refused
                 if (.not. residual_ok()) return
+                why = cause_newton_diverged
             end do
         end subroutine corrector
 
@@ -1068,6 +1103,7 @@ contains
             real(wp) :: erkm2, terkm2, erkp1, terkp1
             logical :: converged, singular, early, passed
             type(status_t) :: refusal
+            integer :: why
 
             nef = 0
             ncf = 0
@@ -1121,7 +1157,7 @@ contains
                         yp = yp + gamma(j) * phi(:, j)
                     end do
                     pnorm = vnorm(y)
-                    call corrector(pnorm, converged, singular, early)
+                    call corrector(pnorm, converged, singular, early, why)
                     if (converged .or. jcalc /= 1 .or. early) exit
                     jcalc = -1
                 end do
@@ -1132,13 +1168,18 @@ contains
                     call res%admissible(tn, y, refusal)
                     if (.not. refusal%ok()) then
                         converged = .false.
+                        why = cause_model_refused
                         model_failure = refusal
                     end if
                 end if
                 if (converged .and. self%nonnegative) then
                     delta = min(y, 0.0_wp)
                     if (vnorm(delta) > conv_tol) then
+                        ! the user's rule y ≥ 0 refuses the corrected state
                         converged = .false.
+                        why = cause_model_refused
+                        call model_failure%set(status_solver_failure, 'negative components ' &
+                            // '(nonnegative) at t = ' // real_text(tn), reason_newton_failure)
                     else
                         e = e - delta
                     end if
@@ -1194,6 +1235,7 @@ contains
                     ! Error-test failure.
                     nef = nef + 1
                     self%native%netf = self%native%netf + 1
+                    call self%rejections%add(cause_error_test)
                     if (nef == 1) then
                         k = knew
                         r = fail_safety * (2.0_wp * est + est_offset)**(-1.0_wp / real(k + 1, wp))
@@ -1215,6 +1257,13 @@ contains
                     end if
                 else
                     self%native%ncfn = self%native%ncfn + 1
+                    if (ires_stop) then
+                        call self%rejections%refuse('the residual asked to stop (IRES = -2)')
+                    else if (why == cause_model_refused) then
+                        call self%rejections%refuse(model_failure%text())
+                    else
+                        call self%rejections%add(why)
+                    end if
                     if (ires_stop) then
                         call st%set(status_interrupted, 'ddassl: the residual asked to stop ' &
                             // 'at t = ' // real_text(tn + h))

@@ -8,7 +8,8 @@
 !> pattern (the union of the patterns of ∂F/∂y and M) is built once.
 !> Statistics map onto `dae_stats_t` as docs/solvers.md says: NST = nst + netf +
 !> ncfn, NAC = nst, NFE = nre, NFE_JAC = nreLS, NJE = nje, NDEC = nsetups,
-!> NSOL = nni.
+!> NSOL = nni. IDA's Newton solver is SUNDIALS' own, observed by a C shim
+!> (ida_observer_shim.c) that counts its failed solves by cause.
 module flexmbs_dae_ida
     use, intrinsic :: iso_c_binding, only: c_int, c_long, c_double, c_int64_t, c_ptr, &
         c_null_ptr, c_associated, c_loc, c_funloc, c_f_pointer, c_char, c_null_char
@@ -30,6 +31,7 @@ module flexmbs_dae_ida
         FIDAGetConsistentIC, FIDASolve, FIDAGetDky, FIDAGetNumSteps, FIDAGetNumResEvals, &
         FIDAGetNumLinResEvals, FIDAGetNumJacEvals, FIDAGetNumLinSolvSetups, &
         FIDAGetNumNonlinSolvIters, FIDAGetNumErrTestFails, FIDAGetNumNonlinSolvConvFails, &
+        FIDAGetNumStepSolveFails, &
         FIDAGetLastStep, FIDAGetLastOrder, FIDAGetCurrentStep, IDA_NORMAL, IDA_ONE_STEP, IDA_YA_YDP_INIT, &
         IDA_TSTOP_RETURN, IDA_TOO_MUCH_WORK, IDA_TOO_MUCH_ACC, IDA_ERR_FAIL, IDA_CONV_FAIL, &
         IDA_LINIT_FAIL, IDA_LSETUP_FAIL, IDA_LSOLVE_FAIL, IDA_RES_FAIL, IDA_REP_RES_ERR, &
@@ -45,9 +47,12 @@ module flexmbs_dae_ida
     use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_identity, storage_dense, &
         storage_sparse
     use flexmbs_linalg_linear_solver, only: auto_sparse_threshold
-    use flexmbs_dae_problem, only: dae_problem_t
+    use flexmbs_dae_problem, only: dae_problem_t, problem_mass_matrix
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t, index3_warning
+    use flexmbs_dae_rejections, only: refusal_len, cause_model_refused
+    use flexmbs_dae_ida_observer, only: observer_attach, observer_refused, observer_free, &
+        observed_rejections
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_solver, only: dae_solver_t
     implicit none
@@ -74,7 +79,10 @@ module flexmbs_dae_ida
         integer :: nsetups = 0  !! linear solver setups (factorisations)
         integer :: nni = 0      !! nonlinear (Newton) iterations
         integer :: netf = 0     !! error test failures
-        integer :: ncfn = 0     !! nonlinear convergence failures
+        integer :: ncfn = 0     !! steps failed in the nonlinear solver (IDAGetNumStepSolveFails)
+        !> nonlinear solver failures, those a new Jacobian recovered within the
+        !> step included (IDAGetNumNonlinSolvConvFails since SUNDIALS 6.2)
+        integer :: nnf = 0
         integer :: last_order = 0
         real(wp) :: last_step = 0.0_wp
     end type ida_native_t
@@ -111,7 +119,9 @@ module flexmbs_dae_ida
         integer, allocatable :: newton_power(:)
         real(wp) :: h_start = 0.0_wp   !! |h| before the first step (IDA's rule)
         type(c_ptr) :: mem = c_null_ptr
+        type(c_ptr) :: observer = c_null_ptr    !! the observed Newton solver
         type(status_t) :: failure               !! first failing callback
+        character(len=refusal_len) :: refusal = '' !! last failing callback (a refusal)
         character(len=:), allocatable :: message !! IDA's last error message
     end type callback_data_t
 
@@ -226,10 +236,12 @@ contains
         logical, allocatable :: flags(:)
         real(wp) :: x, x_old, tout, posneg
         logical :: want_steps, stop_requested, use_klu, suppress
+        logical :: annotated !! the failure message names the rejection causes
 
         n = problem%n
         ctx = c_null_ptr
         mem = c_null_ptr
+        annotated = .false.
         nullify (nv_y, nv_yp, nv_atol, nv_id, nv_dky, a_mat, lin_solver)
         x = t
         posneg = sign(1.0_wp, t_end - t)
@@ -290,6 +302,11 @@ contains
             if (.not. check(FIDAInit(mem, c_funloc(ida_residual), x, nv_y, nv_yp), &
                 'IDAInit')) exit run
             if (.not. check(FIDASetUserData(mem, c_loc(data)), 'IDASetUserData')) exit run
+            data%observer = observer_attach(mem, c_loc(nv_y), ctx)
+            if (.not. c_associated(data%observer)) then
+                call sundials_failure('attaching the observed Newton solver')
+                exit run
+            end if
             call set_tolerances(status)
             if (.not. status%ok()) exit run
             if (.not. check(FIDASetMaxOrd(mem, int(min(options%pmax, ida_max_order), c_int)), &
@@ -364,6 +381,7 @@ contains
         end block run
 
         call collect_statistics()
+        if (.not. annotated) call stats%rejections%annotate(status)
         call free_all()
         t = x
         y = yw
@@ -400,22 +418,8 @@ contains
         subroutine setup_matrices(st)
             type(status_t), intent(inout) :: st
             integer :: storage
-            data%mass%n = n
-            data%mass%storage = problem%mass_storage()
-            select case (data%mass%storage)
-            case (storage_dense)
-                allocate (data%mass%dense(n, n), stat=stat)
-                if (stat /= 0) then
-                    call out_of_memory(st, 'ida dense mass matrix', int(n, i8) * n, 8)
-                    return
-                end if
-                call problem%mass_dense(data%mass%dense)
-            case (storage_sparse)
-                call problem%mass_sparse(data%mass%csc, st)
-                if (.not. st%ok()) return
-            case default
-                data%mass%storage = storage_identity
-            end select
+            call problem_mass_matrix(problem, data%mass, st, 'ida')
+            if (.not. st%ok()) return
             storage = problem%jacobian_storage()
             if (options%jacobian == 'fd') storage = storage_none
             select case (storage)
@@ -749,14 +753,18 @@ contains
                 reason = reason_newton_failure
                 text = what
             end select
-            ! A failing callback says more than IDA's flag.
+            ! A failing callback says more than IDA's flag (the last refusal
+            ! closes the rejection causes).
+            call collect_statistics()
             if (.not. data%failure%ok()) then
                 if (data%failure%reason /= 0 .and. reason /= reason_max_steps) &
                     reason = data%failure%reason
-                text = text // '; last callback failure: ' // data%failure%text()
+                if (stats%rejections%count_of(cause_model_refused) == 0) &
+                    text = text // '; first callback failure: ' // data%failure%text()
             end if
             text = 'ida: ' // text // '; stopped at t = ' // real_text(x) // &
-                ' (IDA flag ' // int_text(flag) // ')'
+                stats%rejections%failure_text() // ' (IDA flag ' // int_text(flag) // ')'
+            annotated = .true.
             if (allocated(data%message)) text = text // ': ' // data%message
             call status%set(status_solver_failure, text, reason)
         end subroutine map_failure
@@ -774,7 +782,8 @@ contains
             if (FIDAGetNumLinSolvSetups(mem, v) == 0) self%native%nsetups = int(v(1))
             if (FIDAGetNumNonlinSolvIters(mem, v) == 0) self%native%nni = int(v(1))
             if (FIDAGetNumErrTestFails(mem, v) == 0) self%native%netf = int(v(1))
-            if (FIDAGetNumNonlinSolvConvFails(mem, v) == 0) self%native%ncfn = int(v(1))
+            if (FIDAGetNumStepSolveFails(mem, v) == 0) self%native%ncfn = int(v(1))
+            if (FIDAGetNumNonlinSolvConvFails(mem, v) == 0) self%native%nnf = int(v(1))
             order = 0
             if (FIDAGetLastOrder(mem, order) == 0) self%native%last_order = int(order(1))
             h = 0.0_wp
@@ -788,12 +797,17 @@ contains
             stats%nje = self%native%nje
             stats%ndec = self%native%nsetups
             stats%nsol = self%native%nni
+            ! netf by the error test, the ncfn failed solves by the observer's causes
+            stats%rejections = observed_rejections(data%observer, self%native%netf, &
+                data%refusal)
         end subroutine collect_statistics
 
         !> IDA memory first (it refers to the others), the context last.
         subroutine free_all()
             integer(c_int) :: ierr
             if (c_associated(mem)) call FIDAFree(mem)
+            if (c_associated(data%observer)) call observer_free(data%observer)
+            data%observer = c_null_ptr
             if (associated(lin_solver)) ierr = FSUNLinSolFree(lin_solver)
             if (associated(a_mat)) call FSUNMatDestroy(a_mat)
             if (associated(nv_y)) call FN_VDestroy(nv_y)
@@ -839,6 +853,7 @@ contains
         type(callback_data_t), pointer :: data
         real(c_double), pointer :: y(:), yp(:), r(:)
         type(status_t) :: st
+        integer :: i
         call c_f_pointer(user_data, data)
         y => FN_VGetArrayPointer(nv_y)
         yp => FN_VGetArrayPointer(nv_yp)
@@ -853,11 +868,13 @@ contains
         end if
         call data%mass%matvec(yp, r)
         r = r - data%f
-        if (.not. all(ieee_is_finite(r))) then
-            call record(data, status_solver_failure, 'non-finite residual at t = ' // &
-                real_text(t), reason_non_finite)
+        do i = 1, size(r)
+            if (ieee_is_finite(r(i))) cycle
+            call record(data, status_solver_failure, 'non-finite residual in component ' // &
+                int_text(i) // ' at t = ' // real_text(t), reason_non_finite)
             ierr = 1
-        end if
+            return
+        end do
     end function ida_residual
 
     !> IDALsJacFn: J = c_j M − ∂F/∂y into the dense or CSC SUNMatrix.
@@ -1015,12 +1032,15 @@ contains
         end do
     end subroutine ida_error_handler
 
-    !> Keep the first callback failure (later ones are its consequences).
+    !> Keep the first callback failure (later ones are its consequences) and
+    !> the last as the refusal that makes IDA's current solve fail.
     subroutine record(data, code, message, reason)
         type(callback_data_t), intent(inout) :: data
         integer, intent(in) :: code, reason
         character(len=*), intent(in) :: message
         if (data%failure%ok()) call data%failure%set(code, message, reason)
+        data%refusal = message
+        call observer_refused(data%observer)
     end subroutine record
 
     !> The reason a failed callback is recorded with: det F <= 0 stays itself

@@ -39,6 +39,8 @@ module flexmbs_dae_mexax
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_rejections, only: cause_error_test, cause_singular_matrix, &
+        cause_model_refused, cause_projection, cause_unstable
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_solver, only: dae_solver_t
     implicit none
@@ -113,8 +115,9 @@ module flexmbs_dae_mexax
     real(wp), parameter :: facp = 5.0_wp, facv = 5.0_wp
     real(wp), parameter :: projection_reject_min = 0.45_wp, projection_reject_safe = 0.9_wp
 
-    ! Outcomes of a column or an attempt.
-    integer, parameter :: ev_ok = 0, ev_restart = 1, ev_stop = 2
+    ! Outcomes of a column (ev_restart: H/2 for an unstable column,
+    ! ev_refused: H/2 when the model refused a substep) or an attempt.
+    integer, parameter :: ev_ok = 0, ev_restart = 1, ev_stop = 2, ev_refused = 3
     integer, parameter :: undecided = 0, do_accept = 1, do_reject = 2, do_restart = 3, do_stop = 4
 
     !> Cubic Hermite interpolation on the last accepted step (§3.7): q from
@@ -295,6 +298,7 @@ contains
         type(status_t) :: refusal !! the model's last refusal since an accepted step
         real(wp), allocatable :: yout(:)
         integer :: k, kc, kopt, km, decision, j, iout, nout, nstab_nonfinite, stat
+        integer :: cause !! why the attempt of a restart or a stop failed (cause_*)
         real(wp) :: h, hmax, posneg, tscale, rmin, c, t_old
         logical :: first, last, reject, need_start, basic_entry, want_steps, stop_requested
 
@@ -516,9 +520,11 @@ contains
 
             select case (decision)
             case (do_stop)
+                call count_failure(fst)
                 exit main
             case (do_restart)
                 ! §3.3/§3.5: H/2, counted in NSTEP and (calibrated) in NREJCT.
+                call count_failure(fst)
                 self%nstab = self%nstab + 1
                 if (restart_is_rejection) self%native%nrejct = self%native%nrejct + 1
                 h = h * restart_factor
@@ -533,6 +539,7 @@ contains
                     if (w%work(k - 1) < w%order_down * w%work(k)) k = k - 1
                 end if
                 self%native%nrejct = self%native%nrejct + 1
+                call stats%rejections%add(cause_error_test)
                 h = posneg * w%hh(k)
                 reject = .true.
                 last = .false.
@@ -547,6 +554,8 @@ contains
             call project(self, problem, w, t + h, c, status)
             stats%nprj = stats%nprj + 1
             if (.not. status%ok()) then
+                cause = cause_projection
+                call count_failure(status)
                 self%failed_in = mexax_failed_projection
                 status%message = 'mexax: ' // status%message // ' at t = ' // &
                     real_text(t + h) // ' (step from t = ' // real_text(t) // ')'
@@ -558,6 +567,9 @@ contains
             if (.not. fst%ok()) then
                 refusal = fst
                 c = huge(1.0_wp)
+                call stats%rejections%refuse(fst%text())
+            else if (c > 1.0_wp) then
+                call stats%rejections%add(cause_projection)
             end if
             if (c > 1.0_wp) then
                 self%nprj_reject = self%nprj_reject + 1
@@ -657,15 +669,17 @@ contains
                 if (j >= 2) call column_error(w, j, h, hmax, ev)
                 if (ev == ev_restart .and. .not. ieee_is_finite(w%err(j))) &
                     nstab_nonfinite = nstab_nonfinite + 1
-            else if (ev == ev_restart .and. fst%reason == reason_non_finite) then
+            else if (ev /= ev_stop .and. fst%reason == reason_non_finite) then
                 nstab_nonfinite = nstab_nonfinite + 1
-            else if (ev == ev_restart .and. fst%reason == reason_det_f) then
-                refusal = fst
             end if
+            if (ev == ev_refused) refusal = fst
+            cause = merge(cause_model_refused, cause_unstable, ev == ev_refused)
             select case (ev)
-            case (ev_restart)
+            case (ev_restart, ev_refused)
                 decision = do_restart
             case (ev_stop)
+                cause = merge(cause_singular_matrix, cause_model_refused, &
+                    fst%reason == reason_singular_matrix)
                 self%failed_in = mexax_failed_step
                 status = fst
                 status%message = 'mexax: ' // fst%message // ' at t = ' // real_text(t) // &
@@ -674,6 +688,24 @@ contains
             end select
             ok = ev == ev_ok
         end function column
+
+        !> Count the failed attempt by `cause`; a refusal (`why` says by
+        !> whom) keeps its reason. A failed projection is the model's when
+        !> a user function failed in it, and a singular matrix's.
+        subroutine count_failure(why)
+            type(status_t), intent(in) :: why
+            if (cause == cause_projection .and. why%reason == reason_singular_matrix) then
+                cause = cause_singular_matrix
+            else if (cause == cause_projection .and. (why%reason == reason_user_function .or. &
+                                                       why%reason == reason_det_f)) then
+                cause = cause_model_refused
+            end if
+            if (cause == cause_model_refused) then
+                call stats%rejections%refuse(why%text())
+            else
+                call stats%rejections%add(cause)
+            end if
+        end subroutine count_failure
 
         !> Hope for convergence in column k+1 (§3.4).
         subroutine hope()
@@ -729,6 +761,7 @@ contains
             stats%t_reached = t
             stats%cpu = timer%cpu()
             stats%wall = timer%wall()
+            call stats%rejections%annotate(status)
             if (present(sink)) then
                 call sink%finish(sink_status)
                 if (status%ok() .and. .not. sink_status%ok()) status = sink_status
@@ -1034,10 +1067,11 @@ contains
         ev = ev_ok
         call factor(w, lst)
         if (.not. lst%ok() .and. lst%reason == reason_non_finite) then
-            ! KLU refuses Inf/NaN entries, which LAPACK would pass on: restart
+            ! KLU refuses Inf/NaN entries (of M or G: the model's), which LAPACK
+            ! would pass on: restart
             call status%set(status_solver_failure, 'non-finite values in the augmented ' // &
                 'matrix ' // where, reason_non_finite)
-            ev = ev_restart
+            ev = ev_refused
             return
         else if (.not. lst%ok()) then
             call status%set(status_solver_failure, 'augmented matrix [M G^T; G 0] is singular ' &
@@ -1050,23 +1084,37 @@ contains
         self%native%nsol = self%native%nsol + 1
     end subroutine factor_solve
 
-    !> A failed user call becomes a stop with the routine's name.
-    logical function user_failed(status, what) result(failed)
+    !> A failed user call becomes a stop with the routine's name; non-finite
+    !> `values` it returned fail it too (reason_non_finite: a refusal).
+    logical function user_failed(status, what, values) result(failed)
         type(status_t), intent(inout) :: status
         character(len=*), intent(in) :: what
+        real(wp), intent(in), optional :: values(:)
+        integer :: i
+        if (status%ok() .and. present(values)) then
+            do i = 1, size(values)
+                if (ieee_is_finite(values(i))) cycle
+                call status%set(status_solver_failure, 'non-finite value in component ' // &
+                    int_text(i), reason_non_finite)
+                exit
+            end do
+        end if
         failed = .not. status%ok()
         if (failed) then
             status%message = 'user function ' // what // ' failed: ' // status%text()
             status%code = status_solver_failure
-            ! det F <= 0 is the model refusing the trial state: a restart
-            ! with H/2 (base_column), not a stop.
-            if (status%reason /= reason_det_f) status%reason = reason_user_function
+            ! det F <= 0 and non-finite values are the model refusing the
+            ! trial state: a restart with H/2 (base_column), not a stop.
+            if (status%reason /= reason_det_f .and. status%reason /= reason_non_finite) &
+                status%reason = reason_user_function
         end if
     end function user_failed
 
     !> T_{j,1} in w%x = (q, v, a, λ) after n substeps of the base method.
     !> ev_restart on non-finite values or a failed stability check (§3.5),
-    !> ev_stop (status set) on a singular matrix or a failed user function.
+    !> ev_refused when the model refused a substep (det F ≤ 0, non-finite
+    !> forces), ev_stop (status set) on a singular matrix or a failed user
+    !> function.
     subroutine base_column(self, problem, w, t, big_h, n, check_stability, ev, status)
         class(mexax_t), intent(inout) :: self
         class(mechanical_problem_t), intent(inout) :: problem
@@ -1111,7 +1159,7 @@ contains
                     call problem%forces(ti, w%p, w%v, w%f, status)
                     self%native%nfcn = self%native%nfcn + 1
                     self%native%nfprob = self%native%nfprob + 1
-                    if (user_failed(status, 'forces')) exit
+                    if (user_failed(status, 'forces', w%f)) exit
                     call problem%kinematics(ti, w%p, w%v, w%pdot, status)
                     if (user_failed(status, 'kinematics')) exit
                 else
@@ -1139,7 +1187,8 @@ contains
                 w%p = w%pn
                 if (unstable(i)) return
             end do
-            if (.not. status%ok()) ev = merge(ev_restart, ev_stop, status%reason == reason_det_f)
+            if (.not. status%ok()) ev = merge(ev_refused, ev_stop, status%reason == reason_det_f &
+                                              .or. status%reason == reason_non_finite)
         end subroutine euler_substeps
 
         !> (M), §3.2: an explicit start step, then q_{i+1} = q_{i−1} + 2h T v_i,
@@ -1181,7 +1230,7 @@ contains
                 call problem%forces(ti, w%p, w%v, w%f, status)
                 self%native%nfcn = self%native%nfcn + 1
                 self%native%nfprob = self%native%nfprob + 1
-                if (user_failed(status, 'forces')) exit
+                if (user_failed(status, 'forces', w%f)) exit
                 call eval_mass(problem, w, ti, w%p, w%mm, status)
                 if (user_failed(status, 'mass')) exit
                 call problem%kinematics(ti, w%p, w%v, w%pdot, status)
@@ -1209,7 +1258,8 @@ contains
                 call copy_block(w%gm, w%gn)
                 if (unstable(i)) return
             end do
-            if (.not. status%ok()) ev = merge(ev_restart, ev_stop, status%reason == reason_det_f)
+            if (.not. status%ok()) ev = merge(ev_refused, ev_stop, status%reason == reason_det_f &
+                                              .or. status%reason == reason_non_finite)
         end subroutine midpoint_substeps
 
         !> Non-finite values, or the §3.5 check after the second substep

@@ -5,12 +5,16 @@
 !> pattern reported once; when `jacobian_storage` says `storage_none`, the
 !> solver differences F. M is identity unless `mass_storage` says otherwise.
 module flexmbs_dae_problem
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_resources, only: out_of_memory
     use flexmbs_linalg_csc, only: csc_matrix_t
-    use flexmbs_linalg_matrix, only: storage_none, storage_identity
+    use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_identity, storage_dense, &
+        storage_sparse
     implicit none
     private
+
+    public :: problem_mass_matrix
 
     type, abstract, public :: dae_problem_t
         integer :: n = 0 !! number of unknowns
@@ -45,6 +49,33 @@ module flexmbs_dae_problem
     end interface
 
 contains
+
+    !> M of `problem` as a matrix_t in the storage the problem reports:
+    !> identity, dense, or CSC values on the pattern it builds. `owner`
+    !> heads an out-of-memory message ('radau5' → 'radau5 dense mass matrix').
+    subroutine problem_mass_matrix(problem, mass, status, owner)
+        class(dae_problem_t), intent(inout) :: problem
+        type(matrix_t), intent(inout) :: mass
+        type(status_t), intent(inout) :: status
+        character(len=*), intent(in) :: owner
+        integer :: stat
+        mass%n = problem%n
+        mass%storage = problem%mass_storage()
+        select case (mass%storage)
+        case (storage_dense)
+            allocate (mass%dense(problem%n, problem%n), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, trim(owner // ' dense mass matrix'), &
+                                   int(problem%n, i8) * problem%n, 8)
+                return
+            end if
+            call problem%mass_dense(mass%dense)
+        case (storage_sparse)
+            call problem%mass_sparse(mass%csc, status)
+        case default
+            mass%storage = storage_identity
+        end select
+    end subroutine problem_mass_matrix
 
     !> storage_none (difference Jacobian), storage_dense or storage_sparse.
     integer function default_jacobian_storage(self)

@@ -23,9 +23,11 @@ module flexmbs_dae_radau5
         storage_sparse
     use flexmbs_linalg_linear_solver, only: linear_solver_t
     use flexmbs_linalg_factory, only: new_linear_solver
-    use flexmbs_dae_problem, only: dae_problem_t
+    use flexmbs_dae_problem, only: dae_problem_t, problem_mass_matrix
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_rejections, only: cause_error_test, cause_newton_diverged, &
+        cause_newton_slow, cause_singular_matrix, cause_model_refused, cause_projection
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_solver, only: dae_solver_t
     implicit none
@@ -180,21 +182,24 @@ contains
         class(linear_solver_t), allocatable :: ls
         type(timer_t) :: timer
         type(status_t) :: fstatus
-        type(status_t) :: rejection  !! why the last step since an acceptance failed
+        type(status_t) :: rejection  !! the last refusal since an acceptance
+        type(status_t) :: f0_status  !! a failed F at the step start (f0 is NaN then)
 
-        integer :: n, nind1, nind2, nind3, nit, newt, block, i, nout, iout, stat
+        integer :: n, nind1, nind2, nind3, nit, newt, block, i, nout, iout, stat, cause
         real(wp) :: x, h, xend, posneg, hmaxn, hhfac, faccon, theta, thet, thq, thqold
         real(wp) :: dyno, dynold, dyth, qnewt, fnewt, err, fac, quot, hnew, hacc, erracc
         real(wp) :: facgus, hopt, hold, xold, fac1, alphn, betan, c3q, sig1, sig2, sig3
         real(wp) :: facl, facr, expm, qt, uround, hee1, hee2, hee3, ak1, ak2, ak3, ak
         logical :: first, reject, last, caljac, mass_identity, stop_requested, want_steps
         logical :: singular, pred, fd_jacobian
+        logical :: abandoned !! stopped at R3 before the attempt it counted (not in NST)
         real(wp) :: hold_saved
         integer :: nsing, naccpt_at_prj
 
         call timer%start()
         stats%t_reached = t
         fd_jacobian = .false.
+        abandoned = .false.
         self%native = radau5_native_t()
         self%h_opt = 0.0_wp
         self%nsol_error = 0
@@ -416,14 +421,16 @@ contains
                     exit main
                 end if
                 if (singular) then
+                    ! an attempt at this h that failed before R3: counted in NST
                     nsing = nsing + 1
                     if (nsing >= max_singular) then
+                        call stats%rejections%add(cause_singular_matrix)
                         call status%set(status_solver_failure, &
                             'radau5: matrix is repeatedly singular at t = ' // real_text(x), &
                             reason_singular_matrix)
                         exit main
                     end if
-                    call unexpected_failure()
+                    call unexpected_failure(cause_singular_matrix)
                     cycle main
                 end if
                 self%native%ndec = self%native%ndec + 1
@@ -432,18 +439,19 @@ contains
             case (blk_attempt) ! ---- R3 ----
                 self%native%nstep = self%native%nstep + 1
                 if (self%native%nstep > options%max_steps) then
+                    abandoned = .true.
                     call status%set(status_solver_failure, 'radau5: more than ' // &
                         int_text(options%max_steps) // ' steps needed; stopped at t = ' // &
                         real_text(x), reason_max_steps)
                     exit main
                 end if
                 if (0.1_wp * abs(h) <= abs(x) * uround) then
+                    abandoned = .true.
+                    ! A model refusal that forced the step down is the reason
+                    ! (its text closes the message: finish).
                     call status%set(status_solver_failure, 'radau5: step size too small, h = ' &
-                        // real_text(h) // ' at t = ' // real_text(x), reason_step_too_small)
-                    ! A model failure that forced the step down is the reason.
-                    if (rejection%reason == reason_det_f) call status%set( &
-                        status_solver_failure, status%message // '; the last rejected ' // &
-                        'step failed: ' // rejection%text(), reason_det_f)
+                        // real_text(h) // ' at t = ' // real_text(x), merge(reason_det_f, &
+                        reason_step_too_small, rejection%reason == reason_det_f))
                     exit main
                 end if
                 ! §1.4: cumulative index scaling of the weights.
@@ -477,7 +485,7 @@ contains
                 newt = 0
                 newton: do
                     if (newt >= nit) then
-                        call unexpected_failure()
+                        call unexpected_failure(cause_newton_slow)
                         cycle main
                     end if
                     ytmp = y + z1
@@ -488,7 +496,7 @@ contains
                     if (fstatus%ok()) call eval_f(x + h, ytmp, f3, fstatus)
                     self%native%nfcn = self%native%nfcn + 3
                     if (.not. fstatus%ok()) then
-                        call unexpected_failure()
+                        call unexpected_failure(cause_model_refused)
                         cycle main
                     end if
                     ! G = (T⁻¹ ⊗ I) F, then the transformed residuals r1, r2 + i r3.
@@ -513,7 +521,7 @@ contains
                     end do
                     dyno = sqrt(dyno / real(3 * n, wp))
                     if (.not. ieee_is_finite(dyno)) then
-                        call unexpected_failure()
+                        call unexpected_failure(cause_newton_diverged)
                         cycle main
                     end if
                     if (newt > 1 .and. newt < nit) then
@@ -532,13 +540,14 @@ contains
                                 qnewt = max(1.0e-4_wp, min(20.0_wp, dyth))
                                 hhfac = 0.8_wp * qnewt**(-1.0_wp / real(4 + nit - 1 - newt, wp))
                                 h = hhfac * h
+                                call stats%rejections%add(cause_newton_slow)
                                 reject = .true.
                                 last = .false.
                                 call retry_after_failure()
                                 cycle main
                             end if
                         else
-                            call unexpected_failure()
+                            call unexpected_failure(cause_newton_diverged)
                             cycle main
                         end if
                     end if
@@ -559,10 +568,15 @@ contains
                     err = err_floor
                     fstatus%code = status_ok
                 else
-                    call estimate_error(fstatus)
+                    call estimate_error(fstatus, cause)
                 end if
                 if (.not. fstatus%ok()) then
-                    call unexpected_failure()
+                    ! a NaN f0 (F failed at the step start) is the model's refusal
+                    if (cause == cause_error_test .and. .not. f0_status%ok()) then
+                        fstatus = f0_status
+                        cause = cause_model_refused
+                    end if
+                    call unexpected_failure(cause)
                     cycle main
                 end if
                 ! §1.9: step-size proposal.
@@ -603,14 +617,14 @@ contains
                         call problem%project(x, y, fstatus)
                         stats%nprj = stats%nprj + 1
                         if (.not. fstatus%ok() .or. .not. all(ieee_is_finite(y))) then
-                            call undo_step()
+                            call undo_step(cause_projection)
                             cycle main
                         end if
                     end if
                     ! A state the model cannot hold (det F <= 0) is never accepted.
                     call problem%admissible(x, y, fstatus)
                     if (.not. fstatus%ok()) then
-                        call undo_step()
+                        call undo_step(cause_model_refused)
                         cycle main
                     end if
                     call rejection%clear()
@@ -637,6 +651,7 @@ contains
                     call eval_f(x, y, f0, fstatus)
                     self%native%nfcn = self%native%nfcn + 1
                     ! A failing f0 shows up as a non-finite error estimate next step.
+                    f0_status = fstatus
                     if (.not. fstatus%ok()) f0 = ieee_nan()
                     ! ---- R5: next step ----
                     hnew = posneg * min(abs(hnew), hmaxn)
@@ -675,6 +690,7 @@ contains
                         h = hnew
                     end if
                     if (self%native%naccpt >= 1) self%native%nrejct = self%native%nrejct + 1
+                    call stats%rejections%add(cause_error_test)
                     call retry_after_failure()
                 end if
             end select
@@ -696,10 +712,13 @@ contains
             call finish()
         end subroutine interrupted
 
-        !> Common statistics from the native counters (docs/solvers.md).
+        !> Common statistics from the native counters (docs/solvers.md): NST
+        !> counts the attempts made, those that ended at R2 with a singular
+        !> matrix included, the one R3 stopped on (native NSTEP) not.
         subroutine finish()
             type(status_t) :: sink_status
-            stats%nst = self%native%nstep
+            stats%nst = self%native%nstep + stats%rejections%count_of(cause_singular_matrix)
+            if (abandoned) stats%nst = stats%nst - 1
             stats%nac = self%native%naccpt
             stats%nrj = stats%nst - stats%nac
             stats%nfe = self%native%nfcn
@@ -710,17 +729,27 @@ contains
             if (self%h_opt == 0.0_wp) self%h_opt = hopt
             stats%cpu = timer%cpu()
             stats%wall = timer%wall()
+            call stats%rejections%annotate(status)
             if (present(sink)) then
                 call sink%finish(sink_status)
                 if (status%ok() .and. .not. sink_status%ok()) status = sink_status
             end if
         end subroutine finish
 
+        !> F(tt, yy); a non-finite value fails as the model's (a refusal).
         subroutine eval_f(tt, yy, ff, st)
             real(wp), intent(in) :: tt, yy(:)
             real(wp), intent(out) :: ff(:)
             type(status_t), intent(out) :: st
+            integer :: j
             call problem%rhs(tt, yy, ff, st)
+            if (.not. st%ok()) return
+            do j = 1, n
+                if (ieee_is_finite(ff(j))) cycle
+                call st%set(status_solver_failure, 'non-finite right-hand side in component ' &
+                    // int_text(j) // ' at t = ' // real_text(tt), reason_non_finite)
+                return
+            end do
         end subroutine eval_f
 
         !> sc_i = atol'_i + rtol'_i |y_i| (§1.4).
@@ -731,18 +760,27 @@ contains
             end do
         end subroutine compute_scal
 
-        !> §1.10 R8: h/2 after Newton failure, singular matrix or non-finite value.
-        !> Take back the step just accepted and retry with h/2, counted like R8.
-        subroutine undo_step()
+        !> Take back the step just accepted and retry with h/2, counted like R8
+        !> (`cause`: its projection failed, or the model refused its state).
+        subroutine undo_step(cause)
+            integer, intent(in) :: cause
             y = cont
             x = xold
             hold = hold_saved
             self%native%naccpt = self%native%naccpt - 1
-            call unexpected_failure()
+            call unexpected_failure(cause)
         end subroutine undo_step
 
-        subroutine unexpected_failure()
-            if (.not. fstatus%ok()) rejection = fstatus
+        !> §1.10 R8: h/2 after a Newton failure, a singular matrix, a refusal
+        !> (fstatus says why) or a non-finite value, counted by `cause`.
+        subroutine unexpected_failure(cause)
+            integer, intent(in) :: cause
+            if (cause == cause_model_refused) then
+                rejection = fstatus
+                call stats%rejections%refuse(fstatus%text())
+            else
+                call stats%rejections%add(cause)
+            end if
             h = h * failure_factor
             hhfac = failure_factor
             reject = .true.
@@ -786,9 +824,13 @@ contains
 
         !> §1.7: err from ê = E1⁻¹(f0 + v), v = h⁻¹ M Σ e_i z_i; a second
         !> estimate from f(x, y + ê) on the first step or after a rejection.
-        subroutine estimate_error(st)
+        !> A failure's cause: a non-finite err fails the error test, a failed
+        !> F is the model's refusal.
+        subroutine estimate_error(st, cause)
             type(status_t), intent(out) :: st
+            integer, intent(out) :: cause
             integer :: j
+            cause = cause_error_test
             hee1 = dd1 / h
             hee2 = dd2 / h
             hee3 = dd3 / h
@@ -813,6 +855,7 @@ contains
                 cont = y + cont
                 call eval_f(x, cont, f1, st)
                 self%native%nfcn = self%native%nfcn + 1
+                if (.not. st%ok()) cause = cause_model_refused
                 if (.not. st%ok()) return
                 cont = f1 + f2
                 call ls%solve_real(cont)
@@ -855,21 +898,7 @@ contains
                     return
                 end if
             end select
-            mass%n = n
-            mass%storage = problem%mass_storage()
-            select case (mass%storage)
-            case (storage_dense)
-                allocate (mass%dense(n, n), stat=stat)
-                if (stat /= 0) then
-                    call out_of_memory(st, 'radau5 dense mass matrix', int(n, i8) * n, 8)
-                    return
-                end if
-                call problem%mass_dense(mass%dense)
-            case (storage_sparse)
-                call problem%mass_sparse(mass%csc, st)
-            case default
-                mass%storage = storage_identity
-            end select
+            call problem_mass_matrix(problem, mass, st, 'radau5')
         end subroutine setup_matrices
 
         !> J at (x, y): analytic, or by forward differences (§1.12; these

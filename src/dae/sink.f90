@@ -14,6 +14,7 @@ module flexmbs_dae_sink
     type, abstract, public :: dense_output_t
     contains
         procedure(evaluate_i), deferred :: evaluate
+        procedure :: order => default_order
     end type dense_output_t
 
     abstract interface
@@ -45,6 +46,13 @@ module flexmbs_dae_sink
     end interface
 
 contains
+
+    !> The order of the multistep formula the last step used (BDF: 1..5);
+    !> 0 for methods without one such order (Runge–Kutta, extrapolation).
+    integer function default_order(self)
+        class(dense_output_t), intent(in) :: self
+        default_order = 0
+    end function default_order
 
     !> True when `step` should be called after every accepted step.
     logical function default_wants_steps(self)

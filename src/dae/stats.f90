@@ -1,6 +1,7 @@
 !> Common solver statistics, one meaning for every solver (docs/solvers.md).
 module flexmbs_dae_stats
     use flexmbs_core_kinds, only: wp
+    use flexmbs_dae_rejections, only: rejections_t
     implicit none
     private
 
@@ -20,6 +21,9 @@ module flexmbs_dae_stats
         real(wp) :: wall = 0.0_wp !! wall seconds
         real(wp) :: t_reached = 0.0_wp !! last time reached (t_end on success)
         real(wp) :: h_last = 0.0_wp    !! last accepted step size
+        !> The NRJ failed or rejected attempts by cause (they add up to NRJ),
+        !> with the last model refusal's reason (flexmbs_dae_rejections).
+        type(rejections_t) :: rejections
         !> What the caller should know although the run succeeded (e.g. a
         !> formulation the solver is not made for); empty when none.
         character(len=:), allocatable :: warning
@@ -35,19 +39,24 @@ contains
         self%nst = 0; self%nac = 0; self%nrj = 0; self%nfe = 0; self%nfe_jac = 0
         self%nje = 0; self%ndec = 0; self%nsol = 0; self%nprj = 0
         self%cpu = 0.0_wp; self%wall = 0.0_wp; self%t_reached = 0.0_wp; self%h_last = 0.0_wp
+        self%rejections = rejections_t()
         if (allocated(self%warning)) deallocate (self%warning)
     end subroutine stats_reset
 
-    !> One line: 'NST=... NAC=... ...'.
+    !> One line: 'NST=... NAC=... NRJ=... ...', NRJ followed by its causes
+    !> when an attempt failed: 'NRJ=37 (error test 30, Newton slow 5,
+    !> refused 2)'.
     function stats_summary(self) result(line)
         class(dae_stats_t), intent(in) :: self
-        character(len=:), allocatable :: line
-        character(len=400) :: buf
-        write (buf, '(9(a,i0),2(a,f0.4))') 'NST=', self%nst, ' NAC=', self%nac, &
-            ' NRJ=', self%nrj, ' NFE=', self%nfe, ' NFE_JAC=', self%nfe_jac, &
+        character(len=:), allocatable :: line, causes
+        character(len=400) :: head, tail
+        write (head, '(3(a,i0))') 'NST=', self%nst, ' NAC=', self%nac, ' NRJ=', self%nrj
+        write (tail, '(6(a,i0),2(a,f0.4))') ' NFE=', self%nfe, ' NFE_JAC=', self%nfe_jac, &
             ' NJE=', self%nje, ' NDEC=', self%ndec, ' NSOL=', self%nsol, &
             ' NPRJ=', self%nprj, ' CPU=', self%cpu, ' WALL=', self%wall
-        line = trim(buf)
+        causes = self%rejections%summary()
+        if (len(causes) > 0) causes = ' (' // causes // ')'
+        line = trim(head) // causes // trim(tail)
     end function stats_summary
 
     !> The warning for index-3 components given to a BDF code (docs/theory.md §3).

@@ -22,6 +22,7 @@ module flexmbs_io_hdf5_sink
     use flexmbs_core_status, only: status_t, status_io_error, status_bad_input
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_rejections, only: cause_count, cause_attributes
     use flexmbs_core_version, only: creator, version
     use flexmbs_io_record_values, only: record_values_t
     use flexmbs_io_hdf5_text, only: read_string_attribute, write_string_attribute, &
@@ -364,7 +365,7 @@ contains
         type(status_t), intent(out) :: status
         character(len=*), intent(in), optional :: solver  !! solver name
         character(len=*), intent(in), optional :: outcome !! 'ok' or the failure message
-        integer :: err
+        integer :: err, c, counts(cause_count)
         if (.not. self%is_open) then
             call status%set(status_bad_input, 'HDF5 sink: write_statistics before create')
             return
@@ -379,6 +380,15 @@ contains
         call put_int('NDEC', stats%ndec)
         call put_int('NSOL', stats%nsol)
         call put_int('NPRJ', stats%nprj)
+        ! NRJ by cause (NRJ_ERROR_TEST, ...; they add up to NRJ) and the
+        ! reason of the last model refusal, when there was one
+        counts = stats%rejections%counts_by_cause()
+        do c = 1, cause_count
+            call put_int(trim(cause_attributes(c)), counts(c))
+        end do
+        if (err >= 0 .and. len(stats%rejections%refusal_reason()) > 0) &
+            call write_string_attribute(self%file, 'refusal', &
+                                        stats%rejections%refusal_reason(), err)
         call put_real('CPU', stats%cpu)
         call put_real('WALL', stats%wall)
         call put_real('t_reached', stats%t_reached)

@@ -3,7 +3,8 @@
 !> two outputs of a run are never one file, and a file already there is
 !> replaced only when it is a result of the same kind written by flexmbs —
 !> an HDF5 file with the root attribute creator = 'flexmbs ...', a ParaView
-!> or table file headed by the comment 'written by flexmbs ...' — anything
+!> or table file headed by the comment 'written by flexmbs ...', a PNG plot
+!> beside a table of flexmbs (io/spectrum_file) — anything
 !> else only when the user says `--force`. Paths are compared as files
 !> (device and inode) and, for files not yet written, as absolute paths
 !> with links, '.' and '..' resolved.
@@ -15,11 +16,13 @@ module flexmbs_io_output_files
     use flexmbs_io_hdf5_sink, only: hdf5_result_check
     use flexmbs_io_vtk_sink, only: vtk_file_ours
     use flexmbs_io_table, only: table_file_ours
+    use flexmbs_io_spectrum_file, only: spectrum_plot_ours
     implicit none
     private
 
     !> Kinds of output: what a file there must be to be replaced.
-    integer, parameter, public :: output_hdf5 = 1, output_vtk = 2, output_table = 3
+    integer, parameter, public :: output_hdf5 = 1, output_vtk = 2, output_table = 3, &
+        output_plot = 4
 
     !> A file of a run and how messages name it: an output
     !> ('&output: file', kind output_*) or an input ('the scene file itself').
@@ -112,6 +115,10 @@ contains
                     ours = vtk_file_ours(out%path)
                     reason = 'is not a ParaView file written by flexmbs (no comment ' // &
                         '''written by flexmbs'' on its second line)'
+                case (output_plot)
+                    ours = spectrum_plot_ours(out%path)
+                    reason = 'is not a plot written by flexmbs (a PNG beside a table ' // &
+                        'that flexmbs wrote, the same name ending in .csv)'
                 case default
                     ours = table_file_ours(out%path)
                     reason = 'is not a table written by flexmbs (no comment ' // &

@@ -174,6 +174,7 @@ module flexmbs_io_scene_input
         integer :: n_output
         logical :: every_step
         character(len=len_path) :: table
+        logical :: reasons !! the table also counts the rejected steps by cause
         logical :: progress
         !> ParaView files PREFIX_NNNN.vtu, PREFIX_bodies_NNNN.vtu, PREFIX_joints_NNNN.vtu and
         !> PREFIX.pvd ('' = none; flexmbs_io_vtk_sink)

@@ -137,6 +137,7 @@ contains
         call get(e, g, 'every_step', scene%every_step)
         call get(e, g, 'table', scene%table)
         call get(e, g, 'progress', scene%progress)
+        call get(e, g, 'reasons', scene%reasons)
         call get(e, g, 'vtk', scene%vtk)
     end subroutine read_output
 

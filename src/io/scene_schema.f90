@@ -125,6 +125,8 @@ module flexmbs_io_scene_schema
         var_spec_t('output', 'every_step', kind_logical, default='.false.', &
             doc='also record every accepted step'), &
         var_spec_t('output', 'table', kind_string, doc='a table of the outputs (.md, .csv, .tex)'), &
+        var_spec_t('output', 'reasons', kind_logical, default='.false.', &
+            doc='the table also counts the rejected steps by cause'), &
         var_spec_t('output', 'progress', kind_logical, default='.true.', &
             doc='progress display on standard error'), &
         var_spec_t('output', 'vtk', kind_string, &
@@ -277,7 +279,9 @@ module flexmbs_io_scene_schema
         var_spec_t('study', 'max_steps', kind_integer, default='0', rule='[0,inf)', &
             doc='step limit of every run (0: the scene''s)'), &
         var_spec_t('study', 'layout', kind_string, default='table3', choices='table3|table2', &
-            doc='the table''s layout')]
+            doc='the table''s layout'), &
+        var_spec_t('study', 'reasons', kind_logical, default='.false.', &
+            doc='the table also counts the rejected steps by cause (table2: as rows)')]
 
     character(len=16), parameter, public :: group_names(*) = [character(len=16) :: &
         'simulation', 'solver', 'output', 'flexible_body', 'material', 'multibody', &

@@ -36,6 +36,7 @@ module flexmbs_io_study_file
         real(wp) :: t_end !! > 0: the scene's t_end for every run
         integer :: max_steps !! > 0: every run's step limit
         character(len=len_name) :: layout !! 'table3' or 'table2' (the table's)
+        logical :: reasons !! the table also counts the rejected steps by cause
     end type study_input_t
 
     public :: read_study, parse_study
@@ -91,6 +92,7 @@ contains
         call get(entries, g, 't_end', input%t_end)
         call get(entries, g, 'max_steps', input%max_steps)
         call get(entries, g, 'layout', input%layout)
+        call get(entries, g, 'reasons', input%reasons)
         input%layout = lower(input%layout)
         call get(entries, g, 'cpu_reference', input%cpu_reference)
         call get_list(entries, g, 'solvers', input%solvers)

@@ -1,9 +1,11 @@
 !> Statistics tables in Markdown, CSV and LaTeX.
 !>
 !> The columns are those of the paper's Table 3 (solver, TOL, stab., ERR,
-!> NST, NAC, NFE, NJE, CPU) followed by NRJ, NDEC and NSOL. A row whose
-!> error was not measured shows '-' for ERR. A table file starts with the
-!> comment line 'written by flexmbs 0.1.0' of its format (table_file_ours).
+!> NST, NAC, NFE, NJE, CPU) followed by NRJ, NDEC and NSOL; asked for
+!> (`reasons`), NRJ by cause follows in one column a cause (the Table 2
+!> layout: one row a cause). A row whose error was not measured shows '-'
+!> for ERR. A table file starts with the comment line 'written by flexmbs
+!> 0.1.0' of its format (table_file_ours).
 module flexmbs_io_table
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use flexmbs_core_kinds, only: wp
@@ -11,6 +13,7 @@ module flexmbs_io_table
     use flexmbs_core_version, only: written_by, is_written_by
     use flexmbs_core_files, only: read_first_lines
     use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_rejections, only: cause_count, cause_labels
     implicit none
     private
 
@@ -75,40 +78,59 @@ contains
         end select
     end function table_format
 
-    !> The whole table as text, lines ended by newlines.
-    function table_text(rows, format) result(text)
+    !> The whole table as text, lines ended by newlines; with `reasons`, NRJ
+    !> by cause in one more column a cause.
+    function table_text(rows, format, reasons) result(text)
         type(stats_row_t), intent(in) :: rows(:)
         integer, intent(in) :: format !! table_markdown, table_csv or table_latex
+        logical, intent(in), optional :: reasons
         character(len=:), allocatable :: text
         type(cell_t), allocatable :: cells(:, :)
-        integer :: i, j
+        integer :: i, j, n
 
-        allocate (cells(ncol, 0:size(rows)))
+        n = ncol
+        if (present(reasons)) then
+            if (reasons) n = ncol + cause_count
+        end if
+        allocate (cells(n, 0:size(rows)))
         do j = 1, ncol
             cells(j, 0)%s = trim(headers(j))
         end do
-        do i = 1, size(rows)
-            call fill_cells(rows(i), format, cells(:, i))
+        do j = ncol + 1, n
+            cells(j, 0)%s = trim(cause_labels(j - ncol))
         end do
-        text = render(cells, numeric, format)
+        do i = 1, size(rows)
+            call fill_cells(rows(i), format, cells(1:ncol, i))
+            call fill_causes(rows(i), cells(ncol + 1:n, i))
+        end do
+        text = render(cells, [numeric, spread(.true., 1, n - ncol)], format)
     end function table_text
 
     !> The paper's Table 2 layout: one column per run (its solver label),
-    !> rows ERR, NST, rejected/NST, NJE and CPU.
-    function table2_text(rows, format) result(text)
+    !> rows ERR, NST, rejected/NST, NJE and CPU; with `reasons`, NRJ by
+    !> cause in one more row a cause.
+    function table2_text(rows, format, reasons) result(text)
         type(stats_row_t), intent(in) :: rows(:)
         integer, intent(in) :: format
+        logical, intent(in), optional :: reasons
         character(len=:), allocatable :: text
         character(len=12), parameter :: names(5) = [character(len=12) :: 'ERR', 'NST', &
             'rejected/NST', 'NJE', 'CPU']
         type(cell_t), allocatable :: cells(:, :), run(:)
         logical :: flags(size(rows) + 1)
         character(len=32) :: buf
-        integer :: i, k
-        allocate (cells(size(rows) + 1, 0:5), run(ncol))
+        integer :: i, k, nrow, counts(cause_count)
+        nrow = 5
+        if (present(reasons)) then
+            if (reasons) nrow = 5 + cause_count
+        end if
+        allocate (cells(size(rows) + 1, 0:nrow), run(ncol))
         cells(1, 0)%s = ''
         do k = 1, 5
             cells(1, k)%s = trim(names(k))
+        end do
+        do k = 6, nrow
+            cells(1, k)%s = trim(cause_labels(k - 5))
         end do
         do i = 1, size(rows)
             ! fill_cells' columns: 1 solver, 4 ERR, 5 NST, 8 NJE, 9 CPU
@@ -122,6 +144,10 @@ contains
             cells(i + 1, 3)%s = trim(buf)
             cells(i + 1, 4)%s = run(8)%s
             cells(i + 1, 5)%s = run(9)%s
+            counts = rows(i)%stats%rejections%counts_by_cause()
+            do k = 6, nrow
+                cells(i + 1, k)%s = itoa(counts(k - 5))
+            end do
         end do
         flags = .true.
         flags(1) = .false.
@@ -129,16 +155,17 @@ contains
     end function table2_text
 
     !> The table in a study's layout: 'table2' (table2_text), otherwise the
-    !> row per run of table_text.
-    function layout_text(rows, format, layout) result(text)
+    !> row per run of table_text; with `reasons`, NRJ by cause as well.
+    function layout_text(rows, format, layout, reasons) result(text)
         type(stats_row_t), intent(in) :: rows(:)
         integer, intent(in) :: format
         character(len=*), intent(in) :: layout !! 'table3' | 'table2'
+        logical, intent(in), optional :: reasons
         character(len=:), allocatable :: text
         if (layout == 'table2') then
-            text = table2_text(rows, format)
+            text = table2_text(rows, format, reasons)
         else
-            text = table_text(rows, format)
+            text = table_text(rows, format, reasons)
         end if
     end function layout_text
 
@@ -217,12 +244,14 @@ contains
         end function md_line
     end function render
 
-    !> Write the table to `path` in the format of its extension.
-    subroutine write_table(path, rows, status, layout)
+    !> Write the table to `path` in the format of its extension; `reasons`
+    !> adds NRJ by cause (default: the paper's columns only).
+    subroutine write_table(path, rows, status, layout, reasons)
         character(len=*), intent(in) :: path
         type(stats_row_t), intent(in) :: rows(:)
         type(status_t), intent(out) :: status
         character(len=*), intent(in), optional :: layout !! layout_text's; default 'table3'
+        logical, intent(in), optional :: reasons
         integer :: format, unit, ios
         character(len=256) :: msg
         format = table_format(path)
@@ -236,9 +265,9 @@ contains
         if (ios == 0) write (unit, iostat=ios, iomsg=msg) comment(format) // new_line('a')
         if (ios == 0) then
             if (present(layout)) then
-                write (unit, iostat=ios, iomsg=msg) layout_text(rows, format, layout)
+                write (unit, iostat=ios, iomsg=msg) layout_text(rows, format, layout, reasons)
             else
-                write (unit, iostat=ios, iomsg=msg) table_text(rows, format)
+                write (unit, iostat=ios, iomsg=msg) table_text(rows, format, reasons)
             end if
             close (unit)
         end if
@@ -313,6 +342,17 @@ contains
         cells(11)%s = itoa(row%stats%ndec)
         cells(12)%s = itoa(row%stats%nsol)
     end subroutine fill_cells
+
+    !> NRJ by cause, in the order of the cause_* constants.
+    subroutine fill_causes(row, cells)
+        type(stats_row_t), intent(in) :: row
+        type(cell_t), intent(out) :: cells(:)
+        integer :: counts(cause_count), c
+        counts = row%stats%rejections%counts_by_cause()
+        do c = 1, size(cells)
+            cells(c)%s = itoa(counts(c))
+        end do
+    end subroutine fill_causes
 
     !> 1.0e-04 (Markdown, CSV) or $1.0\cdot 10^{-4}$ (LaTeX).
     function sci(x, format) result(s)

@@ -5,7 +5,8 @@ module flexmbs_linalg_lapack
     implicit none
     private
     public :: dgetrf, dgetrs, zgetrf, zgetrs, dgbtrf, dgbtrs, zgbtrf, zgbtrs, dgesvd, dsyev
-    public :: dgesvd_quiet, dsyev_quiet
+    public :: dggev3
+    public :: dgesvd_quiet, dsyev_quiet, dggev3_quiet
 
     interface
         subroutine dgetrf(m, n, a, lda, ipiv, info)
@@ -80,6 +81,16 @@ module flexmbs_linalg_lapack
             real(wp), intent(out) :: w(*), work(*)
             integer, intent(out) :: info
         end subroutine dsyev
+        subroutine dggev3(jobvl, jobvr, n, a, lda, b, ldb, alphar, alphai, beta, vl, ldvl, &
+                         vr, ldvr, work, lwork, info)
+            import :: wp
+            character, intent(in) :: jobvl, jobvr
+            integer, intent(in) :: n, lda, ldb, ldvl, ldvr, lwork
+            real(wp), intent(inout) :: a(lda, *), b(ldb, *)
+            real(wp), intent(out) :: alphar(*), alphai(*), beta(*), vl(ldvl, *), vr(ldvr, *)
+            real(wp), intent(out) :: work(*)
+            integer, intent(out) :: info
+        end subroutine dggev3
     end interface
 
 contains
@@ -113,4 +124,20 @@ contains
         call dsyev(jobz, uplo, n, a, lda, w, work, lwork, info)
         call ieee_set_status(saved)
     end subroutine dsyev_quiet
+
+    !> dggev3, leaving the IEEE flags as they were (see dgesvd_quiet).
+    subroutine dggev3_quiet(jobvl, jobvr, n, a, lda, b, ldb, alphar, alphai, beta, vl, ldvl, &
+                           vr, ldvr, work, lwork, info)
+        character, intent(in) :: jobvl, jobvr
+        integer, intent(in) :: n, lda, ldb, ldvl, ldvr, lwork
+        real(wp), intent(inout) :: a(lda, *), b(ldb, *)
+        real(wp), intent(out) :: alphar(*), alphai(*), beta(*), vl(ldvl, *), vr(ldvr, *)
+        real(wp), intent(out) :: work(*)
+        integer, intent(out) :: info
+        type(ieee_status_type) :: saved
+        call ieee_get_status(saved)
+        call dggev3(jobvl, jobvr, n, a, lda, b, ldb, alphar, alphai, beta, vl, ldvl, vr, ldvr, &
+                   work, lwork, info)
+        call ieee_set_status(saved)
+    end subroutine dggev3_quiet
 end module flexmbs_linalg_lapack

@@ -71,7 +71,7 @@ module flexmbs_run_catalogue
 
     public :: solver_id, solver_info, problem_id, problem_info, mechanical_problem_names, &
         band_solver_names, solver_projects, solver_pmax_grid, solver_mechanical_only, &
-        problem_stabilisations
+        problem_stabilisations, pmax_grid_solver
 
 contains
 
@@ -124,6 +124,20 @@ contains
         info = solver_info(name)
         solver_pmax_grid = info%pmax_grid
     end function solver_pmax_grid
+
+    !> The first solver with a p_max grid (a BDF code whose largest order a
+    !> study varies, as the paper's Table 2 does): `flexmbs modes` checks its
+    !> steps against the A(α) sectors (run/modes).
+    pure function pmax_grid_solver() result(name)
+        character(len=:), allocatable :: name
+        integer :: id
+        do id = 1, size(solvers)
+            if (.not. solvers(id)%pmax_grid) cycle
+            name = trim(solvers(id)%name)
+            return
+        end do
+        name = ''
+    end function pmax_grid_solver
 
     pure logical function solver_mechanical_only(name)
         character(len=*), intent(in) :: name

@@ -245,7 +245,7 @@ contains
         end if
         if (len_trim(scene%table) > 0 .and. status%code /= status_bad_input) then
             call write_table(trim(scene%table), [new_stats_row(result%solver_name, &
-                scene%rtol, scene_stab(scene), result%stats)], io_status)
+                scene%rtol, scene_stab(scene), result%stats)], io_status, reasons=scene%reasons)
             if (status%ok() .and. .not. io_status%ok()) status = io_status
         end if
 

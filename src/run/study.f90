@@ -327,7 +327,7 @@ contains
         end if
         rows = runs%row
         if (len(study%table) > 0) call write_table(study%table, rows, status, &
-                                                   trim(study%layout))
+                                                   trim(study%layout), study%reasons)
     end subroutine run_sweep
 
     !> What every sweep starts from: the study's scene with the sweep's step

@@ -110,7 +110,7 @@ contains
         end if
         if (merged%complete() .and. len(study%table) > 0) then
             rows = merged%runs%row
-            call write_table(study%table, rows, status, trim(study%layout))
+            call write_table(study%table, rows, status, trim(study%layout), study%reasons)
             merged%table_written = status%ok()
         end if
     end subroutine merge_records

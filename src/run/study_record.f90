@@ -20,6 +20,8 @@
 !>   err = ...                   ERR (-1: not measured)
 !>   t_reached, nst, nac, nrj, nfe, nfe_jac, nje, ndec, nsol, nprj, cpu,
 !>   wall, h_last = ...          the statistics (each on its own line)
+!>   nrj_error_test, ... = ...   NRJ by cause (dae_stats_t%rejections,
+!>   refusal = ...               cause_keys) and the last refusal's reason
 !>   summary = ...               the sweep's line for the run
 !>
 !> Reals are written with 17 significant digits, so they read back to the
@@ -33,6 +35,7 @@ module flexmbs_run_study_record
     use flexmbs_core_sha256, only: sha256_hex
     use flexmbs_io_namelist, only: study_input_t, scene_input_t
     use flexmbs_io_table, only: stats_row_t
+    use flexmbs_dae_rejections, only: cause_count, cause_keys
     use flexmbs_run_study_grid, only: sweep_point_t
     implicit none
     private
@@ -57,7 +60,8 @@ module flexmbs_run_study_record
         record_damaged = 3
 
     character(len=*), parameter :: heading = '# flexmbs sweep record'
-    character(len=*), parameter :: record_format = '1'
+    !> 2: with NRJ by cause (a format-1 record is damaged: the point runs again)
+    character(len=*), parameter :: record_format = '2'
     character, parameter :: nl = new_line('a')
 
     type :: pair_t
@@ -93,9 +97,15 @@ contains
         type(fingerprint_t), intent(in) :: print
         type(sweep_run_t), intent(in) :: run
         character(len=:), allocatable :: text
-        character(len=:), allocatable :: reason
+        character(len=:), allocatable :: reason, causes
+        integer :: counts(cause_count), c
         reason = ''
         if (allocated(run%reason)) reason = run%reason
+        counts = run%row%stats%rejections%counts_by_cause()
+        causes = ''
+        do c = 1, cause_count
+            causes = causes // line('nrj_' // trim(cause_keys(c)), int_text(counts(c)))
+        end do
         associate (st => run%row%stats)
             text = heading // nl // line('format', record_format) // &
                 line('point', int_text(k)) // line('solver', trim(point%solver)) // &
@@ -113,7 +123,9 @@ contains
                 line('nje', int_text(st%nje)) // line('ndec', int_text(st%ndec)) // &
                 line('nsol', int_text(st%nsol)) // line('nprj', int_text(st%nprj)) // &
                 line('cpu', exact(st%cpu)) // line('wall', exact(st%wall)) // &
-                line('h_last', exact(st%h_last)) // line('summary', one_line(run%summary))
+                line('h_last', exact(st%h_last)) // causes // &
+                line('refusal', one_line(st%rejections%refusal_reason())) // &
+                line('summary', one_line(run%summary))
         end associate
     end function record_text
 
@@ -145,7 +157,7 @@ contains
         type(status_t) :: status
         character(len=:), allocatable :: text, changed, numbers
         logical :: exists
-        integer :: ios
+        integer :: ios, c, counts(cause_count)
         note = ''
         state = record_missing
         inquire (file=path, exist=exists)
@@ -195,10 +207,14 @@ contains
             ' ' // value_of('nfe_jac') // ' ' // value_of('nje') // ' ' // value_of('ndec') // &
             ' ' // value_of('nsol') // ' ' // value_of('nprj') // ' ' // value_of('cpu') // &
             ' ' // value_of('wall') // ' ' // value_of('h_last')
+        do c = 1, cause_count
+            numbers = numbers // ' ' // value_of('nrj_' // trim(cause_keys(c)))
+        end do
         associate (st => run%row%stats)
             read (numbers, *, iostat=ios) run%row%err, st%t_reached, &
                 st%nst, st%nac, st%nrj, st%nfe, st%nfe_jac, st%nje, st%ndec, st%nsol, &
-                st%nprj, st%cpu, st%wall, st%h_last
+                st%nprj, st%cpu, st%wall, st%h_last, counts
+            if (ios == 0) call st%rejections%restore(counts, value_of('refusal'))
         end associate
         if (ios /= 0 .or. all(value_of('outcome') /= ['ok    ', 'failed'])) then
             note = path // ': a number or the outcome is missing or unreadable'
