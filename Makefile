@@ -139,7 +139,8 @@ run: build
 # checks of test/cli.sh, the documentation's links and generated scene
 # reference (test/docs.py), the signals of test/kill.sh (python3-h5py reads
 # the files they leave), every example scene with empty standard error
-# (test/examples.sh) and the fuzzer of the scene input (test/fuzz, about
+# (test/examples.sh), DDASSL and IDA from 1e-2 to 1e-12 on the scenes
+# against RADAU5 (test/tolerances.sh) and the fuzzer of the scene input (test/fuzz, about
 # a thousand mutated scenes, two at a time); one summary line last.
 test: deps
 	@mkdir -p $(BUILD)
@@ -163,12 +164,14 @@ test: deps
 	    echo "exit $$?" >> $(BUILD)/test-kill.log
 	@set -o pipefail; FPM="$(FPM)" bash test/examples.sh 2>&1 | tee $(BUILD)/test-examples.log; \
 	    echo "exit $$?" >> $(BUILD)/test-examples.log
+	@set -o pipefail; FPM="$(FPM)" bash test/tolerances.sh 2>&1 | tee $(BUILD)/test-tolerances.log; \
+	    echo "exit $$?" >> $(BUILD)/test-tolerances.log
 	@set -o pipefail; FPM="$(FPM)" bash test/fuzz/run.sh 2>&1 | tee $(BUILD)/test-fuzz.log; \
 	    echo "exit $$?" >> $(BUILD)/test-fuzz.log
 	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log \
 	    $(BUILD)/test-programs.log $(BUILD)/test-dependency.log $(BUILD)/test-layers.log \
 	    $(BUILD)/test-cli.log $(BUILD)/test-docs.log $(BUILD)/test-kill.log \
-	    $(BUILD)/test-examples.log $(BUILD)/test-fuzz.log
+	    $(BUILD)/test-examples.log $(BUILD)/test-tolerances.log $(BUILD)/test-fuzz.log
 
 PROFILE     ?= debug
 PREFIX_USED ?= $(PREFIX_DEBUG)

@@ -311,9 +311,9 @@ contains
     end subroutine test_five_body
 
     !> DDASSL and IDA on the four-bar with GGL at rtol = atol = 1e-8: they
-    !> measure GGL's μ in the Newton test as h δμ (correction_flags), without
+    !> measure the multipliers λ and μ in the Newton test as h δ, without
     !> which they stopped at t0 (μ = 0 has only atol for its weight, and the
-    !> round-off of δμ grows like 1/h); they reach RADAU5's state (1e-6).
+    !> round-off of δ grows like 1/h); they reach RADAU5's state (1e-6).
     subroutine test_bdf_tight(error)
         type(error_t), allocatable, intent(out) :: error
         character(len=8), parameter :: solvers(3) = ['radau5', 'ddassl', 'ida   ']

@@ -27,7 +27,7 @@ module flexmbs_dae_ida
     use fida_mod, only: FIDACreate, FIDAInit, FIDAFree, FIDASStolerances, FIDASVtolerances, &
         FIDAWFtolerances, FIDASetUserData, FIDASetErrHandlerFn, FIDASetMaxOrd, &
         FIDASetMaxNumSteps, FIDASetInitStep, FIDASetMaxStep, FIDASetStopTime, FIDASetId, &
-        FIDASetSuppressAlg, FIDASetLinearSolver, FIDASetJacFn, FIDACalcIC, &
+        FIDASetSuppressAlg, FIDASetNonlinConvCoef, FIDASetLinearSolver, FIDASetJacFn, FIDACalcIC, &
         FIDAGetConsistentIC, FIDASolve, FIDAGetDky, FIDAGetNumSteps, FIDAGetNumResEvals, &
         FIDAGetNumLinResEvals, FIDAGetNumJacEvals, FIDAGetNumLinSolvSetups, &
         FIDAGetNumNonlinSolvIters, FIDAGetNumErrTestFails, FIDAGetNumNonlinSolvConvFails, &
@@ -60,6 +60,9 @@ module flexmbs_dae_ida
 
     integer, parameter :: ida_max_order = 5    !! IDA's BDF orders are 1…5
     integer, parameter :: max_message = 1000   !! longest IDA message kept
+    !> IDA's Newton-test coefficient (its default 0.33) when the components of
+    !> index 2 or 3 count as h^(k-1) δ, as DDASSL's (docs/theory.md §6.4)
+    real(c_double), parameter :: newton_coefficient_scaled = 0.01_c_double
 
     ! How the iteration matrix is formed.
     integer, parameter :: jac_quotients = 0    !! IDA's difference quotients (dense)
@@ -110,10 +113,10 @@ module flexmbs_dae_ida
         integer(i8), allocatable :: colptr(:), rowind(:) !! its pattern
         integer(i8), allocatable :: jac_slot(:), mass_slot(:) !! entry -> its slot
         real(wp), allocatable :: f(:), rtol(:), atol(:)
-        !> suppressed correction components (GGL's μ): weights divided by |h|,
-        !> so that their Newton corrections count as h δ (dae_problem_t%
-        !> correction_flags)
-        logical, allocatable :: scaled(:)
+        !> suppressed components of index k (out of the error test): weights
+        !> divided by |h|^(k-1), so that their Newton corrections count as
+        !> h^(k-1) δ (ida_weights)
+        integer, allocatable :: newton_power(:)
         real(wp) :: h_start = 0.0_wp   !! |h| before the first step (IDA's rule)
         type(c_ptr) :: mem = c_null_ptr
         type(c_ptr) :: observer = c_null_ptr    !! the observed Newton solver
@@ -250,7 +253,7 @@ contains
         data%problem => problem
         data%n = n
         allocate (data%f(n), data%rtol(n), data%atol(n), yw(n), ypw(n), atolw(n), idw(n), &
-            dkyw(n), classes(n), flags(n), data%scaled(n), stat=stat)
+            dkyw(n), classes(n), flags(n), data%newton_power(n), stat=stat)
         if (stat /= 0) then
             call out_of_memory(status, 'ida vectors', 11_i8 * n, 8)
             return
@@ -258,10 +261,11 @@ contains
         call options%tolerances(data%rtol, data%atol)
         yw = y
         call problem%index_classes(classes)
-        call problem%differential_flags(flags)
         suppress = self%suppress_alg .and. any(classes > 1)
-        call problem%correction_flags(data%scaled)
-        data%scaled = data%scaled .and. suppress .and. classes > 1
+        call problem%multiplier_flags(flags)
+        data%newton_power = 0
+        if (suppress) where (flags .and. classes > 1) data%newton_power = classes - 1
+        call problem%differential_flags(flags)
         if (any(classes >= 3)) stats%warning = index3_warning('ida')
 
         run: block
@@ -340,6 +344,12 @@ contains
                 idw = merge(1.0_wp, 0.0_wp, classes == 1)
                 if (.not. check(FIDASetId(mem, nv_id), 'IDASetId')) exit run
                 if (.not. check(FIDASetSuppressAlg(mem, 1_c_int), 'IDASetSuppressAlg')) exit run
+                ! their Newton corrections count as h^(k-1) δ (ida_weights): the
+                ! Newton test is tighter, as in DDASSL's
+                if (any(data%newton_power > 0)) then
+                    if (.not. check(FIDASetNonlinConvCoef(mem, newton_coefficient_scaled), &
+                                    'IDASetNonlinConvCoef')) exit run
+                end if
             end if
 
             dense%mem = mem
@@ -562,7 +572,7 @@ contains
             type(status_t), intent(inout) :: st
             logical :: ok
             if (.not. st%ok()) return
-            if (any(data%scaled)) then
+            if (any(data%newton_power > 0)) then
                 ok = check(FIDAWFtolerances(mem, c_funloc(ida_weights)), 'IDAWFtolerances')
                 return
             end if
@@ -982,13 +992,14 @@ contains
             ierr = -1
             return
         end if
-        ! correction components (out of the error test) count as h δ in the
-        ! Newton test, as in DDASSL's (dae_problem_t%correction_flags)
-        if (allocated(data%scaled) .and. c_associated(data%mem)) then
-            if (any(data%scaled)) then
+        ! components out of the error test (index k = 2, 3) count as h^(k-1) δ
+        ! in the Newton test, as in DDASSL's newton_norm: with them out of the
+        ! error test, these weights serve the Newton test alone
+        if (allocated(data%newton_power) .and. c_associated(data%mem)) then
+            if (any(data%newton_power > 0)) then
                 if (FIDAGetCurrentStep(data%mem, hcur) /= 0) hcur = 0.0_wp
                 if (hcur(1) == 0.0_wp) hcur = data%h_start
-                if (hcur(1) /= 0.0_wp) where (data%scaled) w = w / abs(hcur(1))
+                if (hcur(1) /= 0.0_wp) w = w / abs(hcur(1))**data%newton_power
             end if
         end if
         w = 1.0_wp / w

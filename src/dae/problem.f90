@@ -29,7 +29,7 @@ module flexmbs_dae_problem
         procedure :: mass_sparse => default_mass_sparse
         procedure :: index_classes => default_index_classes
         procedure :: differential_flags => default_differential_flags
-        procedure :: correction_flags => default_correction_flags
+        procedure :: multiplier_flags => default_multiplier_flags
         procedure :: has_projection => default_has_projection
         procedure :: project => default_project
         procedure :: consistent_initial => default_consistent_initial
@@ -154,17 +154,16 @@ contains
         flags = .true.
     end subroutine default_differential_flags
 
-    !> Components that only correct the solution: zero on the exact solution,
-    !> they act on the differential components through h times themselves
-    !> (GGL's μ in q' = T (v − Gᵀμ)). Solvers that keep index-2 components
-    !> out of the error test measure these components' Newton corrections as
-    !> h δ: unscaled, the round-off of δ (amplified like 1/h) against their
-    !> absolute tolerance alone stops tight runs at t0. Default: none.
-    subroutine default_correction_flags(self, flags)
+    !> The Lagrange multipliers (and GGL's μ): they act on the differential
+    !> components through h times themselves. Solvers that keep them out of
+    !> the error test measure their Newton corrections as h^(k-1) δ (index
+    !> k): unscaled, the round-off of δ (amplified like 1/h by the iteration
+    !> matrix) against their tolerance stops tight runs at t0. Default: none.
+    subroutine default_multiplier_flags(self, flags)
         class(dae_problem_t), intent(in) :: self
         logical, intent(out) :: flags(:)
         flags = .false.
-    end subroutine default_correction_flags
+    end subroutine default_multiplier_flags
 
     !> Whether `project` does anything (solvers skip the hook otherwise).
     logical function default_has_projection(self)

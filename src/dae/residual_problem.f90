@@ -22,7 +22,7 @@ module flexmbs_dae_residual_problem
         procedure(partials_i), deferred :: partials
         procedure :: index_classes => residual_index_classes
         procedure :: differential_flags => residual_differential_flags
-        procedure :: correction_flags => residual_correction_flags
+        procedure :: multiplier_flags => residual_multiplier_flags
         procedure :: has_iteration_matrix => residual_has_iteration_matrix
         procedure :: iteration_matrix => residual_iteration_matrix
         procedure :: admissible => residual_admissible
@@ -68,7 +68,7 @@ module flexmbs_dae_residual_problem
         procedure :: partials => wrapper_partials
         procedure :: index_classes => wrapper_index_classes
         procedure :: differential_flags => wrapper_differential_flags
-        procedure :: correction_flags => wrapper_correction_flags
+        procedure :: multiplier_flags => wrapper_multiplier_flags
         procedure :: admissible => wrapper_admissible
     end type dae_residual_t
 
@@ -115,12 +115,12 @@ contains
         flags = .true.
     end subroutine residual_differential_flags
 
-    !> Default: no correction components (see dae_problem_t%correction_flags).
-    subroutine residual_correction_flags(self, flags)
+    !> Default: no multipliers (see dae_problem_t%multiplier_flags).
+    subroutine residual_multiplier_flags(self, flags)
         class(residual_problem_t), intent(in) :: self
         logical, intent(out) :: flags(:)
         flags = .false.
-    end subroutine residual_correction_flags
+    end subroutine residual_multiplier_flags
 
     subroutine wrapper_residual(self, t, y, yp, g, status)
         class(dae_residual_t), intent(inout) :: self
@@ -216,11 +216,11 @@ contains
         call self%problem%differential_flags(flags)
     end subroutine wrapper_differential_flags
 
-    subroutine wrapper_correction_flags(self, flags)
+    subroutine wrapper_multiplier_flags(self, flags)
         class(dae_residual_t), intent(in) :: self
         logical, intent(out) :: flags(:)
-        call self%problem%correction_flags(flags)
-    end subroutine wrapper_correction_flags
+        call self%problem%multiplier_flags(flags)
+    end subroutine wrapper_multiplier_flags
 
     subroutine wrapper_admissible(self, t, y, status)
         class(dae_residual_t), intent(inout) :: self

@@ -111,7 +111,7 @@ module flexmbs_mbs_formulation
         procedure :: is_sparse => formulation_is_sparse
         procedure :: index_classes => formulation_index_classes
         procedure :: differential_flags => formulation_differential_flags
-        procedure :: correction_flags => formulation_correction_flags
+        procedure :: multiplier_flags => formulation_multiplier_flags
         procedure :: has_projection => formulation_has_projection
         procedure :: project => formulation_project
         procedure :: consistent_initial => formulation_consistent_initial
@@ -616,14 +616,18 @@ contains
         end select
     end subroutine formulation_index_classes
 
-    !> q and v differential, a, λ, μ algebraic.
-    !> GGL's μ: zero on the exact solution, acting on q as h T Gᵀμ.
-    subroutine formulation_correction_flags(self, flags)
+    !> λ, GGL's μ, and in the acceleration layout with constraints the
+    !> accelerations, which λ determines through M a = f − Gᵀλ (without
+    !> constraints a is M⁻¹f, a function of q and v, and keeps its weight).
+    subroutine formulation_multiplier_flags(self, flags)
         class(formulation_t), intent(in) :: self
         logical, intent(out) :: flags(:)
         flags = .false.
+        if (self%nc == 0) return
+        flags(self%ol + 1:self%ol + self%nc) = .true.
         if (self%form == formulation_ggl) flags(self%om + 1:self%om + self%nc) = .true.
-    end subroutine formulation_correction_flags
+        if (self%accelerations) flags(self%oa + 1:self%oa + self%nv) = .true.
+    end subroutine formulation_multiplier_flags
 
     subroutine formulation_differential_flags(self, flags)
         class(formulation_t), intent(in) :: self
