@@ -27,7 +27,7 @@ module flexmbs_dae_ida
     use fida_mod, only: FIDACreate, FIDAInit, FIDAFree, FIDASStolerances, FIDASVtolerances, &
         FIDAWFtolerances, FIDASetUserData, FIDASetErrHandlerFn, FIDASetMaxOrd, &
         FIDASetMaxNumSteps, FIDASetInitStep, FIDASetMaxStep, FIDASetStopTime, FIDASetId, &
-        FIDASetSuppressAlg, FIDASetNonlinConvCoef, FIDASetLinearSolver, FIDASetJacFn, FIDACalcIC, &
+        FIDASetSuppressAlg, FIDASetLinearSolver, FIDASetJacFn, FIDACalcIC, &
         FIDAGetConsistentIC, FIDASolve, FIDAGetDky, FIDAGetNumSteps, FIDAGetNumResEvals, &
         FIDAGetNumLinResEvals, FIDAGetNumJacEvals, FIDAGetNumLinSolvSetups, &
         FIDAGetNumNonlinSolvIters, FIDAGetNumErrTestFails, FIDAGetNumNonlinSolvConvFails, &
@@ -60,9 +60,9 @@ module flexmbs_dae_ida
 
     integer, parameter :: ida_max_order = 5    !! IDA's BDF orders are 1…5
     integer, parameter :: max_message = 1000   !! longest IDA message kept
-    !> IDA's Newton-test coefficient (its default 0.33) when the components of
-    !> index 2 or 3 count as h^(k-1) δ, as DDASSL's (docs/theory.md §6.4)
-    real(c_double), parameter :: newton_coefficient_scaled = 0.01_c_double
+    !> The multipliers (index k, out of the error test) count in the Newton
+    !> test as h^(k-1) δ / κ, as in DDASSL's (docs/theory.md §6.4)
+    real(wp), parameter :: multiplier_kappa = 0.03_wp
 
     ! How the iteration matrix is formed.
     integer, parameter :: jac_quotients = 0    !! IDA's difference quotients (dense)
@@ -344,12 +344,6 @@ contains
                 idw = merge(1.0_wp, 0.0_wp, classes == 1)
                 if (.not. check(FIDASetId(mem, nv_id), 'IDASetId')) exit run
                 if (.not. check(FIDASetSuppressAlg(mem, 1_c_int), 'IDASetSuppressAlg')) exit run
-                ! their Newton corrections count as h^(k-1) δ (ida_weights): the
-                ! Newton test is tighter, as in DDASSL's
-                if (any(data%newton_power > 0)) then
-                    if (.not. check(FIDASetNonlinConvCoef(mem, newton_coefficient_scaled), &
-                                    'IDASetNonlinConvCoef')) exit run
-                end if
             end if
 
             dense%mem = mem
@@ -992,14 +986,15 @@ contains
             ierr = -1
             return
         end if
-        ! components out of the error test (index k = 2, 3) count as h^(k-1) δ
-        ! in the Newton test, as in DDASSL's newton_norm: with them out of the
-        ! error test, these weights serve the Newton test alone
+        ! multipliers out of the error test (index k = 2, 3) count as
+        ! h^(k-1) δ / κ in the Newton test, as in DDASSL's newton_norm: with
+        ! them out of the error test, these weights serve the Newton test alone
         if (allocated(data%newton_power) .and. c_associated(data%mem)) then
             if (any(data%newton_power > 0)) then
                 if (FIDAGetCurrentStep(data%mem, hcur) /= 0) hcur = 0.0_wp
                 if (hcur(1) == 0.0_wp) hcur = data%h_start
-                if (hcur(1) /= 0.0_wp) w = w / abs(hcur(1))**data%newton_power
+                if (hcur(1) /= 0.0_wp) where (data%newton_power > 0) &
+                    w = multiplier_kappa * w / abs(hcur(1))**data%newton_power
             end if
         end if
         w = 1.0_wp / w
