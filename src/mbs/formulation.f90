@@ -92,6 +92,9 @@ module flexmbs_mbs_formulation
         real(wp), allocatable :: qq(:, :), vq(:, :), vv(:, :), cq(:, :), cq2(:, :), cv(:, :)
         real(wp), allocatable :: gtlq(:, :), minv_gt(:, :), tq(:), q0(:), mass_lu(:, :)
         real(wp), allocatable :: kkt_rhs(:)
+        !> consistent_multipliers' last state (t, q, v) and its λ
+        real(wp) :: multipliers_t = huge(1.0_wp)
+        real(wp), allocatable :: multipliers_state(:), multipliers(:)
         integer, allocatable :: mass_pivots(:)
         type(saddle_point_t) :: kkt          !! dense [M Gᵀ; G 0] (the sparse one is in sp)
         logical :: mass_factored = .false.
@@ -115,6 +118,7 @@ module flexmbs_mbs_formulation
         procedure :: has_projection => formulation_has_projection
         procedure :: project => formulation_project
         procedure :: consistent_initial => formulation_consistent_initial
+        procedure :: consistent_multipliers => formulation_consistent_multipliers
         procedure :: drift => formulation_drift
         procedure :: admissible => formulation_admissible
     end type formulation_t
@@ -755,16 +759,8 @@ contains
             end do
             call project_velocities(self, t, q, v, status)
             if (.not. status%ok()) return
-            call self%mechanical%forces(t, q, v, self%force, status)
-            self%kkt_rhs(1:nv) = self%force
-            if (nc > 0) then
-                call self%mechanical%constraint_curvature(t, q, v, self%c, status)
-                self%kkt_rhs(nv + 1:) = -self%c
-            end if
+            call solve_accelerations(self, t, q, v, status)
             if (.not. status%ok()) return
-            call factor_kkt(self, t, q, status)
-            if (.not. status%ok()) return
-            call solve_kkt(self)
             yp = 0.0_wp
             call self%mechanical%kinematics(t, q, v, yp(self%oq + 1:self%oq + self%nq), status)
             yp(self%ov + 1:self%ov + nv) = self%kkt_rhs(1:nv)
@@ -773,6 +769,64 @@ contains
             if (self%form == formulation_ggl) y(self%om + 1:self%om + nc) = 0.0_wp
         end associate
     end subroutine formulation_consistent_initial
+
+    !> [M Gᵀ; G 0] [a; λ] = [f; -γ] at (t, q, v): a and λ in self%kkt_rhs.
+    subroutine solve_accelerations(self, t, q, v, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        type(status_t), intent(inout) :: status
+        call self%mechanical%forces(t, q, v, self%force, status)
+        self%kkt_rhs(1:self%nv) = self%force
+        if (self%nc > 0) then
+            call self%mechanical%constraint_curvature(t, q, v, self%c, status)
+            self%kkt_rhs(self%nv + 1:) = -self%c
+        end if
+        if (.not. status%ok()) return
+        call factor_kkt(self, t, q, status)
+        if (.not. status%ok()) return
+        call solve_kkt(self)
+    end subroutine solve_accelerations
+
+    !> The multipliers λ consistent with the positions and velocities in y:
+    !> [M Gᵀ; G 0] [a; λ] = [f; -γ] at y's (q, v), as λ of index 1. In the
+    !> index-2, index-3 and GGL forms the integrator's λ is an index-2/3
+    !> variable, less accurate than q and v (RADAU5: order 3 against 5, its
+    !> error weighted by the step), so reactions are computed from these
+    !> (docs/multibody.md). The last state's λ is kept: asked again for the
+    !> same (t, q, v), as every reaction series of one output record asks,
+    !> nothing is factored.
+    subroutine formulation_consistent_multipliers(self, t, y, lambda, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: lambda(:)  !! size nc
+        type(status_t), intent(inout) :: status
+        integer :: stat
+        if (self%nc == 0) return
+        associate (state => y(self%oq + 1:self%ov + self%nv))
+            if (allocated(self%multipliers)) then
+                if (t == self%multipliers_t .and. all(state == self%multipliers_state)) then
+                    lambda = self%multipliers
+                    return
+                end if
+            else
+                allocate (self%multipliers_state(self%nq + self%nv), self%multipliers(self%nc), &
+                          stat=stat)
+                if (stat /= 0) then
+                    call out_of_memory(status, 'formulation multipliers', &
+                                       int(self%nq + self%nv + self%nc, i8), 8)
+                    return
+                end if
+            end if
+            self%multipliers_t = huge(1.0_wp)
+            call solve_accelerations(self, t, y(self%oq + 1:self%oq + self%nq), &
+                                     y(self%ov + 1:self%ov + self%nv), status)
+            if (.not. status%ok()) return
+            lambda = self%kkt_rhs(self%nv + 1:)
+            self%multipliers = lambda
+            self%multipliers_state = state
+            self%multipliers_t = t
+        end associate
+    end subroutine formulation_consistent_multipliers
 
     !> Drift of a state: max-norms of g(t, q) and G v + g_I.
     subroutine formulation_drift(self, t, y, position, velocity, status)
