@@ -382,8 +382,8 @@ contains
                 exact = four_bar_torque(real(i - 1, wp) / 100.0_wp, mass, inertia, 9.81_wp)
                 dev(k) = max(dev(k), abs(named(3, i) - exact))
             end do
-            print '(4x,a,es8.1,a,es9.2)', 'rtol ', tols(k), ': motor torque off the closed form by ', &
-                dev(k)
+            print '(4x,a,es8.1,a,es9.2)', 'rtol ', tols(k), &
+                ': motor torque off the closed form by ', dev(k)
             call check(error, dev(k) <= bounds(k), 'motor torque off the closed form')
             if (allocated(error)) return
         end do

@@ -15,8 +15,9 @@
 !> axis; an angle driver's turning axis, a translation driver's direction),
 !> marker_j_offset x_j − x_i (zero for a satisfied spherical, revolute,
 !> universal or fixed joint; a prismatic joint's stroke, a distance's rod)
-!> and, with constraints in a formulation, reaction_force and reaction_torque on
-!> marker i's body (from the multipliers consistent with q and v), reaction_force_j and reaction_torque_j on marker j's
+!> and, with constraints in a formulation, reaction_force and
+!> reaction_torque on marker i's body (from the multipliers consistent with
+!> q and v), reaction_force_j and reaction_torque_j on marker j's
 !> (as the HDF5 file's /joints; zero on the ground); field data joint_names
 !> — 'joints/NAME', 'joints/NAME (node N)' for an attached node, or
 !> 'drivers/NAME', the HDF5 groups — and joint_types). Field data belongs to
