@@ -23,7 +23,7 @@ module test_mechanisms
     use flexmbs_dae_ddassl, only: ddassl_t
     use flexmbs_dae_ida, only: ida_t
     use flexmbs_problems_mechanisms, only: new_mechanism, slider_crank_exact, four_bar_exact, &
-        crank_angle, bar_b, bar_d
+        four_bar_torque, crank_angle, bar_b, bar_d
     use mbs_random, only: random_state_t, random_vector, random_quaternion, ad_deviation
     use testing, only: test_case_t, new_test, error_t, check
     implicit none
@@ -51,7 +51,8 @@ contains
                  new_test('four_bar_closed_form', test_four_bar), &
                  new_test('four_bar_closed_form_ad', test_four_bar_ad), &
                  new_test('sparse_forms_and_mexax_klu', test_sparse), &
-                 new_test('every_formulation_every_solver', test_all_forms)]
+                 new_test('every_formulation_every_solver', test_all_forms), &
+                 new_test('consistent_multipliers_four_bar', test_consistent_multipliers)]
     end function collect_mechanisms
 
     !> s' and s'' of a polynomial + harmonic driver against central differences.
@@ -172,6 +173,68 @@ contains
         call check(error, sink%samples == 21, name // ': outputs missing')
         call check(error, sink%worst <= 10.0_wp * rtol, name // ': off the closed form')
     end subroutine run_mechanism
+
+    !> consistent_multipliers on the driven four-bar, whose consistent states
+    !> are its exact motion (one degree of freedom, driven): states at
+    !> t = 0.5 (k/25)² s, k = 0..25, by consistent_initial, each from the
+    !> last; then, with K factored at t = 0, λ at each of them in turn (the
+    !> first ones, close together, by refining with the factorization held,
+    !> the later ones, up to 0.04 s apart, by a new one) equals
+    !> consistent_initial's λ, and the motor's torque on the crank the closed
+    !> form's power balance, to round-off (dense and sparse K).
+    subroutine test_consistent_multipliers(error)
+        type(error_t), allocatable, intent(out) :: error
+        integer, parameter :: states = 26
+        type(mbs_system_t), target :: sys
+        type(formulation_t) :: dae
+        type(status_t) :: status
+        real(wp) :: q0(21), t, force(3, 2), torque(3, 2), lambda(18), dev_lambda, dev_torque
+        real(wp), allocatable :: y(:, :), yp(:)
+        integer :: k, i, path
+        call new_mechanism(2, sys, q0, status)
+        do path = 1, 2
+            dae = new_formulation(sys, formulation_ggl, q0, status=status, sparse=path == 2)
+            call check(error, status%ok(), 'formulation: ' // status%text())
+            if (allocated(error)) return
+            allocate (y(dae%n, 0:states - 1), yp(dae%n), source=0.0_wp)
+            y(1:21, 0) = q0
+            do k = 0, states - 1
+                if (k > 0) y(:, k) = y(:, k - 1)
+                ! again: each call first renormalises the quaternions the
+                ! last one's projection moved off the unit sphere
+                do i = 1, 3
+                    call dae%consistent_initial(time(k), y(:, k), yp, status)
+                end do
+            end do
+            call dae%consistent_initial(0.0_wp, y(:, 0), yp, status)
+            call check(error, status%ok(), 'states: ' // status%text())
+            if (allocated(error)) return
+            dev_lambda = 0.0_wp
+            dev_torque = 0.0_wp
+            do k = 0, states - 1
+                t = time(k)
+                call dae%consistent_multipliers(t, y(:, k), lambda, status)
+                call sys%joint_reaction(2, t, y(1:21, k), lambda, force, torque)
+                dev_lambda = max(dev_lambda, maxval(abs(lambda - y(dae%ol + 1:dae%ol + 18, k))) &
+                                 / maxval(abs(lambda)))
+                dev_torque = max(dev_torque, abs(torque(3, 2) - four_bar_torque(t, &
+                    [1.0_wp, 0.5_wp, 1.0_wp / 3.0_wp], [0.01_wp, 0.01_wp, 0.01_wp], 9.81_wp)))
+            end do
+            print '(4x,a,l1,a,es9.2,a,es9.2)', 'sparse ', path == 2, &
+                ': consistent multipliers off the direct solve by ', dev_lambda, &
+                ' (relative), motor torque off the closed form by ', dev_torque
+            call check(error, status%ok(), 'multipliers: ' // status%text())
+            call check(error, dev_lambda <= 1.0e-12_wp .and. dev_torque <= 1.0e-12_wp, &
+                       'consistent multipliers inexact')
+            if (allocated(error)) return
+            deallocate (y, yp)
+        end do
+    contains
+        pure real(wp) function time(k)
+            integer, intent(in) :: k
+            time = 0.5_wp * (real(k, wp) / (states - 1))**2
+        end function time
+    end subroutine test_consistent_multipliers
 
     !> Slider position and rod angle (slider-crank) or coupler-end position
     !> and rocker angle (four-bar) against the closed form at time t.

@@ -15,8 +15,9 @@
 !> axis; an angle driver's turning axis, a translation driver's direction),
 !> marker_j_offset x_j − x_i (zero for a satisfied spherical, revolute,
 !> universal or fixed joint; a prismatic joint's stroke, a distance's rod)
-!> and, with the multipliers in y, reaction_force and reaction_torque on
-!> marker i's body, reaction_force_j and reaction_torque_j on marker j's
+!> and, with constraints in a formulation, reaction_force and
+!> reaction_torque on marker i's body (from the multipliers consistent with
+!> q and v), reaction_force_j and reaction_torque_j on marker j's
 !> (as the HDF5 file's /joints; zero on the ground); field data joint_names
 !> — 'joints/NAME', 'joints/NAME (node N)' for an attached node, or
 !> 'drivers/NAME', the HDF5 groups — and joint_types). Field data belongs to
@@ -38,6 +39,7 @@ module flexmbs_io_vtk_sink
     use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_mbs_joint, only: joint_primitive, joint_name
     use flexmbs_mbs_primitive_kinds, only: primitive_name, primitive_angle_driver, &
         primitive_translation_driver, primitive_dot2
@@ -55,10 +57,11 @@ module flexmbs_io_vtk_sink
         !> each in the bodies' files: field data body_names, point data body_id)
         character(len=32), allocatable :: names(:)
         !> a multibody system's joints and drivers (a point each in the
-        !> joints' files): its q after y(system_q), its multipliers after
-        !> y(system_l) (0: none in y, no reactions)
+        !> joints' files): its q after y(system_q); the reactions from its
+        !> formulation's consistent multipliers (none: no reactions)
         type(mbs_system_t), pointer :: system => null()
-        integer :: system_q = 0, system_l = 0
+        type(formulation_t), pointer :: formulation => null()
+        integer :: system_q = 0
         character(len=80), allocatable :: joint_names(:) !! 'joints/NAME', 'drivers/NAME'
         integer :: records = 0
         real(wp), allocatable :: times(:)
@@ -289,11 +292,18 @@ contains
         character(len=*), intent(in) :: path
         type(status_t), intent(inout) :: status
         real(wp) :: xi(3, joints(self)), offset(3, joints(self)), axis(3, joints(self)), &
-            force(3, 2, joints(self)), torque(3, 2, joints(self)), xj(3), ai(3, 3), aj(3, 3)
+            force(3, 2, joints(self)), torque(3, 2, joints(self)), xj(3), ai(3, 3), aj(3, 3), &
+            lambda(self%system%nc)
         character(len=32) :: types(joints(self))
         character(len=80) :: names(joints(self))
         integer :: unit, k, n
+        logical :: reactions
         n = joints(self)
+        reactions = associated(self%formulation)
+        if (reactions) then
+            call self%formulation%consistent_multipliers(t, y, lambda, status)
+            if (.not. status%ok()) return
+        end if
         associate (sys => self%system, q => y(self%system_q + 1:self%system_q + self%system%nq))
             do k = 1, n
                 associate (jt => sys%joints(k))
@@ -305,9 +315,8 @@ contains
                     types(k) = joint_name(jt%joint%kind)
                     if (jt%joint%kind == joint_primitive) types(k) = &
                         primitive_name(jt%joint%primitive(1))
-                    if (self%system_l > 0) call sys%joint_reaction(k, t, q, &
-                        y(self%system_l + 1:self%system_l + sys%nc), force(:, :, k), &
-                        torque(:, :, k))
+                    if (reactions) call sys%joint_reaction(k, t, q, lambda, force(:, :, k), &
+                                                           torque(:, :, k))
                 end associate
                 names(k) = 'joint ' // int_text(k)
                 if (allocated(self%joint_names)) then
@@ -329,7 +338,7 @@ contains
         call write_integers(unit, 'joint_type', [(self%system%joints(k)%joint%kind, k=1, n)])
         call write_vectors(unit, 'axis', axis)
         call write_vectors(unit, 'marker_j_offset', offset)
-        if (self%system_l > 0) then
+        if (reactions) then
             call write_vectors(unit, 'reaction_force', force(:, 1, :))
             call write_vectors(unit, 'reaction_torque', torque(:, 1, :))
             call write_vectors(unit, 'reaction_force_j', force(:, 2, :))

@@ -43,6 +43,7 @@
 !> the kinematics that are not constraints (unit quaternions): with projection
 !> on, the formulation keeps them; without it they drift at tolerance level.
 module flexmbs_mbs_formulation
+    use, intrinsic :: ieee_exceptions, only: ieee_status_type, ieee_get_status, ieee_set_status
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
@@ -92,6 +93,11 @@ module flexmbs_mbs_formulation
         real(wp), allocatable :: qq(:, :), vq(:, :), vv(:, :), cq(:, :), cq2(:, :), cv(:, :)
         real(wp), allocatable :: gtlq(:, :), minv_gt(:, :), tq(:), q0(:), mass_lu(:, :)
         real(wp), allocatable :: kkt_rhs(:)
+        !> consistent_multipliers' last state (t, q, v), its λ, and its
+        !> right-hand side and iterate (size nv + nc)
+        real(wp) :: multipliers_t = huge(1.0_wp)
+        real(wp), allocatable :: multipliers_state(:), multipliers(:), kkt_b(:), kkt_x(:)
+        logical :: kkt_factored = .false.    !! a factorization of K at some q is held
         integer, allocatable :: mass_pivots(:)
         type(saddle_point_t) :: kkt          !! dense [M Gᵀ; G 0] (the sparse one is in sp)
         logical :: mass_factored = .false.
@@ -115,6 +121,7 @@ module flexmbs_mbs_formulation
         procedure :: has_projection => formulation_has_projection
         procedure :: project => formulation_project
         procedure :: consistent_initial => formulation_consistent_initial
+        procedure :: consistent_multipliers => formulation_consistent_multipliers
         procedure :: drift => formulation_drift
         procedure :: admissible => formulation_admissible
     end type formulation_t
@@ -665,12 +672,14 @@ contains
         type(status_t) :: local
         if (self%sparse) then
             call self%sp%factor_kkt(self%mechanical, t, q, status)
+            self%kkt_factored = status%ok()
             return
         end if
         call self%mechanical%mass(t, q, self%m, status)
         call self%mechanical%constraint_jacobian(t, q, self%gmat, status)
         call self%kkt%assemble(self%m, self%gmat)
         call self%kkt%factor(local)
+        self%kkt_factored = local%ok()
         if (.not. local%ok()) call status%set(status_solver_failure, &
             'formulation: projection matrix [M Gᵀ; G 0] is singular (redundant constraints?)', &
             reason_singular_matrix)
@@ -759,16 +768,8 @@ contains
             end do
             call project_velocities(self, t, q, v, status)
             if (.not. status%ok()) return
-            call self%mechanical%forces(t, q, v, self%force, status)
-            self%kkt_rhs(1:nv) = self%force
-            if (nc > 0) then
-                call self%mechanical%constraint_curvature(t, q, v, self%c, status)
-                self%kkt_rhs(nv + 1:) = -self%c
-            end if
+            call solve_accelerations(self, t, q, v, status)
             if (.not. status%ok()) return
-            call factor_kkt(self, t, q, status)
-            if (.not. status%ok()) return
-            call solve_kkt(self)
             yp = 0.0_wp
             call self%mechanical%kinematics(t, q, v, yp(self%oq + 1:self%oq + self%nq), status)
             yp(self%ov + 1:self%ov + nv) = self%kkt_rhs(1:nv)
@@ -777,6 +778,131 @@ contains
             if (self%form == formulation_ggl) y(self%om + 1:self%om + nc) = 0.0_wp
         end associate
     end subroutine formulation_consistent_initial
+
+    !> [M Gᵀ; G 0] [a; λ] = [f; -γ] at (t, q, v): a and λ in self%kkt_rhs.
+    subroutine solve_accelerations(self, t, q, v, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        type(status_t), intent(inout) :: status
+        call self%mechanical%forces(t, q, v, self%force, status)
+        self%kkt_rhs(1:self%nv) = self%force
+        if (self%nc > 0) then
+            call self%mechanical%constraint_curvature(t, q, v, self%c, status)
+            self%kkt_rhs(self%nv + 1:) = -self%c
+        end if
+        if (.not. status%ok()) return
+        call factor_kkt(self, t, q, status)
+        if (.not. status%ok()) return
+        call solve_kkt(self)
+    end subroutine solve_accelerations
+
+    !> The multipliers λ consistent with the positions and velocities in y:
+    !> [M Gᵀ; G 0] [a; λ] = [f; -γ] at y's (q, v), as λ of index 1. In the
+    !> index-2, index-3 and GGL forms the integrator's λ is an index-2/3
+    !> variable, less accurate than q and v (RADAU5: order 3 against 5, its
+    !> error weighted by the step), so reactions are computed from these
+    !> (docs/multibody.md). The last state's λ is kept: asked again for the
+    !> same (t, q, v), as every reaction series of one output record asks,
+    !> nothing is solved. K is not refactored at every record: the solve
+    !> is refined with the factorization held (of a nearby q), and K is
+    !> factored afresh only when that converges slowly.
+    subroutine formulation_consistent_multipliers(self, t, y, lambda, status)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: lambda(:)  !! size nc
+        type(status_t), intent(inout) :: status
+        type(ieee_status_type) :: flags
+        integer :: stat
+        if (self%nc == 0) return
+        associate (state => y(self%oq + 1:self%ov + self%nv), &
+                   q => y(self%oq + 1:self%oq + self%nq), v => y(self%ov + 1:self%ov + self%nv))
+            if (allocated(self%multipliers)) then
+                if (t == self%multipliers_t .and. all(state == self%multipliers_state)) then
+                    lambda = self%multipliers
+                    return
+                end if
+            else
+                allocate (self%multipliers_state(self%nq + self%nv), self%multipliers(self%nc), &
+                          self%kkt_b(self%nv + self%nc), self%kkt_x(self%nv + self%nc), stat=stat)
+                if (stat /= 0) then
+                    call out_of_memory(status, 'formulation multipliers', &
+                                       int(self%nq + 3 * self%nv + 3 * self%nc, i8), 8)
+                    return
+                end if
+            end if
+            self%multipliers_t = huge(1.0_wp)
+            call self%mechanical%forces(t, q, v, self%force, status)
+            call self%mechanical%constraint_curvature(t, q, v, self%c, status)
+            if (.not. status%ok()) return
+            self%kkt_b = [self%force, -self%c]
+            call ieee_get_status(flags)
+            if (.not. refined(self, t, q, status)) then
+                if (.not. status%ok()) return
+                ! a refinement given up may have overflowed on its way (a huge
+                ! mass): its flags must not outlive it
+                call ieee_set_status(flags)
+                call factor_kkt(self, t, q, status)
+                if (.not. status%ok()) return
+                self%kkt_rhs = self%kkt_b
+                call solve_kkt(self)
+                self%kkt_x = self%kkt_rhs
+            end if
+            lambda = self%kkt_x(self%nv + 1:)
+            self%multipliers = lambda
+            self%multipliers_state = state
+            self%multipliers_t = t
+        end associate
+    end subroutine formulation_consistent_multipliers
+
+    !> Iterative refinement of K(t, q) x = self%kkt_b into self%kkt_x with
+    !> the factorization of K held: x ← x + K₀⁻¹ (b − K x). False when there
+    !> is none or the corrections do not shrink fast enough to reach
+    !> round-off in a few solves (then factoring K costs less).
+    logical function refined(self, t, q, status) result(converged)
+        class(formulation_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        type(status_t), intent(inout) :: status
+        ! correction relative to the solution that counts as round-off, the
+        ! most solves, and the least shrinking per solve that is worth them
+        real(wp), parameter :: converged_below = 1.0e-13_wp, slowest = 0.25_wp
+        integer, parameter :: max_solves = 8
+        real(wp) :: size_x, correction, previous
+        integer :: k
+        converged = .false.
+        if (.not. self%kkt_factored) return
+        associate (nv => self%nv, x => self%kkt_x, r => self%kkt_rhs)
+            self%kkt_rhs = self%kkt_b
+            call solve_kkt(self)
+            x = self%kkt_rhs
+            call eval_g(self, t, q, status)
+            if (.not. status%ok()) return
+            previous = huge(1.0_wp)
+            do k = 2, max_solves
+                ! r = b − K x, K = [M Gᵀ; G 0] at (t, q)
+                call mass_times(self, t, q, x(1:nv), r(1:nv), status)
+                if (.not. status%ok()) return
+                call gt_times(self, x(nv + 1:), self%b)
+                r(1:nv) = self%kkt_b(1:nv) - r(1:nv) - self%b
+                call g_times(self, x(1:nv), self%c)
+                r(nv + 1:) = self%kkt_b(nv + 1:) - self%c
+                call solve_kkt(self)
+                x = x + r
+                size_x = maxval(abs(x))
+                correction = maxval(abs(r))
+                ! overflow (a huge mass) or NaN: not for refinement
+                if (.not. (size_x <= huge(1.0_wp))) return
+                if (correction <= converged_below * size_x) then
+                    converged = .true.
+                    return
+                end if
+                if (.not. (correction < slowest * previous)) return
+                ! too slow to reach round-off within max_solves at this rate
+                if (k > 2 .and. real(k, wp) + log(converged_below * size_x / correction) &
+                    / log(correction / previous) > max_solves) return
+                previous = correction
+            end do
+        end associate
+    end function refined
 
     !> Drift of a state: max-norms of g(t, q) and G v + g_I.
     subroutine formulation_drift(self, t, y, position, velocity, status)

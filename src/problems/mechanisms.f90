@@ -41,7 +41,7 @@ module flexmbs_problems_mechanisms
     real(wp), parameter :: axes_guide(3, 3) = reshape([0, 1, 0, 0, 0, 1, 1, 0, 0] * 1.0_wp, &
                                                      [3, 3])
 
-    public :: new_mechanism, slider_crank_exact, four_bar_exact, crank_angle
+    public :: new_mechanism, slider_crank_exact, four_bar_exact, four_bar_torque, crank_angle
 
 contains
 
@@ -74,6 +74,62 @@ contains
         c = d + bar_c * [cos(alpha) * u(1) + sin(alpha) * u(2), &
                          -sin(alpha) * u(1) + cos(alpha) * u(2), 0.0_wp]
     end subroutine four_bar_exact
+
+    !> The torque about z that the four-bar's driver exerts on the crank at
+    !> time t (θ = crank_angle(t), θ' = mechanism_omega), links of masses
+    !> `mass` and moments of inertia `inertia` about z at their midpoints,
+    !> gravity −g y: the power balance τ θ' = Σ m a·v + I ω ω' + m g v_y
+    !> with the velocities and accelerations of the closed form (the loop
+    !> B + b e(φ) = D + c e(ψ) differentiated once and twice).
+    pure real(wp) function four_bar_torque(t, mass, inertia, g) result(torque)
+        real(wp), intent(in) :: t, mass(3), inertia(3), g
+        real(wp) :: b(3), c(3), theta, w, phi, psi, rate(2), accel(2), loop(2, 2), &
+            v(2, 3), a(2, 3), omega(3), alpha(3), power
+        integer :: k
+        theta = crank_angle(t)
+        w = mechanism_omega
+        call four_bar_exact(theta, b, c)
+        phi = atan2(c(2) - b(2), c(1) - b(1))
+        psi = atan2(c(2), c(1) - bar_d)
+        ! [b n(φ), −c n(ψ)] (φ', ψ') = −a θ' n(θ), and likewise for (φ'', ψ'')
+        loop(:, 1) = bar_b * normal(phi)
+        loop(:, 2) = -bar_c * normal(psi)
+        rate = solve2(loop, -bar_a * w * normal(theta))
+        accel = solve2(loop, bar_a * w**2 * unit(theta) + bar_b * rate(1)**2 * unit(phi) &
+                       - bar_c * rate(2)**2 * unit(psi))
+        v(:, 1) = 0.5_wp * bar_a * w * normal(theta)
+        a(:, 1) = -0.5_wp * bar_a * w**2 * unit(theta)
+        v(:, 2) = bar_a * w * normal(theta) + 0.5_wp * bar_b * rate(1) * normal(phi)
+        a(:, 2) = -bar_a * w**2 * unit(theta) + 0.5_wp * bar_b * (accel(1) * normal(phi) &
+                  - rate(1)**2 * unit(phi))
+        v(:, 3) = 0.5_wp * bar_c * rate(2) * normal(psi)
+        a(:, 3) = 0.5_wp * bar_c * (accel(2) * normal(psi) - rate(2)**2 * unit(psi))
+        omega = [w, rate]
+        alpha = [0.0_wp, accel]
+        power = 0.0_wp
+        do k = 1, 3
+            power = power + mass(k) * (dot_product(a(:, k), v(:, k)) + g * v(2, k)) &
+                + inertia(k) * omega(k) * alpha(k)
+        end do
+        torque = power / w
+    contains
+        pure function unit(x) result(e)
+            real(wp), intent(in) :: x
+            real(wp) :: e(2)
+            e = [cos(x), sin(x)]
+        end function unit
+        pure function normal(x) result(e)
+            real(wp), intent(in) :: x
+            real(wp) :: e(2)
+            e = [-sin(x), cos(x)]
+        end function normal
+        pure function solve2(m, r) result(x)
+            real(wp), intent(in) :: m(2, 2), r(2)
+            real(wp) :: x(2)
+            x = [r(1) * m(2, 2) - m(1, 2) * r(2), m(1, 1) * r(2) - m(2, 1) * r(1)] &
+                / (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1))
+        end function solve2
+    end function four_bar_torque
 
     !> The mechanism (mechanism_slider_crank or mechanism_four_bar) under
     !> gravity −9.81 y, and its closed-form positions at t = 0 (velocities:

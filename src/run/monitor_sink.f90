@@ -10,7 +10,9 @@
 !>
 !> Reactions (multibody systems): for joint k, the force and torque it
 !> exerts on the body of marker i and of marker j (mbs_system_t%joint_reaction,
-!> our sign of λ), 12 numbers per joint and record: F_i, n_i, F_j, n_j.
+!> our sign of λ), 12 numbers per joint and record: F_i, n_i, F_j, n_j, from
+!> the multipliers consistent with the record's q and v (the formulation's
+!> consistent_multipliers), as the HDF5 file's /joints.
 module flexmbs_run_monitor_sink
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_resources, only: out_of_memory
@@ -69,6 +71,7 @@ contains
         type(status_t), intent(inout) :: status
         real(wp), allocatable :: grown(:, :), grown_reactions(:, :)
         real(wp) :: position, velocity, force(3, 2), torque(3, 2)
+        real(wp), allocatable :: lambda(:)
         type(status_t) :: st
         integer :: k, nj, stat
         nj = 0
@@ -98,9 +101,12 @@ contains
         select type (m => self%mechanical)
         type is (mbs_system_t)
             associate (f => self%formulation)
+                if (nj == 0) return
+                allocate (lambda(f%nc))
+                call f%consistent_multipliers(t, y, lambda, status)
+                if (.not. status%ok()) return
                 do k = 1, nj
-                    call m%joint_reaction(k, t, y(f%oq + 1:f%oq + f%nq), &
-                                          y(f%ol + 1:f%ol + f%nc), force, torque)
+                    call m%joint_reaction(k, t, y(f%oq + 1:f%oq + f%nq), lambda, force, torque)
                     self%reactions(12 * k - 11:12 * k, self%records) = [force(:, 1), &
                         torque(:, 1), force(:, 2), torque(:, 2)]
                 end do

@@ -62,10 +62,13 @@ module flexmbs_run_named_output
     end type body_values_t
 
     !> The reaction of joint `joint` of the system on the body of marker i
-    !> (side 1) or j (side 2): force (torque = .false.) or torque.
+    !> (side 1) or j (side 2): force (torque = .false.) or torque, from the
+    !> multipliers consistent with the record's q and v (the formulation's
+    !> consistent_multipliers: more accurate than y's λ of index 2 or 3).
     type, extends(record_values_t) :: reaction_values_t
         type(mbs_system_t), pointer :: system => null()
-        integer :: joint = 0, side = 1, oq = 0, ol = 0
+        type(formulation_t), pointer :: formulation => null()
+        integer :: joint = 0, side = 1, oq = 0
         logical :: torque = .false.
     contains
         procedure :: evaluate => reaction_evaluate
@@ -180,8 +183,8 @@ contains
                 end do
                 if (.not. allocated(plan%joint_names) .or. f%nc == 0) return
                 reaction%system => sys
+                reaction%formulation => f
                 reaction%oq = f%oq
-                reaction%ol = f%ol
                 do k = 1, min(size(plan%joint_names), size(sys%joints))
                     reaction%joint = k
                     base = group_path(plan%joint_names(k)) // '/'
@@ -700,10 +703,12 @@ contains
         real(wp), intent(in) :: t, y(:)
         real(wp), intent(out) :: values(:)
         type(status_t), intent(inout) :: status
-        real(wp) :: force(3, 2), torque(3, 2)
+        real(wp) :: force(3, 2), torque(3, 2), lambda(self%system%nc)
+        call self%formulation%consistent_multipliers(t, y, lambda, status)
+        if (.not. status%ok()) return
         associate (sys => self%system)
-            call sys%joint_reaction(self%joint, t, y(self%oq + 1:self%oq + sys%nq), &
-                                    y(self%ol + 1:self%ol + sys%nc), force, torque)
+            call sys%joint_reaction(self%joint, t, y(self%oq + 1:self%oq + sys%nq), lambda, &
+                                    force, torque)
         end associate
         if (self%torque) then
             values = torque(:, self%side)

@@ -286,11 +286,11 @@ contains
                 if (size(m%joints) > 0) then
                     vtk%system => m
                     if (allocated(plan%joint_names)) vtk%joint_names = plan%joint_names
-                    ! the reactions need the multipliers, which formulations hold
+                    ! the reactions need a formulation's multipliers (consistent with q, v)
                     select type (p => plan%problem)
                     type is (formulation_t)
                         vtk%system_q = p%oq
-                        if (p%nc > 0) vtk%system_l = p%ol
+                        if (p%nc > 0) vtk%formulation => p
                     end select
                 end if
             class default
