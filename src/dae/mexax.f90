@@ -217,7 +217,7 @@ contains
         type(status_t) :: fst
         type(status_t) :: refusal !! the model's last refusal since an accepted step
         real(wp), allocatable :: yout(:)
-        integer :: k, kc, km, decision, j, iout, nout, nstab_nonfinite, stat
+        integer :: k, kc, km, decision, iout, nout, nstab_nonfinite, stat
         integer :: cause !! why the attempt of a restart or a stop failed (cause_*)
         real(wp) :: h, hmax, posneg, tscale, c, t_old
         logical :: first, last, reject, need_start, basic_entry, want_steps, stop_requested
@@ -392,44 +392,7 @@ contains
             end if
 
             ! ---- one attempt: the ODEX column sequence (§3.4) ----
-            decision = undecided
-            if (.not. basic_entry .and. (first .or. last)) then
-                do j = 1, k
-                    if (.not. column(j)) exit
-                    if (j >= 2 .and. w%ctl%err(j) <= 1.0_wp) then
-                        kc = j
-                        decision = do_accept
-                        exit
-                    end if
-                end do
-                if (decision == undecided) then
-                    kc = k
-                    call hope()
-                end if
-            else
-                do j = 1, k - 1
-                    if (.not. column(j)) exit
-                end do
-                if (decision == undecided .and. k /= 2 .and. .not. reject) then
-                    ! convergence monitor on column k−1
-                    kc = k - 1
-                    if (w%ctl%err(k - 1) <= 1.0_wp) then
-                        decision = do_accept
-                    else if (w%ctl%monitor_rejects(k)) then
-                        decision = do_reject
-                    end if
-                end if
-                if (decision == undecided) then
-                    if (column(k)) then
-                        kc = k
-                        if (w%ctl%err(k) <= 1.0_wp) then
-                            decision = do_accept
-                        else
-                            call hope()
-                        end if
-                    end if
-                end if
-            end if
+            call attempt()
 
             select case (decision)
             case (do_stop)
@@ -541,6 +504,50 @@ contains
             call status%set(status_interrupted, &
                 'mexax: interrupted by the output routine at t = ' // real_text(t))
         end subroutine interrupted
+
+        !> One attempt from t with H and the planned column k: the columns in
+        !> the order of ODEX (§3.4); `decision` and kc say how it ended.
+        subroutine attempt()
+            integer :: j
+            decision = undecided
+            if (.not. basic_entry .and. (first .or. last)) then
+                do j = 1, k
+                    if (.not. column(j)) exit
+                    if (j >= 2 .and. w%ctl%err(j) <= 1.0_wp) then
+                        kc = j
+                        decision = do_accept
+                        exit
+                    end if
+                end do
+                if (decision == undecided) then
+                    kc = k
+                    call hope()
+                end if
+            else
+                do j = 1, k - 1
+                    if (.not. column(j)) exit
+                end do
+                if (decision == undecided .and. k /= 2 .and. .not. reject) then
+                    ! convergence monitor on column k−1
+                    kc = k - 1
+                    if (w%ctl%err(k - 1) <= 1.0_wp) then
+                        decision = do_accept
+                    else if (w%ctl%monitor_rejects(k)) then
+                        decision = do_reject
+                    end if
+                end if
+                if (decision == undecided) then
+                    if (column(k)) then
+                        kc = k
+                        if (w%ctl%err(k) <= 1.0_wp) then
+                            decision = do_accept
+                        else
+                            call hope()
+                        end if
+                    end if
+                end if
+            end if
+        end subroutine attempt
 
         !> Column j of the tableau; false (with `decision` set) on a restart
         !> or a stop.
