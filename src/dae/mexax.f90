@@ -232,45 +232,7 @@ contains
         nstab_nonfinite = 0
         stop_requested = .false.
 
-        ! ---- validation ----
-        if (problem%nq <= 0 .or. problem%nv <= 0 .or. problem%nc < 0) then
-            call bad('the problem needs nq > 0, nv > 0 and nc >= 0')
-            return
-        end if
-        if (size(q) /= problem%nq .or. size(v) /= problem%nv) then
-            call bad('sizes of q and v differ from problem%nq and problem%nv')
-            return
-        end if
-        if (present(lambda)) then
-            if (size(lambda) /= problem%nc) then
-                call bad('size of lambda differs from problem%nc')
-                return
-            end if
-        end if
-        if (present(accel)) then
-            if (size(accel) /= problem%nv) then
-                call bad('size of accel differs from problem%nv')
-                return
-            end if
-        end if
-        km = self%max_extrapolation
-        if (km < 2 .or. km > mexax_max_columns) then
-            call bad('max_extrapolation = ' // int_text(km) // ': must lie in 2..12')
-            return
-        end if
-        if (self%base /= mexax_base_midpoint .and. self%base /= mexax_base_euler) then
-            call bad('base must be mexax_base_midpoint or mexax_base_euler')
-            return
-        end if
-        call options%validate(problem%nq + problem%nv, status)
-        if (.not. status%ok()) then
-            status%message = 'mexax: ' // status%message // ' (tolerances cover q and v)'
-            return
-        end if
-        if (t_end == t) then
-            call bad('t_end equals t')
-            return
-        end if
+        if (.not. valid_input()) return
 
         call setup_workspace(w, problem, self%base, km, options%linear_solver, status, &
             options%sparse_ordering, options%classic_lu)
@@ -307,50 +269,9 @@ contains
         reject = .false.
         basic_entry = .false.
 
-        ! ---- t0: projection (no rejection test), consistent a and λ ----
-        w%wt(1:w%nq) = w%rtol(1:w%nq) * abs(w%p0) + w%atol(1:w%nq)
-        w%wt(w%nq + 1:) = w%rtol(w%nq + 1:) * abs(w%v0) + w%atol(w%nq + 1:)
-        w%p = w%p0
-        w%v = w%v0
-        call project(self%native, problem, w, t, c, status)
-        stats%nprj = 1
-        if (.not. status%ok()) then
-            self%failed_in = mexax_failed_projection
-            status%message = 'mexax: ' // status%message // ' at t0 = ' // real_text(t)
+        if (.not. started()) then
             call finish()
             return
-        end if
-        w%p0 = w%p
-        w%v0 = w%v
-        call start_point(self%native, problem, w, t, status, accelerations=.true.)
-        if (.not. status%ok()) then
-            self%failed_in = mexax_failed_step
-            call finish()
-            return
-        end if
-        need_start = .false.
-
-        ! Output at t0.
-        call set_dense_start()
-        want_steps = .false.
-        nout = 0
-        iout = 1
-        if (present(sink)) then
-            want_steps = sink%wants_steps()
-            if (allocated(options%output_times)) nout = size(options%output_times)
-            do while (iout <= nout)
-                if ((options%output_times(iout) - t) * posneg > 0.0_wp) exit
-                if (options%output_times(iout) == t) call sink%output(t, self%dense%y1, status)
-                iout = iout + 1
-                if (.not. status%ok()) exit
-            end do
-            if (want_steps .and. status%ok()) &
-                call sink%step(1, t, t, self%dense%y1, self%dense, stop_requested, status)
-            if (status%ok() .and. stop_requested) call interrupted()
-            if (.not. status%ok()) then
-                call finish()
-                return
-            end if
         end if
 
         main: do
@@ -363,19 +284,7 @@ contains
                 need_start = .false.
             end if
             if (abs(h) <= small_step_factor * epmach * max(abs(t), tscale)) then
-                if (nstab_nonfinite > 0) then
-                    call status%set(status_solver_failure, 'mexax: step size too small, H = ' &
-                        // real_text(h) // ', at t = ' // real_text(t) // ' after ' // &
-                        int_text(nstab_nonfinite) // ' steps with non-finite values (NaN/Inf)', &
-                        reason_non_finite)
-                else if (refusal%reason == reason_det_f) then
-                    call status%set(status_solver_failure, 'mexax: step size too small, H = ' &
-                        // real_text(h) // ', at t = ' // real_text(t) // &
-                        '; the model refused the last attempt: ' // refusal%text(), reason_det_f)
-                else
-                    call status%set(status_solver_failure, 'mexax: step size too small, H = ' &
-                        // real_text(h) // ', at t = ' // real_text(t), reason_step_too_small)
-                end if
+                call too_small()
                 exit main
             end if
             if ((t + end_factor * h - t_end) * posneg >= 0.0_wp) then
@@ -421,38 +330,9 @@ contains
             end select
 
             ! ---- converged: project (§3.6), then accept ----
-            w%p = w%tab(1:w%nq, kc)
-            w%v = w%tab(w%nq + 1:w%nq + w%nv, kc)
-            call step_weights(w, kc)
-            call project(self%native, problem, w, t + h, c, status)
-            stats%nprj = stats%nprj + 1
-            if (.not. status%ok()) then
-                cause = cause_projection
-                call count_failure(status)
-                self%failed_in = mexax_failed_projection
-                status%message = 'mexax: ' // status%message // ' at t = ' // &
-                    real_text(t + h) // ' (step from t = ' // real_text(t) // ')'
-                exit main
-            end if
-            ! A state the model cannot hold (det F <= 0) is rejected like a
-            ! projection that moved too far.
-            call problem%admissible(w%p, fst)
-            if (.not. fst%ok()) then
-                refusal = fst
-                c = huge(1.0_wp)
-                call stats%rejections%refuse(fst%text())
-            else if (c > 1.0_wp) then
-                call stats%rejections%add(cause_projection)
-            end if
-            if (c > 1.0_wp) then
-                self%nprj_reject = self%nprj_reject + 1
-                self%native%nrejct = self%native%nrejct + 1
-                h = h * max(projection_reject_min, projection_reject_safe / c)
-                reject = .true.
-                last = .false.
-                basic_entry = .true.
-                cycle main
-            end if
+            call project_converged()
+            if (decision == do_stop) exit main
+            if (decision == do_reject) cycle main
 
             self%native%naccpt = self%native%naccpt + 1
             call refusal%clear()
@@ -494,6 +374,143 @@ contains
         call finish()
 
     contains
+
+        !> t0: project (no rejection test), a and λ from the index-1 system,
+        !> the dense output's start and the outputs at t0. False on a failure
+        !> or an interruption (status set).
+        logical function started()
+            started = .false.
+            w%wt(1:w%nq) = w%rtol(1:w%nq) * abs(w%p0) + w%atol(1:w%nq)
+            w%wt(w%nq + 1:) = w%rtol(w%nq + 1:) * abs(w%v0) + w%atol(w%nq + 1:)
+            w%p = w%p0
+            w%v = w%v0
+            call project(self%native, problem, w, t, c, status)
+            stats%nprj = 1
+            if (.not. status%ok()) then
+                self%failed_in = mexax_failed_projection
+                status%message = 'mexax: ' // status%message // ' at t0 = ' // real_text(t)
+                return
+            end if
+            w%p0 = w%p
+            w%v0 = w%v
+            call start_point(self%native, problem, w, t, status, accelerations=.true.)
+            if (.not. status%ok()) then
+                self%failed_in = mexax_failed_step
+                return
+            end if
+            need_start = .false.
+
+            ! Output at t0.
+            call set_dense_start()
+            want_steps = .false.
+            nout = 0
+            iout = 1
+            if (present(sink)) then
+                want_steps = sink%wants_steps()
+                if (allocated(options%output_times)) nout = size(options%output_times)
+                do while (iout <= nout)
+                    if ((options%output_times(iout) - t) * posneg > 0.0_wp) exit
+                    if (options%output_times(iout) == t) call sink%output(t, self%dense%y1, status)
+                    iout = iout + 1
+                    if (.not. status%ok()) exit
+                end do
+                if (want_steps .and. status%ok()) &
+                    call sink%step(1, t, t, self%dense%y1, self%dense, stop_requested, status)
+                if (status%ok() .and. stop_requested) call interrupted()
+                if (.not. status%ok()) return
+            end if
+            started = .true.
+        end function started
+
+        !> The problem, the arrays and the settings fit (sets km); else bad input.
+        logical function valid_input() result(valid)
+            logical :: lambda_ok, accel_ok
+            valid = .false.
+            km = self%max_extrapolation
+            lambda_ok = .true.
+            accel_ok = .true.
+            if (present(lambda)) lambda_ok = size(lambda) == problem%nc
+            if (present(accel)) accel_ok = size(accel) == problem%nv
+            if (problem%nq <= 0 .or. problem%nv <= 0 .or. problem%nc < 0) then
+                call bad('the problem needs nq > 0, nv > 0 and nc >= 0')
+            else if (size(q) /= problem%nq .or. size(v) /= problem%nv) then
+                call bad('sizes of q and v differ from problem%nq and problem%nv')
+            else if (.not. lambda_ok) then
+                call bad('size of lambda differs from problem%nc')
+            else if (.not. accel_ok) then
+                call bad('size of accel differs from problem%nv')
+            else if (km < 2 .or. km > mexax_max_columns) then
+                call bad('max_extrapolation = ' // int_text(km) // ': must lie in 2..12')
+            else if (self%base /= mexax_base_midpoint .and. self%base /= mexax_base_euler) then
+                call bad('base must be mexax_base_midpoint or mexax_base_euler')
+            else
+                call options%validate(problem%nq + problem%nv, status)
+                if (.not. status%ok()) then
+                    status%message = 'mexax: ' // status%message // ' (tolerances cover q and v)'
+                else if (t_end == t) then
+                    call bad('t_end equals t')
+                else
+                    valid = .true.
+                end if
+            end if
+        end function valid_input
+
+        !> The step-too-small stop, naming non-finite values or the model's
+        !> refusal when they drove H down.
+        subroutine too_small()
+            if (nstab_nonfinite > 0) then
+                call status%set(status_solver_failure, 'mexax: step size too small, H = ' &
+                    // real_text(h) // ', at t = ' // real_text(t) // ' after ' // &
+                    int_text(nstab_nonfinite) // ' steps with non-finite values (NaN/Inf)', &
+                    reason_non_finite)
+            else if (refusal%reason == reason_det_f) then
+                call status%set(status_solver_failure, 'mexax: step size too small, H = ' &
+                    // real_text(h) // ', at t = ' // real_text(t) // &
+                    '; the model refused the last attempt: ' // refusal%text(), reason_det_f)
+            else
+                call status%set(status_solver_failure, 'mexax: step size too small, H = ' &
+                    // real_text(h) // ', at t = ' // real_text(t), reason_step_too_small)
+            end if
+        end subroutine too_small
+
+        !> Project the converged column kc at t + H (§3.6) and apply the
+        !> rejection test; `decision` stays do_accept, or becomes do_reject
+        !> (H reduced) or do_stop (status set).
+        subroutine project_converged()
+            w%p = w%tab(1:w%nq, kc)
+            w%v = w%tab(w%nq + 1:w%nq + w%nv, kc)
+            call step_weights(w, kc)
+            call project(self%native, problem, w, t + h, c, status)
+            stats%nprj = stats%nprj + 1
+            if (.not. status%ok()) then
+                cause = cause_projection
+                call count_failure(status)
+                self%failed_in = mexax_failed_projection
+                status%message = 'mexax: ' // status%message // ' at t = ' // &
+                    real_text(t + h) // ' (step from t = ' // real_text(t) // ')'
+                decision = do_stop
+                return
+            end if
+            ! A state the model cannot hold (det F <= 0) is rejected like a
+            ! projection that moved too far.
+            call problem%admissible(w%p, fst)
+            if (.not. fst%ok()) then
+                refusal = fst
+                c = huge(1.0_wp)
+                call stats%rejections%refuse(fst%text())
+            else if (c > 1.0_wp) then
+                call stats%rejections%add(cause_projection)
+            end if
+            if (c > 1.0_wp) then
+                self%nprj_reject = self%nprj_reject + 1
+                self%native%nrejct = self%native%nrejct + 1
+                h = h * max(projection_reject_min, projection_reject_safe / c)
+                reject = .true.
+                last = .false.
+                basic_entry = .true.
+                decision = do_reject
+            end if
+        end subroutine project_converged
 
         subroutine bad(reason)
             character(len=*), intent(in) :: reason
@@ -554,7 +571,8 @@ contains
         logical function column(j) result(ok)
             integer, intent(in) :: j
             integer :: ev
-            call base_column(self%native, problem, w, t, h, w%ctl%nj(j), j <= stability_columns, ev, fst)
+            call base_column(self%native, problem, w, t, h, w%ctl%nj(j), &
+                             j <= stability_columns, ev, fst)
             if (ev == ev_ok) then
                 call extrapolate_column(w, j)
                 if (j >= 2) call column_error(w, j, h, hmax, ev)
