@@ -28,6 +28,13 @@ contains
     !> Projection of (w%p, w%v) at time t (§3.6): positions onto g = 0 by
     !> simplified Newton with the matrix at p̃, then velocities onto
     !> G v + g_I = 0 at the projected p. c is the rejection ratio.
+    !> The position iteration solves the projection's optimality conditions
+    !> M Δ + Gᵀμ = 0, g = 0 for the increment δ of the accumulated correction
+    !> Δ and the whole multiplier μ: [M Gᵀ; G 0][δ; μ] = [−M Δ; −g]. Its
+    !> iterates are those of the increment form with right-hand side [0; −g],
+    !> but the first-row residual is not assumed zero; the product M Δ is
+    !> counted in NMULT, as the original's counters show it does (docs/theory.md
+    !> §7.7).
     subroutine project(native, problem, w, t, c, status)
         type(mexax_native_t), intent(inout) :: native
         class(mechanical_problem_t), intent(inout) :: problem
@@ -56,12 +63,15 @@ contains
         end if
         native%ndec = native%ndec + 1
         eps_old = 0.0_wp
+        w%shift = 0.0_wp
         do m = 0, itmax - 1
             call problem%constraint(t, w%p, w%gt, status)
             native%ngcn = native%ngcn + 1
             native%nfprob = native%nfprob + 1
             if (user_failed(status, 'constraint')) return
-            w%rhs(1:nv) = 0.0_wp
+            call block_times(w, w%mm, w%mpat, w%shift, w%rhs(1:nv))
+            native%nmult = native%nmult + 1
+            w%rhs(1:nv) = -w%rhs(1:nv)
             w%rhs(nv + 1:) = -w%gt
             call solve(w, w%rhs)
             native%nsol = native%nsol + 1
@@ -70,6 +80,7 @@ contains
             native%nfprob = native%nfprob + 1
             if (user_failed(status, 'kinematics')) return
             w%p = w%p + w%pdot
+            w%shift = w%shift + w%rhs(1:nv)
             eps = rms(w%pdot, w%wt(1:nq))
             if (eps <= epsreq) exit
             if (.not. ieee_is_finite(eps) .or. (m >= 1 .and. eps > projection_growth * eps_old) &

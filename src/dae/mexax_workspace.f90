@@ -66,6 +66,7 @@ module flexmbs_dae_mexax_workspace
         type(saddle_point_t) :: kkt
         real(wp), allocatable :: p(:), pp(:), pn(:), v(:), vp(:), f(:), pdot(:), gt(:)
         real(wp), allocatable :: rhs(:), acc(:), lam(:), x(:), d(:), tab(:, :)
+        real(wp), allocatable :: shift(:) !! the projection's accumulated correction (v space)
     end type workspace_t
 
 contains
@@ -101,9 +102,9 @@ contains
         allocate (w%rtol(w%ne), w%atol(w%ne), w%wt(w%ne), w%wst(nv), w%p0(nq), w%v0(nv), &
             w%a0(nv), w%lam0(nc), w%f0(nv), w%pdot0(nq), w%rhs(w%na), w%p(nq), w%pp(nq), &
             w%pn(nq), w%v(nv), w%vp(nv), w%f(nv), w%pdot(nq), w%gt(nc), w%acc(nv), w%lam(nc), &
-            w%x(w%ny), w%d(w%ny), w%tab(w%ny, km), stat=stat)
+            w%x(w%ny), w%d(w%ny), w%tab(w%ny, km), w%shift(nv), stat=stat)
         if (stat /= 0) then
-            entries = 3_i8 * w%ne + w%na + 6_i8 * nq + 8_i8 * nv + 3_i8 * nc + (2_i8 + km) * w%ny
+            entries = 3_i8 * w%ne + w%na + 6_i8 * nq + 9_i8 * nv + 3_i8 * nc + (2_i8 + km) * w%ny
             call out_of_memory(status, 'mexax workspace', entries, 8)
             return
         end if
