@@ -375,9 +375,12 @@ contains
     end subroutine test_column_limit
 
     !> §8 chain anchor, base (E), H = 1e-3: native counters beside the
-    !> original's. After the calibration of the (E) rules NSTEP and NACCPT
-    !> (all four TOL) and the TOL 1e-3 cost counters hold within 15 %; NREJCT
-    !> is low by up to 4 (9 vs 11, 9 vs 13) and is asserted only to that.
+    !> original's. With the published control (SEULEX's rules for the Euler
+    !> base, docs/theory.md §7.3) NSTEP and NACCPT (all four TOL) hold within
+    !> 15 %, and so do the TOL 1e-3 cost counters (NMULT 995 vs 1126: one
+    !> product with M per substep and per position iteration, as the
+    !> original's counters show, docs/theory.md §7.7). NREJCT is low by up
+    !> to 4 (9 vs 13) and is asserted only to that. No restart happens here.
     !> The augmented systems are factored in the classic order, as the face
     !> does, so the counters do not depend on the BLAS.
     subroutine test_anchor_counters(error)
@@ -418,14 +421,13 @@ contains
                 ': NSTEP not within 15 %')
             call check(error, within(solver%native%naccpt, expected(2, e)), trim(msg) // &
                 ': NACCPT not within 15 %')
-            ! NREJCT is 9..10 against 8..13: within 4 only (see ALGORITHMS.md §8 and
-            ! the calibration notes in src/dae/mexax.f90).
+            ! NREJCT is 7..9 against 8..13: within 4 only.
             call check(error, abs(solver%native%nrejct - expected(3, e)) <= 4, trim(msg) // &
                 ': NREJCT off by more than 4')
-            ! as in every row of the original: a restart counts as a rejection
+            ! every attempt is accepted, rejected or restarted (ODEX's counting)
             call check(error, solver%native%nstep == solver%native%naccpt + &
-                solver%native%nrejct, trim(msg) // &
-                ': NSTEP /= NACCPT + NREJCT')
+                solver%native%nrejct + solver%nstab, trim(msg) // &
+                ': NSTEP /= NACCPT + NREJCT + restarts')
             if (e == 1) then
                 associate (n => solver%native)
                     call check(error, within(n%nfprob, 2080) .and. within(n%nfcn, 871) .and. &
