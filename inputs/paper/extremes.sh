@@ -10,7 +10,8 @@
 # finished, its ERR and drift, or why and where it stopped. (The stiff
 # variant's reference goes unchecked: DDASSL at 1e-8 needs more than 100000
 # steps there.)
-#   extremes.sh FLEXMBS OUTDIR [VARIANT ...]   (default: all six variants)
+#   extremes.sh FLEXMBS OUTDIR [VARIANT ...]   (default: all six variants;
+#   make extremes runs damped and fine unless VARIANTS says otherwise)
 set -u
 exe=$1 out=$2
 shift 2

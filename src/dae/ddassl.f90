@@ -23,6 +23,7 @@ module flexmbs_dae_ddassl
     use flexmbs_dae_residual_problem, only: residual_problem_t, dae_residual_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t, index3_warning, projection_refusal
+    use flexmbs_dae_multiplier_scaling, only: multiplier_kappa
     use flexmbs_dae_rejections, only: rejections_t, cause_error_test, cause_newton_diverged, &
         cause_newton_slow, cause_singular_matrix, cause_model_refused
     use flexmbs_dae_sink, only: sink_t, dense_output_t
@@ -37,10 +38,6 @@ module flexmbs_dae_ddassl
     real(wp), parameter :: s_fresh = 100.0_wp         !! §2.3: s = 100 with a new PD or cj
     real(wp), parameter :: rate_max = 0.9_wp          !! §2.3: ρ > 0.9 fails
     real(wp), parameter :: conv_tol = 0.33_wp         !! §2.3: s·d ≤ 0.33 converges
-    !> The multipliers (index k, out of the error test) count in the Newton
-    !> test as h^(k-1) δ / κ: their accuracy rests on that test alone
-    !> (calibrated, docs/theory.md §6.4)
-    real(wp), parameter :: multiplier_kappa = 0.03_wp
     integer, parameter :: max_iter = 4                !! §2.3: m ≥ 4 fails
     real(wp), parameter :: cj_ratio_low = 0.6_wp      !! §2.3: (1 − 0.25)/(1 + 0.25)
     real(wp), parameter :: roundoff_conv = 100.0_wp   !! §2.3: d ≤ 100·uround·pnorm
@@ -906,14 +903,15 @@ contains
         real(wp) function newton_norm(v)
             real(wp), intent(in) :: v(:)
             integer :: i
+            real(wp) :: kappa
             if (all(newton_power == 0)) then
                 newton_norm = vnorm(v)
                 return
             end if
+            kappa = multiplier_kappa(minval(rtol))
             do i = 1, n
                 ytmp(i) = v(i)
-                if (newton_power(i) > 0) &
-                    ytmp(i) = abs(h)**newton_power(i) * v(i) / multiplier_kappa
+                if (newton_power(i) > 0) ytmp(i) = abs(h)**newton_power(i) * v(i) / kappa
             end do
             newton_norm = vnorm(ytmp)
         end function newton_norm

@@ -50,6 +50,7 @@ module flexmbs_dae_ida
     use flexmbs_dae_problem, only: dae_problem_t, problem_mass_matrix
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t, index3_warning, projection_refusal
+    use flexmbs_dae_multiplier_scaling, only: multiplier_kappa
     use flexmbs_dae_rejections, only: refusal_len, cause_model_refused
     use flexmbs_dae_ida_observer, only: observer_attach, observer_refused, observer_free, &
         observed_rejections
@@ -60,9 +61,6 @@ module flexmbs_dae_ida
 
     integer, parameter :: ida_max_order = 5    !! IDA's BDF orders are 1…5
     integer, parameter :: max_message = 1000   !! longest IDA message kept
-    !> The multipliers (index k, out of the error test) count in the Newton
-    !> test as h^(k-1) δ / κ, as in DDASSL's (docs/theory.md §6.4)
-    real(wp), parameter :: multiplier_kappa = 0.03_wp
 
     ! How the iteration matrix is formed.
     integer, parameter :: jac_quotients = 0    !! IDA's difference quotients (dense)
@@ -978,6 +976,7 @@ contains
         type(callback_data_t), pointer :: data
         real(c_double), pointer :: y(:), w(:)
         real(c_double) :: hcur(1)
+        real(wp) :: kappa
         call c_f_pointer(user_data, data)
         y => FN_VGetArrayPointer(nv_y)
         w => FN_VGetArrayPointer(nv_w)
@@ -993,8 +992,9 @@ contains
             if (any(data%newton_power > 0)) then
                 if (FIDAGetCurrentStep(data%mem, hcur) /= 0) hcur = 0.0_wp
                 if (hcur(1) == 0.0_wp) hcur = data%h_start
+                kappa = multiplier_kappa(minval(data%rtol))
                 if (hcur(1) /= 0.0_wp) where (data%newton_power > 0) &
-                    w = multiplier_kappa * w / abs(hcur(1))**data%newton_power
+                    w = kappa * w / abs(hcur(1))**data%newton_power
             end if
         end if
         w = 1.0_wp / w
