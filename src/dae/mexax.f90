@@ -375,7 +375,7 @@ contains
 
     contains
 
-        !> t0: project (no rejection test), a and λ from the index-1 system,
+        !> At t0: project (no rejection test), a and λ from the index-1 system,
         !> the dense output's start and the outputs at t0. False on a failure
         !> or an interruption (status set).
         logical function started()

@@ -12,8 +12,8 @@ module flexmbs_dae_multiplier_scaling
     private
     public :: multiplier_kappa
 
-    real(wp), parameter :: kappa_accuracy = 0.01_wp  !! calibrated (docs/theory.md §6.4)
-    real(wp), parameter :: roundoff_factor = 450.0_wp !! calibrated: κ ≥ 450 ε / rtol
+    real(wp), parameter :: kappa_accuracy = 0.01_wp  !! κ for accuracy (calibrated, docs/theory.md §6.4)
+    real(wp), parameter :: roundoff_factor = 450.0_wp !! κ ≥ 450 ε / rtol (calibrated)
 
 contains
 
