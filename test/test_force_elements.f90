@@ -17,6 +17,8 @@ module test_force_elements
     use flexmbs_mbs_force_element, only: force_element_t, force_spring_damper, &
         force_rotational, force_bushing, force_applied
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t
+    use flexmbs_mbs_rigid_chain, only: rigid_chain_t, new_rigid_chain, chain_body_t, &
+        chain_joint_revolute, chain_joint_spherical
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index2
     use mbs_random, only: random_state_t, random_vector, random_quaternion
     use test_mbs_system, only: test_body, random_state, integrate, rel_err
@@ -31,6 +33,7 @@ contains
         type(test_case_t), allocatable :: tests(:)
         tests = [new_test('derivatives_vs_differences', test_derivatives), &
                  new_test('sparse_equals_dense', test_sparse_dense), &
+                 new_test('chain_markers_derivatives', test_chain_markers), &
                  new_test('equal_and_opposite', test_equal_opposite), &
                  new_test('spring_mass_frequency', test_spring_mass), &
                  new_test('undamped_energy_conserved', test_energy), &
@@ -118,6 +121,21 @@ contains
         end subroutine evaluate
     end subroutine difference_columns
 
+    !> The sparse ∂f/∂q and ∂f/∂v on their patterns, as dense arrays.
+    subroutine sparse_as_dense(sys, patterns, t, q, v, sq, sv, status)
+        type(mbs_system_t), intent(inout) :: sys
+        type(mechanical_patterns_t), intent(in) :: patterns
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: sq(:, :), sv(:, :)
+        type(status_t), intent(inout) :: status
+        type(csc_matrix_t) :: pq, pv
+        pq = patterns%force_q
+        pv = patterns%force_v
+        call sys%force_derivatives_sparse(t, q, v, pq%values, pv%values, status)
+        call pq%to_dense(sq)
+        call pv%to_dense(sv)
+    end subroutine sparse_as_dense
+
     ! ------------------------------------------------------------------ tests
 
     !> ∂f/∂q and ∂f/∂v (dense binding: bodies plus elements) against central
@@ -162,9 +180,7 @@ contains
         type(mbs_system_t) :: sys
         type(status_t) :: status
         type(mechanical_patterns_t) :: patterns
-        type(csc_matrix_t) :: pq, pv
         real(wp) :: q(14), v(12), fq(12, 14), fv(12, 12), sq(12, 14), sv(12, 12)
-        real(wp), allocatable :: vq(:), vv(:)
         character(len=120) :: msg
         sys = all_elements_system(rng, status)
         if (status%ok()) call sys%derivative_patterns(patterns, status)
@@ -172,22 +188,98 @@ contains
         if (allocated(error)) return
         call random_state(rng, 2, q, v)
         call sys%force_derivatives(1.1_wp, q, v, fq, fv, status)
-        allocate (vq(patterns%force_q%nnz), vv(patterns%force_v%nnz))
-        call sys%force_derivatives_sparse(1.1_wp, q, v, vq, vv, status)
+        call sparse_as_dense(sys, patterns, 1.1_wp, q, v, sq, sv, status)
         call check(error, status%ok(), status%text())
         if (allocated(error)) return
-        pq = patterns%force_q
-        pv = patterns%force_v
-        pq%values = vq
-        pv%values = vv
-        call pq%to_dense(sq)
-        call pv%to_dense(sv)
         write (msg, '(2(a,es9.2))') 'sparse - dense: df/dq ', rel_err(sq, fq), &
             ', df/dv ', rel_err(sv, fv)
         print '(a)', '    ' // trim(msg)
         call check(error, rel_err(sq, fq) < 1.0e-14_wp .and. rel_err(sv, fv) < 1.0e-14_wp, &
                    trim(msg))
     end subroutine test_sparse_dense
+
+    !> Elements on the links of a chain in relative coordinates (a revolute
+    !> link and a spherical one: quaternion coordinates, nq ≠ nv), between
+    !> two links of the same chain, and to a rigid body: ∂f/∂q and ∂f/∂v
+    !> against central differences, sparse equal to dense.
+    subroutine test_chain_markers(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(random_state_t) :: rng
+        type(mbs_system_t) :: sys
+        type(status_t) :: status
+        type(rigid_chain_t) :: chain
+        type(chain_body_t) :: links(2)
+        type(marker_t) :: m(6)
+        type(force_element_t) :: el(4)
+        type(mechanical_patterns_t) :: patterns
+        real(wp), parameter :: eye(3, 3) = reshape([1, 0, 0, 0, 1, 0, 0, 0, 1] * 1.0_wp, [3, 3])
+        real(wp) :: q(12), v(10), fq(10, 12), fv(10, 10), dq(10, 12), dv(10, 10), &
+            sq(10, 12), sv(10, 10), eq, ev, es
+        integer :: k
+        character(len=120) :: msg
+        links(1) = chain_body_t(0, chain_joint_revolute, [0.0_wp, 0.0_wp, 0.0_wp], eye, &
+            [0.0_wp, 0.0_wp, 1.0_wp], [0.3_wp, 0.0_wp, 0.0_wp], 1.0_wp, 0.02_wp * eye)
+        links(2) = chain_body_t(1, chain_joint_spherical, [0.6_wp, 0.0_wp, 0.0_wp], eye, &
+            [0.0_wp, 0.0_wp, 1.0_wp], [0.2_wp, 0.1_wp, 0.0_wp], 0.5_wp, 0.01_wp * eye)
+        chain = new_rigid_chain(links, status, gravity=[0.0_wp, -9.81_wp, 0.0_wp])
+        call check(error, status%ok(), status%text())
+        if (allocated(error)) return
+        do k = 1, 6
+            m(k)%position = random_vector(rng, 3, -0.3_wp, 0.3_wp)
+            m(k)%axes = rotation_matrix(random_quaternion(rng))
+        end do
+        m(1)%body = 0
+        m(2)%chain = 1
+        m(2)%link = 1
+        m(3)%chain = 1
+        m(3)%link = 2
+        m(4)%body = 1
+        m(5)%chain = 1
+        m(5)%link = 2
+        m(6)%chain = 1
+        m(6)%link = 1
+        el(1) = force_element_t(force_bushing, 1, 2)
+        el(1)%stiffness6 = 50.0_wp * eye6()
+        el(1)%damping6 = 2.0_wp * eye6()
+        el(1)%stiffness6(1, 5) = 7.0_wp
+        el(2) = force_element_t(force_spring_damper, 3, 4, reference=0.2_wp, &
+            stiffness=[30.0_wp, 0.0_wp, 10.0_wp, 0.0_wp, 0.0_wp], damping=0.7_wp)
+        el(3) = force_element_t(force_rotational, 4, 5, reference=-0.1_wp, &
+            stiffness=[4.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp], damping=0.3_wp)
+        el(4) = force_element_t(force_spring_damper, 6, 5, reference=0.1_wp, &
+            stiffness=[20.0_wp, 5.0_wp, 0.0_wp, 0.0_wp, 0.0_wp], damping=0.2_wp)
+        sys = new_mbs_system([test_body(1.0_wp, 0.1_wp)], m, [mbs_joint_t ::], &
+            gravity=[0.0_wp, -9.81_wp, 0.0_wp], status=status, chains=[chain], elements=el)
+        if (status%ok()) call sys%derivative_patterns(patterns, status)
+        call check(error, status%ok() .and. sys%nq == 12 .and. sys%nv == 10, status%text())
+        if (allocated(error)) return
+        q(1:3) = random_vector(rng, 3, -1.0_wp, 1.0_wp)
+        q(4:7) = random_quaternion(rng)
+        q(8) = 0.7_wp
+        q(9:12) = random_quaternion(rng)
+        v = random_vector(rng, 10, -1.0_wp, 1.0_wp)
+        call sys%force_derivatives(0.3_wp, q, v, fq, fv, status)
+        call difference_columns(sys, q, v, .true., dq, status)
+        call difference_columns(sys, q, v, .false., dv, status)
+        call sparse_as_dense(sys, patterns, 0.3_wp, q, v, sq, sv, status)
+        call check(error, status%ok(), status%text())
+        if (allocated(error)) return
+        eq = rel_err(fq, dq)
+        ev = rel_err(fv, dv)
+        es = max(rel_err(sq, fq), rel_err(sv, fv))
+        write (msg, '(3(a,es9.2))') 'chain: df/dq ', eq, ', df/dv ', ev, ', sparse - dense ', es
+        print '(a)', '    ' // trim(msg)
+        call check(error, eq < 1.0e-7_wp .and. ev < 1.0e-7_wp .and. es < 1.0e-14_wp, trim(msg))
+    contains
+        pure function eye6() result(a)
+            real(wp) :: a(6, 6)
+            integer :: i
+            a = 0.0_wp
+            do i = 1, 6
+                a(i, i) = 1.0_wp
+            end do
+        end function eye6
+    end subroutine test_chain_markers
 
     !> Each two-marker element: F_i + F_j = 0 and the moments about the
     !> origin cancel; the loads are s(t) F.

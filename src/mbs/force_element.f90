@@ -52,9 +52,10 @@ module flexmbs_mbs_force_element
         real(wp) :: damping = 0.0_wp !! c (spring_damper, rotational)
         real(wp) :: stiffness6(6, 6) = 0.0_wp !! bushing K (force, torque rows)
         real(wp) :: damping6(6, 6) = 0.0_wp   !! bushing C
-        type(driver_t) :: driver !! applied: s(t)
-        real(wp) :: force(3) = 0.0_wp, torque(3) = 0.0_wp !! applied: F, n
-        logical :: world_frame = .true. !! applied: F, n in world (else marker) axes
+        type(driver_t) :: driver !! s(t) of an applied load
+        real(wp) :: force(3) = 0.0_wp, torque(3) = 0.0_wp !! F and n of an applied load
+        !> F and n in world axes (else in the marker's)
+        logical :: world_frame = .true.
     end type force_element_t
 
     !> A marker frame as the laws see it: origin, axes (columns), origin
@@ -127,9 +128,9 @@ contains
         r = fj%x - fi%x
         l = sqrt(dot_product(r, r))
         if (l%val < min_relative_length * max(e%reference, 1.0_wp)) then
-            call status%set(status_solver_failure, 'force element spring_damper: the &
-                &markers are ' // real_text(l%val) // ' m apart: the line of the force is &
-                &undefined (a bushing takes coinciding markers)', reason_user_function)
+            call status%set(status_solver_failure, 'spring_damper: the markers are ' // real_text(l%val) // &
+                ' m apart: the line of the force is undefined (a bushing takes coinciding &
+                &markers)', reason_user_function)
             return
         end if
         u = r / l
@@ -206,7 +207,7 @@ contains
         type(force_element_t), intent(in) :: e
         type(element_frame_t), intent(in) :: fi, fj
         type(dual_t) :: r(3), phi, s(6), sd(6)
-        real(wp) :: stretch
+        real(wp) :: stretch, sv(6)
         integer :: m
         v = 0.0_wp
         select case (e%kind)
@@ -221,7 +222,8 @@ contains
             v = 0.5_wp * e%stiffness(1) * phi%val**2
         case (force_bushing)
             call bushing_motion(fi, fj, s, sd)
-            v = 0.5_wp * dot_product(s%val, matmul(e%stiffness6, s%val))
+            sv = s%val
+            v = 0.5_wp * dot_product(sv, matmul(e%stiffness6, sv))
         end select
     end function element_energy
 end module flexmbs_mbs_force_element
