@@ -22,6 +22,11 @@ module test_force_elements
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index2
     use mbs_random, only: random_state_t, random_vector, random_quaternion
     use test_mbs_system, only: test_body, random_state, integrate, rel_err
+    use flexmbs_fe_hexahedron, only: hex8
+    use flexmbs_fe_neo_hooke, only: neo_hooke_t, new_neo_hooke
+    use flexmbs_fe_mesh, only: mesh_t
+    use flexmbs_fe_box_mesh, only: box_mesh
+    use flexmbs_fe_flexible_body, only: flexible_body_t, new_flexible_body
     use testing, only: test_case_t, new_test, error_t, check
     implicit none
     private
@@ -34,6 +39,7 @@ contains
         tests = [new_test('derivatives_vs_differences', test_derivatives), &
                  new_test('sparse_equals_dense', test_sparse_dense), &
                  new_test('chain_markers_derivatives', test_chain_markers), &
+                 new_test('node_markers_derivatives', test_node_markers), &
                  new_test('equal_and_opposite', test_equal_opposite), &
                  new_test('spring_mass_frequency', test_spring_mass), &
                  new_test('undamped_energy_conserved', test_energy), &
@@ -120,6 +126,33 @@ contains
             end if
         end subroutine evaluate
     end subroutine difference_columns
+
+    !> ∂f/∂q, ∂f/∂v against central differences (1e-7 relative), the sparse
+    !> blocks against the dense ones (1e-14); `what` labels the message.
+    subroutine compare_derivatives(error, sys, patterns, q, v, what)
+        type(error_t), allocatable, intent(inout) :: error
+        type(mbs_system_t), intent(inout) :: sys
+        type(mechanical_patterns_t), intent(in) :: patterns
+        real(wp), intent(in) :: q(:), v(:)
+        character(len=*), intent(in) :: what
+        type(status_t) :: status
+        real(wp) :: fq(size(v), size(q)), fv(size(v), size(v)), dq(size(v), size(q)), &
+            dv(size(v), size(v)), sq(size(v), size(q)), sv(size(v), size(v)), eq, ev, es
+        character(len=120) :: msg
+        call sys%force_derivatives(0.3_wp, q, v, fq, fv, status)
+        call difference_columns(sys, q, v, .true., dq, status)
+        call difference_columns(sys, q, v, .false., dv, status)
+        call sparse_as_dense(sys, patterns, 0.3_wp, q, v, sq, sv, status)
+        call check(error, status%ok(), status%text())
+        if (allocated(error)) return
+        eq = rel_err(fq, dq)
+        ev = rel_err(fv, dv)
+        es = max(rel_err(sq, fq), rel_err(sv, fv))
+        write (msg, '(a,3(a,es9.2))') what, ': df/dq ', eq, ', df/dv ', ev, &
+            ', sparse - dense ', es
+        print '(a)', '    ' // trim(msg)
+        call check(error, eq < 1.0e-7_wp .and. ev < 1.0e-7_wp .and. es < 1.0e-14_wp, trim(msg))
+    end subroutine compare_derivatives
 
     !> The sparse ∂f/∂q and ∂f/∂v on their patterns, as dense arrays.
     subroutine sparse_as_dense(sys, patterns, t, q, v, sq, sv, status)
@@ -213,10 +246,8 @@ contains
         type(force_element_t) :: el(4)
         type(mechanical_patterns_t) :: patterns
         real(wp), parameter :: eye(3, 3) = reshape([1, 0, 0, 0, 1, 0, 0, 0, 1] * 1.0_wp, [3, 3])
-        real(wp) :: q(12), v(10), fq(10, 12), fv(10, 10), dq(10, 12), dv(10, 10), &
-            sq(10, 12), sv(10, 10), eq, ev, es
+        real(wp) :: q(12), v(10)
         integer :: k
-        character(len=120) :: msg
         links(1) = chain_body_t(0, chain_joint_revolute, [0.0_wp, 0.0_wp, 0.0_wp], eye, &
             [0.0_wp, 0.0_wp, 1.0_wp], [0.3_wp, 0.0_wp, 0.0_wp], 1.0_wp, 0.02_wp * eye)
         links(2) = chain_body_t(1, chain_joint_spherical, [0.6_wp, 0.0_wp, 0.0_wp], eye, &
@@ -258,18 +289,7 @@ contains
         q(8) = 0.7_wp
         q(9:12) = random_quaternion(rng)
         v = random_vector(rng, 10, -1.0_wp, 1.0_wp)
-        call sys%force_derivatives(0.3_wp, q, v, fq, fv, status)
-        call difference_columns(sys, q, v, .true., dq, status)
-        call difference_columns(sys, q, v, .false., dv, status)
-        call sparse_as_dense(sys, patterns, 0.3_wp, q, v, sq, sv, status)
-        call check(error, status%ok(), status%text())
-        if (allocated(error)) return
-        eq = rel_err(fq, dq)
-        ev = rel_err(fv, dv)
-        es = max(rel_err(sq, fq), rel_err(sv, fv))
-        write (msg, '(3(a,es9.2))') 'chain: df/dq ', eq, ', df/dv ', ev, ', sparse - dense ', es
-        print '(a)', '    ' // trim(msg)
-        call check(error, eq < 1.0e-7_wp .and. ev < 1.0e-7_wp .and. es < 1.0e-14_wp, trim(msg))
+        call compare_derivatives(error, sys, patterns, q, v, 'chain')
     contains
         pure function eye6() result(a)
             real(wp) :: a(6, 6)
@@ -280,6 +300,50 @@ contains
             end do
         end function eye6
     end subroutine test_chain_markers
+
+    !> Elements on node markers of a soft bar (2 x 1 x 1 hex8, free): a
+    !> spring–damper from a rigid body to a node, one between two nodes and a
+    !> load on a node: ∂f/∂q, ∂f/∂v (the bar's own tangents included)
+    !> against central differences, sparse equal to dense.
+    subroutine test_node_markers(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(random_state_t) :: rng
+        type(mbs_system_t) :: sys
+        type(status_t) :: status
+        type(neo_hooke_t) :: mat
+        type(mesh_t) :: mesh
+        type(flexible_body_t) :: bar(1)
+        type(marker_t) :: m(4)
+        type(mechanical_patterns_t) :: patterns
+        real(wp), allocatable :: q(:), v(:)
+        call new_neo_hooke(mat, 7.0e5_wp, 0.3_wp, 920.0_wp, 5.0_wp, status)
+        if (status%ok()) call box_mesh(mesh, hex8, [2, 1, 1], [0.4_wp, 0.05_wp, 0.05_wp], &
+                                       status, origin=[0.3_wp, -0.025_wp, -0.025_wp])
+        if (status%ok()) call new_flexible_body(bar(1), mesh, [mat], [integer ::], status)
+        call check(error, status%ok(), status%text())
+        if (allocated(error)) return
+        m(1) = marker_t(1, [0.1_wp, 0.05_wp, 0.0_wp])
+        m(2) = marker_t(0, flexible=1, node=1)
+        m(3) = marker_t(0, flexible=1, node=12)
+        m(4) = marker_t(0, flexible=1, node=5)
+        sys = new_mbs_system([test_body(1.0_wp, 0.1_wp)], m, [mbs_joint_t ::], &
+            status=status, flexible=bar, elements=[ &
+            force_element_t(force_spring_damper, 1, 2, reference=0.1_wp, stiffness=[300.0_wp, &
+                0.0_wp, 1.0e3_wp, 0.0_wp, 0.0_wp], damping=2.0_wp), &
+            force_element_t(force_spring_damper, 2, 3, reference=0.3_wp, stiffness=[500.0_wp, &
+                50.0_wp, 0.0_wp, 0.0_wp, 0.0_wp], damping=1.0_wp), &
+            force_element_t(force_applied, 4, 0, force=[0.0_wp, 3.0_wp, 1.0_wp], &
+                driver=driver_t(amplitude=2.0_wp, frequency=7.0_wp))])
+        if (status%ok()) call sys%derivative_patterns(patterns, status)
+        call check(error, status%ok(), status%text())
+        if (allocated(error)) return
+        allocate (q(sys%nq), v(sys%nv))
+        q(1:3) = random_vector(rng, 3, -0.1_wp, 0.1_wp)
+        q(4:7) = random_quaternion(rng)
+        q(8:) = bar(1)%free_positions() + random_vector(rng, sys%nq - 7, -0.005_wp, 0.005_wp)
+        v = random_vector(rng, sys%nv, -0.5_wp, 0.5_wp)
+        call compare_derivatives(error, sys, patterns, q, v, 'nodes')
+    end subroutine test_node_markers
 
     !> Each two-marker element: F_i + F_j = 0 and the moments about the
     !> origin cancel; the loads are s(t) F.

@@ -4,6 +4,7 @@
 !> stiffness and damping values, a load that is not zero). Messages name
 !> file, line, group, variable, value and reason (flexmbs_io_scene_values).
 module flexmbs_io_force_checks
+    use flexmbs_core_kinds, only: wp
     use flexmbs_core_text, only: int_text
     use flexmbs_io_input_errors, only: input_errors_t, at_other
     use flexmbs_io_scene_schema, only: did_you_mean, len_name
@@ -159,9 +160,10 @@ contains
         subroutine load_values(f, own)
             type(force_input_t), intent(in) :: f
             type(entry_t), intent(in) :: own(:)
-            if (all(f%force == 0) .and. all(f%torque == 0)) call bad('force', 'an applied &
-                &load needs force or torque (both are zero)')
-            if (all(f%coefficients == 0) .and. f%amplitude == 0) call bad('coefficients', &
+            if (.not. maxval(abs([f%force, f%torque])) > 0.0_wp) call bad('force', 'an &
+                &applied load needs force or torque (both are zero)')
+            if (.not. maxval(abs([f%coefficients, f%amplitude])) > 0.0_wp) &
+                call bad('coefficients', &
                 's(t) is zero: give coefficients (s = c0 + c1 t + ...) or amplitude')
             if (size(f%stiffness) + size(f%damping) > 0 .or. &
                 has_entry(own, 'force', 'free_length', i) .or. &

@@ -84,7 +84,7 @@ contains
     pure logical function element_uses_rotation(e)
         type(force_element_t), intent(in) :: e
         element_uses_rotation = e%kind == force_rotational .or. e%kind == force_bushing .or. &
-            (e%kind == force_applied .and. (any(e%torque /= 0.0_wp) .or. .not. e%world_frame))
+            (e%kind == force_applied .and. (any(abs(e%torque) > 0.0_wp) .or. .not. e%world_frame))
     end function element_uses_rotation
 
     !> Forces (global) and torques (global, about the marker origins) on
@@ -138,7 +138,7 @@ contains
         stretch = l - e%reference
         f = e%damping * ld
         do m = 1, max_spring_order
-            if (e%stiffness(m) /= 0.0_wp) f = f + e%stiffness(m) * stretch**m
+            if (abs(e%stiffness(m)) > 0.0_wp) f = f + e%stiffness(m) * stretch**m
         end do
         force(:, 1) = f * u
         force(:, 2) = -(f * u)

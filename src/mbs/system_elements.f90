@@ -9,6 +9,7 @@
 !> generalised forces carry their exact ∂f/∂q (or ∂f/∂v), the markers'
 !> Jacobians' own dependence on q included.
 submodule (flexmbs_mbs_system) flexmbs_mbs_system_elements
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use flexmbs_mbs_dual, only: operator(-), operator(*), matmul
     use flexmbs_mbs_rotation_dual, only: cross_d => cross
     use flexmbs_mbs_force_element, only: element_wrench, element_energy, &
@@ -58,8 +59,8 @@ contains
                         &are both marker ' // int_text(e%marker_i))
                     return
                 end if
-                if (e%kind == force_bushing .and. (any(e%stiffness6 /= e%stiffness6) .or. &
-                    any(e%damping6 /= e%damping6))) then
+                if (e%kind == force_bushing .and. .not. (all(ieee_is_finite(e%stiffness6)) &
+                    .and. all(ieee_is_finite(e%damping6)))) then
                     call status%set(status_bad_input, where // ': K or C is not finite')
                     return
                 end if
