@@ -33,6 +33,8 @@ program flexmbs_tests
     use test_formulation, only: collect_formulation
     use test_rigid_body, only: collect_rigid_body
     use test_mbs_system, only: collect_mbs_system
+    use test_force_elements, only: collect_force_elements
+    use test_bushing_mount, only: collect_bushing_mount
     use test_mechanisms, only: collect_mechanisms
     use test_rigid_chain, only: collect_rigid_chain
     use test_flexible_marker, only: collect_flexible_marker
@@ -87,6 +89,8 @@ program flexmbs_tests
     call run_suite('formulation', collect_formulation(), filter, npassed, nfailed)
     call run_suite('rigid_body', collect_rigid_body(), filter, npassed, nfailed)
     call run_suite('mbs_system', collect_mbs_system(), filter, npassed, nfailed)
+    call run_suite('force_elements', collect_force_elements(), filter, npassed, nfailed)
+    call run_suite('bushing_mount', collect_bushing_mount(), filter, npassed, nfailed)
     call run_suite('mechanisms', collect_mechanisms(), filter, npassed, nfailed)
     call run_suite('rigid_chain', collect_rigid_chain(), filter, npassed, nfailed)
     call run_suite('flexible_marker', collect_flexible_marker(), filter, npassed, nfailed)

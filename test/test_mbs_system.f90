@@ -23,7 +23,7 @@ module test_mbs_system
     use testing, only: test_case_t, new_test, error_t, check
     implicit none
     private
-    public :: collect_mbs_system
+    public :: collect_mbs_system, test_body, random_state, integrate, rel_err
 
     !> The issue's bound: AD against hand-coded, relative to the largest entry (floor 1).
     real(wp), parameter :: tol_ad = 1.0e-12_wp
@@ -105,19 +105,21 @@ contains
         end do
     end subroutine random_state
 
-    !> RADAU5 from t = 0 to t_end at rtol = atol (y consistent).
-    subroutine integrate(gen, y, t_end, rtol, stats, status)
+    !> RADAU5 from t = t0 (default 0) to t_end at rtol = atol (y consistent).
+    subroutine integrate(gen, y, t_end, rtol, stats, status, t0)
         type(formulation_t), intent(inout) :: gen
         real(wp), intent(inout) :: y(:)
         real(wp), intent(in) :: t_end, rtol
         type(dae_stats_t), intent(out) :: stats
         type(status_t), intent(out) :: status
+        real(wp), intent(in), optional :: t0
         type(radau5_t) :: solver
         type(dae_options_t) :: options
         real(wp) :: t
         options%rtol = rtol
         options%atol = rtol
         t = 0.0_wp
+        if (present(t0)) t = t0
         call solver%integrate(gen, t, y, t_end, options, stats, status)
     end subroutine integrate
 

@@ -35,7 +35,8 @@ tolerances="1e-2 1e-4 1e-6 1e-8 1e-10 1e-12"
 reference_tolerance=${TOLERANCE_REFERENCE:-1e-13}   # RADAU5's reference
 # every scene of inputs/ but the fine meshes (make extremes runs those)
 scenes=${TOLERANCE_SCENES:-"van_der_pol pendulum double_pendulum_chain four_bar four_bar_chain
-    face_hinge rigid_flexible_pendulum flexible_cantilever five_body five_body_undamped"}
+    face_hinge rigid_flexible_pendulum flexible_cantilever five_body five_body_undamped
+    bushing_mount"}
 
 # scene SOLVER TOL: the scene cut short, at TOL, its result in NAME_SOLVER_TOL.h5
 jobs=()

@@ -76,8 +76,8 @@ contains
         type(scene_input_t), intent(in) :: scene
         type(entry_t), intent(in) :: entries(:)
         type(input_errors_t), intent(inout) :: errors
-        character(len=16), parameter :: mb_groups(5) = [character(len=16) :: 'multibody', &
-            'rigid_body', 'marker', 'joint', 'driver']
+        character(len=16), parameter :: mb_groups(6) = [character(len=16) :: 'multibody', &
+            'rigid_body', 'marker', 'joint', 'driver', 'force']
         integer :: i, j, g
         integer, allocatable :: ranges(:, :)
         if (scene%problem /= 'multibody') then
@@ -162,6 +162,7 @@ contains
             case ('marker'); given = given .or. size(scene%markers) > 0
             case ('joint'); given = given .or. size(scene%joints) > 0
             case ('driver'); given = given .or. size(scene%drivers) > 0
+            case ('force'); given = given .or. size(scene%forces) > 0
             end select
         end function given
 

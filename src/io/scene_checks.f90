@@ -18,6 +18,7 @@ module flexmbs_io_scene_checks
     use flexmbs_io_scene_input, only: scene_input_t
     use flexmbs_io_body_checks, only: check_body
     use flexmbs_io_multibody_checks, only: check_multibody, check_chain
+    use flexmbs_io_force_checks, only: check_forces
     implicit none
     private
 
@@ -36,6 +37,7 @@ contains
         call check_body(scene, entries, errors)
         call check_multibody(scene, entries, errors)
         call check_chain(scene, entries, errors)
+        call check_forces(scene, entries, errors)
     end subroutine check_scene
 
     subroutine check_simulation(scene, entries, errors)

@@ -98,6 +98,23 @@ module flexmbs_io_scene_input
         integer :: line = 0
     end type driver_input_t
 
+    !> One `&force`: a force element between two markers or a load on one.
+    type, public :: force_input_t
+        character(len=len_name) :: name
+        !> 'spring_damper' | 'rotational' | 'bushing' | 'applied'
+        character(len=len_name) :: type
+        character(len=len_name) :: marker_i, marker_j
+        real(wp) :: free_length !! ℓ₀ [m]
+        real(wp) :: free_angle !! φ₀ [rad]
+        real(wp), allocatable :: stiffness(:), damping(:) !! as given, 0 .. 6 values
+        real(wp) :: stiffness_matrix(36), damping_matrix(36) !! rows of K and C
+        logical :: has_stiffness_matrix = .false., has_damping_matrix = .false.
+        real(wp) :: force(3), torque(3) !! applied [N], [N m]
+        character(len=len_name) :: frame !! 'world' | 'marker'
+        real(wp) :: coefficients(4), amplitude, frequency, phase !! s(t) as a driver's
+        integer :: line = 0
+    end type force_input_t
+
     !> One `&rigid_chain` group: a body of a loop-free chain in relative
     !> coordinates and the joint to its parent (flexmbs_mbs_rigid_chain).
     type, public :: chain_body_input_t
@@ -190,6 +207,7 @@ module flexmbs_io_scene_input
         type(marker_input_t), allocatable :: markers(:)
         type(joint_input_t), allocatable :: joints(:)
         type(driver_input_t), allocatable :: drivers(:)
+        type(force_input_t), allocatable :: forces(:) !! &force
         ! &rigid_chain
         type(chain_body_input_t), allocatable :: chain(:)
     end type scene_input_t

@@ -6,7 +6,7 @@ module flexmbs_io_scene_reader
     use flexmbs_core_text, only: lower, int_text
     use flexmbs_io_scene_schema, only: find_group
     use flexmbs_io_scene_lexer, only: entry_t, span_t, has_entry, instance_ranges
-    use flexmbs_io_scene_values, only: get
+    use flexmbs_io_scene_values, only: get, get_list
     use flexmbs_io_scene_input, only: scene_input_t
     implicit none
     private
@@ -32,9 +32,11 @@ contains
                   scene%markers(count(spans%group == find_group('marker'))), &
                   scene%joints(count(spans%group == find_group('joint'))), &
                   scene%drivers(count(spans%group == find_group('driver'))), &
+                  scene%forces(count(spans%group == find_group('force'))), &
                   scene%chain(count(spans%group == find_group('rigid_chain'))))
         call read_body(entries, scene)
         call read_multibody(entries, scene)
+        call read_forces(entries, scene)
         do i = 1, size(spans)
             call set_line(scene, spans(i))
         end do
@@ -55,6 +57,7 @@ contains
         if (span%group == find_group('marker')) scene%markers(span%instance)%line = span%line
         if (span%group == find_group('joint')) scene%joints(span%instance)%line = span%line
         if (span%group == find_group('driver')) scene%drivers(span%instance)%line = span%line
+        if (span%group == find_group('force')) scene%forces(span%instance)%line = span%line
         if (span%group == find_group('rigid_chain')) scene%chain(span%instance)%line = span%line
     end subroutine set_line
 
@@ -270,5 +273,40 @@ contains
             end associate
         end do
     end subroutine read_multibody
+
+    subroutine read_forces(e, scene)
+        type(entry_t), intent(in) :: e(:)
+        type(scene_input_t), intent(inout) :: scene
+        character(len=*), parameter :: g = 'force'
+        integer :: i
+        integer, allocatable :: ranges(:, :)
+        call instance_ranges(e, g, size(scene%forces), ranges)
+        do i = 1, size(scene%forces)
+            associate (f => scene%forces(i), ei => e(ranges(1, i):ranges(2, i)))
+                call get(ei, g, 'name', f%name, i)
+                if (len_trim(f%name) == 0) f%name = 'force ' // int_text(i)
+                call get(ei, g, 'type', f%type, i)
+                f%type = lower(f%type)
+                call get(ei, g, 'marker_i', f%marker_i, i)
+                call get(ei, g, 'marker_j', f%marker_j, i)
+                call get(ei, g, 'free_length', f%free_length, i)
+                call get(ei, g, 'free_angle', f%free_angle, i)
+                call get_list(ei, g, 'stiffness', f%stiffness)
+                call get_list(ei, g, 'damping', f%damping)
+                call get(ei, g, 'stiffness_matrix', f%stiffness_matrix, i)
+                f%has_stiffness_matrix = has_entry(ei, g, 'stiffness_matrix', i)
+                call get(ei, g, 'damping_matrix', f%damping_matrix, i)
+                f%has_damping_matrix = has_entry(ei, g, 'damping_matrix', i)
+                call get(ei, g, 'force', f%force, i)
+                call get(ei, g, 'torque', f%torque, i)
+                call get(ei, g, 'frame', f%frame, i)
+                f%frame = lower(f%frame)
+                call get(ei, g, 'coefficients', f%coefficients, i)
+                call get(ei, g, 'amplitude', f%amplitude, i)
+                call get(ei, g, 'frequency', f%frequency, i)
+                call get(ei, g, 'phase', f%phase, i)
+            end associate
+        end do
+    end subroutine read_forces
 
 end module flexmbs_io_scene_reader

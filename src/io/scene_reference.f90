@@ -26,6 +26,8 @@ module flexmbs_io_scene_reference
         &flexible body.', &
         'A joint between the markers of two bodies.', &
         'A driver: a joint coordinate prescribed as a function of time.', &
+        'A force element between two markers (spring-damper, rotational spring-damper, &
+        &bushing) or a load on one marker, given as a function of time.', &
         'A link of a rigid chain in relative coordinates.', &
         'A study (study files only): the scene, its reference solution and the grid of &
         &runs.']

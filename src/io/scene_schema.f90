@@ -163,8 +163,8 @@ module flexmbs_io_scene_schema
             doc='Poisson''s ratio'), &
         var_spec_t('material', 'density', kind_real, rule='positive', unit='kg/m^3', &
             doc='mass density, required'), &
-        var_spec_t('material', 'viscosity', kind_real, default='0', rule='nonnegative', &
-            unit='Pa s', doc='viscosity (0: undamped)'), &
+        var_spec_t('material', 'viscosity', kind_real, default='0', rule='[0,1e20]', &
+            unit='Pa s', doc='viscosity (0: undamped; above 1e20 its stresses overflow)'), &
         var_spec_t('material', 'elements', kind_string, &
             doc='element set (default: the elements no other material names)'), &
         var_spec_t('multibody', 'formulation', kind_string, default='ggl', &
@@ -224,6 +224,36 @@ module flexmbs_io_scene_schema
         var_spec_t('driver', 'amplitude', kind_real, default='0', doc='... + a sin(w t + phi)'), &
         var_spec_t('driver', 'frequency', kind_real, default='0', unit='rad/s', doc='w'), &
         var_spec_t('driver', 'phase', kind_real, default='0', unit='rad', doc='phi'), &
+        var_spec_t('force', 'name', kind_string, doc='unique name (default: force N)'), &
+        var_spec_t('force', 'type', kind_string, &
+            choices='spring_damper|rotational|bushing|applied', doc='the element, required'), &
+        var_spec_t('force', 'marker_i', kind_string, doc='first marker (applied: the one)'), &
+        var_spec_t('force', 'marker_j', kind_string, doc='second marker (not for applied)'), &
+        var_spec_t('force', 'free_length', kind_real, default='0', rule='nonnegative', &
+            unit='m', doc='spring_damper: unstretched length'), &
+        var_spec_t('force', 'free_angle', kind_real, default='0', unit='rad', &
+            doc='rotational: angle of zero torque'), &
+        var_spec_t('force', 'stiffness', kind_real, 6, .true., &
+            doc='k1..k5 of k1 e + k2 e^2 ..., rotational k, bushing diag K (6)'), &
+        var_spec_t('force', 'damping', kind_real, 6, .true., rule='nonnegative', &
+            doc='c (spring_damper, rotational), bushing diag C (6)'), &
+        var_spec_t('force', 'stiffness_matrix', kind_real, 36, &
+            doc='bushing: full K, row by row (in place of stiffness)'), &
+        var_spec_t('force', 'damping_matrix', kind_real, 36, &
+            doc='bushing: full C, row by row (in place of damping)'), &
+        var_spec_t('force', 'force', kind_real, 3, default='0, 0, 0', unit='N', &
+            doc='applied: F, times s(t)'), &
+        var_spec_t('force', 'torque', kind_real, 3, default='0, 0, 0', unit='N m', &
+            doc='applied: n, times s(t)'), &
+        var_spec_t('force', 'frame', kind_string, default='world', choices='world|marker', &
+            doc='applied: axes of force and torque'), &
+        var_spec_t('force', 'coefficients', kind_real, 4, default='0, 0, 0, 0', &
+            doc='applied: s = c0 + c1 t + c2 t^2 + c3 t^3 ...'), &
+        var_spec_t('force', 'amplitude', kind_real, default='0', &
+            doc='applied: ... + a sin(w t + phi)'), &
+        var_spec_t('force', 'frequency', kind_real, default='0', unit='rad/s', &
+            doc='applied: w'), &
+        var_spec_t('force', 'phase', kind_real, default='0', unit='rad', doc='applied: phi'), &
         var_spec_t('rigid_chain', 'name', kind_string, doc='unique name (default: link N)'), &
         var_spec_t('rigid_chain', 'parent', kind_string, default='ground', &
             doc='''ground'' or an earlier link'), &
@@ -285,10 +315,10 @@ module flexmbs_io_scene_schema
 
     character(len=16), parameter, public :: group_names(*) = [character(len=16) :: &
         'simulation', 'solver', 'output', 'flexible_body', 'material', 'multibody', &
-        'rigid_body', 'marker', 'joint', 'driver', 'rigid_chain', 'study']
+        'rigid_body', 'marker', 'joint', 'driver', 'force', 'rigid_chain', 'study']
     !> The groups that may be given several times (one item each).
     character(len=16), parameter, public :: repeatable_groups(*) = [character(len=16) :: &
-        'material', 'rigid_body', 'marker', 'joint', 'driver', 'rigid_chain']
+        'material', 'rigid_body', 'marker', 'joint', 'driver', 'force', 'rigid_chain']
 
     public :: find_group, find_var, known_vars, group_vars, string_length, choice_list, &
         is_choice, did_you_mean, split_choices

@@ -69,6 +69,8 @@ module flexmbs_mbs_system
         chain_marker_state_d => chain_marker_state, &
         chain_marker_jacobian_d => chain_marker_jacobian
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, chain_joint_spherical
+    use flexmbs_mbs_driver, only: driver_t, driver_values
+    use flexmbs_mbs_force_element, only: force_element_t
     use flexmbs_mbs_jet, only: jet_t
     use flexmbs_mbs_constraint_primitives_jet, only: marker_state_j => marker_state_t, &
         ground_marker_state_j => ground_marker_state, joint_value_j => joint_value
@@ -130,15 +132,6 @@ module flexmbs_mbs_system
         real(wp), allocatable :: jpos(:, :), jrot(:, :, :), axis(:, :)
     end type chain_geometry_t
 
-    !> A prescribed function of time, s(t) = Σ_k poly(k) t^k + amplitude
-    !> sin(frequency t + phase): constant, constant rate, polynomial, harmonic.
-    type, public :: driver_t
-        real(wp) :: poly(0:3) = 0.0_wp
-        real(wp) :: amplitude = 0.0_wp
-        real(wp) :: frequency = 0.0_wp !! ω [rad/s]
-        real(wp) :: phase = 0.0_wp     !! φ [rad]
-    end type driver_t
-
     !> A joint of kind `kind` (joint_spherical ... joint_fixed) between two
     !> markers, or (kind joint_primitive) one constraint primitive on axes
     !> axis_i, axis_j of the markers, driven by `driver` where it has s(t).
@@ -197,6 +190,8 @@ module flexmbs_mbs_system
         type(accumulator_t) :: acc(7)
         !> each flexible body's tangent slots in patterns%force_q and %force_v
         type(tangent_slots_t), allocatable :: flex_slots(:)
+        !> force elements between markers and applied loads (system_elements.f90)
+        type(force_element_t), allocatable :: elements(:)
     contains
         procedure :: kinematics => system_kinematics
         procedure :: has_sparse => system_has_sparse
@@ -236,13 +231,14 @@ module flexmbs_mbs_system
             system_constraint_curvature_derivatives_sparse
         procedure :: joint_first_row => system_joint_first_row
         procedure :: joint_reaction => system_joint_reaction
+        procedure :: element_wrench => system_element_wrench
         procedure :: marker_pose => system_marker_pose
         procedure :: energy => system_energy
         procedure :: total_energy => system_total_energy
         procedure :: momenta => system_momenta
     end type mbs_system_t
 
-    public :: new_mbs_system, driver_values, node_frame_t
+    public :: new_mbs_system, driver_t, driver_values, node_frame_t, force_element_t
 
 
     interface
@@ -549,6 +545,51 @@ module flexmbs_mbs_system
             real(wp), intent(out) :: force(3, 2), torque(3, 2)
         end subroutine system_joint_reaction
 
+        ! force elements (system_elements.f90)
+        module subroutine place_elements(self, elements, status)
+            type(mbs_system_t), intent(inout) :: self
+            type(force_element_t), intent(in) :: elements(:)
+            type(status_t), intent(inout) :: status
+        end subroutine place_elements
+        module subroutine element_generalised(self, ie, t, q, v, seed, gi, gj, ni, nj, di, &
+                                              dj, offj, status)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: ie, seed
+            real(wp), intent(in) :: t, q(:), v(:)
+            type(dual_t), intent(out) :: gi(rigid_body_nq), gj(rigid_body_nq)
+            integer, intent(out) :: ni, nj, di, dj, offj
+            type(status_t), intent(inout) :: status
+        end subroutine element_generalised
+        module subroutine add_element_forces(self, t, q, v, f, status)
+            class(mbs_system_t), intent(in) :: self
+            real(wp), intent(in) :: t, q(:), v(:)
+            real(wp), intent(inout) :: f(:)
+            type(status_t), intent(inout) :: status
+        end subroutine add_element_forces
+        module subroutine add_element_derivatives(self, t, q, v, fq, fv, status)
+            class(mbs_system_t), intent(in) :: self
+            real(wp), intent(in) :: t, q(:), v(:)
+            type(accumulator_t), intent(inout) :: fq, fv
+            type(status_t), intent(inout) :: status
+        end subroutine add_element_derivatives
+        module subroutine add_element_patterns(self, fq, fv)
+            class(mbs_system_t), intent(in) :: self
+            type(triplets_t), intent(inout) :: fq, fv
+        end subroutine add_element_patterns
+        real(wp) module function elements_energy(self, q, v) result(e)
+            class(mbs_system_t), intent(in) :: self
+            real(wp), intent(in) :: q(:), v(:)
+        end function elements_energy
+        !> Force and torque (global; torque about the marker's origin) that
+        !> force element ie exerts on marker i (column 1) and marker j (column 2).
+        module subroutine system_element_wrench(self, ie, t, q, v, force, torque, status)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: ie
+            real(wp), intent(in) :: t, q(:), v(:)
+            real(wp), intent(out) :: force(3, 2), torque(3, 2)
+            type(status_t), intent(inout) :: status
+        end subroutine system_element_wrench
+
         ! second derivatives by AD (system_second_derivatives.f90)
         module subroutine system_constraint_jacobian_derivatives(self, t, q, w, lambda, gwq, gtlq, status)
             class(mbs_system_t), intent(inout) :: self
@@ -615,7 +656,7 @@ contains
     !> `constraint_derivatives` is 'analytic' (default) or 'ad'. On bad input
     !> `status` says which item is wrong and why.
     function new_mbs_system(bodies, markers, joints, gravity, constraint_derivatives, &
-                            status, flexible, chains, frames) result(self)
+                            status, flexible, chains, frames, elements) result(self)
         type(rigid_body_t), intent(in) :: bodies(:)
         type(marker_t), intent(in) :: markers(:)
         type(mbs_joint_t), intent(in) :: joints(:)
@@ -629,6 +670,8 @@ contains
         !> node frames: flexible, body (a frame body of `bodies`) and nodes
         !> given; the rest is filled in here
         type(node_frame_t), intent(in), optional :: frames(:)
+        !> force elements between the markers and applied loads on them
+        type(force_element_t), intent(in), optional :: elements(:)
         type(mbs_system_t) :: self
         integer :: k, row0, f
         character(len=:), allocatable :: where
@@ -778,6 +821,12 @@ contains
             end associate
         end do
         self%markers = markers
+        if (present(elements)) then
+            call place_elements(self, elements, status)
+            if (.not. status%ok()) return
+        else
+            allocate (self%elements(0))
+        end if
         self%nq_rigid = self%rigid%nq
         self%nv_rigid = self%rigid%nv
         allocate (self%flex_q(size(self%flex)), self%flex_v(size(self%flex)), &
@@ -893,19 +942,4 @@ contains
             row = self%joints(k)%row0 + 1
         end if
     end function system_joint_first_row
-
-    !> (s, s', s'') of a driver at t.
-    pure function driver_values(driver, t) result(drv)
-        type(driver_t), intent(in) :: driver
-        real(wp), intent(in) :: t
-        real(wp) :: drv(3), arg
-        associate (c => driver%poly)
-            drv(1) = c(0) + t * (c(1) + t * (c(2) + t * c(3)))
-            drv(2) = c(1) + t * (2.0_wp * c(2) + 3.0_wp * t * c(3))
-            drv(3) = 2.0_wp * c(2) + 6.0_wp * t * c(3)
-        end associate
-        arg = driver%frequency * t + driver%phase
-        drv = drv + driver%amplitude * [sin(arg), driver%frequency * cos(arg), &
-                                        -driver%frequency**2 * sin(arg)]
-    end function driver_values
 end module flexmbs_mbs_system

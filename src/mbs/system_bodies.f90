@@ -104,6 +104,7 @@ contains
                                          f(iv + 1:iv + n), status)
             end associate
         end do
+        if (status%ok()) call add_element_forces(self, t, q, v, f, status)
     end procedure system_forces
 
     module procedure system_force_derivatives
@@ -128,6 +129,17 @@ contains
                     fq(iv + 1:iv + n, iq + 1:iq + n), fv(iv + 1:iv + n, iv + 1:iv + n), status)
             end associate
         end do
+        if (size(self%elements) == 0 .or. .not. status%ok()) return
+        ! the force elements add through the dense accumulators
+        associate (aq => self%acc(block_fq), av => self%acc(block_fv))
+            call aq%start_dense(self%nv, self%nq)
+            call av%start_dense(self%nv, self%nv)
+            call aq%add_range(0, 0, fq)
+            call av%add_range(0, 0, fv)
+            call add_element_derivatives(self, t, q, v, aq, av, status)
+            call aq%get_dense(fq)
+            call av%get_dense(fv)
+        end associate
     end procedure system_force_derivatives
 
     !> det F > 0 in every flexible body (see dae_problem_t%admissible).
@@ -152,7 +164,8 @@ contains
     end procedure system_normalize
 
     !> Kinetic plus potential energy; flexible bodies add kinetic and strain
-    !> energy and the potential −g·(q − X) of their constant applied forces.
+    !> energy and the potential −g·(q − X) of their constant applied forces,
+    !> the force elements their springs' energy.
     module procedure system_energy
         type(status_t) :: st
         integer :: b
@@ -173,6 +186,7 @@ contains
                                   q(iq + 1:iq + n) - self%flex(b)%free_positions())
             end associate
         end do
+        e = e + elements_energy(self, q, v)
     end procedure system_energy
 
     !> The energy through the mechanical problem's binding (the reference

@@ -255,6 +255,7 @@ contains
                 end do
             end associate
         end do
+        call add_element_patterns(self, fq, fv)
         call cq%build(self%nc, self%nq, patterns%constraint_q, status)
         if (status%ok()) call rq%build(self%nv, self%nq, patterns%reaction_q, status)
         if (status%ok()) call tk%build(self%nq, self%nv, patterns%kinematics, status)
@@ -355,8 +356,9 @@ contains
         call self%acc(block_fq)%get_values(values, 'mbs system: d(M w)/dq', status)
     end procedure system_mass_derivative_sparse
 
-    !> ∂f/∂q, ∂f/∂v: gyroscopic blocks, the chains' blocks, and −∂k/∂q,
-    !> −∂k/∂v of the flexible bodies from their analytic tangents.
+    !> ∂f/∂q, ∂f/∂v: gyroscopic blocks, the chains' blocks, the force
+    !> elements' blocks, and −∂k/∂q, −∂k/∂v of the flexible bodies from their
+    !> analytic tangents.
     module procedure system_force_derivatives_sparse
         real(wp) :: bq(rigid_body_nq, rigid_body_nq), bv(rigid_body_nq, rigid_body_nq)
         type(status_t) :: local
@@ -389,6 +391,8 @@ contains
                     end if
                 end associate
             end do
+            call add_element_derivatives(self, t, q, v, aq, av, status)
+            if (.not. status%ok()) return
             call aq%get_values(fq, 'mbs system: df/dq', status)
             call av%get_values(fv, 'mbs system: df/dv', status)
         end associate

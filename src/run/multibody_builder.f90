@@ -25,6 +25,8 @@ module flexmbs_run_multibody_builder
         primitive_translation_driver, primitive_distance
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
         driver_t, node_frame_t
+    use flexmbs_mbs_force_element, only: force_element_t, force_spring_damper, &
+        force_rotational, force_bushing, force_applied
     use flexmbs_io_namelist, only: scene_input_t
     use flexmbs_run_body_builder, only: build_flexible_body
     use flexmbs_run_chain_builder, only: build_rigid_chain
@@ -73,6 +75,10 @@ contains
         do i = 1, size(scene%drivers)
             call use_frame(scene%drivers(i)%marker_i)
             call use_frame(scene%drivers(i)%marker_j)
+        end do
+        do i = 1, size(scene%forces)
+            call use_frame(scene%forces(i)%marker_i)
+            call use_frame(scene%forces(i)%marker_j)
         end do
         nb = size(scene%rigid_bodies) + count(frame_of > 0)
         allocate (bodies(nb))
@@ -222,7 +228,7 @@ contains
         end do
         sys = new_mbs_system(bodies, markers, joints, gravity=scene%multibody%gravity, &
             constraint_derivatives=trim(scene%multibody%constraint_derivatives), status=status, &
-            flexible=flex, chains=chains, frames=frames)
+            flexible=flex, chains=chains, frames=frames, elements=scene_forces(scene))
         if (.not. status%ok()) then
             call status%set(status_bad_input, scene%path // ': ' // status%text())
             return
@@ -257,6 +263,62 @@ contains
             u = u / size(set)
         end function mean_velocity
     end subroutine build_multibody
+
+    !> The force elements of the scene's &force groups (checked already).
+    pure function scene_forces(scene) result(el)
+        type(scene_input_t), intent(in) :: scene
+        type(force_element_t) :: el(size(scene%forces))
+        integer :: i, k
+        do i = 1, size(scene%forces)
+            associate (f => scene%forces(i), e => el(i))
+                e%marker_i = marker_index(scene, f%marker_i)
+                e%marker_j = marker_index(scene, f%marker_j)
+                select case (f%type)
+                case ('spring_damper')
+                    e%kind = force_spring_damper
+                    e%reference = f%free_length
+                case ('rotational')
+                    e%kind = force_rotational
+                    e%reference = f%free_angle
+                case ('bushing')
+                    e%kind = force_bushing
+                case ('applied')
+                    e%kind = force_applied
+                    e%marker_j = 0
+                    e%force = f%force
+                    e%torque = f%torque
+                    e%world_frame = f%frame == 'world'
+                    e%driver = driver_t(f%coefficients, f%amplitude, f%frequency, f%phase)
+                end select
+                if (e%kind == force_bushing) then
+                    e%stiffness6 = bushing_matrix(f%has_stiffness_matrix, &
+                                                  f%stiffness_matrix, f%stiffness)
+                    e%damping6 = bushing_matrix(f%has_damping_matrix, f%damping_matrix, &
+                                                f%damping)
+                else
+                    k = min(size(f%stiffness), size(e%stiffness))
+                    e%stiffness(1:k) = f%stiffness(1:k)
+                    if (size(f%damping) > 0) e%damping = f%damping(1)
+                end if
+            end associate
+        end do
+    end function scene_forces
+
+    !> A bushing's K or C: the full matrix (given row by row) or the diagonal.
+    pure function bushing_matrix(full, rows, diagonal) result(a)
+        logical, intent(in) :: full
+        real(wp), intent(in) :: rows(36), diagonal(:)
+        real(wp) :: a(6, 6)
+        integer :: k
+        if (full) then
+            a = transpose(reshape(rows, [6, 6]))
+            return
+        end if
+        a = 0.0_wp
+        do k = 1, min(6, size(diagonal))
+            a(k, k) = diagonal(k)
+        end do
+    end function bushing_matrix
 
     !> G(t0, q0) must have full row rank: otherwise the constraints are
     !> redundant (or singular at the start); the message names the joints

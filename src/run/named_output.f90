@@ -12,6 +12,9 @@
 !>   /joints/<name>/reaction_force_j, reaction_torque_j: the same on marker j's body
 !>   /joints/<name>/angle             (1)  rad    revolute, cylindrical: x_j from x_i about z_i
 !>   /joints/<name>/displacement      (1)  m      prismatic, cylindrical: along z_i
+!>   /forces/<name>/force_i, torque_i (3)  N, N m the force element's on marker i's
+!>                                                 body (world frame, about the marker);
+!>                                                 force_j, torque_j: on marker j's
 !>
 !>   /chains/<link>/position, rotation_matrix, velocity, angular_velocity: as
 !>                                  bodies; coordinate, rate: the joint to its
@@ -48,6 +51,7 @@ module flexmbs_run_named_output
     use flexmbs_io_record_values, only: record_values_t
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_run_plan, only: run_plan_t
+    use flexmbs_run_force_output, only: add_force_output
     implicit none
     private
 
@@ -138,7 +142,7 @@ contains
         type(body_values_t) :: body
         type(reaction_values_t) :: reaction
         type(coordinate_values_t) :: coordinate
-        character(len=:), allocatable :: base
+        character(len=:), allocatable :: base, groups(:)
         integer :: i, k
         call add_labels(h5, plan, scene, status)
         if (.not. status%ok()) return
@@ -181,6 +185,12 @@ contains
                                       f%ov + sys%flex_v(i), status)
                     if (.not. status%ok()) return
                 end do
+                allocate (character(len=80) :: groups(size(scene%forces)))
+                do i = 1, size(scene%forces)
+                    groups(i) = 'forces/' // path_name(scene%forces(i)%name) // '/'
+                end do
+                call add_force_output(h5, sys, groups, f%oq, f%ov, status)
+                if (.not. status%ok()) return
                 if (.not. allocated(plan%joint_names) .or. f%nc == 0) return
                 reaction%system => sys
                 reaction%formulation => f

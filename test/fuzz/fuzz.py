@@ -128,7 +128,7 @@ STAGES = [
                     r"must be 'ground' or a body of an earlier", r"no such node set",
                     r"no node set named", r"no such element set", r"no element set named"]),
     ('semantics', [r"&(flexible_body|material|multibody|rigid_body|marker|joint|driver|"
-                   r"rigid_chain)\b", r"problem = '[a-z_0-9]*': needs",
+                   r"force|rigid_chain)\b", r"problem = '[a-z_0-9]*': needs",
                    r"constraint set is redundant"]),
     ('run', [r"no consistent initial state", r"no initial y'"]),
 ]
