@@ -648,288 +648,31 @@ module flexmbs_mbs_system
             real(wp), intent(in) :: t, q(:), v(:)
             type(accumulator_t), intent(inout) :: gq, gv
         end subroutine curvature_derivatives_into
+        !> The system of `bodies` under `gravity`, with `markers` and `joints`;
+        !> `constraint_derivatives` is 'analytic' (default) or 'ad'. On bad input
+        !> `status` says which item is wrong and why.
+        module function new_mbs_system(bodies, markers, joints, gravity, constraint_derivatives, &
+                                           status, flexible, chains, frames, elements) result(self)
+            type(rigid_body_t), intent(in) :: bodies(:)
+            type(marker_t), intent(in) :: markers(:)
+            type(mbs_joint_t), intent(in) :: joints(:)
+            real(wp), intent(in), optional :: gravity(3)
+            character(len=*), intent(in), optional :: constraint_derivatives !! 'analytic' | 'ad'
+            type(status_t), intent(out) :: status
+            !> flexible bodies (their own gravity and loads), after the rigid ones
+            type(flexible_body_t), intent(in), optional :: flexible(:)
+            !> rigid chains (their own gravity), after the rigid bodies
+            type(rigid_chain_t), intent(in), optional :: chains(:)
+            !> node frames: flexible, body (a frame body of `bodies`) and nodes
+            !> given; the rest is filled in here
+            type(node_frame_t), intent(in), optional :: frames(:)
+            !> force elements between the markers and applied loads on them
+            type(force_element_t), intent(in), optional :: elements(:)
+            type(mbs_system_t) :: self
+        end function new_mbs_system
     end interface
 
 contains
-
-    !> The system of `bodies` under `gravity`, with `markers` and `joints`;
-    !> `constraint_derivatives` is 'analytic' (default) or 'ad'. On bad input
-    !> `status` says which item is wrong and why.
-    function new_mbs_system(bodies, markers, joints, gravity, constraint_derivatives, &
-                            status, flexible, chains, frames, elements) result(self)
-        type(rigid_body_t), intent(in) :: bodies(:)
-        type(marker_t), intent(in) :: markers(:)
-        type(mbs_joint_t), intent(in) :: joints(:)
-        real(wp), intent(in), optional :: gravity(3)
-        character(len=*), intent(in), optional :: constraint_derivatives !! 'analytic' | 'ad'
-        type(status_t), intent(out) :: status
-        !> flexible bodies (their own gravity and loads), after the rigid ones
-        type(flexible_body_t), intent(in), optional :: flexible(:)
-        !> rigid chains (their own gravity), after the rigid bodies
-        type(rigid_chain_t), intent(in), optional :: chains(:)
-        !> node frames: flexible, body (a frame body of `bodies`) and nodes
-        !> given; the rest is filled in here
-        type(node_frame_t), intent(in), optional :: frames(:)
-        !> force elements between the markers and applied loads on them
-        type(force_element_t), intent(in), optional :: elements(:)
-        type(mbs_system_t) :: self
-        integer :: k, row0, f
-        character(len=:), allocatable :: where
-
-        self%rigid = new_rigid_bodies(bodies, gravity, status)
-        if (.not. status%ok()) return
-        if (present(constraint_derivatives)) then
-            select case (constraint_derivatives)
-            case ('analytic')
-                self%derivatives = constraint_derivatives_analytic
-            case ('ad')
-                self%derivatives = constraint_derivatives_ad
-            case ('ad_full')
-                self%derivatives = constraint_derivatives_ad_full
-            case default
-                call status%set(status_bad_input, 'mbs system: constraint_derivatives = ''' &
-                                // constraint_derivatives // ''': use ''analytic'', ''ad'' or &
-                                &''ad_full''')
-                return
-            end select
-        end if
-        if (present(flexible)) then
-            self%flex = flexible
-        else
-            allocate (self%flex(0))
-        end if
-        if (present(chains)) then
-            self%chains = chains
-        else
-            allocate (self%chains(0))
-        end if
-        allocate (self%chain_geom(size(self%chains)))
-        do f = 1, size(self%chains)
-            associate (ch => self%chains(f), g => self%chain_geom(f))
-                if (ch%nq > rigid_body_nq) then
-                    call status%set(status_bad_input, 'mbs system: chain ' // int_text(f) // &
-                        ': at most ' // int_text(rigid_body_nq) // ' coordinates inside a system')
-                    return
-                end if
-                g%parent = ch%bodies%parent
-                g%kinds = ch%bodies%joint
-                g%iq = ch%iq(1:size(ch%bodies))
-                g%iv = ch%iv(1:size(ch%bodies))
-                allocate (g%jpos(3, size(ch%bodies)), g%jrot(3, 3, size(ch%bodies)), &
-                          g%axis(3, size(ch%bodies)))
-                do k = 1, size(ch%bodies)
-                    g%jpos(:, k) = ch%bodies(k)%joint_position
-                    g%jrot(:, :, k) = ch%bodies(k)%joint_rotation
-                    g%axis(:, k) = ch%bodies(k)%axis
-                end do
-            end associate
-        end do
-        do k = 1, size(markers)
-            where = 'mbs system: marker ' // int_text(k)
-            if (markers(k)%chain /= 0) then
-                if (markers(k)%chain < 1 .or. markers(k)%chain > size(self%chains)) then
-                    call status%set(status_bad_input, where // ': chain = ' // &
-                        int_text(markers(k)%chain) // ': must name a chain 1 .. ' // &
-                        int_text(size(self%chains)))
-                    return
-                end if
-                if (markers(k)%link < 1 .or. &
-                    markers(k)%link > size(self%chains(markers(k)%chain)%bodies)) then
-                    call status%set(status_bad_input, where // ': link ' // &
-                        int_text(markers(k)%link) // ' is not a body of its chain')
-                    return
-                end if
-            end if
-            if (markers(k)%flexible /= 0) then
-                if (markers(k)%flexible < 1 .or. markers(k)%flexible > size(self%flex)) then
-                    call status%set(status_bad_input, where // ': flexible = ' // &
-                        int_text(markers(k)%flexible) // ': must name a flexible body 1 .. ' &
-                        // int_text(size(self%flex)))
-                    return
-                end if
-                associate (fb => self%flex(markers(k)%flexible))
-                    if (markers(k)%node < 1 .or. markers(k)%node > fb%mesh%node_count()) then
-                        call status%set(status_bad_input, where // ': node ' // &
-                            int_text(markers(k)%node) // ' outside the mesh')
-                        return
-                    end if
-                    if (any(fb%dof(:, markers(k)%node) == 0) .or. &
-                        fb%dof(2, markers(k)%node) /= fb%dof(1, markers(k)%node) + 1 .or. &
-                        fb%dof(3, markers(k)%node) /= fb%dof(1, markers(k)%node) + 2) then
-                        call status%set(status_bad_input, where // ': node ' // &
-                            int_text(markers(k)%node) // ' is fixed (a node marker needs &
-                            &a free node)')
-                        return
-                    end if
-                end associate
-            end if
-            if (markers(k)%body < 0 .or. markers(k)%body > size(bodies)) then
-                call status%set(status_bad_input, where // ': body = ' // &
-                                int_text(markers(k)%body) // ': must be 0 (ground) .. ' // &
-                                int_text(size(bodies)))
-                return
-            end if
-            if (maxval(abs(matmul(transpose(markers(k)%axes), markers(k)%axes) - identity3)) &
-                > axes_tolerance) then
-                call status%set(status_bad_input, where // ': axes are not orthonormal')
-                return
-            end if
-        end do
-        allocate (self%joints(size(joints)))
-        row0 = 0
-        do k = 1, size(joints)
-            where = 'mbs system: joint ' // int_text(k)
-            associate (ji => joints(k), jt => self%joints(k))
-                if (min(ji%marker_i, ji%marker_j) < 1 .or. &
-                    max(ji%marker_i, ji%marker_j) > size(markers)) then
-                    call status%set(status_bad_input, where // ': markers ' // &
-                                    int_text(ji%marker_i) // ', ' // int_text(ji%marker_j) // &
-                                    ': must name markers 1 .. ' // int_text(size(markers)))
-                    return
-                end if
-                if (markers(ji%marker_i)%flexible + markers(ji%marker_j)%flexible > 0) then
-                    if (ji%kind /= joint_spherical .and. .not. (ji%kind == joint_primitive &
-                        .and. ji%primitive == primitive_distance)) then
-                        call status%set(status_bad_input, where // ': a node marker (no &
-                            &rotation) takes spherical joints and distances only')
-                        return
-                    end if
-                else if (markers(ji%marker_i)%body == markers(ji%marker_j)%body .and. &
-                         markers(ji%marker_i)%chain == 0 .and. &
-                         markers(ji%marker_j)%chain == 0) then
-                    call status%set(status_bad_input, where // ': both markers are on body ' &
-                                    // int_text(markers(ji%marker_i)%body) // &
-                                    ': a joint connects two different bodies (or a body &
-                                    &and the ground)')
-                    return
-                end if
-                if (ji%kind == joint_primitive) then
-                    call new_primitive_joint(jt%joint, ji%primitive, ji%axis_i, ji%axis_j, &
-                                             status)
-                else
-                    call new_joint(jt%joint, ji%kind, status)
-                end if
-                jt%driver = ji%driver
-                if (.not. status%ok()) then
-                    call status%set(status_bad_input, where // ': ' // status%text())
-                    return
-                end if
-                jt%marker_i = ji%marker_i
-                jt%marker_j = ji%marker_j
-                jt%row0 = row0
-                row0 = row0 + jt%joint%nrows
-            end associate
-        end do
-        self%markers = markers
-        if (present(elements)) then
-            call place_elements(self, elements, status)
-            if (.not. status%ok()) return
-        else
-            allocate (self%elements(0))
-        end if
-        self%nq_rigid = self%rigid%nq
-        self%nv_rigid = self%rigid%nv
-        allocate (self%flex_q(size(self%flex)), self%flex_v(size(self%flex)), &
-                  self%chain_q(size(self%chains)), self%chain_v(size(self%chains)))
-        self%nq = self%nq_rigid
-        self%nv = self%nv_rigid
-        do f = 1, size(self%chains)
-            self%chain_q(f) = self%nq
-            self%chain_v(f) = self%nv
-            self%nq = self%nq + self%chains(f)%nq
-            self%nv = self%nv + self%chains(f)%nv
-        end do
-        do f = 1, size(self%flex)
-            self%flex_q(f) = self%nq
-            self%flex_v(f) = self%nv
-            self%nq = self%nq + self%flex(f)%nq
-            self%nv = self%nv + self%flex(f)%nv
-        end do
-        if (present(frames)) then
-            self%frames = frames
-        else
-            allocate (self%frames(0))
-        end if
-        call place_frames(self, bodies, row0, status)
-        if (.not. status%ok()) return
-        self%nc = row0
-        allocate (self%zero_v(self%nv))
-        self%zero_v = 0.0_wp
-    end function new_mbs_system
-
-    !> Check the node frames and place them: reference offsets, their bodies'
-    !> and nodes' offsets in q and v, six rows each after row0 (updated).
-    subroutine place_frames(self, bodies, row0, status)
-        type(mbs_system_t), intent(inout) :: self
-        type(rigid_body_t), intent(in) :: bodies(:)
-        integer, intent(inout) :: row0
-        type(status_t), intent(inout) :: status
-        type(flexible_marker_t) :: fit
-        character(len=:), allocatable :: where
-        integer :: i, a, b, f, node
-        do b = 1, size(bodies)
-            if (bodies(b)%frame .and. count(self%frames%body == b) /= 1) then
-                call status%set(status_bad_input, 'mbs system: rigid body ' // int_text(b) // &
-                    ' is a frame: exactly one node frame must hold it')
-                return
-            end if
-        end do
-        do i = 1, size(self%frames)
-            where = 'mbs system: node frame ' // int_text(i)
-            associate (fr => self%frames(i))
-                f = fr%flexible
-                b = fr%body
-                if (f < 1 .or. f > size(self%flex)) then
-                    call status%set(status_bad_input, where // ': flexible = ' // int_text(f) &
-                        // ': must name a flexible body 1 .. ' // int_text(size(self%flex)))
-                    return
-                end if
-                if (b < 1 .or. b > size(bodies)) then
-                    call status%set(status_bad_input, where // ': body = ' // int_text(b) // &
-                        ': must name a rigid body 1 .. ' // int_text(size(bodies)))
-                    return
-                end if
-                if (.not. bodies(b)%frame) then
-                    call status%set(status_bad_input, where // ': rigid body ' // int_text(b) &
-                        // ' is not a frame (massless) body')
-                    return
-                end if
-                associate (fb => self%flex(f))
-                    do a = 1, size(fr%nodes)
-                        node = fr%nodes(a)
-                        if (node < 1 .or. node > fb%mesh%node_count()) then
-                            call status%set(status_bad_input, where // ': node ' // &
-                                int_text(node) // ' outside the mesh')
-                            return
-                        end if
-                        if (any(fb%dof(:, node) == 0) .or. &
-                            fb%dof(2, node) /= fb%dof(1, node) + 1 .or. &
-                            fb%dof(3, node) /= fb%dof(1, node) + 2) then
-                            call status%set(status_bad_input, where // ': node ' // &
-                                int_text(node) // ' is fixed (a node frame needs free nodes)')
-                            return
-                        end if
-                    end do
-                    call new_flexible_marker(fit, fb%mesh%x, fr%nodes, status)
-                    if (.not. status%ok()) then
-                        call status%set(status_bad_input, where // ': ' // status%text())
-                        return
-                    end if
-                    fr%s = fit%dx_ref
-                    fr%weight = fit%weight
-                    fr%iq = rigid_body_nq * (b - 1)
-                    fr%iv = rigid_body_nv * (b - 1)
-                    allocate (fr%nq(size(fr%nodes)), fr%nv(size(fr%nodes)))
-                    do a = 1, size(fr%nodes)
-                        fr%nq(a) = self%flex_q(f) + fb%dof(1, fr%nodes(a)) - 1
-                        fr%nv(a) = self%flex_v(f) + fb%dof(1, fr%nodes(a)) - 1
-                    end do
-                end associate
-                fr%row0 = row0
-                row0 = row0 + node_frame_rows
-            end associate
-        end do
-    end subroutine place_frames
 
     !> First row of joint k in c (rows joint_first_row(k) + 0 .. nrows - 1);
     !> k = size(joints) + i: node frame i (6 rows).
