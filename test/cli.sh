@@ -410,7 +410,11 @@ sed -e "s#'../five_body.nml'#'$root/inputs/five_body.nml'#" -e "s#t_end         
 for sig in TERM INT; do
     rm -rf sig_points sig.md
     [ $sig = INT ] && set -m   # a job of its own: SIGINT not ignored, as at a terminal
-    "$exe" sweep sig.nml -j 2 --quiet > sig.out 2>&1 &
+    # SIGINT ignored by whoever started this script (a background job of a
+    # non-interactive shell) stays ignored in every child, and the shell
+    # cannot reset it: restore the default disposition before the sweep.
+    python3 -c 'import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL);
+os.execv(sys.argv[1], sys.argv[1:])' "$exe" sweep sig.nml -j 2 --quiet > sig.out 2>&1 &
     pid=$!
     set +m
     # until both points have computed for a second (they have caught the
