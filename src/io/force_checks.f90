@@ -10,7 +10,7 @@ module flexmbs_io_force_checks
     use flexmbs_io_scene_schema, only: did_you_mean, len_name
     use flexmbs_io_scene_lexer, only: entry_t, has_entry, instance_ranges
     use flexmbs_io_scene_values, only: value_error, required_error
-    use flexmbs_io_scene_input, only: scene_input_t, force_input_t
+    use flexmbs_io_scene_input, only: scene_input_t, force_input_t, marker_index
     implicit none
     private
 
@@ -73,8 +73,8 @@ contains
             type(force_input_t), intent(in) :: f
             type(entry_t), intent(in) :: own(:)
             integer :: ki, kj
-            ki = marker_index(f%marker_i)
-            kj = marker_index(f%marker_j)
+            ki = marker_index(scene, f%marker_i)
+            kj = marker_index(scene, f%marker_j)
             if (.not. has_entry(own, 'force', 'marker_i', i)) then
                 call required_error(errors, 'force', 'marker_i', 'the marker it acts on', &
                                     f%name, f%line)
@@ -98,15 +98,6 @@ contains
                     'on the same body as marker_i (''' // trim(scene%markers(ki)%body) // ''')')
             end if
         end subroutine check_markers
-
-        pure integer function marker_index(name) result(k)
-            character(len=*), intent(in) :: name
-            integer :: m
-            k = 0
-            do m = size(scene%markers), 1, -1
-                if (scene%markers(m)%name == name) k = m
-            end do
-        end function marker_index
 
         pure function names() result(list)
             character(len=len_name), allocatable :: list(:)

@@ -212,7 +212,7 @@ module flexmbs_io_scene_input
         type(chain_body_input_t), allocatable :: chain(:)
     end type scene_input_t
 
-    public :: setting_given
+    public :: setting_given, marker_index
 
 contains
 
@@ -223,4 +223,14 @@ contains
         setting_given = .false.
         if (allocated(scene%solver_settings)) setting_given = any(scene%solver_settings == name)
     end function setting_given
+
+    !> The index of the first marker called `name` in scene, 0 if none.
+    pure integer function marker_index(scene, name)
+        type(scene_input_t), intent(in) :: scene
+        character(len=*), intent(in) :: name
+        do marker_index = 1, size(scene%markers)
+            if (scene%markers(marker_index)%name == name) return
+        end do
+        marker_index = 0
+    end function marker_index
 end module flexmbs_io_scene_input

@@ -28,6 +28,7 @@ module flexmbs_run_multibody_builder
     use flexmbs_mbs_force_element, only: force_element_t, force_spring_damper, &
         force_rotational, force_bushing, force_applied
     use flexmbs_io_namelist, only: scene_input_t
+    use flexmbs_io_scene_input, only: marker_index
     use flexmbs_run_body_builder, only: build_flexible_body
     use flexmbs_run_chain_builder, only: build_rigid_chain
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
@@ -375,15 +376,6 @@ contains
             &or singular at t_start: ' // int_text(nc) // ' rows of rank ' // int_text(rank) // &
             ' (smallest singular value ' // real_text(sv(nc)) // '); involved: ' // names)
     end subroutine check_rank
-
-    pure integer function marker_index(scene, name)
-        type(scene_input_t), intent(in) :: scene
-        character(len=*), intent(in) :: name
-        do marker_index = 1, size(scene%markers)
-            if (scene%markers(marker_index)%name == name) return
-        end do
-        marker_index = 0
-    end function marker_index
 
     pure integer function body_index(scene, name)
         type(scene_input_t), intent(in) :: scene
