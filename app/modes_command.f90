@@ -12,7 +12,7 @@ module flexmbs_app_modes_command
     use flexmbs_core_processes, only: start_process, wait_any_process
     use flexmbs_io_namelist, only: scene_input_t, read_scene
     use flexmbs_io_output_files, only: named_path_t, named_path, check_output_paths, &
-        output_table, output_plot
+        output_table, output_plot, scene_inputs
     use flexmbs_io_spectrum_file, only: write_spectrum, spectrum_plot_commands
     use flexmbs_run_modes, only: modes_options_t, modes_result_t, analyse_modes, median
     use flexmbs_run_modes_report, only: modes_report
@@ -72,10 +72,7 @@ contains
         allocate (outputs(2))
         outputs(1) = named_path(csv, 'modes: table', output_table)
         outputs(2) = named_path(png, 'modes: plot', output_plot)
-        allocate (inputs(merge(2, 1, len_trim(scene%body%mesh_file) > 0)))
-        inputs(1) = named_path(scene%path, 'the scene file itself')
-        if (size(inputs) > 1) inputs(2) = named_path(trim(scene%body%mesh_file), &
-            'the mesh file ''' // trim(scene%body%mesh_file) // '''')
+        inputs = scene_inputs(scene)
         call check_output_paths(scene%path // ': ', outputs, inputs, force, status)
     end subroutine check_outputs
 

@@ -501,6 +501,36 @@ assert elements == list(range(1, len(cells) + 1)), elements
 PY
 ); then pass vtk-node-ids-are-hdf5-nodes
 else fail vtk-node-ids-are-hdf5-nodes "$problem"; fi
+# two flexible bodies (inputs/two_soft_links.nml): a piece each in the mesh
+# file, in the order of field data flexible_names, cell data flexible_id the
+# body's number; each piece's points are its body's reference_nodes +
+# displacement in the HDF5 file's /flexible/NAME
+sed -e "s/t_end   = 0.2 /t_end   = 0.02 /" \
+    -e "s#^&output#\&output vtk = 'out/tsl', file = 'out/tsl.h5',#" \
+    -e "s/n_output = 21/n_output = 3/" "$root/inputs/two_soft_links.nml" > tsl.nml
+expect vtk-two-flexible-run 0 "radau5: NST=" run tsl.nml --quiet
+if problem=$(/usr/bin/python3 - out/tsl.h5 out/tsl_0002.vtu 2>&1 <<'PY'
+import sys, h5py, numpy as np
+import xml.etree.ElementTree as ET
+f = h5py.File(sys.argv[1], 'r')
+grid = ET.parse(sys.argv[2]).getroot().find('UnstructuredGrid')
+codes = [int(c) for c in grid.find('FieldData/DataArray').text.split()]
+names = ''.join(chr(c) if c else '\n' for c in codes).split()
+assert names == ['upper', 'lower'], names
+pieces = grid.findall('Piece')
+assert len(pieces) == 2, len(pieces)
+for k, (name, piece) in enumerate(zip(names, pieces), start=1):
+    body = f['flexible/' + name]
+    x_h5 = body['reference_nodes'][:] + body['displacement'][2]
+    x = np.array(piece.find('Points/DataArray').text.split(), float).reshape(-1, 3)
+    assert np.abs(x - x_h5).max() < 1e-12, (name, np.abs(x - x_h5).max())
+    arrays = {a.get('Name'): a for a in piece.iter('DataArray') if a.get('Name')}
+    ids = set(int(v) for v in arrays['flexible_id'].text.split())
+    assert ids == {k}, (name, ids)
+assert np.abs(f['flexible/lower/displacement'][2]).max() > 1e-4, 'the lower link did not move'
+PY
+); then pass vtk-two-flexible-bodies
+else fail vtk-two-flexible-bodies "$problem"; fi
 # the joints (part 2): the four-bar's four joints and its driver, a point each at
 # marker i, by name; the points against the markers computed from the HDF5 file's
 # bodies (position + R s), the fixed pivots, the reactions against /joints

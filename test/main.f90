@@ -40,6 +40,7 @@ program flexmbs_tests
     use test_flexible_marker, only: collect_flexible_marker
     use test_multibody_scene, only: collect_multibody_scene
     use test_flexible_coupling, only: collect_flexible_coupling
+    use test_two_flexible, only: collect_two_flexible
     use test_node_frame, only: collect_node_frame
     use test_study, only: collect_study
     use test_run, only: collect_run
@@ -97,6 +98,7 @@ program flexmbs_tests
     call run_suite('multibody_scene', collect_multibody_scene(), filter, npassed, nfailed)
     call run_suite('flexible_coupling', collect_flexible_coupling(), filter, npassed, &
                    nfailed)
+    call run_suite('two_flexible', collect_two_flexible(), filter, npassed, nfailed)
     call run_suite('chain_coupling', collect_chain_coupling(), filter, npassed, nfailed)
     call run_suite('sparse_formulation', collect_sparse_formulation(), filter, npassed, &
                    nfailed)

@@ -310,7 +310,8 @@ contains
     !> Elements on node markers of a soft bar (2 x 1 x 1 hex8, free): a
     !> spring–damper from a rigid body to a node, one between two nodes and a
     !> load on a node: ∂f/∂q, ∂f/∂v (the bar's own tangents included)
-    !> against central differences, sparse equal to dense.
+    !> against central differences, sparse equal to dense. A rotational
+    !> element or a bushing on a node marker is refused.
     subroutine test_node_markers(error)
         type(error_t), allocatable, intent(out) :: error
         type(random_state_t) :: rng
@@ -349,6 +350,17 @@ contains
         q(8:) = bar(1)%free_positions() + random_vector(rng, sys%nq - 7, -0.005_wp, 0.005_wp)
         v = random_vector(rng, sys%nv, -0.5_wp, 0.5_wp)
         call compare_derivatives(error, sys, patterns, q, v, 'nodes')
+        if (allocated(error)) return
+        ! a node has no axes: a rotational element or a bushing on one is refused
+        sys = new_mbs_system([test_body(1.0_wp, 0.1_wp)], m, [mbs_joint_t ::], &
+            status=status, flexible=bar, elements=[force_element_t(force_rotational, 1, 2)])
+        call check(error, .not. status%ok() .and. index(status%text(), 'marker 2 is a node &
+            &marker (no rotation)') > 0, 'rotational on a node: ' // status%text())
+        if (allocated(error)) return
+        sys = new_mbs_system([test_body(1.0_wp, 0.1_wp)], m, [mbs_joint_t ::], &
+            status=status, flexible=bar, elements=[force_element_t(force_bushing, 3, 1)])
+        call check(error, .not. status%ok() .and. index(status%text(), 'marker 3 is a node &
+            &marker (no rotation)') > 0, 'bushing on a node: ' // status%text())
     end subroutine test_node_markers
 
     !> Each two-marker element: F_i + F_j = 0 and the moments about the

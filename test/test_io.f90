@@ -752,14 +752,14 @@ contains
         call check(error, status%ok(), 'parse: ' // status%text())
         if (allocated(error)) return
         call check(error, scene%problem == 'flexible_body' .and. scene%has_body, 'problem')
-        call check(error, scene%body%element == 'hex27', 'element lower-cased')
-        call check(error, all(scene%body%divisions == [4, 2, 1]), 'divisions')
-        call check(error, all(scene%body%lengths == [0.4_wp, 0.05_wp, 0.05_wp]), 'lengths')
-        call check(error, all(scene%body%origin == [-1.0_wp, 0.0_wp, 0.0_wp]), 'origin')
-        call check(error, scene%body%fixed(1) == 'xmin' .and. scene%body%fixed(2) == 'ymin' &
-                   .and. all(scene%body%fixed(3:) == ''), 'fixed')
-        call check(error, all(scene%body%gravity == [0.0_wp, 0.0_wp, -9.81_wp]), 'gravity')
-        call check(error, scene%body%formulation == 'index2', 'formulation default')
+        call check(error, scene%bodies(1)%element == 'hex27', 'element lower-cased')
+        call check(error, all(scene%bodies(1)%divisions == [4, 2, 1]), 'divisions')
+        call check(error, all(scene%bodies(1)%lengths == [0.4_wp, 0.05_wp, 0.05_wp]), 'lengths')
+        call check(error, all(scene%bodies(1)%origin == [-1.0_wp, 0.0_wp, 0.0_wp]), 'origin')
+        call check(error, scene%bodies(1)%fixed(1) == 'xmin' .and. scene%bodies(1)%fixed(2) == 'ymin' &
+                   .and. all(scene%bodies(1)%fixed(3:) == ''), 'fixed')
+        call check(error, all(scene%bodies(1)%gravity == [0.0_wp, 0.0_wp, -9.81_wp]), 'gravity')
+        call check(error, scene%bodies(1)%formulation == 'index2', 'formulation default')
         call check(error, size(scene%materials) == 2, 'two materials')
         if (allocated(error)) return
         call check(error, scene%materials(1)%name == 'material 1' .and. &
@@ -801,8 +801,9 @@ contains
         call expect(error, parse_status(body_scene('', '')), &
             'in.nml: &flexible_body: needs a &material group')
         call expect(error, parse_status(body_scene('', soft() // &
-            '&flexible_body lengths = 1, 1, 1 /')), 'in.nml: &flexible_body: group given ' // &
-            'more than once (one flexible body per scene for now) (line 4)')
+            '&flexible_body lengths = 1, 1, 1 /')), 'in.nml: &flexible_body: given 2 times, ' // &
+            'but problem = ''flexible_body'' simulates one body (several are joined in ' // &
+            'problem = ''multibody'') (line 4)')
         call expect(error, parse_status(body_scene(', origin = 2, 1', soft())), &
             'in.nml: &flexible_body: origin = 2, 1: needs 3 values (line 2)')
         call expect(error, parse_status(body_scene(', gravity = 0, 0, -9.81, 1', soft())), &

@@ -219,7 +219,7 @@ contains
             '&material youngs_modulus = 7e5, density = 920 /' // nl // &
             '&marker name = ''tip'', body = ''link'' /' // nl // '&output file = ''none'' /' // nl
         call expect(error, base // '&marker name = ''root'', body = ''bar'' /', &
-            "&marker: body = 'bar': a marker on the flexible body needs node_set")
+            "&marker: body = 'bar': a marker on a flexible body needs node_set")
         call expect(error, base // '&marker name = ''root'', body = ''bar'', node_set = &
             &''xmn'' /' // nl // '&joint type = ''attach'', marker_i = ''tip'', marker_j = &
             &''root'' /', "marker_j 'root': mesh: no node set named 'xmn'")
@@ -230,7 +230,20 @@ contains
             &''xmn'' /' // nl // '&joint type = ''revolute'', marker_i = ''tip'', marker_j = &
             &''root'' /', "&marker 'root': mesh: no node set named 'xmn'")
         call expect(error, base // '&marker name = ''m2'', body = ''link'', node_set = &
-            &''xmin'' /', "&marker: node_set = 'xmin': only for markers on the &flexible_body")
+            &''xmin'' /', "&marker: node_set = 'xmin': only for markers on a &flexible_body")
+        ! several flexible bodies: each material names its body, names are unique
+        call expect(error, base // '&flexible_body name = ''pad'', lengths = 1, 1, 1 /', &
+            "&material 'material 1': body: required (the &flexible_body it belongs to: the &
+            &scene has 2)")
+        call expect(error, base // '&flexible_body name = ''pad'', lengths = 1, 1, 1 /' // nl &
+            // '&material youngs_modulus = 1e6, density = 1, body = ''pda'' /', &
+            "&material: body = 'pda': no &flexible_body of that name (did you mean 'pad'?)")
+        call expect(error, base // '&flexible_body name = ''pad'', lengths = 1, 1, 1 /', &
+            "&flexible_body 'pad': needs a &material group naming it in body")
+        call expect(error, base // '&flexible_body name = ''bar'', lengths = 1, 1, 1 /', &
+            "&flexible_body: name = 'bar': also the name of the &flexible_body at line 3")
+        call expect(error, base // '&flexible_body name = ''link'', lengths = 1, 1, 1 /', &
+            "&flexible_body: name = 'link': also the name of a &rigid_body or &rigid_chain")
     end subroutine test_rigid_flexible_bad
     !> inputs/face_hinge.nml, a revolute joint on a node-set marker: the
     !> frame sits on the Kabsch fit of the bar's xmax face, the link's hub on

@@ -58,7 +58,7 @@ contains
         call check(error, status%ok(), path // ': ' // status%text())
         if (allocated(error)) return
         scene%multibody%formulation = form
-        scene%body%formulation = form
+        if (size(scene%bodies) > 0) scene%bodies(1)%formulation = form
         scene%linear_solver = ls
         call build_problem(scene, problem, y, blocks, status, mech)
         call check(error, status%ok(), path // ' ' // form // ': ' // status%text())
@@ -309,8 +309,8 @@ contains
             name = 'none'
             call read_scene(path, scene, status)
             if (cube) then
-                scene%body%divisions = [12, 12, 12]
-                scene%body%lengths = [0.4_wp, 0.4_wp, 0.4_wp]
+                scene%bodies(1)%divisions = [12, 12, 12]
+                scene%bodies(1)%lengths = [0.4_wp, 0.4_wp, 0.4_wp]
             end if
             call build_problem(scene, problem, y, blocks, status, mech)
             call check(error, status%ok(), path // ': ' // status%text())

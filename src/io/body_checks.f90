@@ -9,7 +9,8 @@ module flexmbs_io_body_checks
     use flexmbs_io_input_errors, only: input_errors_t, at_other
     use flexmbs_io_scene_lexer, only: entry_t, has_entry, entry_index
     use flexmbs_io_scene_values, only: value_error, required_error
-    use flexmbs_io_scene_input, only: scene_input_t
+    use flexmbs_io_scene_input, only: scene_input_t, flexible_index, material_of
+    use flexmbs_io_scene_schema, only: did_you_mean
     implicit none
     private
 
@@ -22,16 +23,15 @@ contains
         type(entry_t), intent(in) :: entries(:)
         type(input_errors_t), intent(inout) :: errors
         character(len=*), parameter :: fb = 'flexible_body', mat = 'material'
-        character(len=:), allocatable :: why
-        logical :: meshed
-        integer :: i, k
+        character(len=len(scene%bodies%name)), allocatable :: body_names(:)
+        integer :: i
 
         if (scene%problem /= 'flexible_body' .and. &
             .not. (scene%problem == 'multibody' .and. scene%has_body)) then
             if (scene%has_body) then
                 call errors%add('&flexible_body: given, but problem = ''' // &
                     trim(scene%problem) // ''' (a scene builds only what it declares)', &
-                    scene%body%line)
+                    scene%bodies(1)%line)
             else if (size(scene%materials) > 0) then
                 call errors%add('&material: given without &flexible_body', &
                                 scene%materials(1)%line)
@@ -43,40 +43,16 @@ contains
                 &group', 0)
             return
         end if
-        associate (b => scene%body)
-            meshed = len_trim(b%mesh_file) > 0
-            if (meshed) then
-                if (has_entry(entries, fb, 'divisions')) call value_error(errors, entries, fb, &
-                    'divisions', 'not used with mesh_file (the file gives the mesh)')
-                if (has_entry(entries, fb, 'lengths')) call value_error(errors, entries, fb, &
-                    'lengths', 'not used with mesh_file (the file gives the mesh)')
-                if (has_entry(entries, fb, 'origin')) call value_error(errors, entries, fb, &
-                    'origin', 'not used with mesh_file (the file gives the mesh)')
-            else
-                if (.not. has_entry(entries, fb, 'lengths')) call errors%add('&flexible_body: &
-                    &lengths: required (the box edge lengths in m), or mesh_file', b%line)
-                k = entry_index(entries, fb, 'divisions')
-                why = ''
-                if (k > 0) then
-                    if (.not. entries(k)%bad) why = box_size_problem(b%divisions, b%element)
-                end if
-                if (len(why) > 0) call value_error(errors, entries, fb, 'divisions', why)
-            end if
-            k = entry_index(entries, fb, 'fixed')
-            if (k > 0) then
-                if (.not. entries(k)%bad .and. any(b%fixed(1:min(size(b%fixed), &
-                    size(entries(k)%items))) == '')) call value_error(errors, entries, fb, &
-                    'fixed', 'node-set names must not be empty')
-            end if
-            if (has_entry(entries, fb, 'load') .and. len_trim(b%load_set) == 0) &
-                call value_error(errors, entries, fb, 'load', 'needs load_set (the node set &
-                &that carries it)')
-            if (has_entry(entries, fb, 'load_set') .and. .not. has_entry(entries, fb, 'load')) &
-                call value_error(errors, entries, fb, 'load_set', 'needs load = fx, fy, fz &
-                &(the total force in N)')
-            if (size(scene%materials) == 0) call errors%add('&flexible_body: needs a &material &
-                &group (youngs_modulus, density, ...)', b%line)
-        end associate
+        if (scene%problem == 'flexible_body' .and. size(scene%bodies) > 1) then
+            call errors%add('&flexible_body: given ' // int_text(size(scene%bodies)) // &
+                ' times, but problem = ''flexible_body'' simulates one body (several are &
+                &joined in problem = ''multibody'')', scene%bodies(2)%line)
+            return
+        end if
+        do i = 1, size(scene%bodies)
+            call check_one_body(i)
+        end do
+        body_names = scene%bodies%name   ! contiguous, for did_you_mean
         do i = 1, size(scene%materials)
             associate (m => scene%materials(i))
                 if (.not. has_entry(entries, mat, 'youngs_modulus', i)) call required_error( &
@@ -86,13 +62,86 @@ contains
                 if (has_entry(entries, mat, 'elements', i) .and. len_trim(m%elements) == 0) &
                     call value_error(errors, entries, mat, 'elements', 'must name an element &
                     &set (leave it out for the elements no other material names)', i)
+                if (len_trim(m%body) == 0 .and. size(scene%bodies) > 1) then
+                    call required_error(errors, mat, 'body', 'the &flexible_body it belongs &
+                        &to: the scene has ' // int_text(size(scene%bodies)), m%name, m%line)
+                else if (len_trim(m%body) > 0 .and. flexible_index(scene, m%body) == 0) then
+                    call value_error(errors, entries, mat, 'body', 'no &flexible_body of that &
+                        &name' // did_you_mean(trim(m%body), body_names), i)
+                end if
                 call check_unique(i)
             end associate
         end do
 
     contains
 
-        !> Material i's name and element set differ from the earlier ones'.
+        !> &flexible_body i: its mesh, supports and load, a unique name and a material.
+        subroutine check_one_body(i)
+            integer, intent(in) :: i
+            character(len=:), allocatable :: why
+            integer :: k, j
+            associate (b => scene%bodies(i))
+                if (len_trim(b%mesh_file) > 0) then
+                    if (has_entry(entries, fb, 'divisions', i)) call value_error(errors, &
+                        entries, fb, 'divisions', 'not used with mesh_file (the file gives &
+                        &the mesh)', i)
+                    if (has_entry(entries, fb, 'lengths', i)) call value_error(errors, entries, &
+                        fb, 'lengths', 'not used with mesh_file (the file gives the mesh)', i)
+                    if (has_entry(entries, fb, 'origin', i)) call value_error(errors, entries, &
+                        fb, 'origin', 'not used with mesh_file (the file gives the mesh)', i)
+                else
+                    if (.not. has_entry(entries, fb, 'lengths', i)) call errors%add( &
+                        label(i) // ': lengths: required (the box edge lengths in m), or &
+                        &mesh_file', b%line)
+                    k = entry_index(entries, fb, 'divisions', i)
+                    why = ''
+                    if (k > 0) then
+                        if (.not. entries(k)%bad) why = box_size_problem(b%divisions, b%element)
+                    end if
+                    if (len(why) > 0) call value_error(errors, entries, fb, 'divisions', why, i)
+                end if
+                k = entry_index(entries, fb, 'fixed', i)
+                if (k > 0) then
+                    if (.not. entries(k)%bad .and. any(b%fixed(1:min(size(b%fixed), &
+                        size(entries(k)%items))) == '')) call value_error(errors, entries, fb, &
+                        'fixed', 'node-set names must not be empty', i)
+                end if
+                if (has_entry(entries, fb, 'load', i) .and. len_trim(b%load_set) == 0) &
+                    call value_error(errors, entries, fb, 'load', 'needs load_set (the node &
+                    &set that carries it)', i)
+                if (has_entry(entries, fb, 'load_set', i) .and. &
+                    .not. has_entry(entries, fb, 'load', i)) call value_error(errors, entries, &
+                    fb, 'load_set', 'needs load = fx, fy, fz (the total force in N)', i)
+                if (.not. any([(material_of(scene, j, i), j = 1, size(scene%materials))])) then
+                    if (size(scene%bodies) > 1) then
+                        call errors%add(label(i) // ': needs a &material group naming it in &
+                            &body (youngs_modulus, density, ...)', b%line)
+                    else
+                        call errors%add(label(i) // ': needs a &material group &
+                            &(youngs_modulus, density, ...)', b%line)
+                    end if
+                end if
+                do j = 1, i - 1
+                    if (scene%bodies(j)%name == b%name) call value_error(errors, entries, fb, &
+                        'name', 'also the name of the &flexible_body' // &
+                        at_other(scene%bodies(j)%line), i, b%name, b%line)
+                end do
+                if (any(scene%rigid_bodies%name == b%name) .or. any(scene%chain%name == b%name)) &
+                    call value_error(errors, entries, fb, 'name', 'also the name of a &
+                    &&rigid_body or &rigid_chain body (markers name bodies)', i, b%name, b%line)
+            end associate
+        end subroutine check_one_body
+
+        !> '&flexible_body', or with several '&flexible_body ''NAME'''.
+        function label(i) result(text)
+            integer, intent(in) :: i
+            character(len=:), allocatable :: text
+            text = '&flexible_body'
+            if (size(scene%bodies) > 1) text = text // ' ''' // trim(scene%bodies(i)%name) // ''''
+        end function label
+
+        !> Material i's name differs from the earlier ones', and its element
+        !> set from those of the earlier materials of its body.
         subroutine check_unique(i)
             integer, intent(in) :: i
             integer :: j
@@ -101,6 +150,8 @@ contains
                     if (scene%materials(j)%name == m%name) then
                         call value_error(errors, entries, mat, 'name', 'also the name of the &
                             &&material' // at_other(scene%materials(j)%line), i)
+                    else if (scene%materials(j)%body /= m%body) then
+                        cycle
                     else if (scene%materials(j)%elements == m%elements .and. &
                              len_trim(m%elements) > 0) then
                         call value_error(errors, entries, mat, 'elements', 'the same set as &

@@ -10,7 +10,7 @@ module flexmbs_io_hdf5_text
     private
 
     public :: read_string_attribute, write_string_attribute, delete_attribute, string_type, &
-        utf8_string_type, group_creating
+        utf8_string_type, group_creating, path_name
 
     interface
         !> The length of a C string (a variable-length HDF5 string read back).
@@ -151,4 +151,16 @@ contains
         call h5pcreate_f(H5P_LINK_CREATE_F, lcpl, err)
         if (err >= 0) call h5pset_create_inter_group_f(lcpl, 1, err)
     end subroutine group_creating
+
+    !> A scene name as one HDF5 path component ('/' would open a group).
+    pure function path_name(name) result(part)
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable :: part
+        integer :: i
+        part = trim(name)
+        do i = 1, len(part)
+            if (part(i:i) == '/') part(i:i) = '_'
+        end do
+        if (part == '.' .or. len(part) == 0) part = '_' // part
+    end function path_name
 end module flexmbs_io_hdf5_text

@@ -11,7 +11,7 @@ module flexmbs_io_multibody_checks
     use flexmbs_io_scene_schema, only: did_you_mean, len_name
     use flexmbs_io_scene_lexer, only: entry_t, has_entry, instance_ranges
     use flexmbs_io_scene_values, only: value_error, required_error
-    use flexmbs_io_scene_input, only: scene_input_t
+    use flexmbs_io_scene_input, only: scene_input_t, marker_index, flexible_index
     implicit none
     private
 
@@ -92,8 +92,9 @@ contains
             end do
             return
         end if
-        if (size(scene%rigid_bodies) + size(scene%chain) == 0) call errors%add('&simulation: &
-            &problem = ''multibody'': needs at least one &rigid_body or &rigid_chain group', 0)
+        if (size(scene%rigid_bodies) + size(scene%chain) + size(scene%bodies) == 0) &
+            call errors%add('&simulation: problem = ''multibody'': needs at least one &
+            &&rigid_body, &rigid_chain or &flexible_body group', 0)
         ! each occurrence's own entries: linear in the number of groups
         call instance_ranges(entries, 'rigid_body', size(scene%rigid_bodies), ranges)
         do i = 1, size(scene%rigid_bodies)
@@ -131,7 +132,7 @@ contains
                     if (.not. (on_flexible(jt%marker_j) .and. .not. on_flexible(jt%marker_i))) &
                         call value_error(errors, entries, 'joint', 'type', '''attach'' joins a &
                         &marker of a rigid body or the ground (marker_i) to a node-set marker of &
-                        &the flexible body (marker_j)', i)
+                        &a flexible body (marker_j)', i)
                 end if
             end associate
         end do
@@ -172,13 +173,13 @@ contains
             integer :: j
             real(wp) :: c(3)
             associate (m => scene%markers(i))
-                if (scene%has_body .and. m%body == scene%body%name) then
+                if (flexible_index(scene, m%body) > 0) then
                     if (len_trim(m%node_set) == 0) call value_error(errors, entries, 'marker', &
-                        'body', 'a marker on the flexible body needs node_set (the nodes a &
+                        'body', 'a marker on a flexible body needs node_set (the nodes a &
                         &joint attaches)', i, m%name, m%line)
                 else if (len_trim(m%node_set) > 0) then
                     call value_error(errors, entries, 'marker', 'node_set', 'only for markers on &
-                        &the &flexible_body', i)
+                        &a &flexible_body', i)
                 else if (m%body /= 'ground' .and. .not. any(scene%rigid_bodies%name == m%body) &
                          .and. .not. any(scene%chain%name == m%body)) then
                     call value_error(errors, entries, 'marker', 'body', 'no &rigid_body or &
@@ -207,19 +208,16 @@ contains
             character(len=len_name), allocatable :: names(:)
             names = [character(len=len_name) :: 'ground', &
                      scene%rigid_bodies%name, scene%chain%name]
-            if (scene%has_body) names = [names, scene%body%name]
+            if (scene%has_body) names = [names, scene%bodies%name]
         end function body_names
 
-        !> The marker of that name sits on the flexible body.
+        !> The marker of that name sits on a flexible body.
         logical function on_flexible(name)
             character(len=*), intent(in) :: name
             integer :: k
             on_flexible = .false.
-            if (.not. scene%has_body) return
-            do k = 1, size(scene%markers)
-                if (scene%markers(k)%name == name) on_flexible = scene%markers(k)%body == &
-                                                                 scene%body%name
-            end do
+            k = marker_index(scene, name)
+            if (k > 0) on_flexible = flexible_index(scene, scene%markers(k)%body) > 0
         end function on_flexible
 
         !> Both markers exist and sit on different bodies.

@@ -17,6 +17,7 @@ module flexmbs_io_output_files
     use flexmbs_io_vtk_sink, only: vtk_file_ours
     use flexmbs_io_table, only: table_file_ours
     use flexmbs_io_spectrum_file, only: spectrum_plot_ours
+    use flexmbs_io_scene_input, only: scene_input_t
     implicit none
     private
 
@@ -34,7 +35,7 @@ module flexmbs_io_output_files
         logical :: series = .false.
     end type named_path_t
 
-    public :: named_path, check_output_paths
+    public :: named_path, check_output_paths, scene_inputs
 
 contains
 
@@ -48,6 +49,28 @@ contains
         named%name = name
         if (present(kind)) named%kind = kind
     end function named_path
+
+    !> The files a scene reads: itself and its flexible bodies' mesh files.
+    function scene_inputs(scene) result(inputs)
+        type(scene_input_t), intent(in) :: scene
+        type(named_path_t), allocatable :: inputs(:)
+        integer :: b, n
+        n = 1
+        if (allocated(scene%bodies)) n = n + count(len_trim(scene%bodies%mesh_file) > 0)
+        ! element by element: gfortran 12 leaks the components of structure
+        ! constructors inside an array constructor
+        allocate (inputs(n))
+        inputs(1) = named_path(scene%path, 'the scene file itself')
+        if (n == 1) return
+        n = 1
+        do b = 1, size(scene%bodies)
+            associate (file => scene%bodies(b)%mesh_file)
+                if (len_trim(file) == 0) cycle
+                n = n + 1
+                inputs(n) = named_path(trim(file), 'the mesh file ''' // trim(file) // '''')
+            end associate
+        end do
+    end function scene_inputs
 
     !> The rules of the module header for `outputs`, against `inputs`;
     !> messages start with `where` (e.g. 'scene.nml: '). Bad input names

@@ -110,9 +110,12 @@ contains
         type(entry_t), intent(in) :: entries(:)
         type(input_errors_t), intent(inout) :: errors
         character(len=:), allocatable :: dir
+        integer :: b
         dir = folder_of(scene%path)
-        if (len_trim(scene%body%mesh_file) > 0) &
-            scene%body%mesh_file = relative_to(dir, trim(scene%body%mesh_file))
+        do b = 1, size(scene%bodies)
+            if (len_trim(scene%bodies(b)%mesh_file) > 0) scene%bodies(b)%mesh_file = &
+                relative_to(dir, trim(scene%bodies(b)%mesh_file))
+        end do
         if (len_trim(scene%table) > 0) scene%table = relative_to(dir, trim(scene%table))
         if (len_trim(scene%vtk) > 0) scene%vtk = relative_to(dir, trim(scene%vtk))
         if (.not. has_entry(entries, 'output', 'file')) then

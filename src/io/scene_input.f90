@@ -17,10 +17,12 @@ module flexmbs_io_scene_input
         real(wp) :: viscosity !! η [Pa·s], ≥ 0 (0: undamped)
         !> element set it covers; '' = every element no other material names
         character(len=len_name) :: elements
+        !> the &flexible_body it belongs to; '' = the scene's only one
+        character(len=len_name) :: body
         integer :: line = 0                      !! where the group starts
     end type material_input_t
 
-    !> The `&flexible_body` group: mesh, supports, loads, initial velocity.
+    !> One `&flexible_body` group: mesh, supports, loads, initial velocity.
     type, public :: body_input_t
         character(len=len_name) :: name
         character(len=len_name) :: element !! 'hex8' | 'hex27'
@@ -198,7 +200,7 @@ module flexmbs_io_scene_input
         character(len=len_path) :: vtk
         ! &flexible_body and &material
         logical :: has_body = .false.                 !! a &flexible_body group was given
-        type(body_input_t) :: body
+        type(body_input_t), allocatable :: bodies(:)  !! the &flexible_body groups, in order
         type(material_input_t), allocatable :: materials(:) !! in the order given
         ! &multibody, &rigid_body, &marker, &joint, &driver
         logical :: has_multibody = .false.
@@ -212,7 +214,7 @@ module flexmbs_io_scene_input
         type(chain_body_input_t), allocatable :: chain(:)
     end type scene_input_t
 
-    public :: setting_given, marker_index
+    public :: setting_given, marker_index, flexible_index, material_of
 
 contains
 
@@ -233,4 +235,28 @@ contains
         end do
         marker_index = 0
     end function marker_index
+
+    !> The index of the &flexible_body called `name`, 0 if none.
+    pure integer function flexible_index(scene, name)
+        type(scene_input_t), intent(in) :: scene
+        character(len=*), intent(in) :: name
+        flexible_index = 0
+        if (.not. allocated(scene%bodies)) return
+        do flexible_index = 1, size(scene%bodies)
+            if (scene%bodies(flexible_index)%name == name) return
+        end do
+        flexible_index = 0
+    end function flexible_index
+
+    !> Whether &material `m` belongs to the &flexible_body numbered `body`
+    !> (a material naming no body belongs to the only one).
+    pure logical function material_of(scene, m, body)
+        type(scene_input_t), intent(in) :: scene
+        integer, intent(in) :: m, body
+        if (len_trim(scene%materials(m)%body) == 0) then
+            material_of = size(scene%bodies) == 1 .and. body == 1
+        else
+            material_of = scene%materials(m)%body == scene%bodies(body)%name
+        end if
+    end function material_of
 end module flexmbs_io_scene_input

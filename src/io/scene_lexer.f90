@@ -87,11 +87,7 @@ contains
                 instance = 1
             else
                 instance = count(spans(1:nspans)%group == g) + 1
-                if (instance > 1 .and. group == 'flexible_body') then
-                    call errors%add('&' // group // ': group given more than once (one &
-                        &flexible body per scene for now)', line)
-                    skip = .true.
-                else if (instance > 1 .and. all(repeatable_groups /= group)) then
+                if (instance > 1 .and. all(repeatable_groups /= group)) then
                     call errors%add('&' // group // ': group given more than once', line)
                     skip = .true.
                 end if

@@ -27,7 +27,8 @@ contains
         call read_output(entries, scene)
         scene%has_body = any(spans%group == find_group('flexible_body'))
         scene%has_multibody = any(spans%group == find_group('multibody'))
-        allocate (scene%materials(count(spans%group == find_group('material'))), &
+        allocate (scene%bodies(count(spans%group == find_group('flexible_body'))), &
+                  scene%materials(count(spans%group == find_group('material'))), &
                   scene%rigid_bodies(count(spans%group == find_group('rigid_body'))), &
                   scene%markers(count(spans%group == find_group('marker'))), &
                   scene%joints(count(spans%group == find_group('joint'))), &
@@ -49,7 +50,8 @@ contains
     subroutine set_line(scene, span)
         type(scene_input_t), intent(inout) :: scene
         type(span_t), intent(in) :: span
-        if (span%group == find_group('flexible_body')) scene%body%line = span%line
+        if (span%group == find_group('flexible_body')) scene%bodies(span%instance)%line = &
+            span%line
         if (span%group == find_group('multibody')) scene%multibody%line = span%line
         if (span%group == find_group('material')) scene%materials(span%instance)%line = span%line
         if (span%group == find_group('rigid_body')) &
@@ -150,23 +152,28 @@ contains
         character(len=*), parameter :: g = 'flexible_body'
         integer :: i
         integer, allocatable :: ranges(:, :)
-        associate (b => scene%body)
-            call get(e, g, 'name', b%name)
-            call get(e, g, 'element', b%element)
-            b%element = lower(b%element)
-            call get(e, g, 'mesh_file', b%mesh_file)
-            call get(e, g, 'divisions', b%divisions)
-            call get(e, g, 'lengths', b%lengths)
-            call get(e, g, 'origin', b%origin)
-            call get(e, g, 'fixed', b%fixed)
-            call get(e, g, 'load_set', b%load_set)
-            call get(e, g, 'load', b%load)
-            call get(e, g, 'gravity', b%gravity)
-            call get(e, g, 'initial_velocity', b%initial_velocity)
-            call get(e, g, 'initial_angular_velocity', b%initial_angular_velocity)
-            call get(e, g, 'formulation', b%formulation)
-            b%formulation = lower(b%formulation)
-        end associate
+        call instance_ranges(e, g, size(scene%bodies), ranges)
+        do i = 1, size(scene%bodies)
+            associate (b => scene%bodies(i), ei => e(ranges(1, i):ranges(2, i)))
+                call get(ei, g, 'name', b%name, i)
+                if (size(scene%bodies) > 1 .and. .not. has_entry(ei, g, 'name', i)) &
+                    b%name = 'body ' // int_text(i)
+                call get(ei, g, 'element', b%element, i)
+                b%element = lower(b%element)
+                call get(ei, g, 'mesh_file', b%mesh_file, i)
+                call get(ei, g, 'divisions', b%divisions, i)
+                call get(ei, g, 'lengths', b%lengths, i)
+                call get(ei, g, 'origin', b%origin, i)
+                call get(ei, g, 'fixed', b%fixed, i)
+                call get(ei, g, 'load_set', b%load_set, i)
+                call get(ei, g, 'load', b%load, i)
+                call get(ei, g, 'gravity', b%gravity, i)
+                call get(ei, g, 'initial_velocity', b%initial_velocity, i)
+                call get(ei, g, 'initial_angular_velocity', b%initial_angular_velocity, i)
+                call get(ei, g, 'formulation', b%formulation, i)
+                b%formulation = lower(b%formulation)
+            end associate
+        end do
         call instance_ranges(e, 'material', size(scene%materials), ranges)
         do i = 1, size(scene%materials)
             associate (m => scene%materials(i), ei => e(ranges(1, i):ranges(2, i)))
@@ -177,6 +184,7 @@ contains
                 call get(ei, 'material', 'density', m%density, i)
                 call get(ei, 'material', 'viscosity', m%viscosity, i)
                 call get(ei, 'material', 'elements', m%elements, i)
+                call get(ei, 'material', 'body', m%body, i)
             end associate
         end do
     end subroutine read_body

@@ -17,12 +17,12 @@ module flexmbs_io_scene_reference
         &keep the solver''s default when left out.', &
         'What is written: the HDF5 result, a statistics table, ParaView files.', &
         'A flexible body of hexahedra: a box mesh or a mesh file, supports, loads and &
-        &initial motion.', &
-        'A material of the flexible body (neo-Hookean with viscous damping) on an element &
+        &initial motion. A multibody scene may join several.', &
+        'A material of a flexible body (neo-Hookean with viscous damping) on an element &
         &set.', &
         'The multibody system: formulation, gravity, derivatives of the joints, projection.', &
         'A rigid body in absolute coordinates.', &
-        'A marker: a frame on a body, the ground, a chain link or a node set of the &
+        'A marker: a frame on a body, the ground, a chain link or a node set of a &
         &flexible body.', &
         'A joint between the markers of two bodies.', &
         'A driver: a joint coordinate prescribed as a function of time.', &

@@ -132,7 +132,7 @@ module flexmbs_io_scene_schema
         var_spec_t('output', 'vtk', kind_string, &
             doc='ParaView files PREFIX.pvd, PREFIX_NNNN.vtu, PREFIX_bodies|joints_NNNN.vtu'), &
         var_spec_t('flexible_body', 'name', kind_string, default='body', &
-            doc='name of the flexible body'), &
+            doc='unique name (default: body; body N when there are several)'), &
         var_spec_t('flexible_body', 'element', kind_string, default='hex8', &
             choices='hex8|hex27', doc='element type of a box mesh'), &
         var_spec_t('flexible_body', 'mesh_file', kind_string, &
@@ -155,7 +155,7 @@ module flexmbs_io_scene_schema
         var_spec_t('flexible_body', 'initial_angular_velocity', kind_real, 3, &
             default='0, 0, 0', unit='rad/s', doc='initial angular velocity about the centroid'), &
         var_spec_t('flexible_body', 'formulation', kind_string, default='index2', &
-            choices='index3|index2|index1|ggl', doc='DAE formulation of the supports'), &
+            choices='index3|index2|index1|ggl', doc='DAE formulation (problem = flexible_body)'), &
         var_spec_t('material', 'name', kind_string, doc='for messages (default: material N)'), &
         var_spec_t('material', 'youngs_modulus', kind_real, rule='positive', unit='Pa', &
             doc='Young''s modulus E, required'), &
@@ -167,6 +167,8 @@ module flexmbs_io_scene_schema
             unit='Pa s', doc='viscosity (0: undamped; above 1e20 its stresses overflow)'), &
         var_spec_t('material', 'elements', kind_string, &
             doc='element set (default: the elements no other material names)'), &
+        var_spec_t('material', 'body', kind_string, &
+            doc='its &flexible_body (default: the only one; required with several)'), &
         var_spec_t('multibody', 'formulation', kind_string, default='ggl', &
             choices='index3|index2|index1|ggl', doc='DAE formulation of the joints'), &
         var_spec_t('multibody', 'gravity', kind_real, 3, default='0, -9.81, 0', &
@@ -318,7 +320,7 @@ module flexmbs_io_scene_schema
         'rigid_body', 'marker', 'joint', 'driver', 'force', 'rigid_chain', 'study']
     !> The groups that may be given several times (one item each).
     character(len=16), parameter, public :: repeatable_groups(*) = [character(len=16) :: &
-        'material', 'rigid_body', 'marker', 'joint', 'driver', 'force', 'rigid_chain']
+        'flexible_body', 'material', 'rigid_body', 'marker', 'joint', 'driver', 'force', 'rigid_chain']
 
     public :: find_group, find_var, known_vars, group_vars, string_length, choice_list, &
         is_choice, did_you_mean, split_choices

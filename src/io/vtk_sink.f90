@@ -1,9 +1,11 @@
-!> ParaView output: at every output time, the flexible body's mesh as an
-!> XML unstructured grid (`PREFIX_NNNN.vtu`: current node positions, the
-!> hexahedra in VTK order — hex8 cell type 12, hex27 type 29 —, point data
-!> displacement, velocity and node_id (flexmbs's node number, from 1: VTK's
-!> point k - 1 is node k), cell data Cauchy stress (xx, yy, zz, xy, yz, xz),
-!> its von Mises value and element_id), the rigid bodies (`PREFIX_bodies_NNNN.vtu`:
+!> ParaView output: at every output time, the flexible bodies' meshes as an
+!> XML unstructured grid (`PREFIX_NNNN.vtu`, a piece per flexible body:
+!> current node positions, the hexahedra in VTK order — hex8 cell type 12,
+!> hex27 type 29 —, point data displacement, velocity and node_id
+!> (flexmbs's node number in its body, from 1: the piece's point k - 1 is
+!> node k), cell data Cauchy stress (xx, yy, zz, xy, yz, xz), its von Mises
+!> value, element_id and flexible_id, the body's number in field data
+!> flexible_names), the rigid bodies (`PREFIX_bodies_NNNN.vtu`:
 !> one vertex per body at its centre of mass, the bodies in absolute
 !> coordinates first, then a chain's links; point data the body's three
 !> axes and body_id, field data body_names) and a multibody system's joints
@@ -46,10 +48,16 @@ module flexmbs_io_vtk_sink
     implicit none
     private
 
+    !> A flexible body to draw: its free q and v after y(oq) and y(ov).
+    type, public :: vtk_flexible_t
+        type(flexible_body_t), pointer :: body => null()
+        integer :: oq = 0, ov = 0
+        character(len=32) :: name = ''
+    end type vtk_flexible_t
+
     type, extends(sink_t), public :: vtk_sink_t
         character(len=:), allocatable :: prefix
-        type(flexible_body_t), pointer :: body => null() !! none: rigid bodies only
-        integer :: oq = 0, ov = 0     !! the body's q and v in y
+        type(vtk_flexible_t), allocatable :: flexible(:) !! none: no mesh files
         integer :: bodies = 0         !! rigid bodies: (r, p) at y(7 b − 6 : 7 b)
         type(rigid_chain_t), pointer :: chain => null() !! its links after them
         integer :: chain_q = 0        !! the chain's coordinates in y
@@ -84,7 +92,7 @@ contains
         character(len=:), allocatable :: paths(:)
         integer :: k, n, width
         n = 0
-        if (associated(self%body)) n = n + records
+        if (meshes(self)) n = n + records
         if (self%bodies + links(self) > 0) n = n + records
         if (joints(self) > 0) n = n + records
         ! '_joints_' is as long as '_bodies_'
@@ -92,7 +100,7 @@ contains
         allocate (character(len=width) :: paths(n))
         n = 0
         do k = 1, records
-            if (associated(self%body)) then
+            if (meshes(self)) then
                 n = n + 1
                 paths(n) = mesh_piece(self%prefix, k)
             end if
@@ -149,8 +157,8 @@ contains
         real(wp), allocatable :: tt(:)
         if (.not. status%ok()) return
         self%records = self%records + 1
-        if (associated(self%body)) call write_mesh(self, y, &
-            mesh_piece(self%prefix, self%records), status)
+        if (meshes(self)) call write_meshes(self, y, mesh_piece(self%prefix, self%records), &
+                                            status)
         if (status%ok() .and. self%bodies + links(self) > 0) call write_bodies(self, y, &
             bodies_piece(self%prefix, self%records), status)
         if (status%ok() .and. joints(self) > 0) call write_joints(self, t, y, &
@@ -170,15 +178,39 @@ contains
         if (len(s) < 4) s = repeat('0', 4 - len(s)) // s
     end function digits
 
-    subroutine write_mesh(self, y, path, status)
+    !> The mesh file: a piece per flexible body, the names as field data.
+    subroutine write_meshes(self, y, path, status)
         class(vtk_sink_t), intent(inout) :: self
+        real(wp), intent(in) :: y(:)
+        character(len=*), intent(in) :: path
+        type(status_t), intent(inout) :: status
+        character(len=32) :: names(size(self%flexible))
+        integer :: unit, b
+        call open_grid(path, unit, status)
+        if (.not. status%ok()) return
+        names = self%flexible%name
+        write (unit, '(a)') '<FieldData>'
+        call write_strings(unit, 'flexible_names', names)
+        write (unit, '(a)') '</FieldData>'
+        do b = 1, size(self%flexible)
+            call write_mesh_piece(self%flexible(b), b, y, unit, path, status)
+            if (.not. status%ok()) exit
+        end do
+        call close_grid(unit, path, status)
+    end subroutine write_meshes
+
+    !> Flexible body `id`'s piece of the mesh file.
+    subroutine write_mesh_piece(flexible, id, y, unit, path, status)
+        type(vtk_flexible_t), intent(in) :: flexible
+        integer, intent(in) :: id, unit
         real(wp), intent(in) :: y(:)
         character(len=*), intent(in) :: path
         type(status_t), intent(inout) :: status
         real(wp), allocatable :: x(:, :), v(:, :), sigma(:, :), mises(:)
         type(status_t) :: stress_status
-        integer :: unit, n, ne, nn, i, j, celltype, stat
-        associate (body => self%body, mesh => self%body%mesh)
+        integer :: n, ne, nn, i, j, celltype, stat
+        associate (body => flexible%body, mesh => flexible%body%mesh, oq => flexible%oq, &
+                   ov => flexible%ov)
             n = mesh%node_count()
             ne = mesh%element_count()
             nn = size(mesh%connectivity, 1)
@@ -193,20 +225,18 @@ contains
             do i = 1, n
                 do j = 1, 3
                     if (body%dof(j, i) == 0) cycle
-                    x(j, i) = y(self%oq + body%dof(j, i))
-                    v(j, i) = y(self%ov + body%dof(j, i))
+                    x(j, i) = y(oq + body%dof(j, i))
+                    v(j, i) = y(ov + body%dof(j, i))
                 end do
             end do
-            call body%element_stress(y(self%oq + 1:self%oq + body%nq), &
-                                     y(self%ov + 1:self%ov + body%nv), sigma, mises, &
+            call body%element_stress(y(oq + 1:oq + body%nq), &
+                                     y(ov + 1:ov + body%nv), sigma, mises, &
                                      stress_status)
             if (.not. stress_status%ok()) then
                 sigma = 0.0_wp
                 mises = 0.0_wp
             end if
             celltype = merge(12, 29, nn == 8)
-            call open_grid(path, unit, status)
-            if (.not. status%ok()) return
             call begin_piece(unit, n, ne)
             write (unit, '(3es24.15e3)') x
             write (unit, '(a)') '</DataArray></Points>'
@@ -237,10 +267,11 @@ contains
             write (unit, '(es24.15e3)') mises
             write (unit, '(a)') '</DataArray>'
             call write_integers(unit, 'element_id', [(i, i=1, ne)])
+            call write_integers(unit, 'flexible_id', [(id, i=1, ne)])
             write (unit, '(a)') '</CellData>'
-            call close_grid(unit, path, status)
+            write (unit, '(a)') '</Piece>'
         end associate
-    end subroutine write_mesh
+    end subroutine write_mesh_piece
 
     subroutine write_bodies(self, y, path, status)
         class(vtk_sink_t), intent(inout) :: self
@@ -281,7 +312,7 @@ contains
         end do
         ! which body a point is: its number, and the names in the field data
         call write_integers(unit, 'body_id', [(b, b=1, n)])
-        write (unit, '(a)') '</PointData>'
+        write (unit, '(a)') '</PointData></Piece>'
         call close_grid(unit, path, status)
     end subroutine write_bodies
 
@@ -344,7 +375,7 @@ contains
             call write_vectors(unit, 'reaction_force_j', force(:, 2, :))
             call write_vectors(unit, 'reaction_torque_j', torque(:, 2, :))
         end if
-        write (unit, '(a)') '</PointData>'
+        write (unit, '(a)') '</PointData></Piece>'
         call close_grid(unit, path, status)
     end subroutine write_joints
 
@@ -415,16 +446,23 @@ contains
         write (unit, '(a)') '</DataArray>'
     end subroutine write_strings
 
-    !> The end of a piece's file.
+    !> The end of the file, after its pieces.
     subroutine close_grid(unit, path, status)
         integer, intent(in) :: unit
         character(len=*), intent(in) :: path
         type(status_t), intent(inout) :: status
         integer :: ios
-        write (unit, '(a)') '</Piece></UnstructuredGrid></VTKFile>'
+        write (unit, '(a)') '</UnstructuredGrid></VTKFile>'
         close (unit, iostat=ios)
         if (ios /= 0) call status%set(status_io_error, path // ': cannot close')
     end subroutine close_grid
+
+    !> Whether there are flexible bodies to draw.
+    pure logical function meshes(self)
+        class(vtk_sink_t), intent(in) :: self
+        meshes = .false.
+        if (allocated(self%flexible)) meshes = size(self%flexible) > 0
+    end function meshes
 
     !> Links of the chain (none without one).
     pure integer function links(self)
@@ -482,7 +520,7 @@ contains
         do k = 1, self%records
             ! 17 significant digits: a reader gets back the HDF5 file's /time exactly
             write (tbuf, '(es25.16e3)') self%times(k)
-            if (associated(self%body)) write (unit, '(a)') '<DataSet timestep="' // &
+            if (meshes(self)) write (unit, '(a)') '<DataSet timestep="' // &
                 trim(adjustl(tbuf)) // '" part="0" file="' // mesh_piece(base, k) // '"/>'
             if (self%bodies + links(self) > 0) write (unit, '(a)') '<DataSet timestep="' // &
                 trim(adjustl(tbuf)) // '" part="1" file="' // bodies_piece(base, k) // '"/>'

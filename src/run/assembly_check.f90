@@ -57,13 +57,13 @@ contains
                 end do
             end associate
         end if
-        if (size(sys%flex) > 0) then
-            associate (f => sys%flex_q(1))
-                move = maxval([0.0_wp, abs(q(f + 1:) - q0(f + 1:))])
-                call note('flexible body ''' // trim(scene%body%name) // '''', &
+        do i = 1, size(sys%flex)
+            associate (f => sys%flex_q(i), n => sys%flex(i)%nq)
+                move = maxval([0.0_wp, abs(q(f + 1:f + n) - q0(f + 1:f + n))])
+                call note('flexible body ''' // trim(scene%bodies(i)%name) // '''', &
                           real_text(move) // ' m (largest node move)', move, 0)
             end associate
-        end if
+        end do
         if (worst <= scene%multibody%assembly_tolerance) return
         call status%set(status_bad_input, scene%path // ': &multibody: assembly_tolerance = ' &
             // real_text(scene%multibody%assembly_tolerance) // ': the initial assembly moves ' &

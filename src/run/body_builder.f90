@@ -22,6 +22,7 @@ module flexmbs_run_body_builder
     use flexmbs_fe_flexible_body, only: flexible_body_t, new_flexible_body
     use flexmbs_mbs_rotation, only: cross
     use flexmbs_io_namelist, only: scene_input_t
+    use flexmbs_io_scene_input, only: material_of
     implicit none
     private
 
@@ -29,10 +30,11 @@ module flexmbs_run_body_builder
 
 contains
 
-    !> The body of the scene, its initial free positions q0 (the reference
-    !> configuration) and velocities v0.
-    subroutine build_flexible_body(scene, body, q0, v0, status)
+    !> Flexible body `ib` of the scene (its `ib`-th &flexible_body group), its
+    !> initial free positions q0 (the reference configuration) and velocities v0.
+    subroutine build_flexible_body(scene, ib, body, q0, v0, status)
         type(scene_input_t), intent(in) :: scene
+        integer, intent(in) :: ib
         type(flexible_body_t), intent(out) :: body
         real(wp), allocatable, intent(out) :: q0(:), v0(:)
         type(status_t), intent(out) :: status
@@ -44,7 +46,9 @@ contains
         integer :: k, i, nfree, nnode_element, stat
 
         where = scene%path // ': &flexible_body: '
-        associate (b => scene%body)
+        if (size(scene%bodies) > 1) where = scene%path // ': &flexible_body ''' // &
+            trim(scene%bodies(ib)%name) // ''': '
+        associate (b => scene%bodies(ib))
             nnode_element = merge(hex8, hex27, b%element == 'hex8')
             if (len_trim(b%mesh_file) > 0) then
                 call read_mesh(trim(b%mesh_file), mesh, status)
@@ -67,7 +71,7 @@ contains
                 end if
             end if
 
-            call assign_materials(scene, mesh, materials, element_material, status)
+            call assign_materials(scene, ib, mesh, materials, element_material, status)
             if (.not. status%ok()) return
 
             allocate (fixed(0))
@@ -129,18 +133,22 @@ contains
         end associate
     end subroutine build_flexible_body
 
-    !> The materials and the material of each element (see the module header).
-    subroutine assign_materials(scene, mesh, materials, element_material, status)
+    !> The materials of body `ib` and the material of each of its elements
+    !> (see the module header); materials(k) is the k-th &material of the body.
+    subroutine assign_materials(scene, ib, mesh, materials, element_material, status)
         type(scene_input_t), intent(in) :: scene
+        integer, intent(in) :: ib
         type(mesh_t), intent(in) :: mesh
         type(neo_hooke_t), allocatable, intent(out) :: materials(:)
         integer, allocatable, intent(out) :: element_material(:)
         type(status_t), intent(inout) :: status
-        integer, allocatable :: set(:)
-        integer :: i, j, e, rest, stat
-        character(len=:), allocatable :: where
+        integer, allocatable :: set(:), own(:)
+        integer :: i, j, e, rest, stat, k
+        character(len=:), allocatable :: where, where_body
 
-        allocate (materials(size(scene%materials)))
+        own = pack([(i, i=1, size(scene%materials))], &
+                   [(material_of(scene, i, ib), i=1, size(scene%materials))])
+        allocate (materials(size(own)))
         allocate (element_material(mesh%element_count()), stat=stat)
         if (stat /= 0) then
             call out_of_memory(status, scene%path // ': material of each element', &
@@ -149,17 +157,18 @@ contains
         end if
         element_material = 0
         rest = 0
-        do i = 1, size(scene%materials)
+        do k = 1, size(own)
+            i = own(k)
             associate (m => scene%materials(i))
                 where = scene%path // ': &material ''' // trim(m%name) // ''': '
-                call new_neo_hooke(materials(i), m%youngs_modulus, m%poisson_ratio, &
+                call new_neo_hooke(materials(k), m%youngs_modulus, m%poisson_ratio, &
                                    m%density, m%viscosity, status)
                 if (.not. status%ok()) then
                     call status%set(status_bad_input, where // status%text() // at(m%line))
                     return
                 end if
                 if (len_trim(m%elements) == 0) then
-                    rest = i
+                    rest = k
                     cycle
                 end if
                 call mesh%element_set(trim(m%elements), set, status)
@@ -174,20 +183,23 @@ contains
                         call status%set(status_bad_input, where // 'elements = ''' // &
                             trim(m%elements) // ''': element ' // int_text(e) // &
                             ' is also in ''' // &
-                            trim(scene%materials(element_material(e))%elements) // &
+                            trim(scene%materials(own(element_material(e)))%elements) // &
                             ''' of &material ''' // &
-                            trim(scene%materials(element_material(e))%name) // &
+                            trim(scene%materials(own(element_material(e)))%name) // &
                             ''' (each element takes one material)' // at(m%line))
                         return
                     end if
-                    element_material(e) = i
+                    element_material(e) = k
                 end do
             end associate
         end do
         if (rest > 0) where (element_material == 0) element_material = rest
         if (any(element_material == 0)) then
+            where_body = scene%path // ': '
+            if (size(scene%bodies) > 1) where_body = where_body // '&flexible_body ''' // &
+                trim(scene%bodies(ib)%name) // ''': '
             e = findloc(element_material, 0, dim=1)
-            call status%set(status_bad_input, scene%path // ': &material: elements: element ' &
+            call status%set(status_bad_input, where_body // '&material: elements: element ' &
                 // int_text(e) // ' has no material (name a set containing it, or leave &
                 &elements out of one &material to cover the rest)')
         end if

@@ -1,4 +1,5 @@
-!> A multibody system from the `&multibody`, `&rigid_body`, `&marker`,
+!> A multibody system from the `&multibody`, `&rigid_body`, `&rigid_chain`,
+!> `&flexible_body`, `&marker`, `&force`,
 !> `&joint` and `&driver` groups of a validated scene (names already
 !> checked): rigid bodies in absolute coordinates, markers (axes from z_axis
 !> and x_axis, made orthonormal), joints and drivers, as an mbs_system_t
@@ -28,7 +29,7 @@ module flexmbs_run_multibody_builder
     use flexmbs_mbs_force_element, only: force_element_t, force_spring_damper, &
         force_rotational, force_bushing, force_applied
     use flexmbs_io_namelist, only: scene_input_t
-    use flexmbs_io_scene_input, only: marker_index
+    use flexmbs_io_scene_input, only: marker_index, flexible_index
     use flexmbs_run_body_builder, only: build_flexible_body
     use flexmbs_run_chain_builder, only: build_rigid_chain
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
@@ -61,10 +62,10 @@ contains
         type(rigid_chain_t), allocatable :: chains(:)
         type(node_frame_t), allocatable :: frames(:)
         real(wp), allocatable :: qf(:), vf(:), qc(:), vc(:)
-        integer, allocatable :: nodes(:), frame_of(:)
+        integer, allocatable :: nodes(:), frame_of(:), flex_v0(:)
         character(len=:), allocatable :: labels(:), frame_labels(:), defect, names(:)
         real(wp) :: p(4), r(3, 3), anchor(3)
-        integer :: i, nb, k, n, b, mi
+        integer :: i, nb, k, n, b, mi, fb
         ! node-set markers that a joint other than 'attach' or a driver uses
         ! get a node frame (a massless body after the scene's rigid bodies)
         allocate (frame_of(size(scene%markers)), source=0)
@@ -110,15 +111,16 @@ contains
             q0 = [q0, qc]
             v0 = [v0, vc]
         end if
-        ! the flexible body, after them
-        allocate (flex(merge(1, 0, scene%has_body)))
-        if (scene%has_body) then
-            call build_flexible_body(scene, flex(1), qf, vf, status)
+        ! the flexible bodies, after them (body fb's velocities after v0(flex_v0(fb)))
+        allocate (flex(size(scene%bodies)), flex_v0(size(scene%bodies)))
+        do fb = 1, size(flex)
+            call build_flexible_body(scene, fb, flex(fb), qf, vf, status)
             if (.not. status%ok()) return
+            flex_v0(fb) = size(v0)
             q0 = [q0, qf]
             v0 = [v0, vf]
-        end if
-        ! node frames: at the set's centroid with the reference axes (the
+        end do
+        ! node frames: at the set's centroid with the reference axes (a
         ! flexible body starts in its reference configuration), moving with
         ! the mean velocity of the set and the body's initial spin
         allocate (frames(count(frame_of > 0)))
@@ -126,7 +128,8 @@ contains
         do i = 1, size(scene%markers)
             k = frame_of(i)
             if (k == 0) cycle
-            call flex(1)%mesh%node_set(trim(scene%markers(i)%node_set), nodes, status)
+            fb = flexible_index(scene, scene%markers(i)%body)
+            call flex(fb)%mesh%node_set(trim(scene%markers(i)%node_set), nodes, status)
             if (.not. status%ok()) then
                 call status%set(status_bad_input, scene%path // ': &marker ''' // &
                     trim(scene%markers(i)%name) // ''': ' // status%text())
@@ -134,11 +137,12 @@ contains
             end if
             b = size(scene%rigid_bodies) + k
             bodies(b)%frame = .true.
-            frames(k) = node_frame_t(flexible=1, body=b, nodes=nodes)
+            frames(k) = node_frame_t(flexible=fb, body=b, nodes=nodes)
             frame_labels(k) = '&marker ''' // trim(scene%markers(i)%name) // ''' (node frame)'
-            anchor = sum(flex(1)%mesh%x(:, nodes), dim=2) / size(nodes)
+            anchor = sum(flex(fb)%mesh%x(:, nodes), dim=2) / size(nodes)
             q0(7 * b - 6:7 * b) = [anchor, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
-            v0(6 * b - 5:6 * b) = [mean_velocity(nodes), scene%body%initial_angular_velocity]
+            v0(6 * b - 5:6 * b) = [mean_velocity(fb, nodes), &
+                                   scene%bodies(fb)%initial_angular_velocity]
         end do
         ! scene markers first (node-set markers of 'attach' joints are
         ! placeholders: the joint expands into node markers, appended below)
@@ -191,8 +195,10 @@ contains
                         &ground, not to a chain body')
                     return
                 end if
-                call flex(1)%mesh%node_set(trim(scene%markers(marker_index(scene, &
-                    jt%marker_j))%node_set), nodes, status)
+                associate (mj => scene%markers(marker_index(scene, jt%marker_j)))
+                    fb = flexible_index(scene, mj%body)
+                    call flex(fb)%mesh%node_set(trim(mj%node_set), nodes, status)
+                end associate
                 if (.not. status%ok()) then
                     call status%set(status_bad_input, scene%path // ': &joint ''' // &
                         trim(jt%name) // ''': marker_j ''' // trim(jt%marker_j) // ''': ' // &
@@ -201,13 +207,13 @@ contains
                 end if
                 b = markers(mi)%body
                 do n = 1, size(nodes)
-                    anchor = flex(1)%mesh%x(:, nodes(n))
+                    anchor = flex(fb)%mesh%x(:, nodes(n))
                     if (b > 0) then
                         r = rotation_matrix(q0(7 * b - 3:7 * b))
                         anchor = matmul(transpose(r), anchor - q0(7 * b - 6:7 * b - 4))
                     end if
                     markers = [markers, marker_t(b, anchor), &
-                               marker_t(0, flexible=1, node=nodes(n))]
+                               marker_t(0, flexible=fb, node=nodes(n))]
                     joints = [joints, mbs_joint_t(joint_spherical, size(markers) - 1, &
                                                   size(markers))]
                     labels = [character(len=80) :: labels, '&joint ''' // trim(jt%name) // &
@@ -250,15 +256,17 @@ contains
             frame_of(k) = maxval(frame_of) + 1
         end subroutine use_frame
 
-        !> Mean initial velocity of nodes (fixed nodes at rest).
-        function mean_velocity(set) result(u)
-            integer, intent(in) :: set(:)
+        !> Mean initial velocity of nodes of flexible body fb (fixed nodes at rest).
+        function mean_velocity(fb, set) result(u)
+            integer, intent(in) :: fb, set(:)
             real(wp) :: u(3)
             integer :: a, l
             u = 0.0_wp
             do a = 1, size(set)
                 do l = 1, 3
-                    if (flex(1)%dof(l, set(a)) > 0) u(l) = u(l) + vf(flex(1)%dof(l, set(a)))
+                    associate (d => flex(fb)%dof(l, set(a)))
+                        if (d > 0) u(l) = u(l) + v0(flex_v0(fb) + d)
+                    end associate
                 end do
             end do
             u = u / size(set)

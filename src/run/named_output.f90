@@ -26,6 +26,7 @@
 !>   /flexible/<name>/velocity        (3, nodes) m/s
 !>   /flexible/<name>/stress          (6, elements) Pa  Cauchy, mean over the element
 !>   /flexible/<name>/von_mises       (elements)    Pa
+!>   /flexible/<name>/energy          (2)           J   strain, kinetic (src/run/flexible_output)
 !>
 !>   /y_labels, /y_units               every component of y by name, and its unit
 !>
@@ -52,6 +53,8 @@ module flexmbs_run_named_output
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_run_plan, only: run_plan_t
     use flexmbs_run_force_output, only: add_force_output
+    use flexmbs_run_flexible_output, only: add_flexible
+    use flexmbs_io_hdf5_text, only: path_name
     implicit none
     private
 
@@ -78,28 +81,6 @@ module flexmbs_run_named_output
         procedure :: evaluate => reaction_evaluate
     end type reaction_values_t
 
-    !> Displacements (or velocities) of every node of a flexible body whose
-    !> free q start after y(oq), v after y(ov).
-    type, extends(record_values_t) :: node_values_t
-        type(flexible_body_t), pointer :: body => null()
-        integer :: oq = 0, ov = 0
-        logical :: velocity = .false.
-    contains
-        procedure :: evaluate => node_evaluate
-    end type node_values_t
-
-    !> The Cauchy stress of every element (the mean over its quadrature
-    !> points, as ParaView shows it), or its von Mises value, of a flexible
-    !> body whose q start after y(oq), v after y(ov). The work arrays are
-    !> allocated when the series is added, not per record.
-    type, extends(record_values_t) :: stress_values_t
-        type(flexible_body_t), pointer :: body => null()
-        integer :: oq = 0, ov = 0
-        logical :: von_mises = .false.
-        real(wp), allocatable :: sigma(:, :), mises(:)
-    contains
-        procedure :: evaluate => stress_evaluate
-    end type stress_values_t
 
     integer, parameter :: link_position = 1, link_rotation = 2, link_velocity = 3, &
         link_angular_velocity = 4, link_coordinate = 5, link_rate = 6
@@ -181,7 +162,7 @@ contains
                     if (.not. status%ok()) return
                 end do
                 do i = 1, size(sys%flex)
-                    call add_flexible(h5, sys%flex(i), scene%body%name, f%oq + sys%flex_q(i), &
+                    call add_flexible(h5, sys%flex(i), scene%bodies(i)%name, f%oq + sys%flex_q(i), &
                                       f%ov + sys%flex_v(i), status)
                     if (.not. status%ok()) return
                 end do
@@ -221,7 +202,7 @@ contains
             type(flexible_body_t), intent(in), target :: b
             select type (f => plan%problem)
             type is (formulation_t)
-                call add_flexible(h5, b, scene%body%name, f%oq, f%ov, status)
+                call add_flexible(h5, b, scene%bodies(1)%name, f%oq, f%ov, status)
             end select
         end subroutine add_standalone
 
@@ -294,7 +275,7 @@ contains
                 type is (rigid_chain_t)
                     call chain_labels(m, f%oq, f%ov, accelerations(f))
                 type is (flexible_body_t)
-                    call flexible_labels(m, trim(scene%body%name), f%oq, f%ov, accelerations(f))
+                    call flexible_labels(m, trim(scene%bodies(1)%name), f%oq, f%ov, accelerations(f))
                 end select
                 if (f%nc > 0 .and. f%n > f%om) then   ! GGL: μ after λ
                     do k = 1, f%nc
@@ -339,7 +320,7 @@ contains
                     merge(f%oa + sys%chain_v(i), -1, f%accelerations))
             end do
             do i = 1, size(sys%flex)
-                call flexible_labels(sys%flex(i), trim(scene%body%name), f%oq + sys%flex_q(i), &
+                call flexible_labels(sys%flex(i), trim(scene%bodies(i)%name), f%oq + sys%flex_q(i), &
                     f%ov + sys%flex_v(i), merge(f%oa + sys%flex_v(i), -1, f%accelerations))
             end do
             ! multipliers: a row's unit is the force its constraint exerts
@@ -463,120 +444,6 @@ contains
         end select
     end function multiplier_unit
 
-    !> /flexible/<name>/: the mesh (reference nodes, connectivity, element
-    !> type, node sets) and every node's displacement and velocity per
-    !> record, (3, nodes, records): node k of the mesh file is index k - 1
-    !> in Python, f['flexible/coupler/displacement'][:, k - 1, 0] its x.
-    subroutine add_flexible(h5, body, name, oq, ov, status)
-        type(hdf5_sink_t), intent(inout) :: h5
-        type(flexible_body_t), intent(in), target :: body
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: oq, ov  !! the body's free q and v start after y(oq), y(ov)
-        type(status_t), intent(out) :: status
-        type(node_values_t) :: nodes
-        type(stress_values_t) :: stress
-        character(len=:), allocatable :: base
-        integer :: k, nn, ne, stat
-        base = 'flexible/' // path_name(name) // '/'
-        nn = body%mesh%node_count()
-        call h5%write_matrix(base // 'reference_nodes', body%mesh%x, status)
-        if (status%ok()) call h5%annotate(base // 'reference_nodes', 'unit', 'm', status)
-        if (status%ok()) call h5%write_integers(base // 'connectivity', &
-                                                body%mesh%connectivity, status)
-        if (status%ok()) call h5%annotate(base // 'connectivity', 'description', 'the nodes &
-            &of each element (numbered from 1, as in the mesh file)', status)
-        if (status%ok()) call h5%annotate(base // 'connectivity', 'element_type', &
-            element_type(body%mesh%nnode_element), status)
-        if (allocated(body%mesh%node_sets)) then
-            do k = 1, size(body%mesh%node_sets)
-                if (.not. status%ok()) exit
-                associate (set => body%mesh%node_sets(k))
-                    call h5%write_integers(base // 'node_sets/' // path_name(set%name), &
-                                           set%nodes, status)
-                end associate
-            end do
-        end if
-        if (allocated(body%mesh%element_sets)) then
-            do k = 1, size(body%mesh%element_sets)
-                if (.not. status%ok()) exit
-                associate (set => body%mesh%element_sets(k))
-                    call h5%write_integers(base // 'element_sets/' // path_name(set%name), &
-                                           set%elements, status)
-                end associate
-            end do
-        end if
-        if (.not. status%ok()) return
-        nodes%body => body
-        nodes%oq = oq
-        nodes%ov = ov
-        nodes%velocity = .false.
-        call h5%add_series(base // 'displacement', 3, 'm', nodes, status, 'x - X of every &
-            &node (fixed ones 0), world frame', columns=nn)
-        if (.not. status%ok()) return
-        nodes%velocity = .true.
-        call h5%add_series(base // 'velocity', 3, 'm/s', nodes, status, 'of every node', &
-            columns=nn)
-        if (.not. status%ok()) return
-        ne = body%mesh%element_count()
-        allocate (stress%sigma(6, ne), stress%mises(ne), stat=stat)
-        if (stat /= 0) then
-            call out_of_memory(status, 'the elements'' stress for the HDF5 file', &
-                7_i8 * ne, 8)
-            return
-        end if
-        stress%body => body
-        stress%oq = oq
-        stress%ov = ov
-        call h5%add_series(base // 'stress', 6, 'Pa', stress, status, 'Cauchy stress of &
-            &every element, mean over its quadrature points: xx, yy, zz, xy, yz, xz', &
-            columns=ne)
-        if (.not. status%ok()) return
-        stress%von_mises = .true.
-        call h5%add_series(base // 'von_mises', ne, 'Pa', stress, status, 'von Mises &
-            &stress of every element, from its mean Cauchy stress')
-    end subroutine add_flexible
-
-    subroutine stress_evaluate(self, t, y, values, status)
-        class(stress_values_t), intent(inout) :: self
-        real(wp), intent(in) :: t, y(:)
-        real(wp), intent(out) :: values(:)
-        type(status_t), intent(inout) :: status
-        integer :: el
-        associate (body => self%body)
-            call body%element_stress(y(self%oq + 1:self%oq + body%nq), &
-                                     y(self%ov + 1:self%ov + body%nv), self%sigma, &
-                                     self%mises, status)
-        end associate
-        if (self%von_mises) then
-            values = self%mises
-        else
-            do el = 1, size(self%sigma, 2)
-                values(6 * el - 5:6 * el) = self%sigma(:, el)
-            end do
-        end if
-    end subroutine stress_evaluate
-
-    subroutine node_evaluate(self, t, y, values, status)
-        class(node_values_t), intent(inout) :: self
-        real(wp), intent(in) :: t, y(:)
-        real(wp), intent(out) :: values(:)
-        type(status_t), intent(inout) :: status
-        integer :: i, j, d
-        associate (dof => self%body%dof)
-            do i = 1, size(dof, 2)
-                do j = 1, 3
-                    d = dof(j, i)
-                    if (d == 0) then
-                        values(3 * (i - 1) + j) = 0.0_wp
-                    else if (self%velocity) then
-                        values(3 * (i - 1) + j) = y(self%ov + d)
-                    else
-                        values(3 * (i - 1) + j) = y(self%oq + d) - self%body%mesh%x(j, i)
-                    end if
-                end do
-            end do
-        end associate
-    end subroutine node_evaluate
 
     !> /chains/<link>/: each link of a rigid chain (relative coordinates)
     !> whose q start after y(oq), v after y(ov); `names` in the chain's order.
@@ -727,24 +594,7 @@ contains
         end if
     end subroutine reaction_evaluate
 
-    pure function element_type(nodes) result(name)
-        integer, intent(in) :: nodes
-        character(len=:), allocatable :: name
-        name = 'hex27'
-        if (nodes == 8) name = 'hex8'
-    end function element_type
 
-    !> A scene name as one HDF5 path component ('/' would open a group).
-    pure function path_name(name) result(part)
-        character(len=*), intent(in) :: name
-        character(len=:), allocatable :: part
-        integer :: i
-        part = trim(name)
-        do i = 1, len(part)
-            if (part(i:i) == '/') part(i:i) = '_'
-        end do
-        if (part == '.' .or. len(part) == 0) part = '_' // part
-    end function path_name
 
     !> 'joints/NAME' with NAME made one path component.
     pure function group_path(joint_name) result(path)

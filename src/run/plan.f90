@@ -110,7 +110,7 @@ contains
         case (problem_pendulum)
             stab = trim(scene%pendulum_formulation)
         case (problem_flexible_body)
-            stab = trim(scene%body%formulation)
+            stab = trim(scene%bodies(1)%formulation)
         case (problem_multibody, problem_rigid_chain)
             stab = trim(scene%multibody%formulation)
         case default

@@ -126,14 +126,14 @@ contains
             allocate (flexible_body_t :: mechanical)
             select type (body => mechanical)
             type is (flexible_body_t)
-                call build_flexible_body(scene, body, q0, v0, status)
+                call build_flexible_body(scene, 1, body, q0, v0, status)
             end select
             if (.not. status%ok()) return
             call check_dense_size(scene, mechanical, status)
             if (.not. status%ok()) return
             ! M is constant in absolute nodal coordinates: y = (q, v[, λ]).
             formulation = new_formulation(mechanical, &
-                mechanical_formulation(scene%body%formulation), q0, constant_mass=.true., &
+                mechanical_formulation(scene%bodies(1)%formulation), q0, constant_mass=.true., &
                 status=status, sparse=scene%linear_solver /= 'dense')
             if (.not. status%ok()) then
                 status%message = scene%path // ': &flexible_body: ' // status%message

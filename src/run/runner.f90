@@ -24,7 +24,7 @@ module flexmbs_run_runner
     use flexmbs_io_table, only: new_stats_row, write_table
     use flexmbs_io_vtk_sink, only: vtk_sink_t
     use flexmbs_io_output_files, only: named_path_t, named_path, check_output_paths, &
-        output_hdf5, output_vtk, output_table
+        output_hdf5, output_vtk, output_table, scene_inputs
     use flexmbs_run_problem_factory, only: block_spec_t
     use flexmbs_run_plan, only: run_plan_t, make_plan, scene_stab
     use flexmbs_run_monitor_sink, only: monitor_sink_t
@@ -251,10 +251,11 @@ contains
 
     contains
 
-        !> ParaView output of the flexible body, the rigid bodies and the
+        !> ParaView output of the flexible bodies, the rigid bodies and the
         !> joints (y starts with q in every layout: the bodies' (r, p), then v
         !> behind q).
         subroutine setup_vtk()
+            integer :: k
             vtk%prefix = trim(scene%vtk)
             if (.not. allocated(plan%mechanical)) then
                 call status%set(status_bad_input, scene%path // ': &output: vtk: problem = ''' &
@@ -263,9 +264,10 @@ contains
             end if
             select type (m => plan%mechanical)
             type is (flexible_body_t)
-                vtk%body => m
-                vtk%oq = 0
-                vtk%ov = m%nq
+                allocate (vtk%flexible(1))
+                vtk%flexible(1)%body => m
+                vtk%flexible(1)%ov = m%nq
+                vtk%flexible(1)%name = scene%bodies(1)%name
             type is (mbs_system_t)
                 vtk%bodies = size(m%rigid%bodies)
                 vtk%names = body_names(size(m%rigid%bodies))
@@ -273,16 +275,18 @@ contains
                     vtk%chain => m%chains(1)
                     vtk%chain_q = m%chain_q(1)
                 end if
-                if (size(m%flex) > 0) then
-                    vtk%body => m%flex(1)
-                    vtk%oq = m%flex_q(1)
-                    vtk%ov = m%nq + m%flex_v(1)
+                allocate (vtk%flexible(size(m%flex)))
+                do k = 1, size(m%flex)
+                    vtk%flexible(k)%body => m%flex(k)
+                    vtk%flexible(k)%name = scene%bodies(k)%name
+                    vtk%flexible(k)%oq = m%flex_q(k)
+                    vtk%flexible(k)%ov = m%nq + m%flex_v(k)
                     select type (p => plan%problem)
                     type is (formulation_t)
-                        vtk%oq = p%oq + m%flex_q(1)
-                        vtk%ov = p%ov + m%flex_v(1)
+                        vtk%flexible(k)%oq = p%oq + m%flex_q(k)
+                        vtk%flexible(k)%ov = p%ov + m%flex_v(k)
                     end select
-                end if
+                end do
                 if (size(m%joints) > 0) then
                     vtk%system => m
                     if (allocated(plan%joint_names)) vtk%joint_names = plan%joint_names
@@ -354,10 +358,7 @@ contains
         type(named_path_t), allocatable :: outputs(:), inputs(:)
         character(len=:), allocatable :: pieces(:)
         integer :: n, k
-        allocate (inputs(merge(2, 1, len_trim(scene%body%mesh_file) > 0)))
-        inputs(1) = named_path(scene%path, 'the scene file itself')
-        if (size(inputs) > 1) inputs(2) = named_path(trim(scene%body%mesh_file), &
-            'the mesh file ''' // trim(scene%body%mesh_file) // '''')
+        inputs = scene_inputs(scene)
         allocate (character(len=0) :: pieces(0))
         if (len_trim(scene%vtk) > 0) pieces = vtk%pieces(records)
         allocate (outputs(3 + size(pieces)))

@@ -116,10 +116,10 @@ contains
         integer, intent(in) :: kind
         logical, intent(in) :: force
         type(status_t), intent(inout) :: status
-        type(named_path_t) :: inputs(4), outputs(1)
+        type(named_path_t) :: inputs(3 + size(base%bodies)), outputs(1)
         character(len=:), allocatable :: folder
         logical :: exists
-        integer :: slash, n
+        integer :: slash, n, b
         slash = index(output, '/', back=.true.)
         if (slash > 1) then
             folder = output(1:slash - 1)
@@ -133,11 +133,12 @@ contains
         inputs(1) = named_path(study%path, 'an input of the study (the study file)')
         inputs(2) = named_path(study%scene, 'an input of the study (its scene file)')
         n = 2
-        if (len_trim(base%body%mesh_file) > 0) then
+        do b = 1, size(base%bodies)
+            if (len_trim(base%bodies(b)%mesh_file) == 0) cycle
             n = n + 1
-            inputs(n) = named_path(trim(base%body%mesh_file), 'an input of the study &
+            inputs(n) = named_path(trim(base%bodies(b)%mesh_file), 'an input of the study &
                 &(the scene''s mesh file)')
-        end if
+        end do
         if (kind == output_table) then
             n = n + 1
             inputs(n) = named_path(study%reference_file, 'an input of the sweep (the &

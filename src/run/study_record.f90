@@ -78,16 +78,21 @@ contains
         type(scene_input_t), intent(in) :: base
         type(fingerprint_t), intent(out) :: print
         type(status_t), intent(out) :: status
-        character(len=:), allocatable :: text
+        character(len=:), allocatable :: text, meshes
+        integer :: b
         call read_text_file(study%path, text, status)
         if (.not. status%ok()) return
         print%study = sha256_hex(text)
         print%scene = sha256_hex(base%text)
-        if (len_trim(base%body%mesh_file) > 0) then
-            call read_text_file(trim(base%body%mesh_file), text, status)
+        ! the mesh files' texts one after the other (one file: its hash alone)
+        meshes = ''
+        do b = 1, size(base%bodies)
+            if (len_trim(base%bodies(b)%mesh_file) == 0) cycle
+            call read_text_file(trim(base%bodies(b)%mesh_file), text, status)
             if (.not. status%ok()) return
-            print%mesh = sha256_hex(text)
-        end if
+            meshes = meshes // text
+            print%mesh = sha256_hex(meshes)
+        end do
     end subroutine study_fingerprint
 
     !> The record of grid point k (module header).

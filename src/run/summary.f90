@@ -56,14 +56,14 @@ contains
                     end do
                 end if
                 do i = 1, size(m%flex)
-                    text = text // flexible_line(m%flex(i), trim(scene%body%name), &
+                    text = text // flexible_line(m%flex(i), trim(scene%bodies(i)%name), &
                         y(f%oq + m%flex_q(i) + 1:f%oq + m%flex_q(i) + m%flex(i)%nq), &
                         y(f%ov + m%flex_v(i) + 1:f%ov + m%flex_v(i) + m%flex(i)%nv))
                 end do
             type is (rigid_chain_t)
                 text = chain_lines(m, y(f%oq + 1:f%oq + m%nq))
             type is (flexible_body_t)
-                text = flexible_line(m, trim(scene%body%name), y(f%oq + 1:f%oq + m%nq), &
+                text = flexible_line(m, trim(scene%bodies(1)%name), y(f%oq + 1:f%oq + m%nq), &
                                      y(f%ov + 1:f%ov + m%nv))
             end select
         end select

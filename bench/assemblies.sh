@@ -1,0 +1,99 @@
+#!/usr/bin/env bash
+# `make bench` (part): the cost of modular assemblies. Prints figures,
+# asserts nothing (docs/benchmarks.md has a measured copy).
+#   Several flexible bodies: a soft bar of n x 2 x 2 hex8 elements hanging
+#   from the ground by a spherical joint at its xmin face and falling under
+#   gravity, against the same elements as two bars of n/2 x 2 x 2, the
+#   upper hanging the same way, the lower from the upper by a spherical
+#   joint between the faces they share (joints on node sets act through
+#   node frames). CPU per step of both, best of 3 runs, and their ratio
+#   (goal: two bodies at most 1.3 x one body's per step), for RADAU5 and
+#   DDASSL (GGL, TOL 1e-6, 0.05 s, the sparse path, one BLAS thread). Then
+#   the same against the bar clamped at xmin (no joint, no node frame: the
+#   layout without accelerations and multipliers), which prices the joints.
+set -u
+cd "$(dirname "$0")/.."
+FPM=${FPM:-fpm}
+BIN=$($FPM run --profile release flexmbs --runner echo 2>/dev/null | tail -1)
+[ -x "$BIN" ] || { echo "bench/assemblies.sh: could not build flexmbs" >&2; exit 1; }
+OUT=build/bench/assemblies
+mkdir -p "$OUT"
+export OPENBLAS_NUM_THREADS=1
+
+# bar NAME N X0 [CLAMP] -> a &flexible_body of N x 2 x 2 elements, 0.025 m each
+# (CLAMP = 1: fixed at xmin when it starts at x = 0)
+bar() {
+    awk -v name="$1" -v n="$2" -v x0="$3" -v clamp="${4:-0}" 'BEGIN {
+        printf "&flexible_body name = '\''%s'\'', divisions = %d, 2, 2,\n", name, n
+        printf "    lengths = %.6f, 0.05, 0.05, origin = %.6f, -0.025, -0.025,\n", 0.025 * n, x0
+        printf "    gravity = 0, -9.81, 0%s /\n", (x0 == 0 && clamp ? ", fixed = '\''xmin'\''" : "")
+        printf "&material name = '\''%s soft'\'', body = '\''%s'\'', youngs_modulus = 7e5,\n", name, name
+        printf "    density = 920, viscosity = 1000 /\n" }'
+}
+
+# scene FILE SOLVER N BODIES -> the bar (BODIES = 1), the two halves (2), both
+# hanging from the ground by their root face; or the bar clamped (BODIES = 0)
+scene() {
+    {
+        echo "&simulation problem = 'multibody', t_end = 0.05 /"
+        echo "&multibody formulation = 'ggl', gravity = 0, -9.81, 0 /"
+        case "$4" in
+        0) bar one "$3" 0 1 ;;
+        1) bar one "$3" 0
+           hang one ;;
+        2) bar upper $(($3 / 2)) 0
+           hang upper
+           bar lower $(($3 / 2)) "$(awk -v n="$3" 'BEGIN { printf "%.6f", 0.0125 * n }')"
+           echo "&marker name = 'upper tip', body = 'upper', node_set = 'xmax' /"
+           echo "&marker name = 'lower root', body = 'lower', node_set = 'xmin' /"
+           echo "&joint type = 'spherical', marker_i = 'upper tip', marker_j = 'lower root' /" ;;
+        esac
+        echo "&solver name = '$2', rtol = 1e-6, atol = 1e-6 /"
+        echo "&output file = 'none' /"
+    } > "$1"
+}
+
+# hang NAME -> a spherical joint from the ground to body NAME's xmin face
+hang() {
+    echo "&marker name = 'pivot', body = 'ground' /"
+    echo "&marker name = '$1 root', body = '$1', node_set = 'xmin' /"
+    echo "&joint type = 'spherical', marker_i = 'pivot', marker_j = '$1 root' /"
+}
+
+# best FILE -> "CPU/step NST" of the best of 3 runs (CPU from the statistics line)
+best() {
+    local best="" line cpu nst per
+    for _ in 1 2 3; do
+        line=$("$BIN" run "$1" --quiet 2>&1 | grep -E '^[a-z0-9]+: NST=' | tail -1)
+        [ -n "$line" ] || { echo "failed -"; return; }
+        cpu=$(echo "$line" | sed 's/.*CPU=\([0-9.]*\).*/\1/')
+        nst=$(echo "$line" | sed 's/.*NST=\([0-9]*\).*/\1/')
+        per=$(awk -v c="$cpu" -v n="$nst" 'BEGIN { printf "%.3e", c / n }')
+        if [ -z "$best" ] || awk -v a="$per" -v b="${best%% *}" 'BEGIN { exit !(a < b) }'; then
+            best="$per $nst"
+        fi
+    done
+    echo "$best"
+}
+
+# compare TITLE BASE: rows of one body (scene kind BASE) against two
+compare() {
+    echo "== $1, best CPU per step of 3 (GGL, TOL 1e-6, 0.05 s)"
+    echo "  solver  n   elements  one: CPU/step[s] NST  two: CPU/step[s] NST  ratio (goal <= 1.3)"
+    for solver in radau5 ddassl; do
+        for n in 16 32 64; do
+            scene "$OUT/one${2}_${solver}_$n.nml" "$solver" "$n" "$2"
+            scene "$OUT/two_${solver}_$n.nml" "$solver" "$n" 2
+            one=$(best "$OUT/one${2}_${solver}_$n.nml")
+            two=$(best "$OUT/two_${solver}_$n.nml")
+            awk -v s="$solver" -v n="$n" -v o="$one" -v t="$two" 'BEGIN {
+                split(o, a, " "); split(t, b, " ")
+                r = (a[1] > 0 && b[1] > 0) ? sprintf("%.2f", b[1] / a[1]) : "-"
+                printf "  %-7s %-3d %-9d %-16s %-4s %-16s %-4s %s\n", s, n, 4 * n, a[1], a[2], b[1], b[2], r }'
+        done
+    done
+}
+
+compare "one bar of n x 2 x 2 hex8 hanging by a spherical joint against two of n/2 x 2 x 2" 1
+echo
+compare "the same two bars against one bar clamped at xmin (no joint)" 0
