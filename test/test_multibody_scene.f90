@@ -225,7 +225,7 @@ contains
             &''root'' /', "marker_j 'root': mesh: no node set named 'xmn'")
         call expect(error, base // '&marker name = ''root'', body = ''bar'', node_set = &
             &''xmin'' /' // nl // '&joint type = ''attach'', marker_i = ''root'', marker_j = &
-            &''tip'' /', "'attach' joins a marker of a rigid body or the ground")
+            &''tip'' /', "'attach' joins a marker of a rigid body, a chain link or the ground")
         call expect(error, base // '&marker name = ''root'', body = ''bar'', node_set = &
             &''xmn'' /' // nl // '&joint type = ''revolute'', marker_i = ''tip'', marker_j = &
             &''root'' /', "&marker 'root': mesh: no node set named 'xmn'")

@@ -131,8 +131,8 @@ contains
                 if (jt%type == 'attach') then
                     if (.not. (on_flexible(jt%marker_j) .and. .not. on_flexible(jt%marker_i))) &
                         call value_error(errors, entries, 'joint', 'type', '''attach'' joins a &
-                        &marker of a rigid body or the ground (marker_i) to a node-set marker of &
-                        &a flexible body (marker_j)', i)
+                        &marker of a rigid body, a chain link or the ground (marker_i) to a &
+                        &node-set marker of a flexible body (marker_j)', i)
                 end if
             end associate
         end do

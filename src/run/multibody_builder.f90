@@ -64,8 +64,8 @@ contains
         real(wp), allocatable :: qf(:), vf(:), qc(:), vc(:)
         integer, allocatable :: nodes(:), frame_of(:), flex_v0(:)
         character(len=:), allocatable :: labels(:), frame_labels(:), defect, names(:)
-        real(wp) :: p(4), r(3, 3), anchor(3)
-        integer :: i, nb, k, n, b, mi, fb
+        real(wp) :: p(4), r(3, 3), anchor(3), origin(3)
+        integer :: i, nb, k, n, b, mi, fb, c
         ! node-set markers that a joint other than 'attach' or a driver uses
         ! get a node frame (a massless body after the scene's rigid bodies)
         allocate (frame_of(size(scene%markers)), source=0)
@@ -187,14 +187,9 @@ contains
                     cycle
                 end if
                 ! 'attach': a spherical joint per node of the set, the rigid side's
-                ! marker at the node's reference position in that body's frame
+                ! marker at the node's reference position in that body's (or chain
+                ! link's) frame
                 mi = marker_index(scene, jt%marker_i)
-                if (markers(mi)%chain > 0) then
-                    call status%set(status_bad_input, scene%path // ': &joint ''' // &
-                        trim(jt%name) // ''': ''attach'' pins nodes to a rigid body or the &
-                        &ground, not to a chain body')
-                    return
-                end if
                 associate (mj => scene%markers(marker_index(scene, jt%marker_j)))
                     fb = flexible_index(scene, mj%body)
                     call flex(fb)%mesh%node_set(trim(mj%node_set), nodes, status)
@@ -206,13 +201,17 @@ contains
                     return
                 end if
                 b = markers(mi)%body
+                c = markers(mi)%chain
+                if (c > 0) call link_frame(c, markers(mi)%link, origin, r)
                 do n = 1, size(nodes)
                     anchor = flex(fb)%mesh%x(:, nodes(n))
-                    if (b > 0) then
+                    if (c > 0) then
+                        anchor = matmul(transpose(r), anchor - origin)
+                    else if (b > 0) then
                         r = rotation_matrix(q0(7 * b - 3:7 * b))
                         anchor = matmul(transpose(r), anchor - q0(7 * b - 6:7 * b - 4))
                     end if
-                    markers = [markers, marker_t(b, anchor), &
+                    markers = [markers, marker_t(b, anchor, chain=c, link=markers(mi)%link), &
                                marker_t(0, flexible=fb, node=nodes(n))]
                     joints = [joints, mbs_joint_t(joint_spherical, size(markers) - 1, &
                                                   size(markers))]
@@ -245,6 +244,19 @@ contains
         if (present(joint_names)) joint_names = names
 
     contains
+
+        !> Origin and axes of link `link` of chain c at q0 (the chains' q
+        !> follow the rigid bodies', chain by chain).
+        subroutine link_frame(c, link, origin, axes)
+            integer, intent(in) :: c, link
+            real(wp), intent(out) :: origin(3), axes(3, 3)
+            integer :: first, k
+            first = 7 * nb
+            do k = 1, c - 1
+                first = first + chains(k)%nq
+            end do
+            call chains(c)%body_frame(q0(first + 1:first + chains(c)%nq), link, origin, axes)
+        end subroutine link_frame
 
         !> Marker `name` gets a node frame if it is a node-set marker.
         subroutine use_frame(name)
