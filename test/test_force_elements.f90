@@ -1,6 +1,8 @@
 !> Force elements between markers (src/mbs/force_element.f90,
 !> src/mbs/system_elements.f90): ∂f/∂q and ∂f/∂v of every kind against
-!> central differences, dense against sparse; equal and opposite wrenches;
+!> central differences, the hand-coded laws (force_element_tangent, the
+!> default 'analytic') against the dual-number laws ('ad'), dense against
+!> sparse; equal and opposite wrenches;
 !> a spring–mass oscillation against its analytic motion; an undamped
 !> pendulum on a torsion spring carrying a body on a nonlinear spring
 !> conserves energy to tolerance level, damped it dissipates; coinciding
@@ -16,7 +18,8 @@ module test_force_elements
     use flexmbs_mbs_driver, only: driver_t
     use flexmbs_mbs_force_element, only: force_element_t, force_spring_damper, &
         force_rotational, force_bushing, force_applied
-    use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t
+    use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
+        constraint_derivatives_ad
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, new_rigid_chain, chain_body_t, &
         chain_joint_revolute, chain_joint_spherical
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index2, &
@@ -160,6 +163,33 @@ contains
         call check(error, eq < 1.0e-7_wp .and. ev < 1.0e-7_wp .and. es < 1.0e-14_wp, trim(msg))
     end subroutine compare_derivatives
 
+    !> The hand-coded laws ('analytic', sys's default) against the dual-number
+    !> laws ('ad', a copy of sys): f, ∂f/∂q and ∂f/∂v equal to round-off.
+    subroutine compare_with_ad(error, sys, q, v, what)
+        type(error_t), allocatable, intent(inout) :: error
+        type(mbs_system_t), intent(inout) :: sys
+        real(wp), intent(in) :: q(:), v(:)
+        character(len=*), intent(in) :: what
+        type(mbs_system_t) :: ad
+        type(status_t) :: status
+        real(wp) :: f(size(v)), fa(size(v)), fq(size(v), size(q)), fv(size(v), size(v)), &
+            aq(size(v), size(q)), av(size(v), size(v)), e(3)
+        character(len=120) :: msg
+        ad = sys
+        ad%derivatives = constraint_derivatives_ad
+        call sys%forces(0.3_wp, q, v, f, status)
+        if (status%ok()) call ad%forces(0.3_wp, q, v, fa, status)
+        if (status%ok()) call sys%force_derivatives(0.3_wp, q, v, fq, fv, status)
+        if (status%ok()) call ad%force_derivatives(0.3_wp, q, v, aq, av, status)
+        call check(error, status%ok(), status%text())
+        if (allocated(error)) return
+        e = [maxval(abs(f - fa)) / maxval(abs(fa)), rel_err(fq, aq), rel_err(fv, av)]
+        write (msg, '(a,3(a,es9.2))') what, ': analytic - AD: f ', e(1), ', df/dq ', e(2), &
+            ', df/dv ', e(3)
+        print '(a)', '    ' // trim(msg)
+        call check(error, all(e < 1.0e-13_wp), trim(msg))
+    end subroutine compare_with_ad
+
     !> The sparse ∂f/∂q and ∂f/∂v on their patterns, as dense arrays.
     subroutine sparse_as_dense(sys, patterns, t, q, v, sq, sv, status)
         type(mbs_system_t), intent(inout) :: sys
@@ -205,6 +235,8 @@ contains
             write (msg, '(a,i0,2(a,es9.2))') 'state ', trial, ': df/dq ', eq, ', df/dv ', ev
             print '(a)', '    ' // trim(msg)
             call check(error, eq < 1.0e-7_wp .and. ev < 1.0e-7_wp, trim(msg))
+            if (allocated(error)) return
+            call compare_with_ad(error, sys, q, v, 'state ' // achar(iachar('0') + trial))
             if (allocated(error)) return
         end do
         ! the elements contribute: without them the blocks differ
@@ -296,6 +328,7 @@ contains
         q(9:12) = random_quaternion(rng)
         v = random_vector(rng, 10, -1.0_wp, 1.0_wp)
         call compare_derivatives(error, sys, patterns, q, v, 'chain')
+        if (.not. allocated(error)) call compare_with_ad(error, sys, q, v, 'chain')
     contains
         pure function eye6() result(a)
             real(wp) :: a(6, 6)
@@ -350,6 +383,7 @@ contains
         q(8:) = bar(1)%free_positions() + random_vector(rng, sys%nq - 7, -0.005_wp, 0.005_wp)
         v = random_vector(rng, sys%nv, -0.5_wp, 0.5_wp)
         call compare_derivatives(error, sys, patterns, q, v, 'nodes')
+        if (.not. allocated(error)) call compare_with_ad(error, sys, q, v, 'nodes')
         if (allocated(error)) return
         ! a node has no axes: a rotational element or a bushing on one is refused
         sys = new_mbs_system([test_body(1.0_wp, 0.1_wp)], m, [mbs_joint_t ::], &

@@ -174,7 +174,8 @@ module flexmbs_io_scene_schema
         var_spec_t('multibody', 'gravity', kind_real, 3, default='0, -9.81, 0', &
             unit='m/s^2', doc='gravity'), &
         var_spec_t('multibody', 'constraint_derivatives', kind_string, default='analytic', &
-            choices='analytic|ad|ad_full', doc='joint derivatives: hand-coded or AD'), &
+            choices='analytic|ad|ad_full', &
+            doc='joint and force-element derivatives: hand-coded or AD'), &
         var_spec_t('multibody', 'projection', kind_logical, default='.false.', &
             doc='coordinate projection after each step'), &
         var_spec_t('multibody', 'assembly_tolerance', kind_real, default='1e-3', &

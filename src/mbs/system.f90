@@ -70,7 +70,7 @@ module flexmbs_mbs_system
         chain_marker_jacobian_d => chain_marker_jacobian
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, chain_joint_spherical
     use flexmbs_mbs_driver, only: driver_t, driver_values
-    use flexmbs_mbs_force_element, only: force_element_t
+    use flexmbs_mbs_force_element, only: force_element_t, element_frame_t
     use flexmbs_mbs_jet, only: jet_t
     use flexmbs_mbs_constraint_primitives_jet, only: marker_state_j => marker_state_t, &
         ground_marker_state_j => ground_marker_state, joint_value_j => joint_value
@@ -572,6 +572,23 @@ module flexmbs_mbs_system
             type(accumulator_t), intent(inout) :: fq, fv
             type(status_t), intent(inout) :: status
         end subroutine add_element_derivatives
+        ! force elements, hand-coded derivatives (system_element_tangents.f90)
+        module subroutine add_element_forces_analytic(self, t, q, v, f, status)
+            class(mbs_system_t), intent(in) :: self
+            real(wp), intent(in) :: t, q(:), v(:)
+            real(wp), intent(inout) :: f(:)
+            type(status_t), intent(inout) :: status
+        end subroutine add_element_forces_analytic
+        module subroutine add_element_derivatives_analytic(self, t, q, v, fq, fv, status)
+            class(mbs_system_t), intent(in) :: self
+            real(wp), intent(in) :: t, q(:), v(:)
+            type(accumulator_t), intent(inout) :: fq, fv
+            type(status_t), intent(inout) :: status
+        end subroutine add_element_derivatives_analytic
+        pure module subroutine frame_of_state(ms, fr)
+            type(marker_state_d), intent(in) :: ms
+            type(element_frame_t), intent(out) :: fr
+        end subroutine frame_of_state
         module subroutine add_element_patterns(self, fq, fv)
             class(mbs_system_t), intent(in) :: self
             type(triplets_t), intent(inout) :: fq, fv

@@ -7,7 +7,9 @@
 !> the same code serves rigid, chain and node markers). Evaluated on dual
 !> numbers seeded with the bodies' coordinates (or velocities), the
 !> generalised forces carry their exact ∂f/∂q (or ∂f/∂v), the markers'
-!> Jacobians' own dependence on q included.
+!> Jacobians' own dependence on q included. That is the 'ad' and 'ad_full'
+!> path; 'analytic' (the default) takes the hand-coded laws of
+!> flexmbs_mbs_system_element_tangents.
 submodule (flexmbs_mbs_system) flexmbs_mbs_system_elements
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use flexmbs_mbs_dual, only: operator(-), operator(*), matmul
@@ -69,20 +71,6 @@ contains
         end do
     end procedure place_elements
 
-    !> The element frame of a dual marker state: ω = ½ Σ_k a_k × ȧ_k.
-    pure subroutine frame_of(m, fr)
-        type(marker_state_d), intent(in) :: m
-        type(element_frame_t), intent(out) :: fr
-        integer :: k
-        fr%x = m%x
-        fr%a = m%a
-        fr%xd = m%xd
-        fr%w = 0.0_wp
-        do k = 1, 3
-            fr%w = fr%w + 0.5_wp * cross_d(m%a(:, k), m%ad(:, k))
-        end do
-    end subroutine frame_of
-
     !> Generalised forces gi(1:ni), gj(1:nj) of element e on the velocity
     !> columns of its markers' bodies, seeded by `seed` (seed_position:
     !> tangents ∂/∂q, seed_velocity: ∂/∂v) in directions 1..di of marker i's
@@ -94,7 +82,7 @@ contains
         integer :: bi, bj, iqi, iqj, ivi, ivj
         associate (e => self%elements(ie))
             call marker_state_dual(self, e%marker_i, q, v, seed, 1, mi, pi, di)
-            call frame_of(mi, fi)
+            call frame_of_state(mi, fi)
             ni = marker_columns(self, e%marker_i, .false.)
             offj = di
             dj = 0
@@ -110,7 +98,7 @@ contains
                 mj = mi
                 pj = pi
             end if
-            call frame_of(mj, fj)
+            call frame_of_state(mj, fj)
             call element_wrench(e, t, fi, fj, force, torque, status)
             if (.not. status%ok()) then
                 status%message = 'force element ' // int_text(ie) // ': ' // status%message
@@ -144,6 +132,10 @@ contains
     module procedure add_element_forces
         type(dual_t) :: gi(rigid_body_nq), gj(rigid_body_nq)
         integer :: ie, ni, nj, di, dj, offj, b, iq, iv
+        if (self%derivatives == constraint_derivatives_analytic) then
+            call add_element_forces_analytic(self, t, q, v, f, status)
+            return
+        end if
         do ie = 1, size(self%elements)
             call element_generalised(self, ie, t, q, v, seed_velocity, gi, gj, ni, nj, di, &
                                      dj, offj, status)
@@ -161,6 +153,10 @@ contains
         type(dual_t) :: gi(rigid_body_nq), gj(rigid_body_nq)
         integer :: ie, ni, nj, di, dj, offj, pass
         logical :: position_space
+        if (self%derivatives == constraint_derivatives_analytic) then
+            call add_element_derivatives_analytic(self, t, q, v, fq, fv, status)
+            return
+        end if
         do ie = 1, size(self%elements)
             do pass = 1, 2
                 position_space = pass == 1
