@@ -120,6 +120,16 @@ contains
                         int_text(markers(k)%link) // ' is not a body of its chain')
                     return
                 end if
+                ! the joints' derivatives seed a marker's body coordinates into
+                ! dual numbers of 16 directions, two bodies and time at once
+                if (self%chains(markers(k)%chain)%nq > rigid_body_nq) then
+                    call status%set(status_bad_input, where // ': chain ' // &
+                        int_text(markers(k)%chain) // ' has ' // &
+                        int_text(self%chains(markers(k)%chain)%nq) // ' coordinates: a ' // &
+                        'marker needs a chain of at most ' // int_text(rigid_body_nq) // &
+                        ' (larger chains without markers have no limit)')
+                    return
+                end if
             end if
             if (markers(k)%flexible /= 0) then
                 if (markers(k)%flexible < 1 .or. markers(k)%flexible > size(self%flex)) then
