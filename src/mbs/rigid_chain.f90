@@ -334,9 +334,8 @@ contains
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: f(:)
         type(status_t), intent(inout) :: status
-        real(wp) :: zero(size(v))
-        zero = 0.0_wp
-        call chain_inverse_dynamics(self, q, v, zero, f)
+        self%rates0 = 0.0_wp
+        call chain_inverse_dynamics(self, q, v, self%rates0, f)
         f = -f
     end subroutine chain_forces
 
