@@ -77,6 +77,15 @@ for mech in fourbar slidercrank; do
     "$BIN" ad $mech 2>>"$ERRORS" | tee -a "$RESULTS"
 done
 
+# Rigid chains: M(q), f, ∂(M w)/∂q, ∂f/∂(q, v) per evaluation for 4..64 links.
+echo
+CHAIN_BIN=$($FPM run --profile release --example flexmbs-bench-chain --runner echo 2>/dev/null | tail -1)
+if [ -x "$CHAIN_BIN" ]; then
+    "$CHAIN_BIN" 2>>"$ERRORS" | tee -a "$RESULTS"
+else
+    echo "bench: could not build flexmbs-bench-chain" | tee -a "$ERRORS"
+fi
+
 # Finite-element assembly: clamped cubes of 1e3..1e5 free dofs, both elements.
 echo
 echo "assembly element ndof elements nnz repeats t_tangent[s] us/element t_force[s] us/element bytes/dof threads"

@@ -37,6 +37,7 @@ program flexmbs_tests
     use test_bushing_mount, only: collect_bushing_mount
     use test_mechanisms, only: collect_mechanisms
     use test_rigid_chain, only: collect_rigid_chain
+    use test_chain_derivatives, only: collect_chain_derivatives
     use test_flexible_marker, only: collect_flexible_marker
     use test_multibody_scene, only: collect_multibody_scene
     use test_flexible_coupling, only: collect_flexible_coupling
@@ -95,6 +96,8 @@ program flexmbs_tests
     call run_suite('bushing_mount', collect_bushing_mount(), filter, npassed, nfailed)
     call run_suite('mechanisms', collect_mechanisms(), filter, npassed, nfailed)
     call run_suite('rigid_chain', collect_rigid_chain(), filter, npassed, nfailed)
+    call run_suite('chain_derivatives', collect_chain_derivatives(), filter, npassed, &
+                   nfailed)
     call run_suite('flexible_marker', collect_flexible_marker(), filter, npassed, nfailed)
     call run_suite('multibody_scene', collect_multibody_scene(), filter, npassed, nfailed)
     call run_suite('flexible_coupling', collect_flexible_coupling(), filter, npassed, &

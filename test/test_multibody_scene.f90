@@ -9,7 +9,7 @@ module test_multibody_scene
     use flexmbs_run_runner, only: run_result_t, run_scene
     use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_problems_mechanisms, only: four_bar_exact, four_bar_torque, crank_angle, bar_b
-    use flexmbs_run_chain_builder, only: build_rigid_chain
+    use flexmbs_run_chain_builder, only: build_rigid_chain, chain_link
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     use flexmbs_mbs_flexible_marker, only: flexible_marker_t, new_flexible_marker
     use testing, only: test_case_t, new_test, error_t, check
@@ -31,6 +31,7 @@ contains
                  new_test('rigid_flexible_bad_scenes', test_rigid_flexible_bad), &
                  new_test('monitor_drift_energy', test_monitor), &
                  new_test('four_bar_chain_file', test_four_bar_chain), &
+                 new_test('four_bar_two_chains_file', test_four_bar_chains), &
                  new_test('face_hinge_file', test_face_hinge), &
                  new_test('five_body_file', test_five_body), &
                  new_test('bdf_ggl_tight_tolerance', test_bdf_tight), &
@@ -517,4 +518,35 @@ contains
             call check(error, dev <= 1.0e-5_wp, trim(solvers(k)) // ': off the closed form')
         end do
     end subroutine test_four_bar_chain
+
+    !> inputs/four_bar_chains.nml: crank and rocker as two chains, a rope of
+    !> 8 links (11 coordinates) as a third between them in the file. Links
+    !> map to (chain, link) tree by tree; the coupler and crank follow the
+    !> closed form (RADAU5, 1e-5 at rtol 1e-7); the rope swings freely.
+    subroutine test_four_bar_chains(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=6), parameter :: links(4) = ['crank ', 'rope 1', 'rocker', 'rope 8']
+        integer, parameter :: chain_of(4) = [1, 2, 3, 2], link_of(4) = [1, 1, 1, 8]
+        type(scene_input_t) :: scene
+        type(run_result_t) :: result
+        real(wp) :: b(3), c(3), r(3, 3), dev
+        integer :: k, chain, link
+        call run_file(error, 'inputs/four_bar_chains.nml', 'radau5', scene, result)
+        if (allocated(error)) return
+        do k = 1, size(links)
+            call chain_link(scene, trim(links(k)), chain, link)
+            call check(error, chain == chain_of(k) .and. link == link_of(k), &
+                       trim(links(k)) // ': wrong chain or link')
+            if (allocated(error)) return
+        end do
+        call four_bar_exact(crank_angle(1.0_wp), b, c)
+        ! q = (coupler r, p; crank; rope; rocker)
+        r = rotation_matrix(result%y(4:7))
+        dev = max(norm2(result%y(1:3) + 0.5_wp * bar_b * r(:, 1) - c), &
+                  abs(atan2(sin(result%y(8) - crank_angle(1.0_wp)), &
+                            cos(result%y(8) - crank_angle(1.0_wp)))))
+        print '(4x,a,es9.2)', 'four-bar with crank and rocker as two chains off by ', dev
+        call check(error, dev <= 1.0e-5_wp, 'two chains: off the closed form')
+        call check(error, abs(result%y(9) + 0.5_wp) > 0.1_wp, 'the rope did not swing')
+    end subroutine test_four_bar_chains
 end module test_multibody_scene

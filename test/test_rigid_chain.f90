@@ -1,7 +1,8 @@
 !> Rigid chains in relative coordinates: the composite-rigid-body mass
 !> matrix against the kinetic energy of the bodies, recursive Newton–Euler
 !> against Lagrange's equations, energy conservation, the same bodies in
-!> absolute coordinates with revolute joints, and MEXAX on the chain.
+!> absolute coordinates with revolute and spherical joints (up to a 12-link
+!> chain and a branching tree), and MEXAX on the chain.
 module test_rigid_chain
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t
@@ -23,6 +24,8 @@ module test_rigid_chain
     public :: collect_rigid_chain
 
     real(wp), parameter :: g_earth(3) = [0.0_wp, 0.0_wp, -9.81_wp]
+    real(wp), parameter :: identity3(3, 3) = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
+        1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
 
 contains
 
@@ -34,7 +37,9 @@ contains
                  new_test('same_motion_as_absolute_coordinates', test_absolute), &
                  new_test('mexax_runs_the_chain', test_mexax), &
                  new_test('spherical_joint_mass_and_energy', test_spherical), &
-                 new_test('spherical_joint_same_motion_as_absolute', test_spherical_absolute)]
+                 new_test('spherical_joint_same_motion_as_absolute', test_spherical_absolute), &
+                 new_test('twelve_links_same_motion_as_absolute', test_twelve_links), &
+                 new_test('branching_tree_same_motion_as_absolute', test_branching_tree)]
     end function collect_rigid_chain
 
     !> A tree of four bodies: 1 on the ground (revolute z), 2 on 1 (revolute
@@ -240,23 +245,46 @@ contains
     subroutine compare_absolute(error, chain, q0, v0, p, markers, joints, label)
         type(error_t), allocatable, intent(inout) :: error
         type(rigid_chain_t), target, intent(inout) :: chain
-        real(wp), intent(in) :: q0(:), v0(:), p(4, 2)
+        real(wp), intent(in) :: q0(:), v0(:), p(:, :)
         type(marker_t), intent(in) :: markers(:)
         type(mbs_joint_t), intent(in) :: joints(:)
         character(len=*), intent(in) :: label
+        real(wp) :: worst
+        call absolute_difference(error, chain, q0, v0, p, markers, joints, label, 1.0e-8_wp, &
+                                 1.0_wp, worst)
+        if (allocated(error)) return
+        print '(4x,a,a,es9.2)', label, ' vs absolute coordinates at t = 1: ', worst
+        call check(error, worst <= 1.0e-6_wp, label // ': chain and absolute coordinates differ')
+    end subroutine compare_absolute
+
+    !> The bodies of `chain` (frames' quaternions p at q0) also as free bodies
+    !> joined by `joints` between `markers` (GGL), both integrated by RADAU5
+    !> to t_end at rtol = atol = tol; worst: the largest difference of a
+    !> centre of mass or a rotation matrix entry at t_end.
+    subroutine absolute_difference(error, chain, q0, v0, p, markers, joints, label, tol, t_end, &
+                                   worst)
+        type(error_t), allocatable, intent(inout) :: error
+        type(rigid_chain_t), target, intent(inout) :: chain
+        real(wp), intent(in) :: q0(:), v0(:), p(:, :), tol, t_end
+        type(marker_t), intent(in) :: markers(:)
+        type(mbs_joint_t), intent(in) :: joints(:)
+        character(len=*), intent(in) :: label
+        real(wp), intent(out) :: worst
         type(mbs_system_t), target :: sys
         type(formulation_t) :: dae_chain, dae_abs
         type(radau5_t) :: solver
         type(dae_options_t) :: options
         type(dae_stats_t) :: stats
         type(status_t) :: status
-        type(rigid_body_t) :: bodies(2)
-        real(wp) :: qa(14), o(3), r(3, 3), vc(3), w(3), t, worst
+        type(rigid_body_t) :: bodies(size(p, 2))
+        real(wp) :: qa(7 * size(p, 2)), o(3), r(3, 3), vc(3), w(3), t
         real(wp), allocatable :: y(:), ya(:), yp(:), qn(:)
-        integer :: i, nq, nv
+        integer :: i, nq, nv, nb
         nq = chain%nq
         nv = chain%nv
-        do i = 1, 2
+        nb = size(p, 2)
+        worst = huge(1.0_wp)
+        do i = 1, nb
             call chain%body_frame(q0, i, o, r)
             call check(error, maxval(abs(rotation_matrix(p(:, i)) - r)) < 1.0e-14_wp, &
                        label // ': quaternion of the chain frame')
@@ -270,41 +298,38 @@ contains
         if (allocated(error)) return
         dae_abs = new_formulation(sys, formulation_ggl, qa, status=status)
         allocate (ya(dae_abs%n), yp(dae_abs%n), source=0.0_wp)
-        ya(1:14) = qa
-        do i = 1, 2
+        ya(1:7 * nb) = qa
+        do i = 1, nb
             call chain%body_velocity(q0, v0, i, vc, w)
             call chain%body_frame(q0, i, o, r)
-            ya(14 + 6 * i - 5:14 + 6 * i - 3) = vc
-            ya(14 + 6 * i - 2:14 + 6 * i) = matmul(transpose(r), w)
+            ya(7 * nb + 6 * i - 5:7 * nb + 6 * i - 3) = vc
+            ya(7 * nb + 6 * i - 2:7 * nb + 6 * i) = matmul(transpose(r), w)
         end do
         call dae_abs%consistent_initial(0.0_wp, ya, yp, status)
-        options%rtol = 1.0e-8_wp
-        options%atol = 1.0e-8_wp
+        options%rtol = tol
+        options%atol = tol
         t = 0.0_wp
-        call solver%integrate(dae_abs, t, ya, 1.0_wp, options, stats, status)
+        call solver%integrate(dae_abs, t, ya, t_end, options, stats, status)
         call check(error, status%ok(), label // ': absolute run: ' // status%text())
         dae_chain = new_formulation(chain, formulation_index2, q0, status=status)
         allocate (y(dae_chain%n), source=0.0_wp)
         y(1:nq) = q0
         y(nq + 1:nq + nv) = v0
         t = 0.0_wp
-        call solver%integrate(dae_chain, t, y, 1.0_wp, options, stats, status)
+        call solver%integrate(dae_chain, t, y, t_end, options, stats, status)
         call check(error, status%ok(), label // ': chain run: ' // status%text())
         if (allocated(error)) return
         qn = y(1:nq)
         call chain%normalize(qn)
         worst = 0.0_wp
-        do i = 1, 2
+        do i = 1, nb
             call chain%body_frame(qn, i, o, r)
             worst = max(worst, norm2(o + matmul(r, chain%bodies(i)%centre) - &
                                      ya(7 * i - 6:7 * i - 4)), &
                         maxval(abs(rotation_matrix(ya(7 * i - 3:7 * i) / &
                                                    norm2(ya(7 * i - 3:7 * i))) - r)))
         end do
-        print '(4x,a,a,es9.2)', label, ' vs absolute coordinates at t = 1: ', worst
-        call check(error, worst <= 1.0e-6_wp, label // ': chain and absolute coordinates differ')
-    end subroutine compare_absolute
-
+    end subroutine absolute_difference
 
     !> MEXAX integrates the chain's mechanical form (nc = 0) to the RADAU5
     !> state within the tolerance.
@@ -428,4 +453,89 @@ contains
         call compare_absolute(error, chain, q0, v0, p, m, [mbs_joint_t(joint_spherical, 1, 2), &
                               mbs_joint_t(joint_revolute, 3, 4)], 'spherical chain')
     end subroutine test_spherical_absolute
+
+    !> A chain of 12 revolute links, each on the one before, axes turning
+    !> from link to link, under gravity.
+    subroutine test_twelve_links(error)
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i
+        call tree_against_absolute(error, [(i - 1, i = 1, 12)], &
+                                   [(chain_joint_revolute, i = 1, 12)], '12-link chain')
+    end subroutine test_twelve_links
+
+    !> A revolute root carrying two 3-link branches, one starting with a
+    !> spherical joint.
+    subroutine test_branching_tree(error)
+        type(error_t), allocatable, intent(out) :: error
+        call tree_against_absolute(error, [0, 1, 2, 3, 1, 5, 6], [chain_joint_revolute, &
+            chain_joint_spherical, chain_joint_revolute, chain_joint_revolute, &
+            chain_joint_revolute, chain_joint_revolute, chain_joint_revolute], 'branching tree')
+    end subroutine test_branching_tree
+
+    !> The tree of `parent`s and joint `kinds` (revolute or spherical; joint
+    !> frames parallel to the parent's, axes varying) as a chain and as free
+    !> bodies with revolute and spherical joints, to t = 1 at tolerances
+    !> 1e-6 and 1e-8: the bodies' difference at most 100 tol, and at least
+    !> ten times smaller at the hundred times tighter tolerance.
+    subroutine tree_against_absolute(error, parent, kinds, label)
+        type(error_t), allocatable, intent(out) :: error
+        integer, intent(in) :: parent(:), kinds(:)
+        character(len=*), intent(in) :: label
+        real(wp), parameter :: tols(2) = [1.0e-6_wp, 1.0e-8_wp]
+        type(rigid_chain_t), target :: chain
+        type(status_t) :: status
+        type(chain_body_t) :: b(size(parent))
+        type(marker_t) :: m(2 * size(parent))
+        type(mbs_joint_t) :: joints(size(parent))
+        real(wp) :: p(4, size(parent)), pj(4), axis(3), q0(4 * size(parent)), &
+            v0(3 * size(parent)), worst(2), centre(3)
+        integer :: i, nq, nv, k
+        nq = 0
+        nv = 0
+        do i = 1, size(parent)
+            axis = [sin(1.7_wp * i), cos(1.7_wp * i), 0.6_wp]
+            axis = axis / norm2(axis)
+            b(i) = chain_body_t(parent(i), kinds(i), &
+                merge([0.0_wp, 0.0_wp, 0.0_wp], [0.3_wp, 0.04_wp * (-1)**i, 0.0_wp], &
+                      parent(i) == 0), identity3, axis, [0.15_wp, 0.02_wp, -0.01_wp * i], &
+                0.4_wp + 0.05_wp * i, inertia(i))
+            if (kinds(i) == chain_joint_spherical) then
+                pj = quat_from_axis_angle(axis, 0.3_wp)
+                q0(nq + 1:nq + 4) = pj
+                v0(nv + 1:nv + 3) = [0.4_wp, -0.3_wp, 0.2_wp]
+                nq = nq + 4
+                nv = nv + 3
+            else
+                q0(nq + 1) = 0.25_wp * sin(0.9_wp * i)
+                pj = quat_from_axis_angle(axis, q0(nq + 1))
+                v0(nv + 1) = 0.5_wp * cos(1.3_wp * i)
+                nq = nq + 1
+                nv = nv + 1
+            end if
+            if (parent(i) == 0) then
+                p(:, i) = pj
+                m(2 * i - 1) = marker_t(0, b(i)%joint_position, axes_with_z(axis))
+            else
+                p(:, i) = quat_product(p(:, parent(i)), pj)
+                centre = b(parent(i))%centre
+                m(2 * i - 1) = marker_t(parent(i), b(i)%joint_position - centre, &
+                                        axes_with_z(axis))
+            end if
+            m(2 * i) = marker_t(i, -b(i)%centre, axes_with_z(axis))
+            joints(i) = mbs_joint_t(merge(joint_spherical, joint_revolute, &
+                                          kinds(i) == chain_joint_spherical), 2 * i - 1, 2 * i)
+        end do
+        chain = new_rigid_chain(b, status, gravity=g_earth)
+        call check(error, status%ok(), label // ': ' // status%text())
+        if (allocated(error)) return
+        do k = 1, 2
+            call absolute_difference(error, chain, q0(1:nq), v0(1:nv), p, m, joints, label, &
+                                     tols(k), 1.0_wp, worst(k))
+            if (allocated(error)) return
+        end do
+        print '(4x,a,a,2es9.2)', label, ' vs absolute coordinates at t = 1, tol 1e-6, 1e-8: ', &
+            worst
+        call check(error, all(worst <= 100 * tols) .and. worst(2) <= 0.1_wp * worst(1), &
+                   label // ': chain and absolute coordinates differ')
+    end subroutine tree_against_absolute
 end module test_rigid_chain

@@ -26,7 +26,8 @@ module test_sparse_formulation
 
     character(len=*), parameter :: scenes(*) = [character(len=40) :: &
         'inputs/flexible_cantilever.nml', 'inputs/rigid_flexible_pendulum.nml', 'inputs/face_hinge.nml', &
-        'inputs/five_body.nml', 'inputs/four_bar_chain.nml', 'inputs/four_bar.nml']
+        'inputs/five_body.nml', 'inputs/four_bar_chain.nml', 'inputs/four_bar.nml', &
+        'inputs/four_bar_chains.nml']
     character(len=*), parameter :: forms(*) = [character(len=8) :: 'index1', 'index2', &
         'index3', 'ggl']
 
@@ -121,7 +122,8 @@ contains
     end subroutine test_equals_dense
 
     !> The sparse ∂F/∂y of the face hinge (flexible body, node frame, GGL and
-    !> index 1 in the acceleration layout) against central differences of F.
+    !> index 1 in the acceleration layout) and of the four-bar with three
+    !> chains (one of 11 coordinates) against central differences of F.
     subroutine test_differences(error)
         type(error_t), allocatable, intent(out) :: error
         class(dae_problem_t), allocatable :: ps
@@ -131,30 +133,36 @@ contains
         type(status_t) :: status
         real(wp), parameter :: delta = 1.0e-6_wp
         real(wp) :: dev
-        integer :: k, j, n
-        do k = 1, size(forms)
-            call build(error, 'inputs/face_hinge.nml', trim(forms(k)), 'auto', ps, ms, y)
-            if (allocated(error)) return
-            n = size(y)
-            allocate (yp(n), fp(n), fm(n), js(n, n), jfd(n, n))
-            call ps%jacobian_pattern(pattern, status)
-            call ps%jacobian_sparse(0.1_wp, y, pattern%values, status)
-            call pattern%to_dense(js)
-            do j = 1, n
-                yp = y
-                yp(j) = y(j) + delta
-                call ps%rhs(0.1_wp, yp, fp, status)
-                yp(j) = y(j) - delta
-                call ps%rhs(0.1_wp, yp, fm, status)
-                jfd(:, j) = (fp - fm) / (2 * delta)
+        character(len=*), parameter :: paths(2) = [character(len=28) :: &
+            'inputs/face_hinge.nml', 'inputs/four_bar_chains.nml']
+        integer :: k, j, n, s
+        do s = 1, size(paths)
+            do k = 1, size(forms)
+                call build(error, trim(paths(s)), trim(forms(k)), 'auto', ps, ms, y)
+                if (allocated(error)) return
+                n = size(y)
+                allocate (yp(n), fp(n), fm(n), js(n, n), jfd(n, n))
+                call ps%jacobian_pattern(pattern, status)
+                call ps%jacobian_sparse(0.1_wp, y, pattern%values, status)
+                call pattern%to_dense(js)
+                do j = 1, n
+                    yp = y
+                    yp(j) = y(j) + delta
+                    call ps%rhs(0.1_wp, yp, fp, status)
+                    yp(j) = y(j) - delta
+                    call ps%rhs(0.1_wp, yp, fm, status)
+                    jfd(:, j) = (fp - fm) / (2 * delta)
+                end do
+                call check(error, status%ok(), 'evaluations: ' // status%text())
+                if (allocated(error)) return
+                dev = maxval(abs(js - jfd)) / maxval(abs(jfd))
+                print '(4x,a,1x,a,a,es9.2)', trim(paths(s)), trim(forms(k)), &
+                    ': sparse dF/dy vs differences ', dev
+                call check(error, dev <= 1.0e-6_wp, trim(paths(s)) // ' ' // trim(forms(k)) // &
+                           ': sparse dF/dy vs differences ' // real_text(dev))
+                deallocate (yp, fp, fm, js, jfd)
+                if (allocated(error)) return
             end do
-            call check(error, status%ok(), 'evaluations: ' // status%text())
-            if (allocated(error)) return
-            dev = maxval(abs(js - jfd)) / maxval(abs(jfd))
-            call check(error, dev <= 1.0e-6_wp, 'face hinge ' // trim(forms(k)) // &
-                       ': sparse dF/dy vs differences ' // real_text(dev))
-            deallocate (yp, fp, fm, js, jfd)
-            if (allocated(error)) return
         end do
     end subroutine test_differences
 

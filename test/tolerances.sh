@@ -34,7 +34,7 @@ export OPENBLAS_NUM_THREADS=1
 tolerances="1e-2 1e-4 1e-6 1e-8 1e-10 1e-12"
 reference_tolerance=${TOLERANCE_REFERENCE:-1e-13}   # RADAU5's reference
 # every scene of inputs/ but the fine meshes (make extremes runs those)
-scenes=${TOLERANCE_SCENES:-"van_der_pol pendulum double_pendulum_chain four_bar four_bar_chain
+scenes=${TOLERANCE_SCENES:-"van_der_pol pendulum double_pendulum_chain four_bar four_bar_chain four_bar_chains
     face_hinge rigid_flexible_pendulum flexible_cantilever five_body five_body_undamped
     bushing_mount"}
 

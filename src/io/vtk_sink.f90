@@ -7,7 +7,7 @@
 !> value, element_id and flexible_id, the body's number in field data
 !> flexible_names), the rigid bodies (`PREFIX_bodies_NNNN.vtu`:
 !> one vertex per body at its centre of mass, the bodies in absolute
-!> coordinates first, then a chain's links; point data the body's three
+!> coordinates first, then the chains' links; point data the body's three
 !> axes and body_id, field data body_names) and a multibody system's joints
 !> and drivers (`PREFIX_joints_NNNN.vtu`: one vertex per joint at its marker
 !> i, wherever that sits — a body, a chain link, a node frame, a node, the
@@ -59,9 +59,11 @@ module flexmbs_io_vtk_sink
         character(len=:), allocatable :: prefix
         type(vtk_flexible_t), allocatable :: flexible(:) !! none: no mesh files
         integer :: bodies = 0         !! rigid bodies: (r, p) at y(7 b − 6 : 7 b)
-        type(rigid_chain_t), pointer :: chain => null() !! its links after them
-        integer :: chain_q = 0        !! the chain's coordinates in y
-        !> the names of the rigid bodies, then of the chain's links (a point
+        !> chains (substructures), their links after them, chain c's
+        !> coordinates after y(chain_q(c))
+        type(rigid_chain_t), pointer :: chains(:) => null()
+        integer, allocatable :: chain_q(:)
+        !> the names of the rigid bodies, then of the chains' links (a point
         !> each in the bodies' files: field data body_names, point data body_id)
         character(len=32), allocatable :: names(:)
         !> a multibody system's joints and drivers (a point each in the
@@ -280,19 +282,25 @@ contains
         type(status_t), intent(inout) :: status
         real(wp) :: a(3, 3), centre(3, self%bodies + links(self)), &
             axes(3, 3, self%bodies + links(self))
-        integer :: unit, b, k, n
+        integer :: unit, b, k, n, f
         n = self%bodies + links(self)
         do b = 1, self%bodies
             centre(:, b) = y(7 * b - 6:7 * b - 4)
             axes(:, :, b) = rotation_matrix(y(7 * b - 3:7 * b))
         end do
-        do b = 1, links(self)
-            associate (ch => self%chain, c => centre(:, self%bodies + b))
-                call ch%body_frame(y(self%chain_q + 1:self%chain_q + ch%nq), b, c, a)
-                c = c + matmul(a, ch%bodies(b)%centre)
-                axes(:, :, self%bodies + b) = a
-            end associate
-        end do
+        n = self%bodies
+        if (associated(self%chains)) then
+            do f = 1, size(self%chains)
+                do b = 1, size(self%chains(f)%bodies)
+                    n = n + 1
+                    associate (ch => self%chains(f), c => centre(:, n), oq => self%chain_q(f))
+                        call ch%body_frame(y(oq + 1:oq + ch%nq), b, c, a)
+                        c = c + matmul(a, ch%bodies(b)%centre)
+                        axes(:, :, n) = a
+                    end associate
+                end do
+            end do
+        end if
         call open_grid(path, unit, status)
         if (.not. status%ok()) return
         ! the names: field data of the data set (VTK reads none in a piece)
@@ -464,11 +472,15 @@ contains
         if (allocated(self%flexible)) meshes = size(self%flexible) > 0
     end function meshes
 
-    !> Links of the chain (none without one).
+    !> Links of the chains (none without them).
     pure integer function links(self)
         class(vtk_sink_t), intent(in) :: self
+        integer :: f
         links = 0
-        if (associated(self%chain)) links = size(self%chain%bodies)
+        if (.not. associated(self%chains)) return
+        do f = 1, size(self%chains)
+            links = links + size(self%chains(f)%bodies)
+        end do
     end function links
 
     !> Open an unstructured-grid file and write up to its data set's field

@@ -32,6 +32,8 @@
 !> b(q, v) = τ(q, v, q̈ = 0) holds the Coriolis, centrifugal and gravity terms.
 !>
 !> Markers on chain bodies: their pose and their Jacobians ∂(ẋ, ω)/∂v.
+!> The derivatives ∂(M w)/∂q, ∂f/∂q and ∂f/∂v are the RNEA's recursion
+!> differentiated along each coordinate (submodule rigid_chain_derivatives).
 module flexmbs_mbs_rigid_chain
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_resources, only: out_of_memory
@@ -80,6 +82,14 @@ module flexmbs_mbs_rigid_chain
         !> coordinates iq(i)+1 .. iq(i+1) and rates iv(i)+1 .. iv(i+1) of body i;
         !> s holds the motion subspace columns by rate index
         integer, allocatable :: iq(:), iv(:)
+        !> each joint's own rotation (Rot(a, q), 1 or R(p)), set by the frames
+        real(wp), allocatable :: rloc(:, :, :)
+        !> tangents of the frames, subspaces, inertias, velocities,
+        !> accelerations and forces along one coordinate (rigid_chain_derivatives),
+        !> the bodies that direction moves, and two rate-sized scratch vectors
+        real(wp), allocatable :: tan_o(:, :), tan_r(:, :, :), tan_s(:, :), tan_inert(:, :, :), &
+            tan_vel(:, :), tan_acc(:, :), tan_frc(:, :), rates0(:), tau0(:)
+        logical, allocatable :: moved(:)
     contains
         procedure :: kinematics => chain_kinematics
         procedure :: mass => chain_mass
@@ -95,9 +105,38 @@ module flexmbs_mbs_rigid_chain
         procedure :: energy => chain_energy
         procedure :: total_energy => chain_total_energy
         procedure :: body_velocity => chain_body_velocity
+        procedure :: mass_derivative => chain_mass_derivative
+        procedure :: force_derivatives => chain_force_derivatives
     end type rigid_chain_t
 
     public :: new_rigid_chain
+
+    interface
+        !> ∂(M(q) w)/∂q, nv x nq (rigid_chain_derivatives).
+        module subroutine chain_mass_derivative(self, t, q, w, dq, status)
+            class(rigid_chain_t), intent(inout) :: self
+            real(wp), intent(in) :: t, q(:), w(:)
+            real(wp), intent(out) :: dq(:, :)
+            type(status_t), intent(inout) :: status
+        end subroutine chain_mass_derivative
+        !> ∂f/∂q (nv x nq) and ∂f/∂v (nv x nv), f = −b (rigid_chain_derivatives).
+        module subroutine chain_force_derivatives(self, t, q, v, fq, fv, status)
+            class(rigid_chain_t), intent(inout) :: self
+            real(wp), intent(in) :: t, q(:), v(:)
+            real(wp), intent(out) :: fq(:, :), fv(:, :)
+            type(status_t), intent(inout) :: status
+        end subroutine chain_force_derivatives
+        !> Spatial motion cross product v ×m u (rigid_chain_derivatives).
+        pure module function cross_motion(v, u) result(w)
+            real(wp), intent(in) :: v(6), u(6)
+            real(wp) :: w(6)
+        end function cross_motion
+        !> Spatial force cross product v ×* f (rigid_chain_derivatives).
+        pure module function cross_force(v, f) result(w)
+            real(wp), intent(in) :: v(6), f(6)
+            real(wp) :: w(6)
+        end function cross_force
+    end interface
 
 contains
 
@@ -158,10 +197,14 @@ contains
         self%nc = 0
         allocate (self%o(3, 0:n), self%r(3, 3, 0:n), self%s(6, self%nv), self%vel(6, 0:n), &
                   self%acc(6, 0:n), self%inert(6, 6, n), self%comp(6, 6, n), self%frc(6, n), &
-                  stat=stat)
-        ! 3 + 9 + 6 + 6 values per frame (n + 1), 6 per velocity, 36 + 36 + 6 per body
+                  self%rloc(3, 3, n), self%tan_o(3, 0:n), self%tan_r(3, 3, 0:n), &
+                  self%tan_s(6, self%nv), self%tan_inert(6, 6, n), self%tan_vel(6, 0:n), &
+                  self%tan_acc(6, 0:n), self%tan_frc(6, n), self%rates0(self%nv), &
+                  self%tau0(self%nv), self%moved(0:n), stat=stat)
+        ! 24 + 24 values per frame (n + 1), 6 + 6 + 2 per velocity,
+        ! 78 + 9 + 42 per body (the moved flags counted as values)
         if (stat /= 0) call out_of_memory(status, 'rigid chain workspace', &
-            24 * (n + 1_i8) + 6_i8 * self%nv + 78_i8 * n, 8)
+            49 * (n + 1_i8) + 14_i8 * self%nv + 129_i8 * n, 8)
     end function new_rigid_chain
 
     !> Forward kinematics: frames o, R, motion subspaces S and spatial
@@ -183,17 +226,19 @@ contains
                 self%o(:, i) = self%o(:, p) + matmul(self%r(:, :, p), b%joint_position)
                 select case (b%joint)
                 case (chain_joint_revolute)
-                    self%r(:, :, i) = matmul(rj, rotation_matrix(quat_from_axis_angle(b%axis, &
-                                                                                      q(jq))))
+                    self%rloc(:, :, i) = rotation_matrix(quat_from_axis_angle(b%axis, q(jq)))
+                    self%r(:, :, i) = matmul(rj, self%rloc(:, :, i))
                     self%s(1:3, jv) = u
                     self%s(4:6, jv) = cross(self%o(:, i), u)
                 case (chain_joint_prismatic)
                     self%o(:, i) = self%o(:, i) + u * q(jq)
+                    self%rloc(:, :, i) = identity3
                     self%r(:, :, i) = rj
                     self%s(1:3, jv) = 0.0_wp
                     self%s(4:6, jv) = u
                 case default
-                    self%r(:, :, i) = matmul(rj, rotation_matrix(q(jq:jq + 3)))
+                    self%rloc(:, :, i) = rotation_matrix(q(jq:jq + 3))
+                    self%r(:, :, i) = matmul(rj, self%rloc(:, :, i))
                     do k = 0, 2
                         self%s(1:3, jv + k) = self%r(:, k + 1, i)
                         self%s(4:6, jv + k) = cross(self%o(:, i), self%r(:, k + 1, i))
@@ -209,22 +254,6 @@ contains
             end associate
         end do
     end subroutine frames
-
-    !> Spatial motion cross product v ×m u.
-    pure function cross_motion(v, u) result(w)
-        real(wp), intent(in) :: v(6), u(6)
-        real(wp) :: w(6)
-        w(1:3) = cross(v(1:3), u(1:3))
-        w(4:6) = cross(v(1:3), u(4:6)) + cross(v(4:6), u(1:3))
-    end function cross_motion
-
-    !> Spatial force cross product v ×* f.
-    pure function cross_force(v, f) result(w)
-        real(wp), intent(in) :: v(6), f(6)
-        real(wp) :: w(6)
-        w(1:3) = cross(v(1:3), f(1:3)) + cross(v(4:6), f(4:6))
-        w(4:6) = cross(v(1:3), f(4:6))
-    end function cross_force
 
     !> Recursive Newton–Euler: tau = M(q) qdd + b(q, qd), gravity included
     !> when `with_gravity` (default true).
@@ -305,9 +334,8 @@ contains
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: f(:)
         type(status_t), intent(inout) :: status
-        real(wp) :: zero(size(v))
-        zero = 0.0_wp
-        call chain_inverse_dynamics(self, q, v, zero, f)
+        self%rates0 = 0.0_wp
+        call chain_inverse_dynamics(self, q, v, self%rates0, f)
         f = -f
     end subroutine chain_forces
 

@@ -169,9 +169,14 @@ module flexmbs_mbs_system
         !> v(flex_v(f)+1 : flex_v(f)+nv_f)
         type(flexible_body_t), allocatable :: flex(:)
         integer, allocatable :: flex_q(:), flex_v(:)
-        !> rigid chains in relative coordinates (revolute and prismatic joints,
-        !> at most 7 coordinates each), between the rigid and the flexible bodies
+        !> rigid chains in relative coordinates (revolute, prismatic and
+        !> spherical joints, any number of coordinates), between the rigid and
+        !> the flexible bodies
         type(rigid_chain_t), allocatable :: chains(:)
+        !> scratch blocks of the largest chain (nv x nq, nv x nv, nq x nq) and
+        !> vectors (nv, nq), for the chains' dense derivative blocks
+        real(wp), allocatable :: chain_vq(:, :), chain_vv(:, :), chain_qq(:, :), &
+            chain_unit(:), chain_rate(:)
         type(chain_geometry_t), allocatable :: chain_geom(:)
         integer, allocatable :: chain_q(:), chain_v(:)
         !> node frames (flexmbs_mbs_node_frame): massless rigid bodies held on

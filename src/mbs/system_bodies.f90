@@ -62,26 +62,15 @@ contains
     end procedure system_mass_derivative
 
     !> ∂(M w)/∂q added into dq: zero for rigid and flexible bodies (constant
-    !> M), central differences of the chains' M(q) w (at most 7 coordinates each).
+    !> M), the chains' analytic blocks (differentiated RNEA).
     module procedure mass_derivative_into
-        real(wp) :: mp(rigid_body_nq, rigid_body_nq), mm(rigid_body_nq, rigid_body_nq), &
-            qc(rigid_body_nq), h, col(rigid_body_nq)
-        integer :: f, j, i
+        integer :: f
         do f = 1, size(self%chains)
             associate (iq => self%chain_q(f), iv => self%chain_v(f), n => self%chains(f)%nv, &
                        nq => self%chains(f)%nq)
-                do j = 1, nq
-                    qc(1:nq) = q(iq + 1:iq + nq)
-                    h = difference_step(qc(j))
-                    qc(j) = q(iq + j) + h
-                    call self%chains(f)%mass(t, qc(1:nq), mp(1:n, 1:n), status)
-                    qc(j) = q(iq + j) - h
-                    call self%chains(f)%mass(t, qc(1:nq), mm(1:n, 1:n), status)
-                    col(1:n) = matmul(mp(1:n, 1:n) - mm(1:n, 1:n), w(iv + 1:iv + n)) / (2 * h)
-                    do i = 1, n
-                        call dq%add(iv + i, iq + j, col(i))
-                    end do
-                end do
+                call self%chains(f)%mass_derivative(t, q(iq + 1:iq + nq), w(iv + 1:iv + n), &
+                                                    self%chain_vq(1:n, 1:nq), status)
+                call dq%add_range(iv, iq, self%chain_vq(1:n, 1:nq))
             end associate
         end do
     end procedure mass_derivative_into
@@ -115,7 +104,7 @@ contains
                                           fq(1:self%nv_rigid, 1:self%nq_rigid), &
                                           fv(1:self%nv_rigid, 1:self%nv_rigid), status)
         do b = 1, size(self%chains)
-            ! the chains' defaults: differences of their RNEA forces
+            ! the chains' analytic derivatives (differentiated RNEA)
             associate (iq => self%chain_q(b), iv => self%chain_v(b), n => self%chains(b)%nv, &
                        nq => self%chains(b)%nq)
                 call self%chains(b)%force_derivatives(t, q(iq + 1:iq + nq), v(iv + 1:iv + n), &

@@ -64,20 +64,23 @@ contains
         type(mbs_system_t), intent(inout) :: self
         type(rigid_chain_t), intent(in), optional :: chains(:)
         type(status_t), intent(inout) :: status
-        integer :: k, f
+        integer :: k, f, nq, nv
         if (present(chains)) then
             self%chains = chains
         else
             allocate (self%chains(0))
         end if
         allocate (self%chain_geom(size(self%chains)))
+        nq = 0
+        nv = 0
+        do f = 1, size(self%chains)
+            nq = max(nq, self%chains(f)%nq)
+            nv = max(nv, self%chains(f)%nv)
+        end do
+        allocate (self%chain_vq(nv, nq), self%chain_vv(nv, nv), self%chain_qq(nq, nq), &
+                  self%chain_unit(nv), self%chain_rate(nq))
         do f = 1, size(self%chains)
             associate (ch => self%chains(f), g => self%chain_geom(f))
-                if (ch%nq > rigid_body_nq) then
-                    call status%set(status_bad_input, 'mbs system: chain ' // int_text(f) // &
-                        ': at most ' // int_text(rigid_body_nq) // ' coordinates inside a system')
-                    return
-                end if
                 g%parent = ch%bodies%parent
                 g%kinds = ch%bodies%joint
                 g%iq = ch%iq(1:size(ch%bodies))
@@ -115,6 +118,16 @@ contains
                     markers(k)%link > size(self%chains(markers(k)%chain)%bodies)) then
                     call status%set(status_bad_input, where // ': link ' // &
                         int_text(markers(k)%link) // ' is not a body of its chain')
+                    return
+                end if
+                ! the joints' derivatives seed a marker's body coordinates into
+                ! dual numbers of 16 directions, two bodies and time at once
+                if (self%chains(markers(k)%chain)%nq > rigid_body_nq) then
+                    call status%set(status_bad_input, where // ': chain ' // &
+                        int_text(markers(k)%chain) // ' has ' // &
+                        int_text(self%chains(markers(k)%chain)%nq) // ' coordinates: a ' // &
+                        'marker needs a chain of at most ' // int_text(rigid_body_nq) // &
+                        ' (larger chains without markers have no limit)')
                     return
                 end if
             end if

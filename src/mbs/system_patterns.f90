@@ -70,7 +70,6 @@ contains
     module procedure system_mass_sparse
         integer :: b, i, j, n, f
         integer(i8) :: p
-        real(wp) :: mc(rigid_body_nq, rigid_body_nq)
         n = 0
         values = 0.0_wp
         do b = 1, size(self%rigid%bodies)
@@ -87,11 +86,11 @@ contains
         end do
         do f = 1, size(self%chains)
             associate (iq => self%chain_q(f), nc => self%chains(f)%nv, nq => self%chains(f)%nq)
-                call self%chains(f)%mass(t, q(iq + 1:iq + nq), mc(1:nc, 1:nc), status)
+                call self%chains(f)%mass(t, q(iq + 1:iq + nq), self%chain_vv(1:nc, 1:nc), status)
                 do j = 1, nc
                     do i = 1, nc
                         n = n + 1
-                        values(self%mass_csc%triplet_map(n)) = mc(i, j)
+                        values(self%mass_csc%triplet_map(n)) = self%chain_vv(i, j)
                     end do
                 end do
             end associate
@@ -292,7 +291,7 @@ contains
     !> Values of T: I₃ and L(p)ᵀ/2 per rigid body, the chains' columns T e_l, I for
     !> flexible bodies.
     module procedure system_kinematics_sparse
-        real(wp) :: e(rigid_body_nq), rate(rigid_body_nq), l(3, 4)
+        real(wp) :: l(3, 4)
         integer :: b, f, i, k, iq, iv
         associate (acc => self%acc(block_kin))
             call acc%start_sparse(self%patterns%kinematics)
@@ -309,11 +308,12 @@ contains
                 associate (cq => self%chain_q(f), nq => self%chains(f)%nq, &
                            nv => self%chains(f)%nv)
                     do i = 1, nv
-                        e(1:nv) = 0.0_wp
-                        e(i) = 1.0_wp
-                        call chain_rates(self, f, q(cq + 1:cq + nq), e(1:nv), rate(1:nq))
+                        self%chain_unit(1:nv) = 0.0_wp
+                        self%chain_unit(i) = 1.0_wp
+                        call self%chains(f)%kinematics(t, q(cq + 1:cq + nq), &
+                            self%chain_unit(1:nv), self%chain_rate(1:nq), status)
                         do k = 1, nq
-                            call acc%add(cq + k, self%chain_v(f) + i, rate(k))
+                            call acc%add(cq + k, self%chain_v(f) + i, self%chain_rate(k))
                         end do
                     end do
                 end associate
@@ -329,7 +329,6 @@ contains
 
     !> ∂(T w)/∂q: the quaternion blocks of the rigid bodies, the chains' blocks.
     module procedure system_kinematics_derivative_sparse
-        real(wp) :: blk(rigid_body_nq, rigid_body_nq)
         integer :: b, f, iq, iv
         associate (acc => self%acc(block_kinq))
             call acc%start_sparse(self%patterns%kinematics_q)
@@ -342,8 +341,8 @@ contains
                 associate (cq => self%chain_q(f), cv => self%chain_v(f), &
                            nq => self%chains(f)%nq, nv => self%chains(f)%nv)
                     call self%chains(f)%kinematics_derivative(t, q(cq + 1:cq + nq), &
-                        w(cv + 1:cv + nv), blk(1:nq, 1:nq), status)
-                    call acc%add_range(cq, cq, blk(1:nq, 1:nq))
+                        w(cv + 1:cv + nv), self%chain_qq(1:nq, 1:nq), status)
+                    call acc%add_range(cq, cq, self%chain_qq(1:nq, 1:nq))
                 end associate
             end do
             call acc%get_values(values, 'mbs system: d(T w)/dq', status)
@@ -360,7 +359,6 @@ contains
     !> elements' blocks, and −∂k/∂q, −∂k/∂v of the flexible bodies from their
     !> analytic tangents.
     module procedure system_force_derivatives_sparse
-        real(wp) :: bq(rigid_body_nq, rigid_body_nq), bv(rigid_body_nq, rigid_body_nq)
         type(status_t) :: local
         integer :: b, iv
         integer(i8) :: p
@@ -376,9 +374,10 @@ contains
                 associate (cq => self%chain_q(b), cv => self%chain_v(b), &
                            nq => self%chains(b)%nq, nv => self%chains(b)%nv)
                     call self%chains(b)%force_derivatives(t, q(cq + 1:cq + nq), &
-                        v(cv + 1:cv + nv), bq(1:nv, 1:nq), bv(1:nv, 1:nv), status)
-                    call aq%add_range(cv, cq, bq(1:nv, 1:nq))
-                    call av%add_range(cv, cv, bv(1:nv, 1:nv))
+                        v(cv + 1:cv + nv), self%chain_vq(1:nv, 1:nq), &
+                        self%chain_vv(1:nv, 1:nv), status)
+                    call aq%add_range(cv, cq, self%chain_vq(1:nv, 1:nq))
+                    call av%add_range(cv, cv, self%chain_vv(1:nv, 1:nv))
                 end associate
             end do
             do b = 1, size(self%flex)

@@ -12,6 +12,7 @@ module flexmbs_run_assembly_check
     use flexmbs_mbs_system, only: mbs_system_t
     use flexmbs_mbs_rigid_body, only: rigid_body_nq
     use flexmbs_io_scene_input, only: scene_input_t
+    use flexmbs_run_chain_builder, only: link_names
     implicit none
     private
 
@@ -30,7 +31,8 @@ contains
         character(len=:), allocatable, intent(out) :: summary
         type(status_t), intent(inout) :: status
         real(wp) :: move, angle, worst, dot
-        integer :: i, off, worst_body, k
+        integer :: i, off, worst_body, k, c
+        character(len=len(scene%chain%name)), allocatable :: names(:)
         character(len=:), allocatable :: worst_text
 
         summary = ''
@@ -46,17 +48,16 @@ contains
             call note('rigid body ''' // trim(scene%rigid_bodies(i)%name) // '''', &
                       real_text(move) // ' m, ' // real_text(angle) // ' rad', max(move, angle), i)
         end do
-        if (size(sys%chains) > 0) then
-            associate (c => sys%chain_q(1))
-                do i = 1, size(scene%chain)
-                    off = c + sys%chains(1)%iq(i)
-                    k = sys%chains(1)%iq(i + 1) - sys%chains(1)%iq(i)
-                    move = maxval(abs(q(off + 1:off + k) - q0(off + 1:off + k)))
-                    call note('link ''' // trim(scene%chain(i)%name) // '''', &
-                              real_text(move) // ' (joint coordinate)', move, 0)
-                end do
-            end associate
-        end if
+        do c = 1, size(sys%chains)
+            names = link_names(scene, c)
+            do i = 1, size(sys%chains(c)%bodies)
+                off = sys%chain_q(c) + sys%chains(c)%iq(i)
+                k = sys%chains(c)%iq(i + 1) - sys%chains(c)%iq(i)
+                move = maxval(abs(q(off + 1:off + k) - q0(off + 1:off + k)))
+                call note('link ''' // trim(names(i)) // '''', &
+                          real_text(move) // ' (joint coordinate)', move, 0)
+            end do
+        end do
         do i = 1, size(sys%flex)
             associate (f => sys%flex_q(i), n => sys%flex(i)%nq)
                 move = maxval([0.0_wp, abs(q(f + 1:f + n) - q0(f + 1:f + n))])

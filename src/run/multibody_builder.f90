@@ -31,7 +31,7 @@ module flexmbs_run_multibody_builder
     use flexmbs_io_namelist, only: scene_input_t
     use flexmbs_io_scene_input, only: marker_index, flexible_index
     use flexmbs_run_body_builder, only: build_flexible_body
-    use flexmbs_run_chain_builder, only: build_rigid_chain
+    use flexmbs_run_chain_builder, only: build_rigid_chains, chain_link
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
     implicit none
@@ -103,14 +103,11 @@ contains
                 v0(6 * i - 5:6 * i) = [b%velocity, matmul(transpose(r), b%angular_velocity)]
             end associate
         end do
-        ! a rigid chain (&rigid_chain groups), after the rigid bodies
-        allocate (chains(merge(1, 0, size(scene%chain) > 0)))
-        if (size(scene%chain) > 0) then
-            call build_rigid_chain(scene, chains(1), qc, vc, status)
-            if (.not. status%ok()) return
-            q0 = [q0, qc]
-            v0 = [v0, vc]
-        end if
+        ! rigid chains (one per &rigid_chain tree), after the rigid bodies
+        call build_rigid_chains(scene, chains, qc, vc, status)
+        if (.not. status%ok()) return
+        q0 = [q0, qc]
+        v0 = [v0, vc]
         ! the flexible bodies, after them (body fb's velocities after v0(flex_v0(fb)))
         allocate (flex(size(scene%bodies)), flex_v0(size(scene%bodies)))
         do fb = 1, size(flex)
@@ -163,14 +160,8 @@ contains
                 end if
                 if (m%body /= 'ground' .and. len_trim(m%node_set) == 0) &
                     markers(i)%body = body_index(scene, m%body)
-                if (markers(i)%body == 0 .and. m%body /= 'ground') then
-                    do k = 1, size(scene%chain)
-                        if (scene%chain(k)%name == m%body) then
-                            markers(i)%chain = 1
-                            markers(i)%link = k
-                        end if
-                    end do
-                end if
+                if (markers(i)%body == 0 .and. m%body /= 'ground') &
+                    call chain_link(scene, m%body, markers(i)%chain, markers(i)%link)
                 markers(i)%position = m%position
                 markers(i)%axes = axes_from(m%z_axis, m%x_axis)
             end associate

@@ -55,6 +55,7 @@ module flexmbs_run_named_output
     use flexmbs_run_force_output, only: add_force_output
     use flexmbs_run_flexible_output, only: add_flexible
     use flexmbs_io_hdf5_text, only: path_name
+    use flexmbs_run_chain_builder, only: link_names
     implicit none
     private
 
@@ -135,7 +136,7 @@ contains
         type is (rigid_chain_t)
             select type (f => plan%problem)
             type is (formulation_t)
-                call add_chain(h5, sys, chain_names(), f%oq, f%ov, status)
+                call add_chain(h5, sys, link_names(scene, 0), f%oq, f%ov, status)
             end select
             return
         type is (mbs_system_t)
@@ -157,7 +158,7 @@ contains
                     if (.not. status%ok()) return
                 end do
                 do i = 1, size(sys%chains)
-                    call add_chain(h5, sys%chains(i), chain_names(), f%oq + sys%chain_q(i), &
+                    call add_chain(h5, sys%chains(i), link_names(scene, i), f%oq + sys%chain_q(i), &
                                    f%ov + sys%chain_v(i), status)
                     if (.not. status%ok()) return
                 end do
@@ -190,12 +191,6 @@ contains
         end select
 
     contains
-
-        !> The names of the scene's &rigid_chain links, in their order.
-        function chain_names() result(names)
-            character(len=len(scene%chain%name)), allocatable :: names(:)
-            names = scene%chain%name
-        end function chain_names
 
         !> A flexible body alone: its formulation's y = (q, v[, λ]).
         subroutine add_standalone(b)
@@ -273,7 +268,7 @@ contains
                 type is (mbs_system_t)
                     call system_labels(m, f)
                 type is (rigid_chain_t)
-                    call chain_labels(m, f%oq, f%ov, accelerations(f))
+                    call chain_labels(m, link_names(scene, 0), f%oq, f%ov, accelerations(f))
                 type is (flexible_body_t)
                     call flexible_labels(m, trim(scene%bodies(1)%name), f%oq, f%ov, accelerations(f))
                 end select
@@ -316,7 +311,8 @@ contains
                 end if
             end do
             do i = 1, size(sys%chains)
-                call chain_labels(sys%chains(i), f%oq + sys%chain_q(i), f%ov + sys%chain_v(i), &
+                call chain_labels(sys%chains(i), link_names(scene, i), f%oq + sys%chain_q(i), &
+                    f%ov + sys%chain_v(i), &
                     merge(f%oa + sys%chain_v(i), -1, f%accelerations))
             end do
             do i = 1, size(sys%flex)
@@ -350,14 +346,15 @@ contains
             end do
         end subroutine system_labels
 
-        subroutine chain_labels(chain, oq, ov, oa)
+        subroutine chain_labels(chain, names, oq, ov, oa)
             type(rigid_chain_t), intent(in) :: chain
+            character(len=*), intent(in) :: names(:) !! the chain's links'
             integer, intent(in) :: oq, ov, oa   !! oa < 0: no accelerations in y
             character(len=:), allocatable :: name, unit
             integer :: i, j
             do i = 1, size(chain%bodies)
                 name = 'link ' // int_text(i)
-                if (i <= size(scene%chain)) name = trim(scene%chain(i)%name)
+                if (i <= size(names)) name = trim(names(i))
                 unit = 'rad'
                 if (chain%bodies(i)%joint == chain_joint_prismatic) unit = 'm'
                 if (chain%bodies(i)%joint == chain_joint_spherical) unit = '1'

@@ -32,6 +32,7 @@ module flexmbs_run_runner
     use flexmbs_run_summary, only: state_summary
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
     use flexmbs_run_body_builder, only: body_energies
+    use flexmbs_run_chain_builder, only: link_names, tree_count
     implicit none
     private
 
@@ -272,8 +273,8 @@ contains
                 vtk%bodies = size(m%rigid%bodies)
                 vtk%names = body_names(size(m%rigid%bodies))
                 if (size(m%chains) > 0) then
-                    vtk%chain => m%chains(1)
-                    vtk%chain_q = m%chain_q(1)
+                    vtk%chains => m%chains
+                    vtk%chain_q = m%chain_q
                 end if
                 allocate (vtk%flexible(size(m%flex)))
                 do k = 1, size(m%flex)
@@ -304,11 +305,11 @@ contains
         end subroutine setup_vtk
 
         !> The scene's rigid bodies, the node frames after them, then the
-        !> chain's links, by name (the ParaView bodies' names).
+        !> chains' links, by name (the ParaView bodies' names).
         function body_names(n) result(names)
             integer, intent(in) :: n  !! rigid bodies, node frames included
             character(len=len_name), allocatable :: names(:)
-            integer :: i
+            integer :: i, k
             allocate (names(n + size(scene%chain)))
             do i = 1, n
                 if (i <= size(scene%rigid_bodies)) then
@@ -317,8 +318,13 @@ contains
                     names(i) = 'node frame ' // int_text(i - size(scene%rigid_bodies))
                 end if
             end do
-            do i = 1, size(scene%chain)
-                names(n + i) = scene%chain(i)%name
+            ! the chains' links, chain by chain (one chain per tree)
+            k = n
+            do i = 1, tree_count(scene)
+                associate (tree => link_names(scene, i))
+                    names(k + 1:k + size(tree)) = tree
+                    k = k + size(tree)
+                end associate
             end do
         end function body_names
 

@@ -18,6 +18,7 @@ module flexmbs_run_summary
     use flexmbs_io_namelist, only: scene_input_t
     use flexmbs_run_plan, only: run_plan_t
     use flexmbs_run_named_output, only: joint_angle
+    use flexmbs_run_chain_builder, only: link_names
     implicit none
     private
 
@@ -47,7 +48,7 @@ contains
                 end do
                 do i = 1, size(m%chains)
                     text = text // chain_lines(m%chains(i), y(f%oq + m%chain_q(i) + 1: &
-                        f%oq + m%chain_q(i) + m%chains(i)%nq))
+                        f%oq + m%chain_q(i) + m%chains(i)%nq), link_names(scene, i))
                 end do
                 if (allocated(plan%joint_names)) then
                     do k = 1, min(size(plan%joint_names), size(m%joints))
@@ -61,7 +62,7 @@ contains
                         y(f%ov + m%flex_v(i) + 1:f%ov + m%flex_v(i) + m%flex(i)%nv))
                 end do
             type is (rigid_chain_t)
-                text = chain_lines(m, y(f%oq + 1:f%oq + m%nq))
+                text = chain_lines(m, y(f%oq + 1:f%oq + m%nq), link_names(scene, 0))
             type is (flexible_body_t)
                 text = flexible_line(m, trim(scene%bodies(1)%name), y(f%oq + 1:f%oq + m%nq), &
                                      y(f%ov + 1:f%ov + m%nv))
@@ -70,17 +71,18 @@ contains
 
     contains
 
-        !> the names of the chain's links, in order
-        function chain_lines(chain, q) result(lines)
+        !> names: those of the chain's links, in order
+        function chain_lines(chain, q, names) result(lines)
             type(rigid_chain_t), intent(in) :: chain
             real(wp), intent(in) :: q(:)
+            character(len=*), intent(in) :: names(:)
             character(len=:), allocatable :: lines
             character(len=:), allocatable :: name
             integer :: j
             lines = ''
             do j = 1, size(chain%bodies)
                 name = 'link ' // int_text(j)
-                if (j <= size(scene%chain)) name = trim(scene%chain(j)%name)
+                if (j <= size(names)) name = trim(names(j))
                 associate (c => q(chain%iq(j) + 1:chain%iq(j + 1)))
                     select case (chain%bodies(j)%joint)
                     case (chain_joint_prismatic)
