@@ -5,7 +5,7 @@
 !> driver on the chain's first link: 2 + 6 velocities, 5 + 2 + 1 rows.
 module test_chain_coupling
     use flexmbs_core_kinds, only: wp, i8
-    use flexmbs_core_status, only: status_t
+    use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_radau5, only: radau5_t
@@ -38,7 +38,8 @@ contains
                  new_test('formulation_jacobian_fd', test_jacobian), &
                  new_test('four_bar_with_chain_closed_form', test_closed_form), &
                  new_test('spherical_chain_in_system', test_spherical), &
-                 new_test('chain_joint_reactions_balance', test_reactions)]
+                 new_test('chain_joint_reactions_balance', test_reactions), &
+                 new_test('large_chains_in_system', test_large)]
     end function collect_chain_coupling
 
     subroutine make(derivatives, sys, q0, status)
@@ -323,4 +324,49 @@ contains
         q0(1:7) = [1.1_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
         q0(8:12) = [1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
     end subroutine make_pair
+
+    !> Two chains of 9 revolute links (9 coordinates each, more than a rigid
+    !> body's 7) in one system with a rigid body on a spherical joint: built,
+    !> M block diagonal with each chain's own M; a marker on one of them is
+    !> refused with a message that names the limit.
+    subroutine test_large(error)
+        type(error_t), allocatable, intent(out) :: error
+        integer, parameter :: n = 9
+        type(rigid_chain_t) :: chains(2)
+        type(chain_body_t) :: b(n)
+        type(mbs_system_t) :: sys
+        type(status_t) :: status
+        type(marker_t) :: m(3)
+        real(wp) :: q(7 + 2 * n), mass(6 + 2 * n, 6 + 2 * n), mc(n, n)
+        integer :: i, c
+        do i = 1, n
+            b(i) = chain_body_t(i - 1, chain_joint_revolute, [merge(0.0_wp, 0.3_wp, i == 1), &
+                0.0_wp, 0.0_wp], identity, [0.0_wp, sin(0.4_wp * i), cos(0.4_wp * i)], &
+                [0.15_wp, 0.0_wp, 0.0_wp], 0.5_wp, 0.01_wp * identity)
+        end do
+        do c = 1, 2
+            chains(c) = new_rigid_chain(b, status, gravity=g_earth)
+        end do
+        m(1) = marker_t(0, [0.0_wp, 1.0_wp, 0.0_wp])
+        m(2) = marker_t(1, [0.0_wp, 0.2_wp, 0.0_wp])
+        sys = new_mbs_system([rigid_body_t(1.0_wp, 0.02_wp * identity)], m(1:2), &
+            [mbs_joint_t(joint_spherical, 1, 2)], gravity=g_earth, chains=chains, status=status)
+        call check(error, status%ok() .and. sys%nq == 7 + 2 * n .and. sys%nv == 6 + 2 * n, &
+                   'two 9-link chains: ' // status%text())
+        if (allocated(error)) return
+        q = 0.0_wp
+        q(4) = 1.0_wp
+        q(8:) = [(0.1_wp * i, i = 1, 2 * n)]
+        call sys%mass(0.0_wp, q, mass, status)
+        call chains(2)%mass(0.0_wp, q(8 + n:), mc, status)
+        call check(error, maxval(abs(mass(7 + n:, 7 + n:) - mc)) == 0.0_wp .and. &
+                   maxval(abs(mass(7:6 + n, 7 + n:))) == 0.0_wp, 'M of the second chain')
+        if (allocated(error)) return
+        m(3) = marker_t(0, [0.0_wp, 0.0_wp, 0.0_wp], chain=2, link=n)
+        sys = new_mbs_system([rigid_body_t(1.0_wp, 0.02_wp * identity)], m, &
+            [mbs_joint_t(joint_spherical, 1, 3)], gravity=g_earth, chains=chains, status=status)
+        call check(error, status%code == status_bad_input .and. &
+                   index(status%text(), 'at most 7') > 0, 'marker on a 9-coordinate chain: ' // &
+                   status%text())
+    end subroutine test_large
 end module test_chain_coupling

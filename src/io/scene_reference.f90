@@ -28,7 +28,8 @@ module flexmbs_io_scene_reference
         'A driver: a joint coordinate prescribed as a function of time.', &
         'A force element between two markers (spring-damper, rotational spring-damper, &
         &bushing) or a load on one marker, given as a function of time.', &
-        'A link of a rigid chain in relative coordinates.', &
+        'A link of a rigid chain in relative coordinates. Every tree (a link on the &
+        &ground and the links below it) is a substructure of its own.', &
         'A study (study files only): the scene, its reference solution and the grid of &
         &runs.']
 
