@@ -406,13 +406,19 @@ contains
         type(status_t), intent(inout) :: status
     end subroutine chain_constraint_jacobian
 
-    !> Origin o and rotation R of body i's frame at q (body 0: the ground).
+    !> Origin o and rotation R of body i's frame at q (body 0: the ground),
+    !> the spherical joints' quaternions taken at unit length: R is a
+    !> rotation even where the integration let |p| drift (R(p) of the
+    !> dynamics is |p|² times one), as the results and ParaView show it.
     subroutine chain_body_frame(self, q, i, o, r)
         class(rigid_chain_t), intent(inout) :: self
         real(wp), intent(in) :: q(:)
         integer, intent(in) :: i
         real(wp), intent(out) :: o(3), r(3, 3)
-        call frames(self, q)
+        real(wp) :: unit(size(q))
+        unit = q
+        call self%normalize(unit)
+        call frames(self, unit)
         o = self%o(:, i)
         r = self%r(:, :, i)
     end subroutine chain_body_frame

@@ -134,6 +134,18 @@ contains
         end subroutine scatter
     end procedure add_element_derivatives_analytic
 
+    !> Force and torque (global, about the marker origins) element ie
+    !> exerts on marker i (column 1) and marker j (column 2; zero for a load):
+    !> the real laws, whatever the derivatives' setting.
+    module procedure system_element_wrench
+        type(frame_t) :: fr(2)
+        real(wp) :: w(12)
+        call element_frames(self, ie, q, v, fr)
+        call element_wrench_real(self%elements(ie), t, fr(1), fr(2), w, status)
+        force = reshape([w(1:3), w(7:9)], [3, 2])
+        torque = reshape([w(4:6), w(10:12)], [3, 2])
+    end procedure system_element_wrench
+
     !> Marker of side 1 (i) or 2 (j) of element ie; 0 for a load's side 2.
     pure integer function side_marker(self, ie, side) result(k)
         class(mbs_system_t), intent(in) :: self

@@ -261,23 +261,4 @@ contains
             end associate
         end do
     end procedure elements_energy
-
-    !> Force and torque (global, about the marker origins) element ie
-    !> exerts on marker i (column 1) and marker j (column 2; zero for a load).
-    module procedure system_element_wrench
-        type(element_frame_t) :: fi, fj
-        type(dual_t) :: f(3, 2), n(3, 2)
-        associate (el => self%elements(ie))
-            call real_frame(self, el%marker_i, q, v, fi)
-            fj = fi
-            if (el%marker_j > 0) call real_frame(self, el%marker_j, q, v, fj)
-            call element_wrench(el, t, fi, fj, f, n, status)
-            force = f%val
-            torque = n%val
-            if (el%marker_j == 0) then
-                force(:, 2) = 0.0_wp
-                torque(:, 2) = 0.0_wp
-            end if
-        end associate
-    end procedure system_element_wrench
 end submodule flexmbs_mbs_system_elements
