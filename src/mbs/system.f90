@@ -108,6 +108,14 @@ module flexmbs_mbs_system
     ! (6), the rate q' = T v (1).
     integer, parameter :: seed_velocity_space = 1, seed_position = 2, seed_velocity = 3, &
         seed_rate = 4
+    ! A marker's body columns are seeded in windows of at most this many per
+    ! dual pass: two markers and time stay within dual_size = 16 directions
+    ! (a chain of any size takes several passes; first derivatives are
+    ! linear in the columns, so each window adds its own).
+    integer, parameter :: window_columns = rigid_body_nq
+    ! Duals of one marker's pose for the elements (chains of at most
+    ! rigid_body_nq coordinates there): a chain's coordinates, then its rates.
+    integer, parameter :: pose_duals = 2 * rigid_body_nq
 
     real(wp), parameter :: identity3(3, 3) = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
         1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
@@ -125,6 +133,14 @@ module flexmbs_mbs_system
         integer :: chain = 0    !! rigid chain number (chain markers; position, axes
         integer :: link = 0     !! in the frame of this body of the chain)
     end type marker_t
+
+    !> Workspace of one marker side of a joint, sized by the largest marker
+    !> body (a chain's columns): real and dual Jacobians and joint-row
+    !> blocks, and the pose duals p (a chain's coordinates, then its rates).
+    type :: marker_work_t
+        real(wp), allocatable :: jx(:, :), ja(:, :, :), c(:, :)
+        type(dual_t), allocatable :: p(:), jxd(:, :), jad(:, :, :), cd(:, :)
+    end type marker_work_t
 
     !> A chain's joint geometry as plain arrays (for the marker formulas).
     type :: chain_geometry_t
@@ -178,6 +194,9 @@ module flexmbs_mbs_system
         real(wp), allocatable :: chain_vq(:, :), chain_vv(:, :), chain_qq(:, :), &
             chain_unit(:), chain_rate(:)
         type(chain_geometry_t), allocatable :: chain_geom(:)
+        !> the markers' workspace (marker i, marker j), allocated when built; a
+        !> pointer so the evaluations (self intent(in)) write into its target
+        type(marker_work_t), pointer :: work(:) => null()
         integer, allocatable :: chain_q(:), chain_v(:)
         !> node frames (flexmbs_mbs_node_frame): massless rigid bodies held on
         !> node sets of the flexible bodies, rows after the joints' rows
@@ -422,49 +441,60 @@ module flexmbs_mbs_system
             real(wp), intent(in) :: q(:), v(:)
             type(marker_state_t), intent(out) :: m
         end subroutine marker_state
-        pure module subroutine marker_jacobian(self, k, q, position_space, jx, ja, n)
+        pure module subroutine marker_jacobian(self, k, q, position_space, jx, ja, n, p)
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: k
             real(wp), intent(in) :: q(:)
             logical, intent(in) :: position_space
-            real(wp), intent(out) :: jx(3, rigid_body_nq), ja(3, rigid_body_nq, 3)
+            real(wp), intent(out) :: jx(:, :), ja(:, :, :) !! 3 x n (x 3) at least
             integer, intent(out) :: n
+            !> pose duals (position space on a chain with quaternions)
+            type(dual_t), intent(inout), optional :: p(:)
         end subroutine marker_jacobian
-        pure module subroutine marker_state_dual(self, k, q, v, seed, first, m, p, n, pose_only)
+        pure module subroutine marker_state_dual(self, k, q, v, seed, first, m, p, n, pose_only, &
+                                                 window)
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: k, seed, first
             logical, intent(in), optional :: pose_only
+            !> seed the body's columns (window - 1) window_columns + 1 .. (default 1)
+            integer, intent(in), optional :: window
             real(wp), intent(in) :: q(:), v(:)
             type(marker_state_d), intent(out) :: m
-            type(dual_t), intent(out) :: p(rigid_body_nq)
+            type(dual_t), intent(inout) :: p(:) !! pose duals (marker_work_t)
             integer, intent(out) :: n
         end subroutine marker_state_dual
         pure module subroutine marker_jacobian_dual(self, k, p, jx, ja)
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: k
-            type(dual_t), intent(in) :: p(rigid_body_nq)
-            type(dual_t), intent(out) :: jx(3, rigid_body_nq), ja(3, rigid_body_nq, 3)
+            type(dual_t), intent(in) :: p(:)
+            type(dual_t), intent(out) :: jx(:, :), ja(:, :, :) !! 3 x nv (x 3) at least
         end subroutine marker_jacobian_dual
-        pure module subroutine chain_state_dual(self, k, q, v, seed, first, iq, iv, m, p, n)
+        pure module subroutine chain_state_dual(self, k, q, v, seed, first, iq, iv, c0, m, p, n)
             class(mbs_system_t), intent(in) :: self
-            integer, intent(in) :: k, seed, first, iq, iv
+            integer, intent(in) :: k, seed, first, iq, iv, c0
             real(wp), intent(in) :: q(:), v(:)
             type(marker_state_d), intent(out) :: m
-            type(dual_t), intent(inout) :: p(rigid_body_nq)
+            type(dual_t), intent(inout) :: p(:)
             integer, intent(out) :: n
         end subroutine chain_state_dual
+        pure integer module function marker_windows(self, k, position_space) result(n)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: k
+            logical, intent(in) :: position_space
+        end function marker_windows
         pure module subroutine chain_rates(self, c, qc, vc, rate)
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: c
             real(wp), intent(in) :: qc(:), vc(:)
             real(wp), intent(out) :: rate(:)
         end subroutine chain_rates
-        pure module subroutine chain_jacobian_real(self, k, q, iq, position_space, jx, ja)
+        pure module subroutine chain_jacobian_real(self, k, q, iq, position_space, jx, ja, p)
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: k, iq
             real(wp), intent(in) :: q(:)
             logical, intent(in) :: position_space
-            real(wp), intent(out) :: jx(3, rigid_body_nq), ja(3, rigid_body_nq, 3)
+            real(wp), intent(out) :: jx(:, :), ja(:, :, :)
+            type(dual_t), intent(inout), optional :: p(:)
         end subroutine chain_jacobian_real
         pure module function joint_driver(self, k, t) result(drv)
             class(mbs_system_t), intent(in) :: self
@@ -502,7 +532,8 @@ module flexmbs_mbs_system
             integer, intent(in) :: k
             real(wp), intent(in) :: t, q(:)
             logical, intent(in) :: position_space
-            real(wp), intent(out) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq)
+            !> max_rows x ni, nj at least (the workspace's c)
+            real(wp), intent(out) :: ci(:, :), cj(:, :)
             integer, intent(out) :: ni, nj
             real(wp), intent(out) :: ct(max_rows)
         end subroutine joint_first_derivatives

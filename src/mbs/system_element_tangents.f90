@@ -51,7 +51,7 @@ contains
         type(frame_t) :: fr(2), tangent(2)
         type(marker_state_d) :: md
         type(element_frame_t) :: frd
-        type(dual_t) :: p(rigid_body_nq), jxd(3, rigid_body_nq), jad(3, rigid_body_nq, 3), &
+        type(dual_t) :: p(pose_duals), jxd(3, rigid_body_nq), jad(3, rigid_body_nq, 3), &
             jwd(3), g
         real(wp) :: w(12), dw(12), jx(3, rigid_body_nq, 2), jw(3, rigid_body_nq, 2)
         integer :: ie, m, km, n(2), nm, b, iqm, ivm, l, c, a

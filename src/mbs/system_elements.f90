@@ -49,6 +49,19 @@ contains
                             int_text(size(self%markers)))
                         return
                     end if
+                    ! the elements' derivatives seed a marker's whole body into
+                    ! one dual pass (pose_duals): chains of window_columns at most
+                    if (self%markers(mk)%chain > 0) then
+                        if (self%chains(self%markers(mk)%chain)%nq > window_columns) then
+                            call status%set(status_bad_input, where // ': marker ' // &
+                                int_text(mk) // ' is on chain ' // &
+                                int_text(self%markers(mk)%chain) // ' of ' // &
+                                int_text(self%chains(self%markers(mk)%chain)%nq) // &
+                                ' coordinates: a force element needs a chain of at most ' &
+                                // int_text(window_columns) // ' (joints have no limit)')
+                            return
+                        end if
+                    end if
                     if (element_uses_rotation(e) .and. self%markers(mk)%flexible > 0) then
                         call status%set(status_bad_input, where // ': marker ' // &
                             int_text(mk) // ' is a node marker (no rotation): the element &
@@ -78,7 +91,7 @@ contains
     module procedure element_generalised
         type(marker_state_d) :: mi, mj
         type(element_frame_t) :: fi, fj
-        type(dual_t) :: pi(rigid_body_nq), pj(rigid_body_nq), force(3, 2), torque(3, 2)
+        type(dual_t) :: pi(pose_duals), pj(pose_duals), force(3, 2), torque(3, 2)
         integer :: bi, bj, iqi, iqj, ivi, ivj
         associate (e => self%elements(ie))
             call marker_state_dual(self, e%marker_i, q, v, seed, 1, mi, pi, di)
@@ -112,7 +125,7 @@ contains
         !> g(l) = Jx(:, l)·F + Jω(:, l)·n, l = 1 .. n.
         pure subroutine project(k, p, m, f, n_, n, g)
             integer, intent(in) :: k, n
-            type(dual_t), intent(in) :: p(rigid_body_nq), f(3), n_(3)
+            type(dual_t), intent(in) :: p(pose_duals), f(3), n_(3)
             type(marker_state_d), intent(in) :: m
             type(dual_t), intent(out) :: g(rigid_body_nq)
             type(dual_t) :: jx(3, rigid_body_nq), ja(3, rigid_body_nq, 3), jw(3)
