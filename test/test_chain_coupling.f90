@@ -5,7 +5,7 @@
 !> driver on the chain's first link: 2 + 6 velocities, 5 + 2 + 1 rows.
 module test_chain_coupling
     use flexmbs_core_kinds, only: wp, i8
-    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_status, only: status_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_radau5, only: radau5_t
@@ -17,7 +17,9 @@ module test_chain_coupling
     use flexmbs_mbs_primitive_kinds, only: primitive_dot1, primitive_dot2, primitive_angle_driver
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, driver_t, &
         force_element_t
-    use flexmbs_mbs_force_element, only: force_spring_damper
+    use flexmbs_mbs_force_element, only: force_spring_damper, force_bushing
+    use flexmbs_dae_mechanical_problem, only: mechanical_patterns_t
+    use test_force_elements, only: compare_derivatives, compare_with_ad
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_ggl, &
         formulation_index1, formulation_index2, formulation_index3
     use flexmbs_linalg_csc, only: csc_matrix_t
@@ -49,6 +51,7 @@ contains
                  new_test('large_chains_in_system', test_large), &
                  new_test('long_chain_markers_derivatives', test_long_derivatives), &
                  new_test('long_chain_markers_formulations', test_long_formulations), &
+                 new_test('long_chain_force_elements', test_long_elements), &
                  new_test('long_chain_closed_loop_energy', test_long_loop)]
     end function collect_chain_coupling
 
@@ -338,8 +341,8 @@ contains
     !> Two chains of 9 revolute links (9 coordinates each, more than a rigid
     !> body's 7) in one system with a rigid body on a spherical joint: built,
     !> M block diagonal with each chain's own M; a marker on one of them is
-    !> jointed (its rows vanish where the marker meets the body's), and a
-    !> force element on it is refused with a message that names the limit.
+    !> jointed (its rows: the marker's position minus the ground point), and
+    !> a force element takes it.
     subroutine test_large(error)
         type(error_t), allocatable, intent(out) :: error
         integer, parameter :: n = 9
@@ -392,16 +395,17 @@ contains
         sys = new_mbs_system([rigid_body_t(1.0_wp, 0.02_wp * identity)], m, &
             [mbs_joint_t(joint_spherical, 1, 3)], gravity=g_earth, chains=chains, &
             status=status, elements=[spring])
-        call check(error, status%code == status_bad_input .and. &
-                   index(status%text(), 'at most 7') > 0, 'force element on a 9-coordinate &
-                   &chain: ' // status%text())
+        call check(error, status%ok() .and. size(sys%elements) == 1, 'force element on a &
+                   &9-coordinate chain: ' // status%text())
     end subroutine test_large
     !> A chain of 14 links (13 revolute with turning axes, link 7 spherical:
     !> 17 coordinates and 16 rates, three dual windows) and two rigid bodies:
     !> the tip hinged to body 1 (revolute), link 5 held on the ground
     !> (spherical), link 9 turned from the ground by an angle driver, links 3
     !> and 12 tied by a dot-1 row (both markers on the chain), link 10 holding
-    !> body 2 (spherical): 13 rows. q = (bodies 1:14, chain 15:31).
+    !> body 2 (spherical): 13 rows. Force elements: a spring–damper from link
+    !> 13 to body 2, bushings from link 6 to the ground and between links 3
+    !> and 12. q = (bodies 1:14, chain 15:31).
     subroutine make_long(derivatives, sys, q0, status)
         character(len=*), intent(in) :: derivatives
         type(mbs_system_t), intent(out) :: sys
@@ -409,8 +413,9 @@ contains
         type(status_t), intent(out) :: status
         type(rigid_chain_t) :: chain
         type(chain_body_t) :: b(long_links)
-        type(marker_t) :: m(10)
+        type(marker_t) :: m(12)
         type(driver_t) :: drive
+        type(force_element_t) :: el(3)
         real(wp) :: u(3, 3), axis(3)
         integer :: i
         do i = 1, long_links
@@ -436,6 +441,20 @@ contains
         m(8) = marker_t(0, [0.1_wp, -0.03_wp, 0.02_wp], u, chain=1, link=12)
         m(9) = marker_t(0, [0.2_wp, 0.0_wp, -0.02_wp], chain=1, link=10)
         m(10) = marker_t(2, [0.0_wp, 0.1_wp, 0.0_wp])
+        m(11) = marker_t(0, [0.15_wp, -0.02_wp, 0.04_wp], transpose(u), chain=1, link=13)
+        m(12) = marker_t(0, [0.05_wp, 0.03_wp, -0.01_wp], u, chain=1, link=6)
+        el(1) = force_element_t(force_spring_damper, 11, 10, reference=0.3_wp, &
+            stiffness=[40.0_wp, 0.0_wp, 8.0_wp, 0.0_wp, 0.0_wp], damping=0.5_wp)
+        el(2) = force_element_t(force_bushing, 12, 4)
+        el(3) = force_element_t(force_bushing, 7, 8)
+        do i = 1, 6
+            el(2)%stiffness6(i, i) = 30.0_wp
+            el(2)%damping6(i, i) = 1.5_wp
+            el(3)%stiffness6(i, i) = 20.0_wp
+            el(3)%damping6(i, i) = 0.8_wp
+        end do
+        el(2)%stiffness6(1, 5) = 6.0_wp
+        el(3)%stiffness6(4, 2) = -3.0_wp
         drive%poly(0:2) = [0.3_wp, 0.8_wp, -0.2_wp]
         drive%amplitude = 0.1_wp
         drive%frequency = 3.0_wp
@@ -445,7 +464,8 @@ contains
              mbs_joint_t(joint_primitive, 5, 6, primitive_angle_driver, 1, 1, drive), &
              mbs_joint_t(joint_primitive, 7, 8, primitive_dot1, 1, 2), &
              mbs_joint_t(joint_spherical, 9, 10)], &
-            gravity=g_earth, constraint_derivatives=derivatives, status=status, chains=[chain])
+            gravity=g_earth, constraint_derivatives=derivatives, status=status, chains=[chain], &
+            elements=el)
         if (.not. status%ok()) return
         q0(1:7) = [3.2_wp, 0.4_wp, -0.2_wp, 0.9_wp, 0.1_wp, -0.3_wp, 0.2_wp]
         q0(8:14) = [2.4_wp, -0.3_wp, 0.5_wp, 0.8_wp, -0.2_wp, 0.1_wp, 0.5_wp]
@@ -462,6 +482,17 @@ contains
             q(first(k):first(k) + 3) = q(first(k):first(k) + 3) / norm2(q(first(k):first(k) + 3))
         end do
     end subroutine unit_quaternions
+
+    !> A random state of the long system near q0 (unit quaternions).
+    subroutine random_long_state(q0, seed, q, v)
+        real(wp), intent(in) :: q0(long_nq)
+        integer(i8), intent(inout) :: seed
+        real(wp), intent(out) :: q(long_nq), v(long_nv)
+        call fill_random(q, seed, -0.2_wp, 0.2_wp)
+        q = q0 + q
+        call unit_quaternions(q)
+        call fill_random(v, seed, -1.0_wp, 1.0_wp)
+    end subroutine random_long_state
 
     !> Markers on a chain of 17 coordinates (make_long): 'ad' and 'ad_full'
     !> equal 'analytic' (1e-12); c_q, c_t, γ against central differences, G
@@ -485,10 +516,7 @@ contains
         first = 0.0_wp
         second = 0.0_wp
         do trial = 1, 3
-            call fill_random(q, seed, -0.2_wp, 0.2_wp)
-            q = q0 + q
-            call unit_quaternions(q)
-            call fill_random(v, seed, -1.0_wp, 1.0_wp)
+            call random_long_state(q0, seed, q, v)
             worst = max(worst, ad_deviation(hand, ad, 0.2_wp, q, v, status), &
                         ad_deviation(hand, full, 0.2_wp, q, v, status))
             first = max(first, first_deviation(hand, 0.2_wp, q, v, status))
@@ -650,6 +678,33 @@ contains
         call check(error, fd_dev <= 1.0e-6_wp, 'Jacobian differs from differences')
         call check(error, sparse_dev <= 1.0e-13_wp, 'sparse Jacobian differs from dense')
     end subroutine test_long_formulations
+
+    !> The force elements on markers of the long chain (make_long; 'analytic'
+    !> laws): ∂f/∂q, ∂f/∂v against central differences (1e-7 relative), the
+    !> sparse blocks equal to the dense (1e-14), 'ad' equal to 'analytic'
+    !> (1e-13), at two random states.
+    subroutine test_long_elements(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(mbs_system_t) :: sys
+        type(mechanical_patterns_t) :: patterns
+        type(status_t) :: status
+        real(wp) :: q0(long_nq), q(long_nq), v(long_nv)
+        integer(i8) :: seed
+        integer :: trial
+        call make_long('analytic', sys, q0, status)
+        if (status%ok()) call sys%derivative_patterns(patterns, status)
+        call check(error, status%ok() .and. size(sys%elements) == 3, 'long system: ' // &
+                   status%text())
+        if (allocated(error)) return
+        seed = 93_i8
+        do trial = 1, 2
+            call random_long_state(q0, seed, q, v)
+            call compare_derivatives(error, sys, patterns, q, v, 'long chain elements')
+            if (allocated(error)) return
+            call compare_with_ad(error, sys, q, v, 'long chain elements')
+            if (allocated(error)) return
+        end do
+    end subroutine test_long_elements
 
     !> A closed loop through a long chain: 10 revolute links with turning
     !> axes (10 coordinates) from the ground, the tip held on the ground by a

@@ -113,9 +113,6 @@ module flexmbs_mbs_system
     ! (a chain of any size takes several passes; first derivatives are
     ! linear in the columns, so each window adds its own).
     integer, parameter :: window_columns = rigid_body_nq
-    ! Duals of one marker's pose for the elements (chains of at most
-    ! rigid_body_nq coordinates there): a chain's coordinates, then its rates.
-    integer, parameter :: pose_duals = 2 * rigid_body_nq
 
     real(wp), parameter :: identity3(3, 3) = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
         1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
@@ -134,12 +131,13 @@ module flexmbs_mbs_system
         integer :: link = 0     !! in the frame of this body of the chain)
     end type marker_t
 
-    !> Workspace of one marker side of a joint, sized by the largest marker
-    !> body (a chain's columns): real and dual Jacobians and joint-row
-    !> blocks, and the pose duals p (a chain's coordinates, then its rates).
+    !> Workspace of one marker side of a joint or force element, sized by the
+    !> largest marker body (a chain's columns): real and dual Jacobians
+    !> (jw: angular velocity), joint-row blocks, an element's generalised
+    !> forces g, and the pose duals p (a chain's coordinates, then its rates).
     type :: marker_work_t
-        real(wp), allocatable :: jx(:, :), ja(:, :, :), c(:, :)
-        type(dual_t), allocatable :: p(:), jxd(:, :), jad(:, :, :), cd(:, :)
+        real(wp), allocatable :: jx(:, :), ja(:, :, :), c(:, :), jw(:, :)
+        type(dual_t), allocatable :: p(:), jxd(:, :), jad(:, :, :), cd(:, :), g(:)
     end type marker_work_t
 
     !> A chain's joint geometry as plain arrays (for the marker formulas).
@@ -587,12 +585,12 @@ module flexmbs_mbs_system
             type(force_element_t), intent(in) :: elements(:)
             type(status_t), intent(inout) :: status
         end subroutine place_elements
-        module subroutine element_generalised(self, ie, t, q, v, seed, gi, gj, ni, nj, di, &
-                                              dj, offj, status)
+        module subroutine element_generalised(self, ie, t, q, v, seed, window, gi, gj, ni, nj, &
+                                              di, dj, offj, status)
             class(mbs_system_t), intent(in) :: self
-            integer, intent(in) :: ie, seed
+            integer, intent(in) :: ie, seed, window
             real(wp), intent(in) :: t, q(:), v(:)
-            type(dual_t), intent(out) :: gi(rigid_body_nq), gj(rigid_body_nq)
+            type(dual_t), intent(out) :: gi(:), gj(:) !! the workspace's g
             integer, intent(out) :: ni, nj, di, dj, offj
             type(status_t), intent(inout) :: status
         end subroutine element_generalised

@@ -72,8 +72,8 @@ contains
         allocate (self%work(2))
         do side = 1, 2
             associate (w => self%work(side))
-                allocate (w%jx(3, n), w%ja(3, n, 3), w%c(max_rows, n), w%p(2 * n), &
-                          w%jxd(3, n), w%jad(3, n, 3), w%cd(max_rows, n))
+                allocate (w%jx(3, n), w%ja(3, n, 3), w%c(max_rows, n), w%jw(3, n), &
+                          w%p(2 * n), w%jxd(3, n), w%jad(3, n, 3), w%cd(max_rows, n), w%g(n))
             end associate
         end do
     end subroutine allocate_marker_work
