@@ -149,8 +149,10 @@ contains
     end procedure marker_jacobian
 
     !> Dual frame and motion of marker k at (q, v) with its body's tangents
-    !> `seed` in directions first, first+1, ...; p the dual quaternion (for the
-    !> dual marker Jacobians); n the directions used (0 on the ground).
+    !> `seed` in directions first, first+1, ... (the columns of `window`); p
+    !> the pose duals (for the dual marker Jacobians: a rigid body's
+    !> quaternion, a chain's coordinates and rates); n the directions used (0
+    !> on the ground and past the body's last window).
     module procedure marker_state_dual
         !> the frame only (rigid markers): values and first derivatives of c
         !> the pose coordinates the dual Jacobians need: the quaternion of a
@@ -301,29 +303,29 @@ contains
             ! the tangents T e_l in the window (unit for single-coordinate
             ! joints, T(p) e_k for a spherical joint's quaternion), or the rate
             ! q' = T v in direction first (first window only)
-            if (n == 0) nb = 0
-            associate (g => self%chain_geom(c))
-                do b = 1, size(g%parent)
-                    if (nb == 0) exit
-                    jq = g%iq(b)
-                    jv = g%iv(b)
-                    if (g%kinds(b) == chain_joint_spherical) then
-                        tp = quat_rate_matrix(q(iq + jq + 1:iq + jq + 4))
-                        if (seed == seed_rate) then
-                            p(jq + 1:jq + 4)%der(first) = matmul(tp, v(iv + jv + 1:iv + jv + 3))
-                            cycle
+            if (n > 0) then
+                associate (g => self%chain_geom(c))
+                    do b = 1, size(g%parent)
+                        jq = g%iq(b)
+                        jv = g%iv(b)
+                        if (g%kinds(b) == chain_joint_spherical) then
+                            tp = quat_rate_matrix(q(iq + jq + 1:iq + jq + 4))
+                            if (seed == seed_rate) then
+                                p(jq + 1:jq + 4)%der(first) = matmul(tp, v(iv + jv + 1:iv + jv + 3))
+                                cycle
+                            end if
+                            do l = 1, 3
+                                if (jv + l <= c0 .or. jv + l > c0 + nb) cycle
+                                p(jq + 1:jq + 4)%der(first + jv + l - 1 - c0) = tp(:, l)
+                            end do
+                        else if (seed == seed_rate) then
+                            p(jq + 1)%der(first) = v(iv + jv + 1)
+                        else if (jv + 1 > c0 .and. jv + 1 <= c0 + nb) then
+                            p(jq + 1)%der(first + jv - c0) = 1.0_wp
                         end if
-                        do l = 1, 3
-                            if (jv + l <= c0 .or. jv + l > c0 + nb) cycle
-                            p(jq + 1:jq + 4)%der(first + jv + l - 1 - c0) = tp(:, l)
-                        end do
-                    else if (seed == seed_rate) then
-                        p(jq + 1)%der(first) = v(iv + jv + 1)
-                    else if (jv + 1 > c0 .and. jv + 1 <= c0 + nb) then
-                        p(jq + 1)%der(first + jv - c0) = 1.0_wp
-                    end if
-                end do
-            end associate
+                    end do
+                end associate
+            end if
         case (seed_position)
             do l = 1, nb
                 p(c0 + l)%der(first + l - 1) = 1.0_wp
