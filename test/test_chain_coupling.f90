@@ -284,7 +284,7 @@ contains
                    &not balance')
     contains
         real(wp) function imbalance(sys, q0, k) result(d)
-            type(mbs_system_t), intent(in) :: sys
+            type(mbs_system_t), intent(inout) :: sys
             real(wp), intent(in) :: q0(:)
             integer, intent(in) :: k
             real(wp) :: q(size(q0)), lambda(sys%nc), force(3, 2), torque(3, 2), &

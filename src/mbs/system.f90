@@ -192,9 +192,9 @@ module flexmbs_mbs_system
         real(wp), allocatable :: chain_vq(:, :), chain_vv(:, :), chain_qq(:, :), &
             chain_unit(:), chain_rate(:)
         type(chain_geometry_t), allocatable :: chain_geom(:)
-        !> the markers' workspace (marker i, marker j), allocated when built; a
-        !> pointer so the evaluations (self intent(in)) write into its target
-        type(marker_work_t), pointer :: work(:) => null()
+        !> the markers' workspace (marker i, marker j), allocated when built;
+        !> the evaluations that fill it take the system intent(inout)
+        type(marker_work_t), allocatable :: work(:)
         integer, allocatable :: chain_q(:), chain_v(:)
         !> node frames (flexmbs_mbs_node_frame): massless rigid bodies held on
         !> node sets of the flexible bodies, rows after the joints' rows
@@ -526,7 +526,7 @@ module flexmbs_mbs_system
 
         ! joint rows and their first derivatives; reactions (system_constraints.f90)
         module subroutine joint_first_derivatives(self, k, t, q, position_space, ci, cj, ni, nj, ct)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             integer, intent(in) :: k
             real(wp), intent(in) :: t, q(:)
             logical, intent(in) :: position_space
@@ -554,7 +554,7 @@ module flexmbs_mbs_system
             type(status_t), intent(inout) :: status
         end subroutine system_constraint_position_jacobian
         module subroutine assemble_first_derivative(self, t, q, position_space, out)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:)
             logical, intent(in) :: position_space
             type(accumulator_t), intent(inout) :: out
@@ -572,7 +572,7 @@ module flexmbs_mbs_system
             type(status_t), intent(inout) :: status
         end subroutine system_constraint_curvature
         module subroutine system_joint_reaction(self, k, t, q, lambda, force, torque)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             integer, intent(in) :: k
             real(wp), intent(in) :: t, q(:)
             real(wp), intent(in) :: lambda(:) !! all nc multipliers
@@ -587,7 +587,7 @@ module flexmbs_mbs_system
         end subroutine place_elements
         module subroutine element_generalised(self, ie, t, q, v, seed, window, gi, gj, ni, nj, &
                                               di, dj, offj, status)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             integer, intent(in) :: ie, seed, window
             real(wp), intent(in) :: t, q(:), v(:)
             type(dual_t), intent(out) :: gi(:), gj(:) !! the workspace's g
@@ -595,26 +595,26 @@ module flexmbs_mbs_system
             type(status_t), intent(inout) :: status
         end subroutine element_generalised
         module subroutine add_element_forces(self, t, q, v, f, status)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:), v(:)
             real(wp), intent(inout) :: f(:)
             type(status_t), intent(inout) :: status
         end subroutine add_element_forces
         module subroutine add_element_derivatives(self, t, q, v, fq, fv, status)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:), v(:)
             type(accumulator_t), intent(inout) :: fq, fv
             type(status_t), intent(inout) :: status
         end subroutine add_element_derivatives
         ! force elements, hand-coded derivatives (system_element_tangents.f90)
         module subroutine add_element_forces_analytic(self, t, q, v, f, status)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:), v(:)
             real(wp), intent(inout) :: f(:)
             type(status_t), intent(inout) :: status
         end subroutine add_element_forces_analytic
         module subroutine add_element_derivatives_analytic(self, t, q, v, fq, fv, status)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:), v(:)
             type(accumulator_t), intent(inout) :: fq, fv
             type(status_t), intent(inout) :: status
@@ -656,7 +656,7 @@ module flexmbs_mbs_system
             type(status_t), intent(inout) :: status
         end subroutine system_constraint_jacobian_derivatives_sparse
         module subroutine jacobian_derivatives_into(self, t, q, w, lambda, gwq, gtlq)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:), w(:), lambda(:)
             type(accumulator_t), intent(inout) :: gwq, gtlq
         end subroutine jacobian_derivatives_into
@@ -678,7 +678,7 @@ module flexmbs_mbs_system
             type(status_t), intent(inout) :: status
         end subroutine system_constraint_time_derivative_jacobian_sparse
         module subroutine time_derivative_jacobian_into(self, t, q, dq)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:)
             type(accumulator_t), intent(inout) :: dq
         end subroutine time_derivative_jacobian_into
@@ -695,7 +695,7 @@ module flexmbs_mbs_system
             type(status_t), intent(inout) :: status
         end subroutine system_constraint_curvature_derivatives_sparse
         module subroutine curvature_derivatives_into(self, t, q, v, gq, gv)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:), v(:)
             type(accumulator_t), intent(inout) :: gq, gv
         end subroutine curvature_derivatives_into
