@@ -38,7 +38,7 @@ module test_force_elements
     use testing, only: test_case_t, new_test, error_t, check
     implicit none
     private
-    public :: collect_force_elements
+    public :: collect_force_elements, compare_derivatives, compare_with_ad
 
 contains
 

@@ -108,6 +108,11 @@ module flexmbs_mbs_system
     ! (6), the rate q' = T v (1).
     integer, parameter :: seed_velocity_space = 1, seed_position = 2, seed_velocity = 3, &
         seed_rate = 4
+    ! A marker's body columns are seeded in windows of at most this many per
+    ! dual pass: two markers and time stay within dual_size = 16 directions
+    ! (a chain of any size takes several passes; first derivatives are
+    ! linear in the columns, so each window adds its own).
+    integer, parameter :: window_columns = rigid_body_nq
 
     real(wp), parameter :: identity3(3, 3) = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
         1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
@@ -125,6 +130,15 @@ module flexmbs_mbs_system
         integer :: chain = 0    !! rigid chain number (chain markers; position, axes
         integer :: link = 0     !! in the frame of this body of the chain)
     end type marker_t
+
+    !> Workspace of one marker side of a joint or force element, sized by the
+    !> largest marker body (a chain's columns): real and dual Jacobians
+    !> (jw: angular velocity), joint-row blocks, an element's generalised
+    !> forces g, and the pose duals p (a chain's coordinates, then its rates).
+    type :: marker_work_t
+        real(wp), allocatable :: jx(:, :), ja(:, :, :), c(:, :), jw(:, :)
+        type(dual_t), allocatable :: p(:), jxd(:, :), jad(:, :, :), cd(:, :), g(:)
+    end type marker_work_t
 
     !> A chain's joint geometry as plain arrays (for the marker formulas).
     type :: chain_geometry_t
@@ -178,6 +192,9 @@ module flexmbs_mbs_system
         real(wp), allocatable :: chain_vq(:, :), chain_vv(:, :), chain_qq(:, :), &
             chain_unit(:), chain_rate(:)
         type(chain_geometry_t), allocatable :: chain_geom(:)
+        !> the markers' workspace (marker i, marker j), allocated when built;
+        !> the evaluations that fill it take the system intent(inout)
+        type(marker_work_t), allocatable :: work(:)
         integer, allocatable :: chain_q(:), chain_v(:)
         !> node frames (flexmbs_mbs_node_frame): massless rigid bodies held on
         !> node sets of the flexible bodies, rows after the joints' rows
@@ -422,49 +439,60 @@ module flexmbs_mbs_system
             real(wp), intent(in) :: q(:), v(:)
             type(marker_state_t), intent(out) :: m
         end subroutine marker_state
-        pure module subroutine marker_jacobian(self, k, q, position_space, jx, ja, n)
+        pure module subroutine marker_jacobian(self, k, q, position_space, jx, ja, n, p)
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: k
             real(wp), intent(in) :: q(:)
             logical, intent(in) :: position_space
-            real(wp), intent(out) :: jx(3, rigid_body_nq), ja(3, rigid_body_nq, 3)
+            real(wp), intent(out) :: jx(:, :), ja(:, :, :) !! 3 x n (x 3) at least
             integer, intent(out) :: n
+            !> pose duals (position space on a chain with quaternions)
+            type(dual_t), intent(inout), optional :: p(:)
         end subroutine marker_jacobian
-        pure module subroutine marker_state_dual(self, k, q, v, seed, first, m, p, n, pose_only)
+        pure module subroutine marker_state_dual(self, k, q, v, seed, first, m, p, n, pose_only, &
+                                                 window)
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: k, seed, first
             logical, intent(in), optional :: pose_only
+            !> seed the body's columns (window - 1) window_columns + 1 .. (default 1)
+            integer, intent(in), optional :: window
             real(wp), intent(in) :: q(:), v(:)
             type(marker_state_d), intent(out) :: m
-            type(dual_t), intent(out) :: p(rigid_body_nq)
+            type(dual_t), intent(inout) :: p(:) !! pose duals (marker_work_t)
             integer, intent(out) :: n
         end subroutine marker_state_dual
         pure module subroutine marker_jacobian_dual(self, k, p, jx, ja)
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: k
-            type(dual_t), intent(in) :: p(rigid_body_nq)
-            type(dual_t), intent(out) :: jx(3, rigid_body_nq), ja(3, rigid_body_nq, 3)
+            type(dual_t), intent(in) :: p(:)
+            type(dual_t), intent(out) :: jx(:, :), ja(:, :, :) !! 3 x nv (x 3) at least
         end subroutine marker_jacobian_dual
-        pure module subroutine chain_state_dual(self, k, q, v, seed, first, iq, iv, m, p, n)
+        pure module subroutine chain_state_dual(self, k, q, v, seed, first, iq, iv, c0, m, p, n)
             class(mbs_system_t), intent(in) :: self
-            integer, intent(in) :: k, seed, first, iq, iv
+            integer, intent(in) :: k, seed, first, iq, iv, c0
             real(wp), intent(in) :: q(:), v(:)
             type(marker_state_d), intent(out) :: m
-            type(dual_t), intent(inout) :: p(rigid_body_nq)
+            type(dual_t), intent(inout) :: p(:)
             integer, intent(out) :: n
         end subroutine chain_state_dual
+        pure integer module function marker_windows(self, k, position_space) result(n)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: k
+            logical, intent(in) :: position_space
+        end function marker_windows
         pure module subroutine chain_rates(self, c, qc, vc, rate)
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: c
             real(wp), intent(in) :: qc(:), vc(:)
             real(wp), intent(out) :: rate(:)
         end subroutine chain_rates
-        pure module subroutine chain_jacobian_real(self, k, q, iq, position_space, jx, ja)
+        pure module subroutine chain_jacobian_real(self, k, q, iq, position_space, jx, ja, p)
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: k, iq
             real(wp), intent(in) :: q(:)
             logical, intent(in) :: position_space
-            real(wp), intent(out) :: jx(3, rigid_body_nq), ja(3, rigid_body_nq, 3)
+            real(wp), intent(out) :: jx(:, :), ja(:, :, :)
+            type(dual_t), intent(inout), optional :: p(:)
         end subroutine chain_jacobian_real
         pure module function joint_driver(self, k, t) result(drv)
             class(mbs_system_t), intent(in) :: self
@@ -498,11 +526,12 @@ module flexmbs_mbs_system
 
         ! joint rows and their first derivatives; reactions (system_constraints.f90)
         module subroutine joint_first_derivatives(self, k, t, q, position_space, ci, cj, ni, nj, ct)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             integer, intent(in) :: k
             real(wp), intent(in) :: t, q(:)
             logical, intent(in) :: position_space
-            real(wp), intent(out) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq)
+            !> max_rows x ni, nj at least (the workspace's c)
+            real(wp), intent(out) :: ci(:, :), cj(:, :)
             integer, intent(out) :: ni, nj
             real(wp), intent(out) :: ct(max_rows)
         end subroutine joint_first_derivatives
@@ -525,7 +554,7 @@ module flexmbs_mbs_system
             type(status_t), intent(inout) :: status
         end subroutine system_constraint_position_jacobian
         module subroutine assemble_first_derivative(self, t, q, position_space, out)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:)
             logical, intent(in) :: position_space
             type(accumulator_t), intent(inout) :: out
@@ -543,7 +572,7 @@ module flexmbs_mbs_system
             type(status_t), intent(inout) :: status
         end subroutine system_constraint_curvature
         module subroutine system_joint_reaction(self, k, t, q, lambda, force, torque)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             integer, intent(in) :: k
             real(wp), intent(in) :: t, q(:)
             real(wp), intent(in) :: lambda(:) !! all nc multipliers
@@ -556,36 +585,36 @@ module flexmbs_mbs_system
             type(force_element_t), intent(in) :: elements(:)
             type(status_t), intent(inout) :: status
         end subroutine place_elements
-        module subroutine element_generalised(self, ie, t, q, v, seed, gi, gj, ni, nj, di, &
-                                              dj, offj, status)
-            class(mbs_system_t), intent(in) :: self
-            integer, intent(in) :: ie, seed
+        module subroutine element_generalised(self, ie, t, q, v, seed, window, gi, gj, ni, nj, &
+                                              di, dj, offj, status)
+            class(mbs_system_t), intent(inout) :: self
+            integer, intent(in) :: ie, seed, window
             real(wp), intent(in) :: t, q(:), v(:)
-            type(dual_t), intent(out) :: gi(rigid_body_nq), gj(rigid_body_nq)
+            type(dual_t), intent(out) :: gi(:), gj(:) !! the workspace's g
             integer, intent(out) :: ni, nj, di, dj, offj
             type(status_t), intent(inout) :: status
         end subroutine element_generalised
         module subroutine add_element_forces(self, t, q, v, f, status)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:), v(:)
             real(wp), intent(inout) :: f(:)
             type(status_t), intent(inout) :: status
         end subroutine add_element_forces
         module subroutine add_element_derivatives(self, t, q, v, fq, fv, status)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:), v(:)
             type(accumulator_t), intent(inout) :: fq, fv
             type(status_t), intent(inout) :: status
         end subroutine add_element_derivatives
         ! force elements, hand-coded derivatives (system_element_tangents.f90)
         module subroutine add_element_forces_analytic(self, t, q, v, f, status)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:), v(:)
             real(wp), intent(inout) :: f(:)
             type(status_t), intent(inout) :: status
         end subroutine add_element_forces_analytic
         module subroutine add_element_derivatives_analytic(self, t, q, v, fq, fv, status)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:), v(:)
             type(accumulator_t), intent(inout) :: fq, fv
             type(status_t), intent(inout) :: status
@@ -627,7 +656,7 @@ module flexmbs_mbs_system
             type(status_t), intent(inout) :: status
         end subroutine system_constraint_jacobian_derivatives_sparse
         module subroutine jacobian_derivatives_into(self, t, q, w, lambda, gwq, gtlq)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:), w(:), lambda(:)
             type(accumulator_t), intent(inout) :: gwq, gtlq
         end subroutine jacobian_derivatives_into
@@ -649,7 +678,7 @@ module flexmbs_mbs_system
             type(status_t), intent(inout) :: status
         end subroutine system_constraint_time_derivative_jacobian_sparse
         module subroutine time_derivative_jacobian_into(self, t, q, dq)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:)
             type(accumulator_t), intent(inout) :: dq
         end subroutine time_derivative_jacobian_into
@@ -666,7 +695,7 @@ module flexmbs_mbs_system
             type(status_t), intent(inout) :: status
         end subroutine system_constraint_curvature_derivatives_sparse
         module subroutine curvature_derivatives_into(self, t, q, v, gq, gv)
-            class(mbs_system_t), intent(in) :: self
+            class(mbs_system_t), intent(inout) :: self
             real(wp), intent(in) :: t, q(:), v(:)
             type(accumulator_t), intent(inout) :: gq, gv
         end subroutine curvature_derivatives_into

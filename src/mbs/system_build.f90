@@ -57,7 +57,26 @@ contains
         self%nc = row0
         allocate (self%zero_v(self%nv))
         self%zero_v = 0.0_wp
+        call allocate_marker_work(self)
     end procedure new_mbs_system
+
+    !> The markers' workspace (marker_work_t), sized by the largest marker
+    !> body: a rigid body's 7 coordinates or a chain's.
+    subroutine allocate_marker_work(self)
+        type(mbs_system_t), intent(inout) :: self
+        integer :: n, f, side
+        n = rigid_body_nq
+        do f = 1, size(self%chains)
+            n = max(n, self%chains(f)%nq)
+        end do
+        allocate (self%work(2))
+        do side = 1, 2
+            associate (w => self%work(side))
+                allocate (w%jx(3, n), w%ja(3, n, 3), w%c(max_rows, n), w%jw(3, n), &
+                          w%p(2 * n), w%jxd(3, n), w%jad(3, n, 3), w%cd(max_rows, n), w%g(n))
+            end associate
+        end do
+    end subroutine allocate_marker_work
 
     !> The rigid chains and the geometry the constraints read from them.
     subroutine place_chains(self, chains, status)
@@ -118,16 +137,6 @@ contains
                     markers(k)%link > size(self%chains(markers(k)%chain)%bodies)) then
                     call status%set(status_bad_input, where // ': link ' // &
                         int_text(markers(k)%link) // ' is not a body of its chain')
-                    return
-                end if
-                ! the joints' derivatives seed a marker's body coordinates into
-                ! dual numbers of 16 directions, two bodies and time at once
-                if (self%chains(markers(k)%chain)%nq > rigid_body_nq) then
-                    call status%set(status_bad_input, where // ': chain ' // &
-                        int_text(markers(k)%chain) // ' has ' // &
-                        int_text(self%chains(markers(k)%chain)%nq) // ' coordinates: a ' // &
-                        'marker needs a chain of at most ' // int_text(rigid_body_nq) // &
-                        ' (larger chains without markers have no limit)')
                     return
                 end if
             end if

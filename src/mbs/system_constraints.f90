@@ -12,51 +12,63 @@ contains
     module procedure joint_first_derivatives
         type(marker_state_t) :: mi, mj
         type(marker_state_d) :: mid, mjd
-        real(wp) :: jxi(3, rigid_body_nq), jai(3, rigid_body_nq, 3), jxj(3, rigid_body_nq), &
-            jaj(3, rigid_body_nq, 3), drv(3)
-        type(dual_t) :: pd(rigid_body_nq), cd(max_rows)
-        integer :: seed, nr, r, td
+        real(wp) :: drv(3)
+        type(dual_t) :: cd(max_rows)
+        integer :: seed, nr, r, td, pass, wi, wj, ci0, cj0
         ci = 0.0_wp
         cj = 0.0_wp
         ct = 0.0_wp
-        associate (jt => self%joints(k))
+        associate (jt => self%joints(k), w1 => self%work(1), w2 => self%work(2))
             nr = jt%joint%nrows
             drv = joint_driver(self, k, t)
-            if (self%derivatives == constraint_derivatives_analytic) then
+            if (self%derivatives /= constraint_derivatives_ad_full) then
                 call marker_state(self, jt%marker_i, q, self%zero_v, mi)
                 call marker_state(self, jt%marker_j, q, self%zero_v, mj)
-                call marker_jacobian(self, jt%marker_i, q, position_space, jxi, jai, ni)
-                call marker_jacobian(self, jt%marker_j, q, position_space, jxj, jaj, nj)
-                call joint_jacobian(jt%joint, mi, jxi(:, 1:ni), jai(:, 1:ni, :), mj, &
-                                    jxj(:, 1:nj), jaj(:, 1:nj, :), drv, ci(1:nr, 1:ni), &
+                call marker_jacobian(self, jt%marker_i, q, position_space, w1%jx, w1%ja, ni, &
+                                     w1%p)
+                call marker_jacobian(self, jt%marker_j, q, position_space, w2%jx, w2%ja, nj, &
+                                     w2%p)
+            else
+                ni = marker_columns(self, jt%marker_i, position_space)
+                nj = marker_columns(self, jt%marker_j, position_space)
+            end if
+            if (self%derivatives == constraint_derivatives_analytic) then
+                call joint_jacobian(jt%joint, mi, w1%jx(:, 1:ni), w1%ja(:, 1:ni, :), mj, &
+                                    w2%jx(:, 1:nj), w2%ja(:, 1:nj, :), drv, ci(1:nr, 1:ni), &
                                     cj(1:nr, 1:nj))
                 call joint_rows(joint_part_time_derivative, jt%joint, mi, mj, drv, ct(1:nr))
-            else if (self%derivatives == constraint_derivatives_ad) then
-                ! the frames' tangents are the markers' Jacobian columns: AD of the
-                ! vector relations only
-                call marker_state(self, jt%marker_i, q, self%zero_v, mi)
-                call marker_state(self, jt%marker_j, q, self%zero_v, mj)
-                call marker_jacobian(self, jt%marker_i, q, position_space, jxi, jai, ni)
-                call marker_jacobian(self, jt%marker_j, q, position_space, jxj, jaj, nj)
-                call seeded_frame(mi, jxi(:, 1:ni), jai(:, 1:ni, :), 0, mid)
-                call seeded_frame(mj, jxj(:, 1:nj), jaj(:, 1:nj, :), ni, mjd)
-            else
-                seed = merge(seed_position, seed_velocity_space, position_space)
-                call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed, 1, mid, pd, ni, &
-                                       pose_only=.true.)
-                call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed, 1 + ni, mjd, &
-                                       pd, nj, pose_only=.true.)
+                return
             end if
-            if (self%derivatives /= constraint_derivatives_analytic) then
-                ! tangents: marker i's columns, marker j's, time
-                td = ni + nj + 1
+            ! AD: one pass per window of each marker's columns (module header)
+            seed = merge(seed_position, seed_velocity_space, position_space)
+            do pass = 1, max(marker_windows(self, jt%marker_i, position_space), &
+                             marker_windows(self, jt%marker_j, position_space))
+                ci0 = (pass - 1) * window_columns
+                cj0 = ci0
+                wi = max(0, min(window_columns, ni - ci0))
+                wj = max(0, min(window_columns, nj - cj0))
+                if (self%derivatives == constraint_derivatives_ad) then
+                    ! the frames' tangents are the markers' Jacobian columns: AD
+                    ! of the vector relations only
+                    call seeded_frame(mi, w1%jx(:, ci0 + 1:ci0 + wi), &
+                                      w1%ja(:, ci0 + 1:ci0 + wi, :), 0, mid)
+                    call seeded_frame(mj, w2%jx(:, cj0 + 1:cj0 + wj), &
+                                      w2%ja(:, cj0 + 1:cj0 + wj, :), wi, mjd)
+                else
+                    call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed, 1, mid, &
+                                           w1%p, wi, pose_only=.true., window=pass)
+                    call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed, 1 + wi, &
+                                           mjd, w2%p, wj, pose_only=.true., window=pass)
+                end if
+                ! tangents: marker i's window, marker j's, time
+                td = wi + wj + 1
                 call joint_value_d(jt%joint, mid, mjd, driver_dual(drv, td), cd(1:nr))
                 do r = 1, nr
-                    ci(r, 1:ni) = cd(r)%der(1:ni)
-                    cj(r, 1:nj) = cd(r)%der(ni + 1:ni + nj)
-                    ct(r) = cd(r)%der(td)
+                    ci(r, ci0 + 1:ci0 + wi) = cd(r)%der(1:wi)
+                    cj(r, cj0 + 1:cj0 + wj) = cd(r)%der(wi + 1:wi + wj)
+                    if (pass == 1) ct(r) = cd(r)%der(td)
                 end do
-            end if
+            end do
         end associate
     end procedure joint_first_derivatives
 
@@ -94,10 +106,10 @@ contains
 
     !> G (velocity space) or c_q (position space) added into out.
     module procedure assemble_first_derivative
-        real(wp) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq), ct(max_rows)
+        real(wp) :: ct(max_rows)
         integer :: k, ni, nj, r0, nr
         do k = 1, size(self%joints)
-            associate (jt => self%joints(k))
+            associate (jt => self%joints(k), ci => self%work(1)%c, cj => self%work(2)%c)
                 r0 = jt%row0
                 nr = jt%joint%nrows
                 call joint_first_derivatives(self, k, t, q, position_space, ci, cj, ni, nj, ct)
@@ -117,11 +129,12 @@ contains
 
     !> c_t = ∂c/∂t.
     module procedure system_constraint_time_derivative
-        real(wp) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq), ct(max_rows)
+        real(wp) :: ct(max_rows)
         integer :: k, ni, nj
         do k = 1, size(self%joints)
             associate (jt => self%joints(k))
-                call joint_first_derivatives(self, k, t, q, .false., ci, cj, ni, nj, ct)
+                call joint_first_derivatives(self, k, t, q, .false., self%work(1)%c, &
+                                             self%work(2)%c, ni, nj, ct)
                 gt(jt%row0 + 1:jt%row0 + jt%joint%nrows) = ct(1:jt%joint%nrows)
             end associate
         end do
@@ -137,13 +150,12 @@ contains
     module procedure system_constraint_curvature
         type(marker_state_t) :: mi, mj
         type(marker_state_d) :: mid, mjd
-        type(dual_t) :: pi(rigid_body_nq), pj(rigid_body_nq), jxi(3, rigid_body_nq), &
-            jai(3, rigid_body_nq, 3), jxj(3, rigid_body_nq), jaj(3, rigid_body_nq, 3), &
-            cid(max_rows, rigid_body_nq), cjd(max_rows, rigid_body_nq), ctd(max_rows), drvd(3), cv
+        type(dual_t) :: xi(3, 1), ai(3, 1, 3), xj(3, 1), aj(3, 1, 3), cid(max_rows, 1), &
+            cjd(max_rows, 1), ctd(max_rows), drvd(3), cv
         type(marker_state_j) :: mij, mjj
         type(jet_t) :: drvj(3), cjet(max_rows)
         real(wp) :: drv(3), tt(max_rows)
-        integer :: k, r0, nr, ni, nj, r, bi, bj, iqi, iqj, ivi, ivj
+        integer :: k, r0, nr, ni, nj, r
         do k = 1, size(self%joints)
             associate (jt => self%joints(k))
                 r0 = jt%row0
@@ -169,23 +181,23 @@ contains
                     call joint_value_j(jt%joint, mij, mjj, drvj, cjet(1:nr))
                     gamma(r0 + 1:r0 + nr) = cjet(1:nr)%f2
                 else
-                    call marker_state_dual(self, jt%marker_i, q, v, seed_rate, 1, mid, pi, ni)
-                    call marker_state_dual(self, jt%marker_j, q, v, seed_rate, 1, mjd, pj, nj)
-                    call marker_jacobian_dual(self, jt%marker_i, pi, jxi, jai)
-                    call marker_jacobian_dual(self, jt%marker_j, pj, jxj, jaj)
-                    ni = marker_columns(self, jt%marker_i, .false.)
-                    nj = marker_columns(self, jt%marker_j, .false.)
+                    ! G v = the joint's first derivatives along the markers'
+                    ! velocities (linear in the columns): one column each
+                    call marker_state_dual(self, jt%marker_i, q, v, seed_rate, 1, mid, &
+                                           self%work(1)%p, ni)
+                    call marker_state_dual(self, jt%marker_j, q, v, seed_rate, 1, mjd, &
+                                           self%work(2)%p, nj)
+                    xi(:, 1) = mid%xd
+                    ai(:, 1, :) = mid%ad
+                    xj(:, 1) = mjd%xd
+                    aj(:, 1, :) = mjd%ad
                     drvd = driver_dual(drv, 2)
-                    call joint_jacobian_d(jt%joint, mid, jxi(:, 1:ni), jai(:, 1:ni, :), mjd, &
-                                          jxj(:, 1:nj), jaj(:, 1:nj, :), drvd, &
-                                          cid(1:nr, 1:ni), cjd(1:nr, 1:nj))
+                    call joint_jacobian_d(jt%joint, mid, xi, ai, mjd, xj, aj, drvd, &
+                                          cid(1:nr, :), cjd(1:nr, :))
                     call joint_rows_d(joint_part_time_derivative, jt%joint, mid, mjd, drvd, &
                                       ctd(1:nr))
-                    call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
-                    call marker_offsets(self, jt%marker_j, bj, iqj, ivj)
                     do r = 1, nr
-                        cv = dot_product(cid(r, 1:ni), v(ivi + 1:ivi + ni)) &
-                             + dot_product(cjd(r, 1:nj), v(ivj + 1:ivj + nj))
+                        cv = cid(r, 1) + cjd(r, 1)
                         gamma(r0 + r) = cv%der(1) + 2.0_wp * cv%der(2) + ctd(r)%der(2)
                     end do
                 end if
@@ -215,12 +227,12 @@ contains
     !> (marker_frame_reaction), since its columns of G are the chain's joint
     !> coordinates.
     module procedure system_joint_reaction
-        real(wp) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq), ct(max_rows)
+        real(wp) :: ct(max_rows)
         real(wp) :: gen(6), a(3, 3)
         integer :: ni, nj, side, b, iq, iv, mk, r0, nr
         force = 0.0_wp
         torque = 0.0_wp
-        associate (jt => self%joints(k))
+        associate (jt => self%joints(k), ci => self%work(1)%c, cj => self%work(2)%c)
             r0 = jt%row0
             nr = jt%joint%nrows
             call joint_first_derivatives(self, k, t, q, .false., ci, cj, ni, nj, ct)

@@ -24,7 +24,7 @@ contains
     !> f += the elements' generalised forces (real laws).
     module procedure add_element_forces_analytic
         type(frame_t) :: fr(2)
-        real(wp) :: w(12), jx(3, rigid_body_nq), jw(3, rigid_body_nq)
+        real(wp) :: w(12)
         integer :: ie, side, k, n, b, iq, iv, l
         do ie = 1, size(self%elements)
             call element_frames(self, ie, q, v, fr)
@@ -36,12 +36,15 @@ contains
             do side = 1, 2
                 k = side_marker(self, ie, side)
                 if (k == 0) cycle
-                call velocity_jacobian(self, k, q, fr(side)%a, jx, jw, n)
-                call marker_offsets(self, k, b, iq, iv)
-                do l = 1, n
-                    f(iv + l) = f(iv + l) + dot_product(jx(:, l), w(6 * side - 5:6 * side - 3)) &
-                        + dot_product(jw(:, l), w(6 * side - 2:6 * side))
-                end do
+                associate (wk => self%work(side))
+                    call velocity_jacobian(self, k, q, fr(side)%a, wk%jx, wk%ja, wk%jw, n)
+                    call marker_offsets(self, k, b, iq, iv)
+                    do l = 1, n
+                        f(iv + l) = f(iv + l) + dot_product(wk%jx(:, l), &
+                            w(6 * side - 5:6 * side - 3)) + dot_product(wk%jw(:, l), &
+                            w(6 * side - 2:6 * side))
+                    end do
+                end associate
             end do
         end do
     end procedure add_element_forces_analytic
@@ -51,56 +54,62 @@ contains
         type(frame_t) :: fr(2), tangent(2)
         type(marker_state_d) :: md
         type(element_frame_t) :: frd
-        type(dual_t) :: p(rigid_body_nq), jxd(3, rigid_body_nq), jad(3, rigid_body_nq, 3), &
-            jwd(3), g
-        real(wp) :: w(12), dw(12), jx(3, rigid_body_nq, 2), jw(3, rigid_body_nq, 2)
-        integer :: ie, m, km, n(2), nm, b, iqm, ivm, l, c, a
+        type(dual_t) :: jwd(3), g
+        real(wp) :: w(12), dw(12)
+        integer :: ie, m, km, n(2), nm, b, iqm, ivm, l, c, a, window, c0
         do ie = 1, size(self%elements)
             call element_frames(self, ie, q, v, fr)
             n = 0
             do m = 1, 2
                 km = side_marker(self, ie, m)
-                if (km > 0) call velocity_jacobian(self, km, q, fr(m)%a, jx(:, :, m), &
-                                                   jw(:, :, m), n(m))
+                if (km > 0) call velocity_jacobian(self, km, q, fr(m)%a, self%work(m)%jx, &
+                                                   self%work(m)%ja, self%work(m)%jw, n(m))
             end do
             do m = 1, 2
                 km = side_marker(self, ie, m)
                 if (km == 0) cycle
                 call marker_offsets(self, km, b, iqm, ivm)
-                ! rates of marker m's body: its motion moves along J_m(:, l)
-                do l = 1, n(m)
-                    tangent = frame_t()
-                    tangent(m)%xd = jx(:, l, m)
-                    tangent(m)%w = jw(:, l, m)
-                    if (.not. law_tangent(tangent)) return
-                    call scatter(fv, ivm + l)
-                end do
-                ! coordinates of marker m's body: pose and motion tangents by
-                ! dual numbers through the hand-coded marker kinematics
-                call marker_state_dual(self, km, q, v, seed_position, 1, md, p, nm)
-                call frame_of_state(md, frd)
-                call marker_jacobian_dual(self, km, p, jxd, jad)
-                do c = 1, nm
-                    tangent = frame_t()
-                    tangent(m)%x = frd%x%der(c)
-                    do a = 1, 3
-                        tangent(m)%a(:, a) = frd%a(:, a)%der(c)
-                    end do
-                    tangent(m)%xd = frd%xd%der(c)
-                    tangent(m)%w = frd%w%der(c)
-                    if (.not. law_tangent(tangent)) return
-                    call scatter(fq, iqm + c)
-                    ! (∂J_m/∂q_c)ᵀ w_m: marker m's own rows
+                associate (wm => self%work(m))
+                    ! rates of marker m's body: its motion moves along J_m(:, l)
                     do l = 1, n(m)
-                        jwd = 0.0_wp
-                        do a = 1, 3
-                            jwd = jwd + 0.5_wp * cross_d(md%a(:, a), jad(:, l, a))
-                        end do
-                        g = dot_product(jxd(:, l), w(6 * m - 5:6 * m - 3)) + &
-                            dot_product(jwd, w(6 * m - 2:6 * m))
-                        call fq%add(ivm + l, iqm + c, g%der(c))
+                        tangent = frame_t()
+                        tangent(m)%xd = wm%jx(:, l)
+                        tangent(m)%w = wm%jw(:, l)
+                        if (.not. law_tangent(tangent)) return
+                        call scatter(fv, ivm + l)
                     end do
-                end do
+                    ! coordinates of marker m's body: pose and motion tangents by
+                    ! dual numbers through the hand-coded marker kinematics, one
+                    ! pass per window of its columns
+                    do window = 1, marker_windows(self, km, .true.)
+                        c0 = (window - 1) * window_columns
+                        call marker_state_dual(self, km, q, v, seed_position, 1, md, wm%p, nm, &
+                                               window=window)
+                        call frame_of_state(md, frd)
+                        call marker_jacobian_dual(self, km, wm%p, wm%jxd, wm%jad)
+                        do c = 1, nm
+                            tangent = frame_t()
+                            tangent(m)%x = frd%x%der(c)
+                            do a = 1, 3
+                                tangent(m)%a(:, a) = frd%a(:, a)%der(c)
+                            end do
+                            tangent(m)%xd = frd%xd%der(c)
+                            tangent(m)%w = frd%w%der(c)
+                            if (.not. law_tangent(tangent)) return
+                            call scatter(fq, iqm + c0 + c)
+                            ! (∂J_m/∂q_c)ᵀ w_m: marker m's own rows
+                            do l = 1, n(m)
+                                jwd = 0.0_wp
+                                do a = 1, 3
+                                    jwd = jwd + 0.5_wp * cross_d(md%a(:, a), wm%jad(:, l, a))
+                                end do
+                                g = dot_product(wm%jxd(:, l), w(6 * m - 5:6 * m - 3)) + &
+                                    dot_product(jwd, w(6 * m - 2:6 * m))
+                                call fq%add(ivm + l, iqm + c0 + c, g%der(c))
+                            end do
+                        end do
+                    end do
+                end associate
             end do
         end do
 
@@ -126,8 +135,8 @@ contains
                 if (k == 0) cycle
                 call marker_offsets(self, k, bk, iqk, ivk)
                 do r = 1, n(side)
-                    call out%add(ivk + r, col, dot_product(jx(:, r, side), &
-                        dw(6 * side - 5:6 * side - 3)) + dot_product(jw(:, r, side), &
+                    call out%add(ivk + r, col, dot_product(self%work(side)%jx(:, r), &
+                        dw(6 * side - 5:6 * side - 3)) + dot_product(self%work(side)%jw(:, r), &
                         dw(6 * side - 2:6 * side)))
                 end do
             end do
@@ -179,17 +188,16 @@ contains
     end subroutine element_frames
 
     !> Marker k's velocity-space Jacobian: jx (origin) and jw (angular
-    !> velocity, ½ Σ a_a × ∂a_a/∂v) for its body's n rates.
-    pure subroutine velocity_jacobian(self, k, q, axes, jx, jw, n)
+    !> velocity, ½ Σ a_a × ∂a_a/∂v) for its body's n rates (ja: scratch).
+    pure subroutine velocity_jacobian(self, k, q, axes, jx, ja, jw, n)
         class(mbs_system_t), intent(in) :: self
         integer, intent(in) :: k
         real(wp), intent(in) :: q(:), axes(3, 3)
-        real(wp), intent(out) :: jx(3, rigid_body_nq), jw(3, rigid_body_nq)
+        real(wp), intent(out) :: jx(:, :), ja(:, :, :), jw(:, :) !! 3 x n at least
         integer, intent(out) :: n
-        real(wp) :: ja(3, rigid_body_nq, 3)
         integer :: l, a
         call marker_jacobian(self, k, q, .false., jx, ja, n)
-        jw = 0.0_wp
+        jw(:, 1:n) = 0.0_wp
         do l = 1, n
             do a = 1, 3
                 jw(:, l) = jw(:, l) + 0.5_wp * cross(axes(:, a), ja(:, l, a))

@@ -73,15 +73,16 @@ contains
 
     !> Generalised forces gi(1:ni), gj(1:nj) of element e on the velocity
     !> columns of its markers' bodies, seeded by `seed` (seed_position:
-    !> tangents ∂/∂q, seed_velocity: ∂/∂v) in directions 1..di of marker i's
-    !> body and offj + 1 .. offj + dj of marker j's (offj = 0: the same body).
+    !> tangents ∂/∂q, seed_velocity: ∂/∂v) in the columns of `window`
+    !> (marker_state_dual): directions 1..di of marker i's body and offj + 1
+    !> .. offj + dj of marker j's (offj = 0: the same body).
     module procedure element_generalised
         type(marker_state_d) :: mi, mj
         type(element_frame_t) :: fi, fj
-        type(dual_t) :: pi(rigid_body_nq), pj(rigid_body_nq), force(3, 2), torque(3, 2)
+        type(dual_t) :: force(3, 2), torque(3, 2)
         integer :: bi, bj, iqi, iqj, ivi, ivj
-        associate (e => self%elements(ie))
-            call marker_state_dual(self, e%marker_i, q, v, seed, 1, mi, pi, di)
+        associate (e => self%elements(ie), w1 => self%work(1), w2 => self%work(2))
+            call marker_state_dual(self, e%marker_i, q, v, seed, 1, mi, w1%p, di, window=window)
             call frame_of_state(mi, fi)
             ni = marker_columns(self, e%marker_i, .false.)
             offj = di
@@ -91,12 +92,12 @@ contains
                 call marker_offsets(self, e%marker_i, bi, iqi, ivi)
                 call marker_offsets(self, e%marker_j, bj, iqj, ivj)
                 if (bi /= 0 .and. bi == bj .and. iqi == iqj) offj = 0
-                call marker_state_dual(self, e%marker_j, q, v, seed, offj + 1, mj, pj, dj)
+                call marker_state_dual(self, e%marker_j, q, v, seed, offj + 1, mj, w2%p, dj, &
+                                       window=window)
                 nj = marker_columns(self, e%marker_j, .false.)
             else
                 ! an applied load: marker j is unused, give it marker i's frame
                 mj = mi
-                pj = pi
             end if
             call frame_of_state(mj, fj)
             call element_wrench(e, t, fi, fj, force, torque, status)
@@ -104,83 +105,96 @@ contains
                 status%message = 'force element ' // int_text(ie) // ': ' // status%message
                 return
             end if
-            call project(e%marker_i, pi, mi, force(:, 1), torque(:, 1), ni, gi)
-            if (e%marker_j > 0) call project(e%marker_j, pj, mj, force(:, 2), &
+            call project(e%marker_i, w1, mi, force(:, 1), torque(:, 1), ni, gi)
+            if (e%marker_j > 0) call project(e%marker_j, w2, mj, force(:, 2), &
                                              torque(:, 2), nj, gj)
         end associate
     contains
-        !> g(l) = Jx(:, l)·F + Jω(:, l)·n, l = 1 .. n.
-        pure subroutine project(k, p, m, f, n_, n, g)
+        !> g(l) = Jx(:, l)·F + Jω(:, l)·n, l = 1 .. n (Jacobians in wk).
+        subroutine project(k, wk, m, f, n_, n, g)
             integer, intent(in) :: k, n
-            type(dual_t), intent(in) :: p(rigid_body_nq), f(3), n_(3)
+            type(marker_work_t), intent(inout) :: wk
+            type(dual_t), intent(in) :: f(3), n_(3)
             type(marker_state_d), intent(in) :: m
-            type(dual_t), intent(out) :: g(rigid_body_nq)
-            type(dual_t) :: jx(3, rigid_body_nq), ja(3, rigid_body_nq, 3), jw(3)
+            type(dual_t), intent(inout) :: g(:)
+            type(dual_t) :: jw(3)
             integer :: l, a
-            call marker_jacobian_dual(self, k, p, jx, ja)
+            call marker_jacobian_dual(self, k, wk%p, wk%jxd, wk%jad)
             do l = 1, n
                 jw = 0.0_wp
                 do a = 1, 3
-                    jw = jw + 0.5_wp * cross_d(m%a(:, a), ja(:, l, a))
+                    jw = jw + 0.5_wp * cross_d(m%a(:, a), wk%jad(:, l, a))
                 end do
-                g(l) = dot_product(jx(:, l), f) + dot_product(jw, n_)
+                g(l) = dot_product(wk%jxd(:, l), f) + dot_product(jw, n_)
             end do
         end subroutine project
     end procedure element_generalised
 
     !> f += the elements' generalised forces.
     module procedure add_element_forces
-        type(dual_t) :: gi(rigid_body_nq), gj(rigid_body_nq)
         integer :: ie, ni, nj, di, dj, offj, b, iq, iv
         if (self%derivatives == constraint_derivatives_analytic) then
             call add_element_forces_analytic(self, t, q, v, f, status)
             return
         end if
-        do ie = 1, size(self%elements)
-            call element_generalised(self, ie, t, q, v, seed_velocity, gi, gj, ni, nj, di, &
-                                     dj, offj, status)
-            if (.not. status%ok()) return
-            call marker_offsets(self, self%elements(ie)%marker_i, b, iq, iv)
-            f(iv + 1:iv + ni) = f(iv + 1:iv + ni) + gi(1:ni)%val
-            if (nj == 0) cycle
-            call marker_offsets(self, self%elements(ie)%marker_j, b, iq, iv)
-            f(iv + 1:iv + nj) = f(iv + 1:iv + nj) + gj(1:nj)%val
-        end do
+        associate (gi => self%work(1)%g, gj => self%work(2)%g)
+            do ie = 1, size(self%elements)
+                call element_generalised(self, ie, t, q, v, seed_velocity, 1, gi, gj, ni, nj, &
+                                         di, dj, offj, status)
+                if (.not. status%ok()) return
+                call marker_offsets(self, self%elements(ie)%marker_i, b, iq, iv)
+                f(iv + 1:iv + ni) = f(iv + 1:iv + ni) + gi(1:ni)%val
+                if (nj == 0) cycle
+                call marker_offsets(self, self%elements(ie)%marker_j, b, iq, iv)
+                f(iv + 1:iv + nj) = f(iv + 1:iv + nj) + gj(1:nj)%val
+            end do
+        end associate
     end procedure add_element_forces
 
-    !> ∂f/∂q and ∂f/∂v of the elements added into fq, fv (dense or sparse).
+    !> ∂f/∂q and ∂f/∂v of the elements added into fq, fv (dense or sparse):
+    !> one dual pass per window of the markers' columns.
     module procedure add_element_derivatives
-        type(dual_t) :: gi(rigid_body_nq), gj(rigid_body_nq)
-        integer :: ie, ni, nj, di, dj, offj, pass
+        integer :: ie, ni, nj, di, dj, offj, pass, window, nw, c0
         logical :: position_space
         if (self%derivatives == constraint_derivatives_analytic) then
             call add_element_derivatives_analytic(self, t, q, v, fq, fv, status)
             return
         end if
-        do ie = 1, size(self%elements)
-            do pass = 1, 2
-                position_space = pass == 1
-                call element_generalised(self, ie, t, q, v, &
-                    merge(seed_position, seed_velocity, position_space), gi, gj, ni, nj, &
-                    di, dj, offj, status)
-                if (.not. status%ok()) return
-                associate (e => self%elements(ie))
-                    if (position_space) then
-                        call scatter(e%marker_i, gi, ni, fq)
-                        if (nj > 0) call scatter(e%marker_j, gj, nj, fq)
-                    else
-                        call scatter(e%marker_i, gi, ni, fv)
-                        if (nj > 0) call scatter(e%marker_j, gj, nj, fv)
-                    end if
-                end associate
+        associate (gi => self%work(1)%g, gj => self%work(2)%g)
+            do ie = 1, size(self%elements)
+                do pass = 1, 2
+                    position_space = pass == 1
+                    associate (e => self%elements(ie))
+                        nw = marker_windows(self, e%marker_i, position_space)
+                        if (e%marker_j > 0) nw = max(nw, marker_windows(self, e%marker_j, &
+                                                                        position_space))
+                    end associate
+                    do window = 1, nw
+                        c0 = (window - 1) * window_columns
+                        call element_generalised(self, ie, t, q, v, &
+                            merge(seed_position, seed_velocity, position_space), window, gi, &
+                            gj, ni, nj, di, dj, offj, status)
+                        if (.not. status%ok()) return
+                        associate (e => self%elements(ie))
+                            if (position_space) then
+                                call scatter(e%marker_i, gi, ni, fq)
+                                if (nj > 0) call scatter(e%marker_j, gj, nj, fq)
+                            else
+                                call scatter(e%marker_i, gi, ni, fv)
+                                if (nj > 0) call scatter(e%marker_j, gj, nj, fv)
+                            end if
+                        end associate
+                    end do
+                end do
             end do
-        end do
+        end associate
     contains
         !> Rows of marker k's body: tangents 1..di to marker i's body's
-        !> columns, offj + 1 .. offj + dj to marker j's (once if the same body).
+        !> columns c0 + 1 .., offj + 1 .. offj + dj to marker j's (once if the
+        !> same body).
         subroutine scatter(k, g, n, out)
             integer, intent(in) :: k, n
-            type(dual_t), intent(in) :: g(rigid_body_nq)
+            type(dual_t), intent(in) :: g(:)
             type(accumulator_t), intent(inout) :: out
             integer :: b, iq, iv, ci, cj, l, c
             call marker_offsets(self, k, b, iq, iv)
@@ -191,6 +205,8 @@ contains
                 call marker_offsets(self, self%elements(ie)%marker_j, b, cj, c)
                 if (.not. position_space) cj = c
             end if
+            ci = ci + c0
+            cj = cj + c0
             do l = 1, n
                 do c = 1, di
                     call out%add(iv + l, ci + c, g(l)%der(c))

@@ -73,6 +73,13 @@ contains
             self%chains(self%markers(k)%chain)%nv, position_space)
     end procedure marker_columns
 
+    !> Dual passes marker k's body columns take (windows of window_columns;
+    !> one on the ground, for the values and time).
+    module procedure marker_windows
+        n = max(1, (marker_columns(self, k, position_space) + window_columns - 1) &
+                / window_columns)
+    end procedure marker_windows
+
     !> Real frame and motion of marker k at (q, v).
     module procedure system_marker_pose
         type(marker_state_t) :: m
@@ -106,17 +113,19 @@ contains
     end procedure marker_state
 
     !> Hand-coded marker Jacobians of marker k: velocity space (3 x 6) or
-    !> position space (3 x 7) in the leading columns of jx, ja; n columns.
+    !> position space (3 x 7), a chain's (3 x its columns), in the leading
+    !> columns of jx, ja; n columns.
     module procedure marker_jacobian
-        real(wp) :: jx6(3, 6), ja6(3, 6, 3)
+        real(wp) :: jx6(3, 6), ja6(3, 6, 3), jx7(3, rigid_body_nq), ja7(3, rigid_body_nq, 3)
         integer :: b, iq, iv
         call marker_offsets(self, k, b, iq, iv)
         n = marker_columns(self, k, position_space)
-        jx = 0.0_wp
-        ja = 0.0_wp
+        jx(:, 1:max(n, rigid_body_nq)) = 0.0_wp
+        ja(:, 1:max(n, rigid_body_nq), :) = 0.0_wp
         if (b == 0) return
         if (self%markers(k)%chain > 0) then
-            call chain_jacobian_real(self, k, q, iq, position_space, jx, ja)
+            call chain_jacobian_real(self, k, q, iq, position_space, jx(:, 1:n), &
+                                     ja(:, 1:n, :), p)
             return
         end if
         if (b < 0) then
@@ -128,7 +137,9 @@ contains
         end if
         associate (mk => self%markers(k))
             if (position_space) then
-                call rigid_marker_jacobian_q(q(iq + 4:iq + 7), mk%position, mk%axes, jx, ja)
+                call rigid_marker_jacobian_q(q(iq + 4:iq + 7), mk%position, mk%axes, jx7, ja7)
+                jx(:, 1:rigid_body_nq) = jx7
+                ja(:, 1:rigid_body_nq, :) = ja7
             else
                 call rigid_marker_jacobian(q(iq + 4:iq + 7), mk%position, mk%axes, jx6, ja6)
                 jx(:, 1:6) = jx6
@@ -138,27 +149,35 @@ contains
     end procedure marker_jacobian
 
     !> Dual frame and motion of marker k at (q, v) with its body's tangents
-    !> `seed` in directions first, first+1, ...; p the dual quaternion (for the
-    !> dual marker Jacobians); n the directions used (0 on the ground).
+    !> `seed` in directions first, first+1, ... (the columns of `window`); p
+    !> the pose duals (for the dual marker Jacobians: a rigid body's
+    !> quaternion, a chain's coordinates and rates); n the directions used (0
+    !> on the ground and past the body's last window).
     module procedure marker_state_dual
         !> the frame only (rigid markers): values and first derivatives of c
         !> the pose coordinates the dual Jacobians need: the quaternion of a
         !> rigid body (1:4), the coordinates of a chain (1:n)
         type(dual_t) :: r(3), rd(3), wb(3), sb(3), ub(3, 3), x(3), a(3, 3)
         real(wp) :: tp(4, 3)
-        integer :: b, iq, iv, l
+        integer :: b, iq, iv, l, s
         call marker_offsets(self, k, b, iq, iv)
         n = 0
-        p = 0.0_wp
+        s = seed
+        if (present(window)) then
+            ! a rigid body or node has one window: later ones seed nothing
+            if (window > 1 .and. self%markers(k)%chain == 0) s = 0
+        end if
         associate (mk => self%markers(k))
             if (mk%chain > 0) then
-                call chain_state_dual(self, k, q, v, seed, first, iq, iv, m, p, n)
+                l = 0
+                if (present(window)) l = (window - 1) * window_columns
+                call chain_state_dual(self, k, q, v, seed, first, iq, iv, l, m, p, n)
                 return
             end if
+            p(1:4) = 0.0_wp
             if (b == 0) then
                 x = mk%position
                 a = mk%axes
-                p = 0.0_wp
                 call ground_marker_state_d(x, a, m)
                 return
             end if
@@ -167,8 +186,7 @@ contains
                 x = q(iq + 1:iq + 3)
                 rd = v(iv + 1:iv + 3)
                 a = mk%axes
-                p = 0.0_wp
-                select case (seed)
+                select case (s)
                 case (seed_velocity_space, seed_position)
                     n = 3
                     do l = 1, 3
@@ -194,7 +212,7 @@ contains
             sb = mk%position
             ub = mk%axes
             tp = quat_rate_matrix(q(iq + 4:iq + 7))
-            select case (seed)
+            select case (s)
             case (seed_velocity_space)
                 n = rigid_body_nv
                 do l = 1, 3
@@ -266,55 +284,62 @@ contains
     end procedure marker_jacobian_dual
 
     !> Dual state of chain marker k: the chain's coordinates (and rates)
-    !> seeded as for a body (T = I: velocity space = position space).
+    !> seeded as for a body (T = I: velocity space = position space), columns
+    !> c0 + 1 .. c0 + window_columns only (directions first, first + 1, ...);
+    !> p(1:nq) the dual coordinates, p(nq + 1:nq + nv) the dual rates.
     module procedure chain_state_dual
-        type(dual_t) :: vc(rigid_body_nq)
-        real(wp) :: tp(4, 3), rate(rigid_body_nq)
-        integer :: c, l, nq, nv, b, jq, jv
+        real(wp) :: tp(4, 3)
+        integer :: c, l, nq, nv, b, jq, jv, nb
         c = self%markers(k)%chain
         nq = self%chains(c)%nq
         nv = self%chains(c)%nv
         p(1:nq) = q(iq + 1:iq + nq)
-        vc(1:nv) = v(iv + 1:iv + nv)
+        p(nq + 1:nq + nv) = v(iv + 1:iv + nv)
+        nb = max(0, min(window_columns, merge(nq, nv, seed == seed_position) - c0))
+        n = nb
+        if (seed == seed_rate) n = merge(1, 0, c0 == 0)
         select case (seed)
-        case (seed_velocity_space)
-            ! the tangents T e_l: unit for single-coordinate joints, T(p) e_k
-            ! for a spherical joint's quaternion
-            n = nv
-            associate (g => self%chain_geom(c))
-                do b = 1, size(g%parent)
-                    jq = g%iq(b)
-                    jv = g%iv(b)
-                    if (g%kinds(b) == chain_joint_spherical) then
-                        tp = quat_rate_matrix(q(iq + jq + 1:iq + jq + 4))
-                        do l = 1, 3
-                            p(jq + 1:jq + 4)%der(first + jv + l - 1) = tp(:, l)
-                        end do
-                    else
-                        p(jq + 1)%der(first + jv) = 1.0_wp
-                    end if
-                end do
-            end associate
+        case (seed_velocity_space, seed_rate)
+            ! the tangents T e_l in the window (unit for single-coordinate
+            ! joints, T(p) e_k for a spherical joint's quaternion), or the rate
+            ! q' = T v in direction first (first window only)
+            if (n > 0) then
+                associate (g => self%chain_geom(c))
+                    do b = 1, size(g%parent)
+                        jq = g%iq(b)
+                        jv = g%iv(b)
+                        if (g%kinds(b) == chain_joint_spherical) then
+                            tp = quat_rate_matrix(q(iq + jq + 1:iq + jq + 4))
+                            if (seed == seed_rate) then
+                                p(jq + 1:jq + 4)%der(first) = matmul(tp, v(iv + jv + 1:iv + jv + 3))
+                                cycle
+                            end if
+                            do l = 1, 3
+                                if (jv + l <= c0 .or. jv + l > c0 + nb) cycle
+                                p(jq + 1:jq + 4)%der(first + jv + l - 1 - c0) = tp(:, l)
+                            end do
+                        else if (seed == seed_rate) then
+                            p(jq + 1)%der(first) = v(iv + jv + 1)
+                        else if (jv + 1 > c0 .and. jv + 1 <= c0 + nb) then
+                            p(jq + 1)%der(first + jv - c0) = 1.0_wp
+                        end if
+                    end do
+                end associate
+            end if
         case (seed_position)
-            n = nq
-            do l = 1, nq
-                p(l)%der(first + l - 1) = 1.0_wp
+            do l = 1, nb
+                p(c0 + l)%der(first + l - 1) = 1.0_wp
             end do
         case (seed_velocity)
-            n = nv
-            do l = 1, nv
-                vc(l)%der(first + l - 1) = 1.0_wp
+            do l = 1, nb
+                p(nq + c0 + l)%der(first + l - 1) = 1.0_wp
             end do
-        case (seed_rate)
-            n = 1
-            call chain_rates(self, c, q(iq + 1:iq + nq), v(iv + 1:iv + nv), rate(1:nq))
-            p(1:nq)%der(first) = rate(1:nq)
         end select
         associate (g => self%chain_geom(c))
             call chain_marker_state_d(g%parent, g%kinds, g%iq, g%iv, g%jpos, g%jrot, &
                     g%axis, &
                 self%markers(k)%link, self%markers(k)%position, self%markers(k)%axes, &
-                p(1:nq), vc(1:nv), m)
+                p(1:nq), p(nq + 1:nq + nv), m)
         end associate
     end procedure chain_state_dual
 
@@ -336,11 +361,11 @@ contains
     end procedure chain_rates
 
     !> Real Jacobians of chain marker k: velocity space by the formulas,
-    !> position space (quaternion coordinates) by one dual pass.
+    !> position space (quaternion coordinates) by dual passes of dual_size
+    !> columns each, in the pose duals p.
     module procedure chain_jacobian_real
         type(marker_state_d) :: m
-        type(dual_t) :: p(rigid_body_nq)
-        integer :: c, nq, nv, n, l
+        integer :: c, nq, nv, n, l, c0
         c = self%markers(k)%chain
         nq = self%chains(c)%nq
         nv = self%chains(c)%nv
@@ -354,13 +379,14 @@ contains
             end associate
             return
         end if
-        p = 0.0_wp
-        call chain_state_dual(self, k, q, self%zero_v, seed_position, 1, iq, 0, m, p, n)
-        do l = 1, 3
-            jx(l, 1:nq) = m%x(l)%der(1:nq)
-            ja(l, 1:nq, 1) = m%a(l, 1)%der(1:nq)
-            ja(l, 1:nq, 2) = m%a(l, 2)%der(1:nq)
-            ja(l, 1:nq, 3) = m%a(l, 3)%der(1:nq)
+        do c0 = 0, nq - 1, window_columns
+            call chain_state_dual(self, k, q, self%zero_v, seed_position, 1, iq, 0, c0, m, p, n)
+            do l = 1, 3
+                jx(l, c0 + 1:c0 + n) = m%x(l)%der(1:n)
+                ja(l, c0 + 1:c0 + n, 1) = m%a(l, 1)%der(1:n)
+                ja(l, c0 + 1:c0 + n, 2) = m%a(l, 2)%der(1:n)
+                ja(l, c0 + 1:c0 + n, 3) = m%a(l, 3)%der(1:n)
+            end do
         end do
     end procedure chain_jacobian_real
 

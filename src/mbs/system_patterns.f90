@@ -149,26 +149,31 @@ contains
     end procedure system_constraint_jacobian_pattern
 
     module procedure system_constraint_jacobian_sparse
-        real(wp) :: ci(max_rows, rigid_body_nq), cj(max_rows, rigid_body_nq), ct(max_rows)
+        real(wp) :: ct(max_rows)
         integer :: k, n, r, c, ni, nj, nr
         n = 0
         values = 0.0_wp
-        do k = 1, size(self%joints)
-            nr = self%joints(k)%joint%nrows
-            call joint_first_derivatives(self, k, t, q, .false., ci, cj, ni, nj, ct)
-            do c = 1, ni
-                do r = 1, nr
-                    n = n + 1
-                    values(self%jacobian_csc%triplet_map(n)) = ci(r, c)
+        associate (ci => self%work(1)%c, cj => self%work(2)%c)
+            do k = 1, size(self%joints)
+                nr = self%joints(k)%joint%nrows
+                call joint_first_derivatives(self, k, t, q, .false., ci, cj, ni, nj, ct)
+                do c = 1, ni
+                    do r = 1, nr
+                        n = n + 1
+                        ! added: both markers may be on one chain (one slot)
+                        values(self%jacobian_csc%triplet_map(n)) = &
+                            values(self%jacobian_csc%triplet_map(n)) + ci(r, c)
+                    end do
+                end do
+                do c = 1, nj
+                    do r = 1, nr
+                        n = n + 1
+                        values(self%jacobian_csc%triplet_map(n)) = &
+                            values(self%jacobian_csc%triplet_map(n)) + cj(r, c)
+                    end do
                 end do
             end do
-            do c = 1, nj
-                do r = 1, nr
-                    n = n + 1
-                    values(self%jacobian_csc%triplet_map(n)) = cj(r, c)
-                end do
-            end do
-        end do
+        end associate
         do k = 1, size(self%frames)
             block
                 real(wp) :: fb(node_frame_rows, frame_columns(self%frames(k), .false.))

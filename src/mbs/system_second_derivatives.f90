@@ -27,42 +27,45 @@ contains
     !> the hand-coded G along the position unit vectors of the joint's two bodies.
     module procedure jacobian_derivatives_into
         type(marker_state_d) :: mid, mjd
-        type(dual_t) :: pi(rigid_body_nq), pj(rigid_body_nq), jxi(3, rigid_body_nq), &
-            jai(3, rigid_body_nq, 3), jxj(3, rigid_body_nq), jaj(3, rigid_body_nq, 3), &
-            cid(max_rows, rigid_body_nq), cjd(max_rows, rigid_body_nq), s
-        integer :: k, r0, nr, qi, qj, ni, nj, r, l, bi, bj, iqi, iqj, ivi, ivj
+        type(dual_t) :: s
+        integer :: k, r0, nr, qi, qj, ni, nj, r, l, bi, bj, iqi, iqj, ivi, ivj, pass, c0
         do k = 1, size(self%joints)
-            associate (jt => self%joints(k))
+            associate (jt => self%joints(k), w1 => self%work(1), w2 => self%work(2))
                 r0 = jt%row0
                 nr = jt%joint%nrows
-                call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed_position, 1, &
-                                       mid, pi, qi, pose_only=.true.)
-                call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed_position, &
-                                       1 + qi, mjd, pj, qj, pose_only=.true.)
-                call marker_jacobian_dual(self, jt%marker_i, pi, jxi, jai)
-                call marker_jacobian_dual(self, jt%marker_j, pj, jxj, jaj)
                 ni = marker_columns(self, jt%marker_i, .false.)
                 nj = marker_columns(self, jt%marker_j, .false.)
-                call joint_jacobian_d(jt%joint, mid, jxi(:, 1:ni), jai(:, 1:ni, :), mjd, &
-                                      jxj(:, 1:nj), jaj(:, 1:nj, :), &
-                                      driver_dual(joint_driver(self, k, t), 0), &
-                                      cid(1:nr, 1:ni), cjd(1:nr, 1:nj))
                 call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
                 call marker_offsets(self, jt%marker_j, bj, iqj, ivj)
-                do r = 1, nr
-                    s = dot_product(cid(r, 1:ni), w(ivi + 1:ivi + ni)) &
-                        + dot_product(cjd(r, 1:nj), w(ivj + 1:ivj + nj))
-                    call add_tangents(gwq, r0 + r, s, qi, iqi, qj, iqj)
-                end do
-                do l = 1, ni
-                    call add_tangents(gtlq, ivi + l, &
-                                      dot_product(cid(1:nr, l), lambda(r0 + 1:r0 + nr)), &
-                                      qi, iqi, qj, iqj)
-                end do
-                do l = 1, nj
-                    call add_tangents(gtlq, ivj + l, &
-                                      dot_product(cjd(1:nr, l), lambda(r0 + 1:r0 + nr)), &
-                                      qi, iqi, qj, iqj)
+                ! one pass per window of the bodies' positions (module header)
+                do pass = 1, max(marker_windows(self, jt%marker_i, .true.), &
+                                 marker_windows(self, jt%marker_j, .true.))
+                    c0 = (pass - 1) * window_columns
+                    call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed_position, 1, &
+                                           mid, w1%p, qi, pose_only=.true., window=pass)
+                    call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed_position, &
+                                           1 + qi, mjd, w2%p, qj, pose_only=.true., window=pass)
+                    call marker_jacobian_dual(self, jt%marker_i, w1%p, w1%jxd, w1%jad)
+                    call marker_jacobian_dual(self, jt%marker_j, w2%p, w2%jxd, w2%jad)
+                    call joint_jacobian_d(jt%joint, mid, w1%jxd(:, 1:ni), w1%jad(:, 1:ni, :), &
+                                          mjd, w2%jxd(:, 1:nj), w2%jad(:, 1:nj, :), &
+                                          driver_dual(joint_driver(self, k, t), 0), &
+                                          w1%cd(1:nr, 1:ni), w2%cd(1:nr, 1:nj))
+                    do r = 1, nr
+                        s = dot_product(w1%cd(r, 1:ni), w(ivi + 1:ivi + ni)) &
+                            + dot_product(w2%cd(r, 1:nj), w(ivj + 1:ivj + nj))
+                        call add_tangents(gwq, r0 + r, s, qi, iqi + c0, qj, iqj + c0)
+                    end do
+                    do l = 1, ni
+                        call add_tangents(gtlq, ivi + l, &
+                                          dot_product(w1%cd(1:nr, l), lambda(r0 + 1:r0 + nr)), &
+                                          qi, iqi + c0, qj, iqj + c0)
+                    end do
+                    do l = 1, nj
+                        call add_tangents(gtlq, ivj + l, &
+                                          dot_product(w2%cd(1:nr, l), lambda(r0 + 1:r0 + nr)), &
+                                          qi, iqi + c0, qj, iqj + c0)
+                    end do
                 end do
             end associate
         end do
@@ -113,21 +116,27 @@ contains
     !> ∂c_t/∂q added into dq: AD of the hand-coded c_t.
     module procedure time_derivative_jacobian_into
         type(marker_state_d) :: mid, mjd
-        type(dual_t) :: pd(rigid_body_nq), ctd(max_rows)
-        integer :: k, nr, qi, qj, r, bi, bj, iqi, iqj, ivi, ivj
+        type(dual_t) :: ctd(max_rows)
+        integer :: k, nr, qi, qj, r, bi, bj, iqi, iqj, ivi, ivj, pass, c0
         do k = 1, size(self%joints)
             associate (jt => self%joints(k))
                 nr = jt%joint%nrows
-                call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed_position, 1, &
-                                       mid, pd, qi, pose_only=.true.)
-                call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed_position, &
-                                       1 + qi, mjd, pd, qj, pose_only=.true.)
-                call joint_rows_d(joint_part_time_derivative, jt%joint, mid, mjd, &
-                                  driver_dual(joint_driver(self, k, t), 0), ctd(1:nr))
                 call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
                 call marker_offsets(self, jt%marker_j, bj, iqj, ivj)
-                do r = 1, nr
-                    call add_tangents(dq, jt%row0 + r, ctd(r), qi, iqi, qj, iqj)
+                do pass = 1, max(marker_windows(self, jt%marker_i, .true.), &
+                                 marker_windows(self, jt%marker_j, .true.))
+                    c0 = (pass - 1) * window_columns
+                    call marker_state_dual(self, jt%marker_i, q, self%zero_v, seed_position, 1, &
+                                           mid, self%work(1)%p, qi, pose_only=.true., &
+                                           window=pass)
+                    call marker_state_dual(self, jt%marker_j, q, self%zero_v, seed_position, &
+                                           1 + qi, mjd, self%work(2)%p, qj, pose_only=.true., &
+                                           window=pass)
+                    call joint_rows_d(joint_part_time_derivative, jt%joint, mid, mjd, &
+                                      driver_dual(joint_driver(self, k, t), 0), ctd(1:nr))
+                    do r = 1, nr
+                        call add_tangents(dq, jt%row0 + r, ctd(r), qi, iqi + c0, qj, iqj + c0)
+                    end do
                 end do
             end associate
         end do
@@ -153,8 +162,8 @@ contains
     !> along the positions and one along the velocities of the joint's two bodies.
     module procedure curvature_derivatives_into
         type(marker_state_d) :: mid, mjd
-        type(dual_t) :: pd(rigid_body_nq), conv(max_rows), tt(max_rows), drvd(3)
-        integer :: k, nr, ni, nj, r, bi, bj, iqi, iqj, ivi, ivj, pass, seed
+        type(dual_t) :: conv(max_rows), tt(max_rows), drvd(3)
+        integer :: k, nr, ni, nj, r, bi, bj, iqi, iqj, ivi, ivj, pass, seed, window, c0
         do k = 1, size(self%joints)
             associate (jt => self%joints(k))
                 nr = jt%joint%nrows
@@ -163,19 +172,26 @@ contains
                 call marker_offsets(self, jt%marker_j, bj, iqj, ivj)
                 do pass = 1, 2
                     seed = merge(seed_position, seed_velocity, pass == 1)
-                    call marker_state_dual(self, jt%marker_i, q, v, seed, 1, mid, pd, ni)
-                    call marker_state_dual(self, jt%marker_j, q, v, seed, 1 + ni, mjd, pd, nj)
-                    call joint_rows_d(joint_part_convective, jt%joint, mid, mjd, drvd, &
-                                      conv(1:nr))
-                    call joint_rows_d(joint_part_time_terms, jt%joint, mid, mjd, drvd, tt(1:nr))
-                    do r = 1, nr
-                        if (pass == 1) then
-                            call add_tangents(gq, jt%row0 + r, conv(r) + tt(r), ni, iqi, nj, &
-                                              iqj)
-                        else
-                            call add_tangents(gv, jt%row0 + r, conv(r) + tt(r), ni, ivi, nj, &
-                                              ivj)
-                        end if
+                    do window = 1, max(marker_windows(self, jt%marker_i, pass == 1), &
+                                       marker_windows(self, jt%marker_j, pass == 1))
+                        c0 = (window - 1) * window_columns
+                        call marker_state_dual(self, jt%marker_i, q, v, seed, 1, mid, &
+                                               self%work(1)%p, ni, window=window)
+                        call marker_state_dual(self, jt%marker_j, q, v, seed, 1 + ni, mjd, &
+                                               self%work(2)%p, nj, window=window)
+                        call joint_rows_d(joint_part_convective, jt%joint, mid, mjd, drvd, &
+                                          conv(1:nr))
+                        call joint_rows_d(joint_part_time_terms, jt%joint, mid, mjd, drvd, &
+                                          tt(1:nr))
+                        do r = 1, nr
+                            if (pass == 1) then
+                                call add_tangents(gq, jt%row0 + r, conv(r) + tt(r), ni, &
+                                                  iqi + c0, nj, iqj + c0)
+                            else
+                                call add_tangents(gv, jt%row0 + r, conv(r) + tt(r), ni, &
+                                                  ivi + c0, nj, ivj + c0)
+                            end if
+                        end do
                     end do
                 end do
             end associate
