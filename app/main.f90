@@ -678,8 +678,9 @@ contains
             '', &
             'FILE.nml holds the namelist groups &simulation, &solver and &output,', &
             'and for a flexible body &flexible_body with one or more &material;', &
-            'for rigid bodies and joints &multibody, &rigid_body, &marker, &joint, &driver;', &
-            'for a chain in relative coordinates &rigid_chain', &
+            'for rigid bodies and joints &multibody, &rigid_body, &marker, &joint, &driver,', &
+            '&force, and any number of &flexible_body groups (each &material naming its', &
+            'body); for chains in relative coordinates &rigid_chain (a tree each)', &
             '(docs/scene_reference.md or flexmbs scene-reference: every variable,', &
             'its type, unit and default; docs/user_guide.md: how to use them).', &
             'STUDY.nml holds one &study group naming a scene file and the grid.', &

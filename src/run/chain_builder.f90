@@ -72,7 +72,7 @@ contains
         type(scene_input_t), intent(in) :: scene
         character(len=*), intent(in) :: name
         integer, intent(out) :: chain, link
-        integer, allocatable :: root(:)
+        integer :: root(size(scene%chain))
         integer :: k, j
         chain = 0
         link = 0
@@ -98,7 +98,10 @@ contains
     function tree_links(scene, t) result(links)
         type(scene_input_t), intent(in) :: scene
         integer, intent(in) :: t
-        integer, allocatable :: links(:), root(:)
+        integer, allocatable :: links(:)
+        ! explicit shape: gfortran's reallocation of an unallocated array from
+        ! this function result reads its bounds uninitialised (valgrind)
+        integer :: root(size(scene%chain))
         integer :: i, j, r
         root = root_of(scene)
         r = 0
