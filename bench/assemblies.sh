@@ -6,7 +6,7 @@
 #   gravity, against the same elements as two bars of n/2 x 2 x 2, the
 #   upper hanging the same way, the lower from the upper by a spherical
 #   joint between the faces they share (joints on node sets act through
-#   node frames). CPU per step of both, best of 3 runs, and their ratio
+#   node frames). CPU per step of both, best of 5 runs, and their ratio
 #   (goal: two bodies at most 1.3 x one body's per step), for RADAU5 and
 #   DDASSL (GGL, TOL 1e-6, 0.05 s, the sparse path, one BLAS thread). Then
 #   the same against the bar clamped at xmin (no joint, no node frame: the
@@ -60,10 +60,10 @@ hang() {
     echo "&joint type = 'spherical', marker_i = 'pivot', marker_j = '$1 root' /"
 }
 
-# best FILE -> "CPU/step NST" of the best of 3 runs (CPU from the statistics line)
+# best FILE -> "CPU/step NST" of the best of 5 runs (CPU from the statistics line)
 best() {
     local best="" line cpu nst per
-    for _ in 1 2 3; do
+    for _ in 1 2 3 4 5; do
         line=$("$BIN" run "$1" --quiet 2>&1 | grep -E '^[a-z0-9]+: NST=' | tail -1)
         [ -n "$line" ] || { echo "failed -"; return; }
         cpu=$(echo "$line" | sed 's/.*CPU=\([0-9.]*\).*/\1/')
@@ -78,7 +78,7 @@ best() {
 
 # compare TITLE BASE: rows of one body (scene kind BASE) against two
 compare() {
-    echo "== $1, best CPU per step of 3 (GGL, TOL 1e-6, 0.05 s)"
+    echo "== $1, best CPU per step of 5 (GGL, TOL 1e-6, 0.05 s)"
     echo "  solver  n   elements  one: CPU/step[s] NST  two: CPU/step[s] NST  ratio (goal <= 1.3)"
     for solver in radau5 ddassl; do
         for n in 16 32 64; do
