@@ -751,7 +751,7 @@ contains
             ' poisson_ratio = 0.25, density = 1000 /', 'in.nml', scene, status)
         call check(error, status%ok(), 'parse: ' // status%text())
         if (allocated(error)) return
-        call check(error, scene%problem == 'flexible_body' .and. scene%has_body, 'problem')
+        call check(error, scene%problem == 'flexible_body' .and. scene%has_body(), 'problem')
         call check(error, scene%bodies(1)%element == 'hex27', 'element lower-cased')
         call check(error, all(scene%bodies(1)%divisions == [4, 2, 1]), 'divisions')
         call check(error, all(scene%bodies(1)%lengths == [0.4_wp, 0.05_wp, 0.05_wp]), 'lengths')

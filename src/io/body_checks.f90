@@ -27,8 +27,8 @@ contains
         integer :: i
 
         if (scene%problem /= 'flexible_body' .and. &
-            .not. (scene%problem == 'multibody' .and. scene%has_body)) then
-            if (scene%has_body) then
+            .not. (scene%problem == 'multibody' .and. scene%has_body())) then
+            if (scene%has_body()) then
                 call errors%add('&flexible_body: given, but problem = ''' // &
                     trim(scene%problem) // ''' (a scene builds only what it declares)', &
                     scene%bodies(1)%line)
@@ -38,7 +38,7 @@ contains
             end if
             return
         end if
-        if (.not. scene%has_body) then
+        if (.not. scene%has_body()) then
             call errors%add('&simulation: problem = ''flexible_body'': needs a &flexible_body &
                 &group', 0)
             return

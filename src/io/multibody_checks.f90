@@ -208,7 +208,7 @@ contains
             character(len=len_name), allocatable :: names(:)
             names = [character(len=len_name) :: 'ground', &
                      scene%rigid_bodies%name, scene%chain%name]
-            if (scene%has_body) names = [names, scene%bodies%name]
+            if (scene%has_body()) names = [names, scene%bodies%name]
         end function body_names
 
         !> The marker of that name sits on a flexible body.

@@ -45,7 +45,7 @@ contains
         type(entry_t), intent(in) :: entries(:)
         type(input_errors_t), intent(inout) :: errors
         character(len=*), parameter :: sim = 'simulation'
-        if (.not. has_entry(entries, sim, 'problem') .and. .not. scene%has_body .and. &
+        if (.not. has_entry(entries, sim, 'problem') .and. .not. scene%has_body() .and. &
             size(scene%rigid_bodies) == 0) call required_error(errors, sim, 'problem', &
             choice_list(split_choices(schema(find_var(sim, 'problem'))%choices)))
         if (.not. has_entry(entries, sim, 't_end')) then

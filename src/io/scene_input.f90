@@ -199,7 +199,6 @@ module flexmbs_io_scene_input
         !> PREFIX.pvd ('' = none; flexmbs_io_vtk_sink)
         character(len=len_path) :: vtk
         ! &flexible_body and &material
-        logical :: has_body = .false.                 !! a &flexible_body group was given
         type(body_input_t), allocatable :: bodies(:)  !! the &flexible_body groups, in order
         type(material_input_t), allocatable :: materials(:) !! in the order given
         ! &multibody, &rigid_body, &marker, &joint, &driver
@@ -212,6 +211,8 @@ module flexmbs_io_scene_input
         type(force_input_t), allocatable :: forces(:) !! &force
         ! &rigid_chain
         type(chain_body_input_t), allocatable :: chain(:)
+    contains
+        procedure :: has_body => scene_has_body
     end type scene_input_t
 
     public :: setting_given, marker_index, flexible_index, material_of
@@ -235,6 +236,13 @@ contains
         end do
         marker_index = 0
     end function marker_index
+
+    !> Whether the scene gives a &flexible_body group.
+    pure logical function scene_has_body(self)
+        class(scene_input_t), intent(in) :: self
+        scene_has_body = .false.
+        if (allocated(self%bodies)) scene_has_body = size(self%bodies) > 0
+    end function scene_has_body
 
     !> The index of the &flexible_body called `name`, 0 if none.
     pure integer function flexible_index(scene, name)

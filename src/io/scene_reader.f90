@@ -25,7 +25,6 @@ contains
         call read_simulation(entries, scene)
         call read_solver(entries, scene)
         call read_output(entries, scene)
-        scene%has_body = any(spans%group == find_group('flexible_body'))
         scene%has_multibody = any(spans%group == find_group('multibody'))
         allocate (scene%bodies(count(spans%group == find_group('flexible_body'))), &
                   scene%materials(count(spans%group == find_group('material'))), &
@@ -41,7 +40,7 @@ contains
         do i = 1, size(spans)
             call set_line(scene, spans(i))
         end do
-        if (scene%has_body .and. .not. has_entry(entries, 'simulation', 'problem')) &
+        if (scene%has_body() .and. .not. has_entry(entries, 'simulation', 'problem')) &
             scene%problem = 'flexible_body'
         if (size(scene%rigid_bodies) > 0 .and. &
             .not. has_entry(entries, 'simulation', 'problem')) scene%problem = 'multibody'

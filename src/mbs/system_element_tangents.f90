@@ -15,6 +15,7 @@
 submodule (flexmbs_mbs_system) flexmbs_mbs_system_element_tangents
     use flexmbs_mbs_dual, only: operator(*), operator(-)
     use flexmbs_mbs_rotation_dual, only: cross_d => cross
+    use flexmbs_mbs_force_element, only: element_energy, force_applied
     use flexmbs_mbs_force_element_tangent, only: frame_t, element_wrench_real, &
         element_wrench_tangent
     implicit none
@@ -154,6 +155,28 @@ contains
         force = reshape([w(1:3), w(7:9)], [3, 2])
         torque = reshape([w(4:6), w(10:12)], [3, 2])
     end procedure system_element_wrench
+
+    !> Potential energy of the elements' springs (the laws' element_energy,
+    !> on the real frames).
+    module procedure elements_energy
+        type(frame_t) :: fr(2)
+        type(element_frame_t) :: fi, fj
+        integer :: ie
+        e = 0.0_wp
+        do ie = 1, size(self%elements)
+            if (self%elements(ie)%kind == force_applied) cycle
+            call element_frames(self, ie, q, v, fr)
+            fi%x = fr(1)%x
+            fi%a = fr(1)%a
+            fi%xd = fr(1)%xd
+            fi%w = fr(1)%w
+            fj%x = fr(2)%x
+            fj%a = fr(2)%a
+            fj%xd = fr(2)%xd
+            fj%w = fr(2)%w
+            e = e + element_energy(self%elements(ie), fi, fj)
+        end do
+    end procedure elements_energy
 
     !> Marker of side 1 (i) or 2 (j) of element ie; 0 for a load's side 2.
     pure integer function side_marker(self, ie, side) result(k)

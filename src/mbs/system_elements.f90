@@ -14,7 +14,7 @@ submodule (flexmbs_mbs_system) flexmbs_mbs_system_elements
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use flexmbs_mbs_dual, only: operator(-), operator(*), matmul
     use flexmbs_mbs_rotation_dual, only: cross_d => cross
-    use flexmbs_mbs_force_element, only: element_wrench, element_energy, &
+    use flexmbs_mbs_force_element, only: element_wrench, &
         element_uses_rotation, force_element_name, element_frame_t, force_applied, &
         force_bushing
     implicit none
@@ -242,39 +242,4 @@ contains
             end associate
         end do
     end procedure add_element_patterns
-
-    !> The real frame of marker k at (q, v), as the laws take it.
-    subroutine real_frame(self, k, q, v, fr)
-        class(mbs_system_t), intent(in) :: self
-        integer, intent(in) :: k
-        real(wp), intent(in) :: q(:), v(:)
-        type(element_frame_t), intent(out) :: fr
-        type(marker_state_t) :: m
-        real(wp) :: w(3)
-        integer :: a
-        call marker_state(self, k, q, v, m)
-        w = 0.0_wp
-        do a = 1, 3
-            w = w + 0.5_wp * cross(m%a(:, a), m%ad(:, a))
-        end do
-        fr%x = m%x
-        fr%a = m%a
-        fr%xd = m%xd
-        fr%w = w
-    end subroutine real_frame
-
-    !> Potential energy of the elements' springs.
-    module procedure elements_energy
-        type(element_frame_t) :: fi, fj
-        integer :: ie
-        e = 0.0_wp
-        do ie = 1, size(self%elements)
-            associate (el => self%elements(ie))
-                if (el%kind == force_applied) cycle
-                call real_frame(self, el%marker_i, q, v, fi)
-                call real_frame(self, el%marker_j, q, v, fj)
-                e = e + element_energy(el, fi, fj)
-            end associate
-        end do
-    end procedure elements_energy
 end submodule flexmbs_mbs_system_elements

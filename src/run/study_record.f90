@@ -91,8 +91,8 @@ contains
             call read_text_file(trim(base%bodies(b)%mesh_file), text, status)
             if (.not. status%ok()) return
             meshes = meshes // text
-            print%mesh = sha256_hex(meshes)
         end do
+        if (any(len_trim(base%bodies%mesh_file) > 0)) print%mesh = sha256_hex(meshes)
     end subroutine study_fingerprint
 
     !> The record of grid point k (module header).
