@@ -5,12 +5,14 @@
 #   from the ground by a spherical joint at its xmin face and falling under
 #   gravity, against the same elements as two bars of n/2 x 2 x 2, the
 #   upper hanging the same way, the lower from the upper by a spherical
-#   joint between the faces they share (joints on node sets act through
-#   node frames). CPU per step of both, best of 5 runs, and their ratio
-#   (goal: two bodies at most 1.3 x one body's per step), for RADAU5 and
-#   DDASSL (GGL, TOL 1e-6, 0.05 s, the sparse path, one BLAS thread). Then
-#   the same against the bar clamped at xmin (no joint, no node frame: the
-#   layout without accelerations and multipliers), which prices the joints.
+#   joint between the faces they share (markers at the sets' centroids:
+#   linear rows on the nodes, no node frame). CPU per step of both, best of
+#   5 runs, and their ratio (goal: two bodies at most 1.3 x one body's per
+#   step), for RADAU5 and DDASSL (GGL, TOL 1e-6, 0.05 s, the sparse path,
+#   one BLAS thread). Then the same scenes with every marker given its
+#   centroid as `position`, which joins through node frames (massless
+#   bodies: the acceleration layout), and the two bars against the bar
+#   clamped at xmin (no joint), which prices the joints.
 set -u
 cd "$(dirname "$0")/.."
 FPM=${FPM:-fpm}
@@ -31,9 +33,13 @@ bar() {
         printf "    density = 920, viscosity = 1000 /\n" }'
 }
 
-# scene FILE SOLVER N BODIES -> the bar (BODIES = 1), the two halves (2), both
-# hanging from the ground by their root face; or the bar clamped (BODIES = 0)
+# scene FILE SOLVER N BODIES [FRAMED] -> the bar (BODIES = 1), the two halves
+# (2), both hanging from the ground by their root face; or the bar clamped
+# (BODIES = 0). FRAMED = 1: the node-set markers have a position (node frames)
 scene() {
+    FRAMED=${5:-0}
+    local mid
+    mid=$(awk -v n="$3" 'BEGIN { printf "%.6f", 0.0125 * n }')
     {
         echo "&simulation problem = 'multibody', t_end = 0.05 /"
         echo "&multibody formulation = 'ggl', gravity = 0, -9.81, 0 /"
@@ -43,9 +49,9 @@ scene() {
            hang one ;;
         2) bar upper $(($3 / 2)) 0
            hang upper
-           bar lower $(($3 / 2)) "$(awk -v n="$3" 'BEGIN { printf "%.6f", 0.0125 * n }')"
-           echo "&marker name = 'upper tip', body = 'upper', node_set = 'xmax' /"
-           echo "&marker name = 'lower root', body = 'lower', node_set = 'xmin' /"
+           bar lower $(($3 / 2)) "$mid"
+           echo "&marker name = 'upper tip', body = 'upper', node_set = 'xmax'$(at "$mid") /"
+           echo "&marker name = 'lower root', body = 'lower', node_set = 'xmin'$(at "$mid") /"
            echo "&joint type = 'spherical', marker_i = 'upper tip', marker_j = 'lower root' /" ;;
         esac
         echo "&solver name = '$2', rtol = 1e-6, atol = 1e-6 /"
@@ -56,8 +62,13 @@ scene() {
 # hang NAME -> a spherical joint from the ground to body NAME's xmin face
 hang() {
     echo "&marker name = 'pivot', body = 'ground' /"
-    echo "&marker name = '$1 root', body = '$1', node_set = 'xmin' /"
+    echo "&marker name = '$1 root', body = '$1', node_set = 'xmin'$(at 0) /"
     echo "&joint type = 'spherical', marker_i = 'pivot', marker_j = '$1 root' /"
+}
+
+# at X -> ", position = X, 0, 0" when FRAMED (the face's centroid: a node frame)
+at() {
+    [ "$FRAMED" = 1 ] && printf ", position = %s, 0, 0" "$1"
 }
 
 # best FILE -> "CPU/step NST" of the best of 5 runs (CPU from the statistics line)
@@ -76,16 +87,16 @@ best() {
     echo "$best"
 }
 
-# compare TITLE BASE: rows of one body (scene kind BASE) against two
+# compare TITLE BASE [FRAMED]: rows of one body (scene kind BASE) against two
 compare() {
     echo "== $1, best CPU per step of 5 (GGL, TOL 1e-6, 0.05 s)"
     echo "  solver  n   elements  one: CPU/step[s] NST  two: CPU/step[s] NST  ratio (goal <= 1.3)"
     for solver in radau5 ddassl; do
         for n in 16 32 64; do
-            scene "$OUT/one${2}_${solver}_$n.nml" "$solver" "$n" "$2"
-            scene "$OUT/two_${solver}_$n.nml" "$solver" "$n" 2
-            one=$(best "$OUT/one${2}_${solver}_$n.nml")
-            two=$(best "$OUT/two_${solver}_$n.nml")
+            scene "$OUT/one${2}${3:-0}_${solver}_$n.nml" "$solver" "$n" "$2" "${3:-0}"
+            scene "$OUT/two${3:-0}_${solver}_$n.nml" "$solver" "$n" 2 "${3:-0}"
+            one=$(best "$OUT/one${2}${3:-0}_${solver}_$n.nml")
+            two=$(best "$OUT/two${3:-0}_${solver}_$n.nml")
             awk -v s="$solver" -v n="$n" -v o="$one" -v t="$two" 'BEGIN {
                 split(o, a, " "); split(t, b, " ")
                 r = (a[1] > 0 && b[1] > 0) ? sprintf("%.2f", b[1] / a[1]) : "-"
@@ -96,4 +107,6 @@ compare() {
 
 compare "one bar of n x 2 x 2 hex8 hanging by a spherical joint against two of n/2 x 2 x 2" 1
 echo
-compare "the same two bars against one bar clamped at xmin (no joint)" 0
+compare "the same through node frames (markers given a position)" 1 1
+echo
+compare "the two bars (set markers) against one bar clamped at xmin (no joint)" 0

@@ -42,6 +42,7 @@ program flexmbs_tests
     use test_multibody_scene, only: collect_multibody_scene
     use test_flexible_coupling, only: collect_flexible_coupling
     use test_two_flexible, only: collect_two_flexible
+    use test_set_markers, only: collect_set_markers
     use test_arm_with_pad, only: collect_arm_with_pad
     use test_node_frame, only: collect_node_frame
     use test_study, only: collect_study
@@ -103,6 +104,7 @@ program flexmbs_tests
     call run_suite('flexible_coupling', collect_flexible_coupling(), filter, npassed, &
                    nfailed)
     call run_suite('two_flexible', collect_two_flexible(), filter, npassed, nfailed)
+    call run_suite('set_markers', collect_set_markers(), filter, npassed, nfailed)
     call run_suite('arm_with_pad', collect_arm_with_pad(), filter, npassed, nfailed)
     call run_suite('chain_coupling', collect_chain_coupling(), filter, npassed, nfailed)
     call run_suite('sparse_formulation', collect_sparse_formulation(), filter, npassed, &

@@ -1,6 +1,7 @@
 !> Several flexible bodies in one multibody scene (repeatable
 !> `&flexible_body`): a free system of two soft bars and a rigid hub joined
-!> by spherical joints through node frames, undamped and without gravity,
+!> by spherical joints, at the centroids of the bars' face node sets (set
+!> markers) and through node frames, undamped and without gravity,
 !> conserves linear momentum to round-off and angular momentum and energy
 !> to tolerance level, shrinking with the tolerance, for RADAU5, DDASSL,
 !> IDA and MEXAX; and inputs/two_soft_links.nml, the double pendulum of two
@@ -15,9 +16,10 @@ module test_two_flexible
     use testing, only: test_case_t, new_test, error_t, check
     implicit none
     private
-    public :: collect_two_flexible
+    public :: collect_two_flexible, check_invariants, solvers
 
     character(len=*), parameter :: nl = new_line('a')
+    !> the four solvers every invariant is checked with
     character(len=8), parameter :: solvers(4) = [character(len=8) :: 'radau5', 'ddassl', &
         'ida', 'mexax']
 
@@ -33,7 +35,8 @@ contains
     !> 0.5, 4) about the origin, the hub 2 rad/s faster about x: the joints'
     !> markers lie on the x axis, so the initial velocities are consistent,
     !> and the bars swing and stretch (centrifugal load) relative to the hub.
-    function free_scene() result(text)
+    function free_scene(framed) result(text)
+        logical, intent(in) :: framed !! markers given positions: node frames
         character(len=:), allocatable :: text
         text = '&simulation problem = ''multibody'', t_end = 0.05 /' // nl // &
             '&multibody formulation = ''ggl'', gravity = 0, 0, 0 /' // nl // &
@@ -46,8 +49,12 @@ contains
             // nl // &
             '&marker name = ''hr'', body = ''hub'', position = 0.05, 0, 0 /' // nl // &
             '&marker name = ''hl'', body = ''hub'', position = -0.05, 0, 0 /' // nl // &
-            '&marker name = ''r0'', body = ''right'', node_set = ''xmin'' /' // nl // &
-            '&marker name = ''l0'', body = ''left'', node_set = ''xmax'' /' // nl // &
+            '&marker name = ''r0'', body = ''right'', node_set = ''xmin''' // &
+            trim(merge(', position = 0.05, 0, 0 ', '                        ', framed)) // &
+            ' /' // nl // &
+            '&marker name = ''l0'', body = ''left'', node_set = ''xmax''' // &
+            trim(merge(', position = -0.05, 0, 0', '                        ', framed)) // &
+            ' /' // nl // &
             '&joint type = ''spherical'', marker_i = ''hr'', marker_j = ''r0'' /' // nl // &
             '&joint type = ''spherical'', marker_i = ''hl'', marker_j = ''l0'' /' // nl // &
             '&output file = ''none'', n_output = 2 /' // nl
@@ -63,12 +70,41 @@ contains
         end function bar
     end function free_scene
 
-    !> Per solver, at rtol = atol = 1e-5 and 1e-7: the change of linear
-    !> momentum (round-off: every method here keeps linear invariants), of
-    !> angular momentum about the origin and of energy over 0.05 s, relative
-    !> to their sizes at the start.
+    !> Per joining (set markers, node frames): two flexible bodies, the hub
+    !> and (framed) two node frames, and the invariants (check_invariants).
     subroutine test_invariants(error)
         type(error_t), allocatable, intent(out) :: error
+        type(scene_input_t) :: scene
+        type(mbs_system_t) :: sys
+        type(status_t) :: status
+        real(wp), allocatable :: q0(:), v0(:)
+        integer :: framed
+        do framed = 0, 1
+            call parse_scene(free_scene(framed == 1), 'free.nml', scene, status)
+            if (status%ok()) call build_multibody(scene, sys, q0, v0, status)
+            call check(error, status%ok(), 'scene: ' // status%text())
+            if (allocated(error)) return
+            call check(error, size(sys%flex) == 2 .and. size(sys%rigid%bodies) == 1 + 2 * framed, &
+                       'two flexible bodies, the hub and (framed) two node frames')
+            if (allocated(error)) return
+            if (framed == 1) then
+                print '(4x,a)', 'through node frames:'
+            else
+                print '(4x,a)', 'at the sets'' centroids (set markers):'
+            end if
+            call check_invariants(error, free_scene(framed == 1))
+            if (allocated(error)) return
+        end do
+    end subroutine test_invariants
+
+    !> The free system of scene `text` per solver, at rtol = atol = 1e-5 and
+    !> 1e-7: the change of linear momentum (round-off: every method here
+    !> keeps linear invariants), of angular momentum about the origin and of
+    !> energy over t_end, relative to their sizes at the start, within 100
+    !> rtol and smaller at the tighter tolerance.
+    subroutine check_invariants(error, text)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: text
         real(wp), parameter :: tols(2) = [1.0e-5_wp, 1.0e-7_wp]
         type(scene_input_t) :: scene
         type(run_result_t) :: result
@@ -77,12 +113,9 @@ contains
         real(wp), allocatable :: q0(:), v0(:)
         real(wp) :: l0(3), a0(3), l1(3), a1(3), e0, e1, dl(2), da(2), de(2)
         integer :: k, i
-        call parse_scene(free_scene(), 'free.nml', scene, status)
+        call parse_scene(text, 'free.nml', scene, status)
         if (status%ok()) call build_multibody(scene, sys, q0, v0, status)
         call check(error, status%ok(), 'scene: ' // status%text())
-        if (allocated(error)) return
-        call check(error, size(sys%flex) == 2 .and. size(sys%rigid%bodies) == 3, &
-                   'two flexible bodies, the hub and two node frames')
         if (allocated(error)) return
         call sys%momenta(q0, v0, l0, a0)
         e0 = sys%total_energy(q0, v0)
@@ -113,7 +146,7 @@ contains
                        ': angular momentum or energy error does not shrink with the tolerance')
             if (allocated(error)) return
         end do
-    end subroutine test_invariants
+    end subroutine check_invariants
 
     !> inputs/two_soft_links.nml over its first 0.1 s: DDASSL, IDA and MEXAX
     !> end where RADAU5 does (the lower bar's positions, 1e-4 m at rtol 1e-6),

@@ -118,17 +118,20 @@ module flexmbs_mbs_system
         1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
 
     !> A frame fixed in a body (body >= 1) or in the ground (body = 0), or a
-    !> node of a flexible body (flexible >= 1, node >= 1; body and position
-    !> unused): the node's position with constant axes, for joints that use
-    !> no marker rotation (spherical, distance).
+    !> point of a flexible body (flexible >= 1; body and position unused): a
+    !> node (node >= 1), or the centroid of a node set (nodes, equal
+    !> weights), with constant axes, for joints that use no marker rotation
+    !> (a node: spherical, distance; a set: spherical, whose rows are then
+    !> linear in the set's nodes).
     type, public :: marker_t
         integer :: body = 0 !! body number, 0 for the ground
         real(wp) :: position(3) = 0.0_wp !! origin: body coordinates (ground: global)
         real(wp) :: axes(3, 3) = identity3 !! orthonormal axes as columns, same frame
-        integer :: flexible = 0 !! flexible body number (node markers)
-        integer :: node = 0     !! its mesh node
+        integer :: flexible = 0 !! flexible body number (node and set markers)
+        integer :: node = 0     !! its mesh node (node markers)
         integer :: chain = 0    !! rigid chain number (chain markers; position, axes
         integer :: link = 0     !! in the frame of this body of the chain)
+        integer, allocatable :: nodes(:) !! set markers: the set's mesh nodes
     end type marker_t
 
     !> Workspace of one marker side of a joint or force element, sized by the
@@ -163,6 +166,10 @@ module flexmbs_mbs_system
         type(driver_t) :: driver
         integer :: marker_i = 0, marker_j = 0
         integer :: row0 = 0 !! rows row0+1 .. row0+joint%nrows of c
+        !> a spherical joint between points (nodes, set centroids) or a point
+        !> and the ground: c is linear in q, so G is constant and every
+        !> second derivative vanishes
+        logical :: linear = .false.
     end type assembled_joint_t
 
     !> Where a flexible body's tangent entries go in the system's ∂f/∂q (q)
@@ -505,6 +512,17 @@ module flexmbs_mbs_system
             integer, intent(in) :: td
             type(dual_t) :: d(3)
         end function driver_dual
+        !> Whether marker k is the centroid of a node set.
+        pure logical module function is_set_marker(self, k)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: k
+        end function is_set_marker
+        !> Offset in q (position space) or v of node a of set marker k's x coordinate.
+        pure integer module function set_node_offset(self, k, a, position_space) result(c)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: k, a
+            logical, intent(in) :: position_space
+        end function set_node_offset
         pure module subroutine add_columns(self, k, position_space, block, row0, out)
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: k
@@ -660,10 +678,14 @@ module flexmbs_mbs_system
             real(wp), intent(in) :: t, q(:), w(:), lambda(:)
             type(accumulator_t), intent(inout) :: gwq, gtlq
         end subroutine jacobian_derivatives_into
-        pure module subroutine add_tangents(out, row, s, qi, iqi, qj, iqj)
+        !> keep_i, keep_j false: that side is a set marker, whose tangents
+        !> vanish (its rows are linear in the nodes) and whose three
+        !> columns are no body's
+        pure module subroutine add_tangents(out, row, s, qi, iqi, qj, iqj, keep_i, keep_j)
             type(accumulator_t), intent(inout) :: out
             integer, intent(in) :: row, qi, iqi, qj, iqj
             type(dual_t), intent(in) :: s
+            logical, intent(in) :: keep_i, keep_j
         end subroutine add_tangents
         module subroutine system_constraint_time_derivative_jacobian(self, t, q, dq, status)
             class(mbs_system_t), intent(inout) :: self

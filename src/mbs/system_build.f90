@@ -122,7 +122,7 @@ contains
         type(rigid_body_t), intent(in) :: bodies(:)
         type(marker_t), intent(in) :: markers(:)
         type(status_t), intent(inout) :: status
-        integer :: k
+        integer :: k, i
         character(len=:), allocatable :: where
         do k = 1, size(markers)
             where = 'mbs system: marker ' // int_text(k)
@@ -147,21 +147,22 @@ contains
                         // int_text(size(self%flex)))
                     return
                 end if
-                associate (fb => self%flex(markers(k)%flexible))
-                    if (markers(k)%node < 1 .or. markers(k)%node > fb%mesh%node_count()) then
-                        call status%set(status_bad_input, where // ': node ' // &
-                            int_text(markers(k)%node) // ' outside the mesh')
+                if (allocated(markers(k)%nodes)) then
+                    if (size(markers(k)%nodes) == 0 .or. markers(k)%node /= 0) then
+                        call status%set(status_bad_input, where // ': a set marker needs &
+                            &nodes and no single node')
                         return
                     end if
-                    if (any(fb%dof(:, markers(k)%node) == 0) .or. &
-                        fb%dof(2, markers(k)%node) /= fb%dof(1, markers(k)%node) + 1 .or. &
-                        fb%dof(3, markers(k)%node) /= fb%dof(1, markers(k)%node) + 2) then
-                        call status%set(status_bad_input, where // ': node ' // &
-                            int_text(markers(k)%node) // ' is fixed (a node marker needs &
-                            &a free node)')
-                        return
-                    end if
-                end associate
+                    do i = 1, size(markers(k)%nodes)
+                        call check_free_node(self%flex(markers(k)%flexible), &
+                            markers(k)%nodes(i), where, status)
+                        if (.not. status%ok()) return
+                    end do
+                else
+                    call check_free_node(self%flex(markers(k)%flexible), markers(k)%node, &
+                        where, status)
+                    if (.not. status%ok()) return
+                end if
             end if
             if (markers(k)%body < 0 .or. markers(k)%body > size(bodies)) then
                 call status%set(status_bad_input, where // ': body = ' // &
@@ -176,6 +177,24 @@ contains
             end if
         end do
     end subroutine check_markers
+
+    !> Node `node` of body fb exists and is free (x, y, z consecutive in q).
+    subroutine check_free_node(fb, node, where, status)
+        type(flexible_body_t), intent(in) :: fb
+        integer, intent(in) :: node
+        character(len=*), intent(in) :: where
+        type(status_t), intent(inout) :: status
+        if (node < 1 .or. node > fb%mesh%node_count()) then
+            call status%set(status_bad_input, where // ': node ' // int_text(node) // &
+                ' outside the mesh')
+            return
+        end if
+        if (any(fb%dof(:, node) == 0) .or. fb%dof(2, node) /= fb%dof(1, node) + 1 .or. &
+            fb%dof(3, node) /= fb%dof(1, node) + 2) then
+            call status%set(status_bad_input, where // ': node ' // int_text(node) // &
+                ' is fixed (a node or set marker needs free nodes)')
+        end if
+    end subroutine check_free_node
 
     !> The joints between the markers, their rows in c from 0 (row0 out:
     !> the rows they take).
@@ -206,6 +225,16 @@ contains
                             &rotation) takes spherical joints and distances only')
                         return
                     end if
+                    jt%linear = ji%kind == joint_spherical .and. &
+                        point_or_ground(markers(ji%marker_i)) .and. &
+                        point_or_ground(markers(ji%marker_j))
+                    if ((allocated(markers(ji%marker_i)%nodes) .or. &
+                         allocated(markers(ji%marker_j)%nodes)) .and. &
+                        ji%kind /= joint_spherical) then
+                        call status%set(status_bad_input, where // ': a set marker (the &
+                            &centroid of a node set) takes spherical joints only')
+                        return
+                    end if
                 else if (markers(ji%marker_i)%body == markers(ji%marker_j)%body .and. &
                          markers(ji%marker_i)%chain == 0 .and. &
                          markers(ji%marker_j)%chain == 0) then
@@ -233,6 +262,12 @@ contains
             end associate
         end do
     end subroutine place_joints
+
+    !> A point of a flexible body (node or set centroid) or the ground.
+    pure logical function point_or_ground(m)
+        type(marker_t), intent(in) :: m
+        point_or_ground = m%flexible > 0 .or. (m%body == 0 .and. m%chain == 0)
+    end function point_or_ground
 
     !> Offsets in q and v: the rigid bodies, then the chains, then the
     !> flexible bodies.

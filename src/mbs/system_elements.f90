@@ -49,6 +49,12 @@ contains
                             int_text(size(self%markers)))
                         return
                     end if
+                    if (allocated(self%markers(mk)%nodes)) then
+                        call status%set(status_bad_input, where // ': marker ' // &
+                            int_text(mk) // ' is a node-set centroid (spherical joints &
+                            &only): the element needs a node or a marker frame')
+                        return
+                    end if
                     if (element_uses_rotation(e) .and. self%markers(mk)%flexible > 0) then
                         call status%set(status_bad_input, where // ': marker ' // &
                             int_text(mk) // ' is a node marker (no rotation): the element &

@@ -41,7 +41,8 @@ contains
 
     !> Offsets of marker k's body in q and v; ground: body = 0.
     !> A node marker reports body = −(its flexible body) and the offsets of
-    !> the node's x coordinate.
+    !> the node's x coordinate; a set marker the same body and its body's
+    !> offsets (its columns are spread over the set: set_node_offset).
     module procedure marker_offsets
         integer :: f, d
         if (self%markers(k)%chain > 0) then
@@ -54,7 +55,8 @@ contains
         f = self%markers(k)%flexible
         if (f > 0) then
             body = -f
-            d = self%flex(f)%dof(1, self%markers(k)%node) - 1
+            d = 0
+            if (self%markers(k)%node > 0) d = self%flex(f)%dof(1, self%markers(k)%node) - 1
             iq = self%flex_q(f) + d
             iv = self%flex_v(f) + d
             return
@@ -64,7 +66,46 @@ contains
         iv = rigid_body_nv * (body - 1)
     end procedure marker_offsets
 
+    module procedure is_set_marker
+        is_set_marker = allocated(self%markers(k)%nodes)
+    end procedure is_set_marker
+
+    module procedure set_node_offset
+        integer :: f
+        f = self%markers(k)%flexible
+        c = merge(self%flex_q(f), self%flex_v(f), position_space) &
+            + self%flex(f)%dof(1, self%markers(k)%nodes(a)) - 1
+    end procedure set_node_offset
+
+    !> Position x and velocity xd of point marker k (its node, or the
+    !> centroid of its set).
+    pure subroutine point_motion(self, k, q, v, x, xd)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(out) :: x(3), xd(3)
+        integer :: b, iq, iv, a, n
+        if (.not. is_set_marker(self, k)) then
+            call marker_offsets(self, k, b, iq, iv)
+            x = q(iq + 1:iq + 3)
+            xd = v(iv + 1:iv + 3)
+            return
+        end if
+        x = 0.0_wp
+        xd = 0.0_wp
+        n = size(self%markers(k)%nodes)
+        do a = 1, n
+            iq = set_node_offset(self, k, a, .true.)
+            iv = set_node_offset(self, k, a, .false.)
+            x = x + q(iq + 1:iq + 3)
+            xd = xd + v(iv + 1:iv + 3)
+        end do
+        x = x / n
+        xd = xd / n
+    end subroutine point_motion
+
     !> Columns of marker k's body in velocity space (6) or position space (7); 0 on ground.
+    !> A point (node or set centroid) has 3: its x, y, z.
     module procedure marker_columns
         n = 0
         if (self%markers(k)%body > 0) n = merge(rigid_body_nq, rigid_body_nv, position_space)
@@ -100,9 +141,13 @@ contains
                         v(iv + 1:iv + nv), m)
                 end associate
             else if (b < 0) then
-                ! a node: its position and velocity, constant axes
-                call ground_marker_state(q(iq + 1:iq + 3), mk%axes, m)
-                m%xd = v(iv + 1:iv + 3)
+                ! a point: its position and velocity, constant axes
+                block
+                    real(wp) :: x(3), xd(3)
+                    call point_motion(self, k, q, v, x, xd)
+                    call ground_marker_state(x, mk%axes, m)
+                    m%xd = xd
+                end block
             else if (b == 0) then
                 call ground_marker_state(mk%position, mk%axes, m)
             else
@@ -182,9 +227,14 @@ contains
                 return
             end if
             if (b < 0) then
-                ! a node: x = q_node, ẋ = v_node; every seed space is (x, y, z)
-                x = q(iq + 1:iq + 3)
-                rd = v(iv + 1:iv + 3)
+                ! a point: x = q_node (or the set's centroid), ẋ = v_node;
+                ! every seed space is (x, y, z)
+                block
+                    real(wp) :: xp(3), xdp(3)
+                    call point_motion(self, k, q, v, xp, xdp)
+                    x = xp
+                    rd = xdp
+                end block
                 a = mk%axes
                 select case (s)
                 case (seed_velocity_space, seed_position)
@@ -199,7 +249,7 @@ contains
                     end do
                 case (seed_rate)
                     n = 1
-                    x%der(first) = v(iv + 1:iv + 3)
+                    x%der(first) = rd%val
                 end select
                 call ground_marker_state_d(x, a, m)
                 m%xd = rd
@@ -406,10 +456,20 @@ contains
 
     !> out(row0 + rows, columns of marker k's body) += block (velocity or
     !> position space).
+    !> A set marker's three columns (its centroid's x, y, z) go to each node
+    !> of the set with weight 1/n.
     module procedure add_columns
-        integer :: b, iq, iv
+        integer :: b, iq, iv, a, n
         call marker_offsets(self, k, b, iq, iv)
         if (b == 0) return
+        if (is_set_marker(self, k)) then
+            n = size(self%markers(k)%nodes)
+            do a = 1, n
+                call out%add_range(row0, set_node_offset(self, k, a, position_space), &
+                                   block / n)
+            end do
+            return
+        end if
         call out%add_range(row0, merge(iq, iv, position_space), block)
     end procedure add_columns
 

@@ -106,15 +106,17 @@ contains
     end procedure system_mass_sparse
 
     !> Pattern of G: joint k's rows times the 6 velocity columns of each of its
-    !> markers' bodies (none for the ground), joint by joint.
+    !> markers' bodies (none for the ground; a set marker's 3 at each node of
+    !> the set), joint by joint.
     module procedure system_constraint_jacobian_pattern
         integer, allocatable :: rows(:), cols(:)
-        integer :: k, n, r, c, side, mk, b, iq, iv, nt
+        integer :: k, n, r, c, side, mk, b, iq, iv, nt, a
         nt = 0
         do k = 1, size(self%joints)
             do side = 1, 2
                 mk = merge(self%joints(k)%marker_i, self%joints(k)%marker_j, side == 1)
-                nt = nt + self%joints(k)%joint%nrows * marker_columns(self, mk, .false.)
+                nt = nt + self%joints(k)%joint%nrows * marker_columns(self, mk, .false.) &
+                    * set_size(self, mk)
             end do
         end do
         do k = 1, size(self%frames)
@@ -126,11 +128,14 @@ contains
             do side = 1, 2
                 mk = merge(self%joints(k)%marker_i, self%joints(k)%marker_j, side == 1)
                 call marker_offsets(self, mk, b, iq, iv)
-                do c = 1, marker_columns(self, mk, .false.)
-                    do r = 1, self%joints(k)%joint%nrows
-                        n = n + 1
-                        rows(n) = self%joints(k)%row0 + r
-                        cols(n) = iv + c
+                do a = 1, set_size(self, mk)
+                    if (is_set_marker(self, mk)) iv = set_node_offset(self, mk, a, .false.)
+                    do c = 1, marker_columns(self, mk, .false.)
+                        do r = 1, self%joints(k)%joint%nrows
+                            n = n + 1
+                            rows(n) = self%joints(k)%row0 + r
+                            cols(n) = iv + c
+                        end do
                     end do
                 end do
             end do
@@ -150,26 +155,33 @@ contains
 
     module procedure system_constraint_jacobian_sparse
         real(wp) :: ct(max_rows)
-        integer :: k, n, r, c, ni, nj, nr
+        integer :: k, n, r, c, ni, nj, nr, a, ns
         n = 0
         values = 0.0_wp
         associate (ci => self%work(1)%c, cj => self%work(2)%c)
             do k = 1, size(self%joints)
                 nr = self%joints(k)%joint%nrows
                 call joint_first_derivatives(self, k, t, q, .false., ci, cj, ni, nj, ct)
-                do c = 1, ni
-                    do r = 1, nr
-                        n = n + 1
-                        ! added: both markers may be on one chain (one slot)
-                        values(self%jacobian_csc%triplet_map(n)) = &
-                            values(self%jacobian_csc%triplet_map(n)) + ci(r, c)
+                ! a set marker's columns once per node, weight 1/n (the pattern's order)
+                ns = set_size(self, self%joints(k)%marker_i)
+                do a = 1, ns
+                    do c = 1, ni
+                        do r = 1, nr
+                            n = n + 1
+                            ! added: both markers may be on one chain (one slot)
+                            values(self%jacobian_csc%triplet_map(n)) = &
+                                values(self%jacobian_csc%triplet_map(n)) + ci(r, c) / ns
+                        end do
                     end do
                 end do
-                do c = 1, nj
-                    do r = 1, nr
-                        n = n + 1
-                        values(self%jacobian_csc%triplet_map(n)) = &
-                            values(self%jacobian_csc%triplet_map(n)) + cj(r, c)
+                ns = set_size(self, self%joints(k)%marker_j)
+                do a = 1, ns
+                    do c = 1, nj
+                        do r = 1, nr
+                            n = n + 1
+                            values(self%jacobian_csc%triplet_map(n)) = &
+                                values(self%jacobian_csc%triplet_map(n)) + cj(r, c) / ns
+                        end do
                     end do
                 end do
             end do
@@ -233,12 +245,32 @@ contains
         do k = 1, size(self%joints)
             associate (jt => self%joints(k))
                 do side = 1, 2
+                    ! a set marker: its c_q, spread over the set; its side of G
+                    ! is constant (no second derivative rows or columns). A
+                    ! linear joint's node: its c_q alone.
+                    mk = merge(jt%marker_i, jt%marker_j, side == 1)
+                    if (.not. is_set_marker(self, mk)) then
+                        call marker_offsets(self, mk, b, iq, iv)
+                        if (jt%linear .and. b < 0) call cq%add_range(jt%row0, iq, &
+                                                                     jt%joint%nrows, 3)
+                        cycle
+                    end if
+                    do i = 1, set_size(self, mk)
+                        call cq%add_range(jt%row0, set_node_offset(self, mk, i, .true.), &
+                                          jt%joint%nrows, 3)
+                    end do
+                end do
+                if (jt%linear) cycle ! c_q only (constant)
+                do side = 1, 2
                     mk = merge(jt%marker_i, jt%marker_j, side == 1)
                     call marker_offsets(self, mk, b, iq, iv)
-                    if (marker_columns(self, mk, .true.) == 0) cycle
+                    if (marker_columns(self, mk, .true.) == 0 .or. is_set_marker(self, mk)) &
+                        cycle
                     call cq%add_range(jt%row0, iq, jt%joint%nrows, &
                                       marker_columns(self, mk, .true.))
                     do other = 1, 2
+                        if (is_set_marker(self, merge(jt%marker_i, jt%marker_j, other == 1))) &
+                            cycle
                         call marker_offsets(self, merge(jt%marker_i, jt%marker_j, other == 1), &
                                             bo, oq, ov)
                         call rq%add_range(iv, oq, marker_columns(self, mk, .false.), &
@@ -417,4 +449,12 @@ contains
         call assemble_first_derivative(self, t, q, .true., self%acc(block_cq))
         call self%acc(block_cq)%get_values(values, 'mbs system: g_q', status)
     end procedure system_constraint_position_jacobian_sparse
+
+    !> Nodes a set marker spreads its columns over; 1 for any other marker.
+    pure integer function set_size(self, k) result(n)
+        class(mbs_system_t), intent(in) :: self
+        integer, intent(in) :: k
+        n = 1
+        if (is_set_marker(self, k)) n = size(self%markers(k)%nodes)
+    end function set_size
 end submodule flexmbs_mbs_system_patterns

@@ -24,13 +24,19 @@ contains
     end procedure system_constraint_jacobian_derivatives_sparse
 
     !> ∂(G w)/∂q (nc x nq) and ∂(Gᵀλ)/∂q (nv x nq) added into gwq, gtlq: AD of
-    !> the hand-coded G along the position unit vectors of the joint's two bodies.
+    !> the hand-coded G along the position unit vectors of the joint's two
+    !> bodies. A set marker's side of G is constant: it adds nothing, and
+    !> its rows of Gᵀλ are left out.
     module procedure jacobian_derivatives_into
         type(marker_state_d) :: mid, mjd
         type(dual_t) :: s
         integer :: k, r0, nr, qi, qj, ni, nj, r, l, bi, bj, iqi, iqj, ivi, ivj, pass, c0
+        logical :: keep_i, keep_j
         do k = 1, size(self%joints)
             associate (jt => self%joints(k), w1 => self%work(1), w2 => self%work(2))
+                if (jt%linear) cycle ! G constant
+                keep_i = .not. is_set_marker(self, jt%marker_i)
+                keep_j = .not. is_set_marker(self, jt%marker_j)
                 r0 = jt%row0
                 nr = jt%joint%nrows
                 ni = marker_columns(self, jt%marker_i, .false.)
@@ -52,19 +58,21 @@ contains
                                           driver_dual(joint_driver(self, k, t), 0), &
                                           w1%cd(1:nr, 1:ni), w2%cd(1:nr, 1:nj))
                     do r = 1, nr
-                        s = dot_product(w1%cd(r, 1:ni), w(ivi + 1:ivi + ni)) &
-                            + dot_product(w2%cd(r, 1:nj), w(ivj + 1:ivj + nj))
-                        call add_tangents(gwq, r0 + r, s, qi, iqi + c0, qj, iqj + c0)
+                        s = 0.0_wp
+                        if (keep_i) s = dot_product(w1%cd(r, 1:ni), w(ivi + 1:ivi + ni))
+                        if (keep_j) s = s + dot_product(w2%cd(r, 1:nj), w(ivj + 1:ivj + nj))
+                        call add_tangents(gwq, r0 + r, s, qi, iqi + c0, qj, iqj + c0, &
+                                          keep_i, keep_j)
                     end do
-                    do l = 1, ni
+                    do l = 1, merge(ni, 0, keep_i)
                         call add_tangents(gtlq, ivi + l, &
                                           dot_product(w1%cd(1:nr, l), lambda(r0 + 1:r0 + nr)), &
-                                          qi, iqi + c0, qj, iqj + c0)
+                                          qi, iqi + c0, qj, iqj + c0, keep_i, keep_j)
                     end do
-                    do l = 1, nj
+                    do l = 1, merge(nj, 0, keep_j)
                         call add_tangents(gtlq, ivj + l, &
                                           dot_product(w2%cd(1:nr, l), lambda(r0 + 1:r0 + nr)), &
-                                          qi, iqi + c0, qj, iqj + c0)
+                                          qi, iqi + c0, qj, iqj + c0, keep_i, keep_j)
                     end do
                 end do
             end associate
@@ -93,12 +101,16 @@ contains
     !> for body i at offset iqi, qi+1..qi+qj for body j at offset iqj).
     module procedure add_tangents
         integer :: l
-        do l = 1, qi
-            call out%add(row, iqi + l, s%der(l))
-        end do
-        do l = 1, qj
-            call out%add(row, iqj + l, s%der(qi + l))
-        end do
+        if (keep_i) then
+            do l = 1, qi
+                call out%add(row, iqi + l, s%der(l))
+            end do
+        end if
+        if (keep_j) then
+            do l = 1, qj
+                call out%add(row, iqj + l, s%der(qi + l))
+            end do
+        end if
     end procedure add_tangents
 
     module procedure system_constraint_time_derivative_jacobian
@@ -120,6 +132,7 @@ contains
         integer :: k, nr, qi, qj, r, bi, bj, iqi, iqj, ivi, ivj, pass, c0
         do k = 1, size(self%joints)
             associate (jt => self%joints(k))
+                if (jt%linear) cycle ! c_t = 0
                 nr = jt%joint%nrows
                 call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
                 call marker_offsets(self, jt%marker_j, bj, iqj, ivj)
@@ -135,7 +148,9 @@ contains
                     call joint_rows_d(joint_part_time_derivative, jt%joint, mid, mjd, &
                                       driver_dual(joint_driver(self, k, t), 0), ctd(1:nr))
                     do r = 1, nr
-                        call add_tangents(dq, jt%row0 + r, ctd(r), qi, iqi + c0, qj, iqj + c0)
+                        call add_tangents(dq, jt%row0 + r, ctd(r), qi, iqi + c0, qj, iqj + c0, &
+                                          .not. is_set_marker(self, jt%marker_i), &
+                                          .not. is_set_marker(self, jt%marker_j))
                     end do
                 end do
             end associate
@@ -166,6 +181,7 @@ contains
         integer :: k, nr, ni, nj, r, bi, bj, iqi, iqj, ivi, ivj, pass, seed, window, c0
         do k = 1, size(self%joints)
             associate (jt => self%joints(k))
+                if (jt%linear) cycle ! γ = 0
                 nr = jt%joint%nrows
                 drvd = driver_dual(joint_driver(self, k, t), 0)
                 call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
@@ -186,10 +202,14 @@ contains
                         do r = 1, nr
                             if (pass == 1) then
                                 call add_tangents(gq, jt%row0 + r, conv(r) + tt(r), ni, &
-                                                  iqi + c0, nj, iqj + c0)
+                                                  iqi + c0, nj, iqj + c0, &
+                                                  .not. is_set_marker(self, jt%marker_i), &
+                                                  .not. is_set_marker(self, jt%marker_j))
                             else
                                 call add_tangents(gv, jt%row0 + r, conv(r) + tt(r), ni, &
-                                                  ivi + c0, nj, ivj + c0)
+                                                  ivi + c0, nj, ivj + c0, &
+                                                  .not. is_set_marker(self, jt%marker_i), &
+                                                  .not. is_set_marker(self, jt%marker_j))
                             end if
                         end do
                     end do

@@ -63,11 +63,14 @@ contains
         type(node_frame_t), allocatable :: frames(:)
         real(wp), allocatable :: qf(:), vf(:), qc(:), vc(:)
         integer, allocatable :: nodes(:), frame_of(:), flex_v0(:)
+        logical, allocatable :: centroid(:)
         character(len=:), allocatable :: labels(:), frame_labels(:), defect, names(:)
         real(wp) :: p(4), r(3, 3), anchor(3), origin(3)
         integer :: i, nb, k, n, b, mi, fb, c
         ! node-set markers that a joint other than 'attach' or a driver uses
-        ! get a node frame (a massless body after the scene's rigid bodies)
+        ! get a node frame (a massless body after the scene's rigid bodies),
+        ! unless spherical joints to points alone use them (centroid_markers)
+        centroid = centroid_markers(scene)
         allocate (frame_of(size(scene%markers)), source=0)
         do i = 1, size(scene%joints)
             if (scene%joints(i)%type == 'attach') cycle
@@ -155,7 +158,21 @@ contains
                     markers(i)%position = 0.0_wp
                     if (m%position_given) markers(i)%position = m%position - &
                         q0(7 * b - 6:7 * b - 4)
+                    ! a position at the centroid (to round-off) is the centroid
+                    if (norm2(markers(i)%position) <= 1.0e-12_wp * max(1.0_wp, &
+                        norm2(m%position))) markers(i)%position = 0.0_wp
                     markers(i)%axes = axes_from(m%z_axis, m%x_axis)
+                    cycle
+                end if
+                if (centroid(i)) then
+                    fb = flexible_index(scene, m%body)
+                    call flex(fb)%mesh%node_set(trim(m%node_set), nodes, status)
+                    if (.not. status%ok()) then
+                        call status%set(status_bad_input, scene%path // ': &marker ''' // &
+                            trim(m%name) // ''': ' // status%text())
+                        return
+                    end if
+                    markers(i) = marker_t(0, flexible=fb, nodes=nodes)
                     cycle
                 end if
                 if (m%body /= 'ground' .and. len_trim(m%node_set) == 0) &
@@ -255,7 +272,8 @@ contains
             integer :: k
             k = marker_index(scene, name)
             if (k == 0) return
-            if (len_trim(scene%markers(k)%node_set) == 0 .or. frame_of(k) > 0) return
+            if (len_trim(scene%markers(k)%node_set) == 0 .or. frame_of(k) > 0 .or. &
+                centroid(k)) return
             frame_of(k) = maxval(frame_of) + 1
         end subroutine use_frame
 
@@ -275,6 +293,52 @@ contains
             u = u / size(set)
         end function mean_velocity
     end subroutine build_multibody
+
+    !> The node-set markers that need no node frame: without a `position`
+    !> (at the set's centroid) and used by spherical joints only (besides
+    !> 'attach', which works node by node). A spherical joint loads no
+    !> rotation, so its rows can take the centroid of the set, linear in the
+    !> nodes' positions, and the system keeps a constant mass matrix (no
+    !> massless frame body). A marker that a driver, a force element or
+    !> another joint uses keeps its frame.
+    pure function centroid_markers(scene) result(centroid)
+        type(scene_input_t), intent(in) :: scene
+        logical :: centroid(size(scene%markers))
+        logical :: used(size(scene%markers))
+        integer :: i, k
+        do k = 1, size(scene%markers)
+            centroid(k) = len_trim(scene%markers(k)%node_set) > 0 .and. &
+                .not. scene%markers(k)%position_given
+        end do
+        used = .false.
+        do i = 1, size(scene%drivers)
+            call exclude(marker_index(scene, scene%drivers(i)%marker_i))
+            call exclude(marker_index(scene, scene%drivers(i)%marker_j))
+        end do
+        do i = 1, size(scene%forces)
+            call exclude(marker_index(scene, scene%forces(i)%marker_i))
+            call exclude(marker_index(scene, scene%forces(i)%marker_j))
+        end do
+        do i = 1, size(scene%joints)
+            select case (scene%joints(i)%type)
+            case ('attach')
+            case ('spherical')
+                k = marker_index(scene, scene%joints(i)%marker_i)
+                if (k > 0) used(k) = .true.
+                k = marker_index(scene, scene%joints(i)%marker_j)
+                if (k > 0) used(k) = .true.
+            case default
+                call exclude(marker_index(scene, scene%joints(i)%marker_i))
+                call exclude(marker_index(scene, scene%joints(i)%marker_j))
+            end select
+        end do
+        centroid = centroid .and. used
+    contains
+        pure subroutine exclude(k)
+            integer, intent(in) :: k
+            if (k > 0) centroid(k) = .false.
+        end subroutine exclude
+    end function centroid_markers
 
     !> The force elements of the scene's &force groups (checked already).
     pure function scene_forces(scene) result(el)
