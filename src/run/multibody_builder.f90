@@ -63,7 +63,7 @@ contains
         type(node_frame_t), allocatable :: frames(:)
         real(wp), allocatable :: qf(:), vf(:), qc(:), vc(:)
         integer, allocatable :: nodes(:), frame_of(:), flex_v0(:)
-        logical, allocatable :: centroid(:)
+        logical :: centroid(size(scene%markers))
         character(len=:), allocatable :: labels(:), frame_labels(:), defect, names(:)
         real(wp) :: p(4), r(3, 3), anchor(3), origin(3)
         integer :: i, nb, k, n, b, mi, fb, c
@@ -172,7 +172,10 @@ contains
                             trim(m%name) // ''': ' // status%text())
                         return
                     end if
-                    markers(i) = marker_t(0, flexible=fb, nodes=nodes)
+                    ! component by component: a structure constructor with an
+                    ! allocatable component leaks its temporary (gfortran 12)
+                    markers(i)%flexible = fb
+                    markers(i)%nodes = nodes
                     cycle
                 end if
                 if (m%body /= 'ground' .and. len_trim(m%node_set) == 0) &
