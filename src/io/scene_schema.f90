@@ -202,12 +202,12 @@ module flexmbs_io_scene_schema
         var_spec_t('marker', 'body', kind_string, default='ground', &
             doc='the body it sits on'), &
         var_spec_t('marker', 'position', kind_real, 3, default='0, 0, 0', unit='m', &
-            doc='in the body''s frame (node sets: their centroid)'), &
+            doc='in the body''s frame (node sets: their centroid; given, a node frame)'), &
         var_spec_t('marker', 'z_axis', kind_real, 3, default='0, 0, 1', doc='z axis'), &
         var_spec_t('marker', 'x_axis', kind_real, 3, default='0, 0, 0', &
             doc='x axis (0: any normal to z)'), &
         var_spec_t('marker', 'node_set', kind_string, &
-            doc='on the flexible body: the nodes it follows'), &
+            doc='the flexible body''s nodes it follows: centroid, or if needed a fitted frame'), &
         var_spec_t('joint', 'name', kind_string, doc='unique name (default: joint N)'), &
         var_spec_t('joint', 'type', kind_string, choices='spherical|revolute|cylindrical|&
             &prismatic|universal|fixed|attach', doc='joint type, required'), &
