@@ -459,14 +459,18 @@ contains
     !> A set marker's three columns (its centroid's x, y, z) go to each node
     !> of the set with weight 1/n.
     module procedure add_columns
-        integer :: b, iq, iv, a, n
+        integer :: b, iq, iv, a, n, c0, r, l
         call marker_offsets(self, k, b, iq, iv)
         if (b == 0) return
         if (is_set_marker(self, k)) then
             n = size(self%markers(k)%nodes)
             do a = 1, n
-                call out%add_range(row0, set_node_offset(self, k, a, position_space), &
-                                   block / n)
+                c0 = set_node_offset(self, k, a, position_space)
+                do l = 1, size(block, 2)
+                    do r = 1, size(block, 1)
+                        call out%add(row0 + r, c0 + l, block(r, l) / n)
+                    end do
+                end do
             end do
             return
         end if
