@@ -354,7 +354,7 @@ contains
         call check(error, size(sys%flex) == 3 .and. size(sys%frames) == 0, &
                    'three flexible bodies and no node frame')
         if (allocated(error)) return
-        call check_invariants(error, free_scene())
+        call check_invariants(error, scene, sys, q0, v0)
     end subroutine test_invariants
 
     !> The system refuses a set marker in a revolute joint, in a distance and

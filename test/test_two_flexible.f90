@@ -92,31 +92,27 @@ contains
             else
                 print '(4x,a)', 'at the sets'' centroids (set markers):'
             end if
-            call check_invariants(error, free_scene(framed == 1))
+            call check_invariants(error, scene, sys, q0, v0)
             if (allocated(error)) return
         end do
     end subroutine test_invariants
 
-    !> The free system of scene `text` per solver, at rtol = atol = 1e-5 and
-    !> 1e-7: the change of linear momentum (round-off: every method here
-    !> keeps linear invariants), of angular momentum about the origin and of
-    !> energy over t_end, relative to their sizes at the start, within 100
-    !> rtol and smaller at the tighter tolerance.
-    subroutine check_invariants(error, text)
+    !> The free system of `scene` (built as sys, starting at q0, v0) per
+    !> solver, at rtol = atol = 1e-5 and 1e-7: the change of linear momentum
+    !> (round-off: every method here keeps linear invariants), of angular
+    !> momentum about the origin and of energy over t_end, relative to their
+    !> sizes at the start, within 100 rtol and smaller at the tighter
+    !> tolerance.
+    subroutine check_invariants(error, scene, sys, q0, v0)
         type(error_t), allocatable, intent(out) :: error
-        character(len=*), intent(in) :: text
+        type(scene_input_t), intent(inout) :: scene !! its solver and tolerances are set
+        type(mbs_system_t), intent(inout) :: sys !! (its energy and momenta evaluations)
+        real(wp), intent(in) :: q0(:), v0(:)
         real(wp), parameter :: tols(2) = [1.0e-5_wp, 1.0e-7_wp]
-        type(scene_input_t) :: scene
         type(run_result_t) :: result
-        type(mbs_system_t) :: sys
         type(status_t) :: status
-        real(wp), allocatable :: q0(:), v0(:)
         real(wp) :: l0(3), a0(3), l1(3), a1(3), e0, e1, dl(2), da(2), de(2)
         integer :: k, i
-        call parse_scene(text, 'free.nml', scene, status)
-        if (status%ok()) call build_multibody(scene, sys, q0, v0, status)
-        call check(error, status%ok(), 'scene: ' // status%text())
-        if (allocated(error)) return
         call sys%momenta(q0, v0, l0, a0)
         e0 = sys%total_energy(q0, v0)
         do k = 1, size(solvers)

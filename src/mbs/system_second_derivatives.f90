@@ -130,9 +130,12 @@ contains
         type(marker_state_d) :: mid, mjd
         type(dual_t) :: ctd(max_rows)
         integer :: k, nr, qi, qj, r, bi, bj, iqi, iqj, ivi, ivj, pass, c0
+        logical :: keep_i, keep_j
         do k = 1, size(self%joints)
             associate (jt => self%joints(k))
                 if (jt%linear) cycle ! c_t = 0
+                keep_i = .not. is_set_marker(self, jt%marker_i)
+                keep_j = .not. is_set_marker(self, jt%marker_j)
                 nr = jt%joint%nrows
                 call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
                 call marker_offsets(self, jt%marker_j, bj, iqj, ivj)
@@ -149,8 +152,7 @@ contains
                                       driver_dual(joint_driver(self, k, t), 0), ctd(1:nr))
                     do r = 1, nr
                         call add_tangents(dq, jt%row0 + r, ctd(r), qi, iqi + c0, qj, iqj + c0, &
-                                          .not. is_set_marker(self, jt%marker_i), &
-                                          .not. is_set_marker(self, jt%marker_j))
+                                          keep_i, keep_j)
                     end do
                 end do
             end associate
@@ -179,9 +181,12 @@ contains
         type(marker_state_d) :: mid, mjd
         type(dual_t) :: conv(max_rows), tt(max_rows), drvd(3)
         integer :: k, nr, ni, nj, r, bi, bj, iqi, iqj, ivi, ivj, pass, seed, window, c0
+        logical :: keep_i, keep_j
         do k = 1, size(self%joints)
             associate (jt => self%joints(k))
                 if (jt%linear) cycle ! γ = 0
+                keep_i = .not. is_set_marker(self, jt%marker_i)
+                keep_j = .not. is_set_marker(self, jt%marker_j)
                 nr = jt%joint%nrows
                 drvd = driver_dual(joint_driver(self, k, t), 0)
                 call marker_offsets(self, jt%marker_i, bi, iqi, ivi)
@@ -202,14 +207,10 @@ contains
                         do r = 1, nr
                             if (pass == 1) then
                                 call add_tangents(gq, jt%row0 + r, conv(r) + tt(r), ni, &
-                                                  iqi + c0, nj, iqj + c0, &
-                                                  .not. is_set_marker(self, jt%marker_i), &
-                                                  .not. is_set_marker(self, jt%marker_j))
+                                                  iqi + c0, nj, iqj + c0, keep_i, keep_j)
                             else
                                 call add_tangents(gv, jt%row0 + r, conv(r) + tt(r), ni, &
-                                                  ivi + c0, nj, ivj + c0, &
-                                                  .not. is_set_marker(self, jt%marker_i), &
-                                                  .not. is_set_marker(self, jt%marker_j))
+                                                  ivi + c0, nj, ivj + c0, keep_i, keep_j)
                             end if
                         end do
                     end do
