@@ -10,7 +10,7 @@ module flexmbs_dae_ddassl_start
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         status_interrupted, reason_step_too_small, reason_singular_matrix, &
         reason_newton_failure, reason_det_f
-    use flexmbs_linalg_matrix, only: storage_none, storage_dense
+    use flexmbs_linalg_matrix, only: storage_none, storage_dense, storage_sparse
     use flexmbs_linalg_factory, only: new_linear_solver
     use flexmbs_dae_residual_problem, only: residual_problem_t
     use flexmbs_dae_options, only: dae_options_t
@@ -178,10 +178,14 @@ contains
             if (.not. status%ok()) return
             w%fd = w%bmat%storage == storage_none
             w%direct = .not. w%fd .and. res%has_iteration_matrix()
-            call new_linear_solver(options%linear_solver, n, w%bmat%storage, w%ls, status, &
-                lower=options%band_lower, upper=options%band_upper, &
-                ordering=options%sparse_ordering, classic_order=options%classic_lu, &
-                mass=w%amat, jac=w%bmat)
+            ! the problem's own solver of c A − B (condensed Newton systems), or ours
+            if (w%bmat%storage == storage_sparse) &
+                call res%iteration_solver(options, w%ls, status)
+            if (.not. status%ok()) return
+            if (.not. allocated(w%ls)) call new_linear_solver(options%linear_solver, n, &
+                w%bmat%storage, w%ls, status, lower=options%band_lower, &
+                upper=options%band_upper, ordering=options%sparse_ordering, &
+                classic_order=options%classic_lu, mass=w%amat, jac=w%bmat)
             if (.not. status%ok()) return
             if (w%fd) then
                 ! The difference PD is held as −PD and factored with shift 0.

@@ -47,13 +47,16 @@ module flexmbs_dae_ida
     use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_identity, storage_dense, &
         storage_sparse
     use flexmbs_linalg_linear_solver, only: auto_sparse_threshold
+    use flexmbs_linalg_factory, only: new_linear_solver
     use flexmbs_dae_problem, only: dae_problem_t, problem_mass_matrix
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t, index3_warning, projection_refusal
     use flexmbs_dae_multiplier_scaling, only: multiplier_kappa
     use flexmbs_dae_rejections, only: refusal_len, cause_model_refused
     use flexmbs_dae_ida_callbacks, only: callback_data_t, ida_residual, ida_jacobian, &
-        ida_weights, ida_error_handler, jac_quotients, jac_dense, jac_scatter, jac_sparse
+        ida_weights, ida_error_handler, jac_quotients, jac_dense, jac_scatter, jac_sparse, &
+        jac_own
+    use flexmbs_dae_ida_linear_solver, only: own_linear_solver
     use flexmbs_dae_ida_observer, only: observer_attach, observer_free, &
         observed_rejections
     use flexmbs_dae_sink, only: sink_t, dense_output_t
@@ -87,8 +90,9 @@ module flexmbs_dae_ida
         logical :: calc_ic = .false.
         logical :: suppress_alg = .true.
         type(ida_native_t) :: native
-        !> Linear solver used by the last integration: 'dense' or 'klu'.
-        character(len=8) :: linear_solver_used = ''
+        !> Linear solver used by the last integration: 'dense', 'klu' (SUNDIALS'),
+        !> 'mumps', or the problem's ('condensed klu', 'condensed mumps').
+        character(len=16) :: linear_solver_used = ''
     contains
         procedure :: integrate_dae => ida_integrate
         procedure :: name => ida_name
@@ -395,6 +399,10 @@ contains
             case default
                 data%jac_mode = jac_quotients
             end select
+            if (data%jac_mode == jac_scatter) then
+                call own_solver(st)
+                if (.not. st%ok() .or. data%jac_mode == jac_own) return
+            end if
             select case (options%linear_solver)
             case ('klu')
                 use_klu = .true.
@@ -402,8 +410,9 @@ contains
                 use_klu = .false.
             case ('band', 'mumps')
                 call st%set(status_bad_input, "ida: linear_solver = '" &
-                    // trim(options%linear_solver) // "' is not offered " &
-                    // "with IDA (dense or KLU); use 'dense', 'klu' or 'auto'")
+                    // trim(options%linear_solver) // "' needs an analytic sparse " &
+                    // "Jacobian with IDA (jacobian_storage = storage_sparse, jacobian = " &
+                    // "'analytic'); 'band' is not offered; use 'dense', 'klu' or 'auto'")
                 return
             case default
                 use_klu = data%jac_mode == jac_scatter .and. n >= auto_sparse_threshold
@@ -419,6 +428,28 @@ contains
                 call build_iteration_pattern(st)
             end if
         end subroutine setup_matrices
+
+        !> With a sparse analytic ∂F/∂y: the problem's solver of c_j M − ∂F/∂y
+        !> (condensed Newton systems), or MUMPS when asked for, behind our
+        !> SUNLinearSolver (mode jac_own); otherwise SUNDIALS' own solvers.
+        subroutine own_solver(st)
+            type(status_t), intent(inout) :: st
+            call problem%iteration_solver(options, data%ls, st)
+            if (.not. st%ok()) return
+            if (.not. allocated(data%ls) .and. options%linear_solver == 'mumps') &
+                call new_linear_solver('mumps', n, storage_sparse, data%ls, st, &
+                    ordering=options%sparse_ordering)
+            if (.not. st%ok() .or. .not. allocated(data%ls)) return
+            data%jac_matrix%n = n
+            data%jac_matrix%storage = storage_sparse
+            data%jac_matrix%csc = data%jac
+            call data%ls%init(data%mass, data%jac_matrix, st)
+            if (.not. st%ok()) then
+                st%message = 'ida: ' // st%message
+                return
+            end if
+            data%jac_mode = jac_own
+        end subroutine own_solver
 
         !> Union of the patterns of ∂F/∂y and M; slot maps for both.
         subroutine build_iteration_pattern(st)
@@ -559,7 +590,16 @@ contains
         subroutine attach_linear_solver(st)
             type(status_t), intent(inout) :: st
             logical :: ok
-            if (data%jac_mode == jac_sparse) then
+            if (data%jac_mode == jac_own) then
+                ! IDA's matrix is a placeholder; data%ls holds the real one
+                a_mat => FSUNDenseMatrix(1_c_int64_t, 1_c_int64_t, ctx)
+                if (.not. associated(a_mat)) then
+                    call out_of_memory(status, 'ida placeholder matrix', 1_i8, 8)
+                    return
+                end if
+                lin_solver => own_linear_solver(data, ctx)
+                self%linear_solver_used = data%ls%name()
+            else if (data%jac_mode == jac_sparse) then
                 a_mat => FSUNSparseMatrix(int(n, c_int64_t), int(n, c_int64_t), &
                     int(data%nnz, c_int64_t), CSC_MAT, ctx)
                 if (.not. associated(a_mat)) then

@@ -18,6 +18,7 @@ module flexmbs_dae_ida_callbacks
         reason_non_finite, reason_det_f
     use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_linalg_matrix, only: matrix_t, storage_dense, storage_sparse
+    use flexmbs_linalg_linear_solver, only: linear_solver_t
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_rejections, only: refusal_len
     use flexmbs_dae_ida_observer, only: observer_refused
@@ -32,6 +33,9 @@ module flexmbs_dae_ida_callbacks
     integer, parameter, public :: jac_dense = 1     !! problem dense, SUNDIALS dense
     integer, parameter, public :: jac_scatter = 2   !! problem CSC, SUNDIALS dense
     integer, parameter, public :: jac_sparse = 3    !! problem CSC, SUNDIALS CSC + KLU
+    !> problem CSC, a linear_solver_t of ours (the problem's condensed Newton
+    !> system, or MUMPS) behind a SUNLinearSolver (ida_linear_solver)
+    integer, parameter, public :: jac_own = 4
 
     !> What the callbacks need; IDA's user data points here.
     type, public :: callback_data_t
@@ -41,6 +45,11 @@ module flexmbs_dae_ida_callbacks
         type(matrix_t) :: mass
         type(csc_matrix_t) :: jac               !! the problem's ∂F/∂y pattern and values
         type(csc_matrix_t) :: mass_csc          !! M as CSC (sparse mode)
+        !> jac_own: our solver of c_j M − ∂F/∂y, ∂F/∂y for it, and the c_j
+        !> of the last Jacobian call (the one its setup factors with)
+        class(linear_solver_t), allocatable :: ls
+        type(matrix_t) :: jac_matrix
+        real(wp) :: cj = 0.0_wp
         integer(i8) :: nnz = 0                  !! non-zeros of the iteration matrix
         integer(i8), allocatable :: colptr(:), rowind(:) !! its pattern
         integer(i8), allocatable :: jac_slot(:), mass_slot(:) !! entry -> its slot
@@ -118,6 +127,12 @@ contains
         n = data%n
         y => FN_VGetArrayPointer(nv_y)
         ierr = 0
+        if (data%jac_mode == jac_own) then
+            ! IDA's matrix is a placeholder: our solver's setup factors c_j M − J
+            call data%problem%jacobian_sparse(t, y, data%jac_matrix%csc%values, st)
+            if (.not. failed()) data%cj = cj
+            return
+        end if
         if (data%jac_mode == jac_sparse) then
             call data%problem%jacobian_sparse(t, y, data%jac%values, st)
             if (.not. failed()) then
@@ -186,6 +201,8 @@ contains
             end if
             if (data%jac_mode == jac_dense) then
                 finite = all(ieee_is_finite(jm))
+            else if (data%jac_mode == jac_own) then
+                finite = all(ieee_is_finite(data%jac_matrix%csc%values))
             else
                 finite = all(ieee_is_finite(data%jac%values))
             end if

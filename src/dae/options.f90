@@ -29,6 +29,10 @@ module flexmbs_dae_options
         !> the BLAS build. The classic faces set it to repeat the original
         !> programs' counters on round-off-sensitive problems.
         logical :: classic_lu = .false.
+        !> 'condensed': a problem that offers its own solver of the iteration
+        !> matrices (the mechanical formulations) is solved through it;
+        !> 'full': every solver factors c M − ∂F/∂y as it stands
+        character(len=9) :: newton_system = 'condensed'
         real(wp), allocatable :: output_times(:)   !! dense output at these times
         logical :: output_steps = .false.          !! also every accepted step
     contains
@@ -93,6 +97,9 @@ contains
         else if (all(self%sparse_ordering /= [character(len=8) :: 'auto', 'amd', 'nd'])) then
             call status%set(status_bad_input, "options: sparse_ordering = '" // &
                 trim(self%sparse_ordering) // "': must be 'auto', 'amd' or 'nd'")
+        else if (all(self%newton_system /= [character(len=9) :: 'condensed', 'full'])) then
+            call status%set(status_bad_input, "options: newton_system = '" // &
+                trim(self%newton_system) // "': must be 'condensed' or 'full'")
         end if
     end subroutine options_validate
 

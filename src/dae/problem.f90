@@ -11,6 +11,8 @@ module flexmbs_dae_problem
     use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_identity, storage_dense, &
         storage_sparse
+    use flexmbs_linalg_linear_solver, only: linear_solver_t
+    use flexmbs_dae_options, only: dae_options_t
     implicit none
     private
 
@@ -34,6 +36,7 @@ module flexmbs_dae_problem
         procedure :: project => default_project
         procedure :: consistent_initial => default_consistent_initial
         procedure :: admissible => default_admissible
+        procedure :: iteration_solver => default_iteration_solver
     end type dae_problem_t
 
     abstract interface
@@ -180,6 +183,19 @@ contains
         type(status_t), intent(out) :: status
         call status%clear()
     end subroutine default_admissible
+
+    !> A linear solver for the iteration matrices c M − ∂F/∂y that knows
+    !> this problem's structure (the mechanical formulations' condensed
+    !> Newton systems), chosen by `options` (linear_solver, sparse_ordering,
+    !> newton_system); left unallocated when the problem offers none, and the
+    !> solver then takes its own (flexmbs_linalg_factory). Solvers ask for it
+    !> only with an analytic Jacobian. Default: none.
+    subroutine default_iteration_solver(self, options, solver, status)
+        class(dae_problem_t), intent(inout) :: self
+        type(dae_options_t), intent(in) :: options
+        class(linear_solver_t), allocatable, intent(out) :: solver
+        type(status_t), intent(inout) :: status
+    end subroutine default_iteration_solver
 
     !> Post-step hook: project y onto the constraint manifold.
     subroutine default_project(self, t, y, status)

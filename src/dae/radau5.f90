@@ -296,9 +296,12 @@ contains
                 "options%band_lower and band_upper; or give J as a sparse pattern")
             return
         end if
-        call new_linear_solver(options%linear_solver, n, jac%storage, ls, status, &
-            options%band_lower, options%band_upper, options%sparse_ordering, mass=mass, &
-            jac=jac)
+        ! the problem's own solver of c M − J (condensed Newton systems), or ours
+        if (jac%storage == storage_sparse) call problem%iteration_solver(options, ls, status)
+        if (.not. status%ok()) return
+        if (.not. allocated(ls)) call new_linear_solver(options%linear_solver, n, jac%storage, &
+            ls, status, options%band_lower, options%band_upper, options%sparse_ordering, &
+            mass=mass, jac=jac)
         if (.not. status%ok()) return
         call ls%init(mass, jac, status)
         if (.not. status%ok()) return

@@ -10,6 +10,8 @@ module flexmbs_dae_residual_problem
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_linalg_matrix, only: matrix_t, storage_none, storage_identity, &
         storage_dense, storage_sparse
+    use flexmbs_linalg_linear_solver, only: linear_solver_t
+    use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_problem, only: dae_problem_t
     implicit none
     private
@@ -26,6 +28,7 @@ module flexmbs_dae_residual_problem
         procedure :: has_iteration_matrix => residual_has_iteration_matrix
         procedure :: iteration_matrix => residual_iteration_matrix
         procedure :: admissible => residual_admissible
+        procedure :: iteration_solver => residual_iteration_solver
     end type residual_problem_t
 
     abstract interface
@@ -70,6 +73,7 @@ module flexmbs_dae_residual_problem
         procedure :: differential_flags => wrapper_differential_flags
         procedure :: multiplier_flags => wrapper_multiplier_flags
         procedure :: admissible => wrapper_admissible
+        procedure :: iteration_solver => wrapper_iteration_solver
     end type dae_residual_t
 
 contains
@@ -82,6 +86,24 @@ contains
         type(status_t), intent(out) :: status
         call status%clear()
     end subroutine residual_admissible
+
+    !> A linear solver for c A − B that knows the problem's structure
+    !> (dae_problem_t%iteration_solver); default: none (left unallocated).
+    subroutine residual_iteration_solver(self, options, solver, status)
+        class(residual_problem_t), intent(inout) :: self
+        type(dae_options_t), intent(in) :: options
+        class(linear_solver_t), allocatable, intent(out) :: solver
+        type(status_t), intent(inout) :: status
+    end subroutine residual_iteration_solver
+
+    !> The wrapped problem's solver: A = M and B = J are the problem's own.
+    subroutine wrapper_iteration_solver(self, options, solver, status)
+        class(dae_residual_t), intent(inout) :: self
+        type(dae_options_t), intent(in) :: options
+        class(linear_solver_t), allocatable, intent(out) :: solver
+        type(status_t), intent(inout) :: status
+        call self%problem%iteration_solver(options, solver, status)
+    end subroutine wrapper_iteration_solver
 
     !> Default: every component of index 1.
     subroutine residual_index_classes(self, classes)

@@ -85,6 +85,7 @@ contains
         options%pmax = min(scene%pmax, 12)
         options%linear_solver = trim(scene%linear_solver)
         options%sparse_ordering = trim(scene%sparse_ordering)
+        options%newton_system = trim(scene%newton_system)
         options%jacobian = trim(scene%jacobian)
         options%output_steps = scene%every_step
         m = max(scene%n_output, 2)

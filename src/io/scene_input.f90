@@ -166,6 +166,7 @@ module flexmbs_io_scene_input
         integer :: max_steps
         character(len=len_name) :: linear_solver
         character(len=len_name) :: sparse_ordering !! KLU: 'auto' | 'amd' | 'nd'
+        character(len=len_name) :: newton_system   !! 'condensed' | 'full'
         character(len=len_name) :: jacobian
         !> A solver's own settings (below, down to mexax_base) count only
         !> when given: the solver factory leaves every other at the solver

@@ -105,6 +105,8 @@ contains
         scene%linear_solver = lower(scene%linear_solver)
         call get(e, g, 'sparse_ordering', scene%sparse_ordering)
         scene%sparse_ordering = lower(scene%sparse_ordering)
+        call get(e, g, 'newton_system', scene%newton_system)
+        scene%newton_system = lower(scene%newton_system)
         call get(e, g, 'jacobian', scene%jacobian)
         scene%jacobian = lower(scene%jacobian)
         call get(e, g, 'nit', scene%nit)

@@ -84,6 +84,9 @@ module flexmbs_io_scene_schema
             doc='linear algebra of the Newton matrices: auto, dense, klu, band or mumps'), &
         var_spec_t('solver', 'sparse_ordering', kind_string, default='auto', &
             choices='auto|amd|nd', doc='KLU fill-reducing ordering'), &
+        var_spec_t('solver', 'newton_system', kind_string, default='condensed', &
+            choices='condensed|full', doc='mechanical scenes: factor the Newton matrix ' // &
+            'condensed to velocities and multipliers, or the full first-order one'), &
         var_spec_t('solver', 'jacobian', kind_string, default='analytic', &
             choices='analytic|fd', doc='Jacobian: analytic or finite differences'), &
         var_spec_t('solver', 'nit', kind_integer, rule='[1,inf)', &

@@ -14,7 +14,7 @@ module flexmbs_linalg_klu_solver
     use flexmbs_linalg_matrix, only: matrix_t
     use flexmbs_linalg_linear_solver, only: linear_solver_t, fill_nan
     use flexmbs_linalg_shifted_pattern, only: shifted_pattern_t
-    use flexmbs_linalg_klu, only: klu_factor_t, klu_stats_t, klu_ordering_auto
+    use flexmbs_linalg_klu, only: klu_factor_t, klu_stats_t, klu_ordering_auto, klu_part_real
     implicit none
     private
 
@@ -38,6 +38,7 @@ module flexmbs_linalg_klu_solver
         procedure :: name => klu_solver_name
         procedure :: stats => klu_solver_stats
         procedure :: nonzeros => klu_solver_nonzeros
+        procedure :: factor_nonzeros => klu_solver_factor_nonzeros
         procedure :: destroy => klu_solver_destroy
     end type klu_solver_t
 
@@ -121,6 +122,12 @@ contains
         class(klu_solver_t), intent(in) :: self
         klu_solver_nonzeros = self%lu%nonzeros()
     end function klu_solver_nonzeros
+
+    !> Entries of the real L + U (-1 before the first factorisation).
+    integer(i8) function klu_solver_factor_nonzeros(self)
+        class(klu_solver_t), intent(in) :: self
+        klu_solver_factor_nonzeros = self%lu%factor_nonzeros(klu_part_real)
+    end function klu_solver_factor_nonzeros
 
     !> Free the KLU objects now (finalisation does it too); init may follow.
     subroutine klu_solver_destroy(self)

@@ -55,6 +55,10 @@ module flexmbs_mbs_formulation
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_mbs_formulation_sparse, only: sparse_formulation_t, sparse_layout_t
     use flexmbs_linalg_saddle_point, only: saddle_point_t
+    use flexmbs_linalg_linear_solver, only: linear_solver_t
+    use flexmbs_dae_options, only: dae_options_t
+    use flexmbs_mbs_condensed_structure, only: condensed_layout_t
+    use flexmbs_mbs_condensed_newton, only: new_condensed_solver
     implicit none
     private
 
@@ -124,6 +128,7 @@ module flexmbs_mbs_formulation
         procedure :: consistent_multipliers => formulation_consistent_multipliers
         procedure :: drift => formulation_drift
         procedure :: admissible => formulation_admissible
+        procedure :: iteration_solver => formulation_iteration_solver
     end type formulation_t
 
     public :: new_formulation
@@ -921,6 +926,25 @@ contains
             velocity = maxval(abs(self%c))
         end associate
     end subroutine formulation_drift
+
+    !> The condensed Newton systems (docs/theory.md §3.7) on the sparse path
+    !> with newton_system = 'condensed' and a sparse LU ('auto', 'klu',
+    !> 'mumps'); otherwise none, and the solvers factor ∂F/∂y's matrices.
+    subroutine formulation_iteration_solver(self, options, solver, status)
+        class(formulation_t), intent(inout) :: self
+        type(dae_options_t), intent(in) :: options
+        class(linear_solver_t), allocatable, intent(out) :: solver
+        type(status_t), intent(inout) :: status
+        if (.not. self%sparse .or. options%newton_system /= 'condensed' .or. &
+            options%jacobian == 'fd') return
+        select case (trim(options%linear_solver))
+        case ('auto', 'klu', 'mumps')
+            allocate (solver, source=new_condensed_solver(condensed_layout_t(n=self%n, &
+                nq=self%nq, nv=self%nv, oq=self%oq, ov=self%ov, oa=self%oa, ol=self%ol, &
+                accelerations=self%accelerations), options%linear_solver, &
+                options%sparse_ordering))
+        end select
+    end subroutine formulation_iteration_solver
 
     !> The mechanical problem's test of the positions in y.
     subroutine formulation_admissible(self, t, y, status)

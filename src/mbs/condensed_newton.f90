@@ -1,0 +1,251 @@
+!> The condensed Newton systems of the mechanical formulations
+!> (docs/theory.md §3.7): a `linear_solver_t` for A = c M_dae − J that
+!> eliminates the kinematic rows exactly (flexmbs_mbs_condensed_structure)
+!> and factors the matrix S that remains, in the velocities, the kept
+!> positions and the multipliers: c M − ∂f/∂v − ∂f/∂q T / c + ... on the
+!> pattern of the FE stiffness graph and the joints, not three times it.
+!>
+!> The formulation hands it to the solvers through the DAE interface
+!> (dae_problem_t%iteration_solver), so RADAU5 (real and complex), DDASSL
+!> and IDA factor and solve through it without knowing mechanics. Solutions
+!> are those of A to round-off: no term is dropped or approximated.
+!>
+!> S is factored by KLU or MUMPS (`choice`: 'klu', 'mumps' or 'auto', the
+!> rule of condensed_auto_*). A copy made by assignment owns no KLU or MUMPS
+!> objects and must be initialised again.
+module flexmbs_mbs_condensed_newton
+    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_status, only: status_t, status_bad_input
+    use flexmbs_core_resources, only: out_of_memory
+    use flexmbs_linalg_matrix, only: matrix_t, storage_sparse
+    use flexmbs_linalg_linear_solver, only: linear_solver_t, fill_nan
+    use flexmbs_linalg_sparse_lu, only: sparse_lu_t, sparse_lu_auto, sparse_lu_klu, &
+        sparse_lu_mumps
+    use flexmbs_mbs_condensed_structure, only: condensed_structure_t, condensed_layout_t
+    use flexmbs_mbs_condensed_kernels, only: factor_blocks, w_values, s_values, &
+        condensed_solve
+    implicit none
+    private
+
+    !> `linear_solver = 'auto'` on the condensed matrices S: MUMPS when
+    !> S has order >= condensed_auto_min_order and KLU's AMD analysis
+    !> predicts fill (nnz(L) + nnz(U)) / nnz(S) >= condensed_auto_min_fill,
+    !> otherwise KLU (docs/linear_algebra.md, "Choosing the LU").
+    integer, parameter, public :: condensed_auto_min_order = 1000
+    real(wp), parameter, public :: condensed_auto_min_fill = 4.0_wp
+
+    character(len=*), parameter :: who = 'condensed Newton system'
+
+    !> A = c M_dae − J through its condensed matrix (module header).
+    type, extends(linear_solver_t), public :: condensed_solver_t
+        private
+        type(condensed_layout_t) :: lay
+        character(len=8) :: choice = 'auto'    !! 'auto' | 'klu' | 'mumps'
+        character(len=8) :: ordering = 'auto'  !! 'auto' | 'amd' | 'nd'
+        type(condensed_structure_t) :: st
+        type(sparse_lu_t) :: lu
+        integer(i8), allocatable :: va_slot(:) !! J's slot of (v_i, a_i): v' = a
+        real(wp) :: c_real = 0.0_wp
+        complex(wp) :: c_complex = (0.0_wp, 0.0_wp)
+        real(wp), allocatable :: lu_r(:), w_r(:), s_r(:), rhs_r(:)
+        real(wp), allocatable :: xe_r(:), xk_r(:), rv_r(:), buf_r(:)
+        complex(wp), allocatable :: lu_z(:), w_z(:), s_z(:), rhs_z(:)
+        complex(wp), allocatable :: xe_z(:), xk_z(:), rv_z(:), buf_z(:)
+        integer, allocatable :: piv_r(:), piv_z(:)
+        integer(i8), allocatable :: pos(:)
+    contains
+        procedure :: init => condensed_init
+        procedure :: factor_real => condensed_factor_real
+        procedure :: factor_complex => condensed_factor_complex
+        procedure :: solve_real => condensed_solve_real
+        procedure :: solve_complex => condensed_solve_complex
+        procedure :: name => condensed_name
+        procedure :: order => condensed_order
+        procedure :: eliminated => condensed_eliminated
+        procedure :: largest_block => condensed_largest_block
+        procedure :: nonzeros => condensed_nonzeros
+        procedure :: factor_nonzeros => condensed_factor_nonzeros
+    end type condensed_solver_t
+
+    public :: new_condensed_solver
+
+contains
+
+    !> A solver for the layout `lay`; `choice` and `ordering` as the
+    !> options' linear_solver ('auto', 'klu', 'mumps') and sparse_ordering.
+    function new_condensed_solver(lay, choice, ordering) result(self)
+        type(condensed_layout_t), intent(in) :: lay
+        character(len=*), intent(in) :: choice, ordering
+        type(condensed_solver_t) :: self
+        self%lay = lay
+        self%choice = choice
+        self%ordering = ordering
+    end function new_condensed_solver
+
+    !> Structure, patterns and the analysis of S, once.
+    subroutine condensed_init(self, mass, jac, status)
+        class(condensed_solver_t), intent(inout) :: self
+        type(matrix_t), intent(in) :: mass, jac
+        type(status_t), intent(out) :: status
+        integer :: stat, choice, i, nr
+        if (mass%storage /= storage_sparse .or. jac%storage /= storage_sparse) then
+            call status%set(status_bad_input, who // ': needs M and J in sparse storage')
+            return
+        end if
+        call self%st%build(self%lay, mass%csc, jac%csc, status)
+        if (.not. status%ok()) return
+        self%n = self%lay%n
+        associate (st => self%st)
+            nr = max(st%comp_ptr(st%ncomp + 1) - 1, 1)
+            allocate (self%lu_r(st%lu_size()), self%lu_z(st%lu_size()), self%piv_r(nr), &
+                self%piv_z(nr), self%w_r(st%w%nnz), self%w_z(st%w%nnz), self%s_r(st%s%nnz), &
+                self%s_z(st%s%nnz), self%rhs_r(st%rhs_size()), self%rhs_z(st%rhs_size()), &
+                self%xe_r(st%ne), self%xe_z(st%ne), self%xk_r(st%nk), self%xk_z(st%nk), &
+                self%rv_r(st%nv), self%rv_z(st%nv), self%buf_r(max(st%max_block, 1)), &
+                self%buf_z(max(st%max_block, 1)), self%pos(st%nk), &
+                self%va_slot(merge(st%nv, 0, st%accelerations)), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, who // ' values', 4 * (st%w%nnz + st%s%nnz) + &
+                    4 * st%lu_size() + 4 * st%rhs_size(), 8)
+                return
+            end if
+            if (st%accelerations) then
+                do i = 1, st%nv
+                    self%va_slot(i) = jac%csc%find(st%ov + i, st%oa + i)
+                end do
+            end if
+            select case (trim(self%choice))
+            case ('klu')
+                choice = sparse_lu_klu
+            case ('mumps')
+                choice = sparse_lu_mumps
+            case ('auto')
+                choice = sparse_lu_auto
+            case default
+                call status%set(status_bad_input, who // ": linear_solver = '" // &
+                    trim(self%choice) // "': use 'auto', 'klu' or 'mumps'")
+                return
+            end select
+            call self%lu%analyse(st%nk, st%s%colptr, st%s%rowind, choice, status, &
+                self%ordering, condensed_auto_min_order, condensed_auto_min_fill)
+        end associate
+    end subroutine condensed_init
+
+    !> The blocks of J and M at this evaluation; false (status set) when the
+    !> v rows do not read v' = a.
+    logical function gathered(self, mass, jac, status)
+        type(condensed_solver_t), intent(inout) :: self
+        type(matrix_t), intent(in) :: mass, jac
+        type(status_t), intent(inout) :: status
+        integer :: i
+        gathered = .false.
+        if (.not. allocated(self%pos)) then
+            call status%set(status_bad_input, who // ': factor before init')
+            return
+        end if
+        do i = 1, size(self%va_slot)
+            if (jac%csc%values(self%va_slot(i)) /= 1.0_wp) then
+                call status%set(status_bad_input, who // ': the v rows of J are not v'' = a')
+                return
+            end if
+        end do
+        call self%st%jee%gather(jac%csc%values)
+        call self%st%jek%gather(jac%csc%values)
+        call self%st%jke%gather(jac%csc%values)
+        call self%st%jkk%gather(jac%csc%values)
+        call self%st%jka%gather(jac%csc%values)
+        call self%st%mkk%gather(mass%csc%values)
+        gathered = .true.
+    end function gathered
+
+    !> Factor A = c M_dae − J (real c): the kinematic blocks, W, S.
+    subroutine condensed_factor_real(self, c, mass, jac, status)
+        class(condensed_solver_t), intent(inout) :: self
+        real(wp), intent(in) :: c
+        type(matrix_t), intent(in) :: mass, jac
+        type(status_t), intent(out) :: status
+        if (.not. gathered(self, mass, jac, status)) return
+        self%c_real = c
+        call factor_blocks(self%st, c, self%lu_r, self%piv_r, status)
+        if (.not. status%ok()) return
+        call w_values(self%st, c, self%lu_r, self%piv_r, self%rhs_r, self%w_r)
+        call s_values(self%st, c, self%w_r, self%s_r, self%pos)
+        call self%lu%factor(self%s_r, status)
+    end subroutine condensed_factor_real
+
+    !> Factor A = c M_dae − J with a complex shift c.
+    subroutine condensed_factor_complex(self, c, mass, jac, status)
+        class(condensed_solver_t), intent(inout) :: self
+        complex(wp), intent(in) :: c
+        type(matrix_t), intent(in) :: mass, jac
+        type(status_t), intent(out) :: status
+        if (.not. gathered(self, mass, jac, status)) return
+        self%c_complex = c
+        call factor_blocks(self%st, c, self%lu_z, self%piv_z, status)
+        if (.not. status%ok()) return
+        call w_values(self%st, c, self%lu_z, self%piv_z, self%rhs_z, self%w_z)
+        call s_values(self%st, c, self%w_z, self%s_z, self%pos)
+        call self%lu%factor(self%s_z, status)
+    end subroutine condensed_factor_complex
+
+    !> b ← A⁻¹ b with the real factorisation.
+    subroutine condensed_solve_real(self, b)
+        class(condensed_solver_t), intent(inout) :: self
+        real(wp), intent(inout) :: b(:)
+        if (.not. allocated(self%pos)) then
+            call fill_nan(b)
+            return
+        end if
+        call condensed_solve(self%st, self%c_real, self%lu_r, self%piv_r, self%lu, b, &
+            self%xe_r, self%xk_r, self%rv_r, self%buf_r)
+    end subroutine condensed_solve_real
+
+    !> b ← A⁻¹ b with the complex factorisation.
+    subroutine condensed_solve_complex(self, b)
+        class(condensed_solver_t), intent(inout) :: self
+        complex(wp), intent(inout) :: b(:)
+        if (.not. allocated(self%pos)) then
+            call fill_nan(b)
+            return
+        end if
+        call condensed_solve(self%st, self%c_complex, self%lu_z, self%piv_z, self%lu, b, &
+            self%xe_z, self%xk_z, self%rv_z, self%buf_z)
+    end subroutine condensed_solve_complex
+
+    !> 'condensed klu' or 'condensed mumps'.
+    function condensed_name(self) result(name)
+        class(condensed_solver_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'condensed ' // self%lu%name()
+    end function condensed_name
+
+    !> Order of S.
+    pure integer function condensed_order(self)
+        class(condensed_solver_t), intent(in) :: self
+        condensed_order = self%st%nk
+    end function condensed_order
+
+    !> Positions eliminated (the accelerations are eliminated too).
+    pure integer function condensed_eliminated(self)
+        class(condensed_solver_t), intent(in) :: self
+        condensed_eliminated = self%st%ne
+    end function condensed_eliminated
+
+    !> Order of the largest kinematic block with a dense LU of its own.
+    pure integer function condensed_largest_block(self)
+        class(condensed_solver_t), intent(in) :: self
+        condensed_largest_block = self%st%max_block
+    end function condensed_largest_block
+
+    !> Slots of S's pattern.
+    pure integer(i8) function condensed_nonzeros(self)
+        class(condensed_solver_t), intent(in) :: self
+        condensed_nonzeros = self%st%s%nnz
+    end function condensed_nonzeros
+
+    !> Entries of S's real LU factors.
+    integer(i8) function condensed_factor_nonzeros(self)
+        class(condensed_solver_t), intent(inout) :: self
+        condensed_factor_nonzeros = self%lu%factor_nonzeros()
+    end function condensed_factor_nonzeros
+end module flexmbs_mbs_condensed_newton
