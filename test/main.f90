@@ -51,6 +51,7 @@ program flexmbs_tests
     use test_chain_coupling, only: collect_chain_coupling
     use test_sparse_formulation, only: collect_sparse_formulation
     use test_condensed_newton, only: collect_condensed_newton
+    use test_structured_saddle, only: collect_structured_saddle
     use test_out_of_memory, only: collect_out_of_memory
     use test_modes, only: collect_modes
     implicit none
@@ -111,6 +112,7 @@ program flexmbs_tests
     call run_suite('sparse_formulation', collect_sparse_formulation(), filter, npassed, &
                    nfailed)
     call run_suite('condensed_newton', collect_condensed_newton(), filter, npassed, nfailed)
+    call run_suite('structured_saddle', collect_structured_saddle(), filter, npassed, nfailed)
     call run_suite('out_of_memory', collect_out_of_memory(), filter, npassed, nfailed)
     call run_suite('modes', collect_modes(), filter, npassed, nfailed)
     call run_suite('node_frame', collect_node_frame(), filter, npassed, nfailed)

@@ -40,15 +40,20 @@ module test_condensed_newton
         'index2', 'index3', 'ggl']
 
     !> Bounds: relative difference to KLU's solution of A, and backward error
-    !> ‖A x − b‖∞ / (‖A‖∞ ‖x‖∞ + ‖b‖∞) of the condensed solution.
-    real(wp), parameter :: max_difference = 1.0e-8_wp, max_backward = 1.0e-13_wp
+    !> ‖A x − b‖∞ / (‖A‖∞ ‖x‖∞ + ‖b‖∞) of the condensed solution. Measured:
+    !> backward errors ≤ 3.3e-16 for the integrators' c, ≤ 7e-13 at the
+    !> modes' small shift c = −1 with KLU (its threshold pivoting admits
+    !> growth; MUMPS ≤ 2e-14 there); differences up to 3e-8 where A is
+    !> ill-conditioned (index 1 and 3 at small c).
+    real(wp), parameter :: max_difference = 5.0e-8_wp, max_backward = 1.0e-12_wp
 
 contains
 
     function collect_condensed_newton() result(tests)
         type(test_case_t), allocatable :: tests(:)
         tests = [new_test('solves_equal_full_matrix', test_solves), &
-                 new_test('trajectories_condensed_vs_full', test_trajectories)]
+                 new_test('trajectories_condensed_vs_full', test_trajectories), &
+                 new_test('mexax_structured_vs_full', test_mexax_structured)]
     end function collect_condensed_newton
 
     !> Every scene, formulation and layout (module header).
@@ -111,9 +116,10 @@ contains
         real(wp), intent(in) :: q0(:), v0(:)
         character(len=*), intent(in) :: what
         real(wp), intent(inout) :: worst_difference, worst_backward
-        ! RADAU5's γ and α ± iβ over h = 1e-3 and 1e-1, DDASSL's cj at h = 1e-4
+        ! RADAU5's γ and α ± iβ over h = 1e-3 and 1e-1, DDASSL's cj at h = 1e-4,
+        ! the modes' default shift σ = −1
         real(wp), parameter :: cs(*) = [3.637834252744495_wp / 1.0e-3_wp, &
-            3.637834252744495_wp / 0.1_wp, 2.0e4_wp]
+            3.637834252744495_wp / 0.1_wp, 2.0e4_wp, -1.0_wp]
         complex(wp), parameter :: zc = cmplx(2.681082873627752_wp, 3.050430199247410_wp, &
             kind=wp) / 1.0e-3_wp
         type(matrix_t) :: jac, mass
@@ -264,17 +270,10 @@ contains
     end subroutine compare
 
     !> Every mechanical scene of inputs/ over a short time, RADAU5, DDASSL
-    !> and IDA at TOL 1e-6 with newton_system = 'condensed' against 'full':
-    !> with the same counters, the positions agree to 1e-9 (relative to their
-    !> scale; measured: at most 2e-11, the multipliers, index-2 variables
-    !> whose round-off the iteration matrix amplifies like 1/h, to 1e-7 of
-    !> the largest); where round-off flipped a step decision, the ERRs
-    !> (eq. 13) of both against a tight reference are within a factor 2 of
-    !> each other and the counters within 5 %.
+    !> and IDA at TOL 1e-6 with newton_system = 'condensed' against 'full'
+    !> (compare_paths).
     subroutine test_trajectories(error)
         type(error_t), allocatable, intent(out) :: error
-        character(len=*), parameter :: solvers(*) = [character(len=8) :: 'radau5', 'ddassl', &
-            'ida']
         character(len=*), parameter :: files(*) = [character(len=40) :: &
             'inputs/arm_with_pad.nml', 'inputs/bushing_mount.nml', 'inputs/face_hinge.nml', &
             'inputs/five_body.nml', 'inputs/five_body_undamped.nml', &
@@ -284,6 +283,39 @@ contains
             'inputs/rigid_flexible_pendulum.nml', 'inputs/two_soft_links.nml']
         real(wp), parameter :: t_ends(*) = [0.02_wp, 0.02_wp, 0.02_wp, 0.05_wp, 0.05_wp, &
             2.0e-3_wp, 2.0e-3_wp, 0.05_wp, 0.1_wp, 0.1_wp, 0.1_wp, 0.05_wp, 0.02_wp]
+        call compare_paths(error, files, t_ends, [character(len=8) :: 'radau5', 'ddassl', &
+            'ida'])
+    end subroutine test_trajectories
+
+    !> MEXAX with its augmented systems solved by the structure of M
+    !> (newton_system = 'condensed': constant mass blocks factored once,
+    !> massless node frames in a small system) against KLU on the whole
+    !> [M Gᵀ; G 0] ('full'), on the five-body and chain scenes (compare_paths).
+    subroutine test_mexax_structured(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), parameter :: files(*) = [character(len=40) :: &
+            'inputs/five_body.nml', 'inputs/five_body_undamped.nml', &
+            'inputs/four_bar_chain.nml', 'inputs/four_bar_chains.nml', &
+            'inputs/arm_with_pad.nml', 'inputs/two_soft_links.nml', 'inputs/face_hinge.nml']
+        ! five_body_undamped over 0.2 s: over 0.05 s its NST differ by 9 %
+        ! (108 and 118, debug build), over 0.2 s by 0.4 % (the fine mesh is
+        ! left out: 'full' needs minutes for a few milliseconds of it there)
+        real(wp), parameter :: t_ends(*) = [0.05_wp, 0.2_wp, 0.1_wp, 0.1_wp, 0.02_wp, &
+            0.02_wp, 0.02_wp]
+        call compare_paths(error, files, t_ends, [character(len=8) :: 'mexax'])
+    end subroutine test_mexax_structured
+
+    !> The scenes `files` up to `t_ends` with each of `solvers` at TOL 1e-6,
+    !> newton_system = 'condensed' against 'full': with the same counters,
+    !> the positions agree to 1e-9 (relative to their scale; the multipliers,
+    !> index-2 variables whose round-off the iteration matrix amplifies like
+    !> 1/h, are not compared); where round-off flipped a step decision, the
+    !> ERRs (eq. 13) of both against a tight reference (RADAU5, 1e-10) are
+    !> within a factor 2 of each other and NST, NFE, NJE within 5 %.
+    subroutine compare_paths(error, files, t_ends, solvers)
+        type(error_t), allocatable, intent(inout) :: error
+        character(len=*), intent(in) :: files(:), solvers(:)
+        real(wp), intent(in) :: t_ends(:)
         real(wp), parameter :: tol = 1.0e-6_wp
         type(run_result_t) :: rf, rc, ref
         logical :: same, have_ref
@@ -367,5 +399,5 @@ contains
             call check(error, status%ok(), path // ' ' // solver // ' ' // system // ': ' // &
                 status%text())
         end subroutine run
-    end subroutine test_trajectories
+    end subroutine compare_paths
 end module test_condensed_newton

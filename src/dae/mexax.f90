@@ -235,7 +235,7 @@ contains
         if (.not. valid_input()) return
 
         call setup_workspace(w, problem, self%base, km, options%linear_solver, status, &
-            options%sparse_ordering, options%classic_lu)
+            options%sparse_ordering, options%classic_lu, options%newton_system == 'condensed')
         if (.not. status%ok()) return
         call options%tolerances(w%rtol, w%atol)
         self%dense = mexax_dense_t()  ! drops the last run's arrays

@@ -13,6 +13,7 @@ module flexmbs_dae_mexax_workspace
     use flexmbs_linalg_csc, only: csc_matrix_t, pattern_matvec
     use flexmbs_linalg_klu, only: klu_ordering_auto
     use flexmbs_linalg_saddle_point, only: saddle_point_t
+    use flexmbs_linalg_structured_saddle, only: structured_saddle_t
     use flexmbs_linalg_factory, only: klu_ordering_code
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_mexax_control, only: control_t
@@ -64,6 +65,10 @@ module flexmbs_dae_mexax_workspace
         logical :: classic_lu = .false. !! dense LU in the classic elimination order (options)
         type(csc_matrix_t) :: mpat, gpat
         type(saddle_point_t) :: kkt
+        !> the sparse path by the structure of M (newton_system = 'condensed'):
+        !> constant mass blocks factored once, massless frames in a small system
+        logical :: structured = .false.
+        type(structured_saddle_t) :: skkt
         real(wp), allocatable :: p(:), pp(:), pn(:), v(:), vp(:), f(:), pdot(:), gt(:)
         real(wp), allocatable :: rhs(:), acc(:), lam(:), x(:), d(:), tab(:, :)
         real(wp), allocatable :: shift(:) !! the projection's accumulated correction (v space)
@@ -74,7 +79,7 @@ contains
     !> Allocate the workspace for `km` columns and set up the linear solver
     !> of the augmented system ('auto' | 'dense' | 'klu').
     subroutine setup_workspace(w, problem, base, km, linear_solver, status, ordering, &
-                               classic_lu)
+                               classic_lu, structured)
         type(workspace_t), intent(out) :: w
         class(mechanical_problem_t), intent(inout) :: problem
         integer, intent(in) :: base, km
@@ -83,6 +88,9 @@ contains
         character(len=*), intent(in), optional :: ordering !! 'auto' | 'amd' | 'nd'
         !> dense: the classic elimination order (options%classic_lu)
         logical, intent(in), optional :: classic_lu
+        !> sparse: [M Gᵀ; G 0] by the structure of M (structured_saddle_t)
+        !> instead of KLU on the whole matrix
+        logical, intent(in), optional :: structured
         integer :: nq, nv, nc, stat
         integer(i8) :: entries
         call default_blas_threads()
@@ -130,6 +138,7 @@ contains
         end select
         if (w%sparse) then
             if (present(ordering)) w%klu_ordering = klu_ordering_code(ordering)
+            if (present(structured)) w%structured = structured
             call setup_sparse(w, problem, status)
         else
             allocate (w%m0%dense(nv, nv), w%g0%dense(nc, nv), w%mm%dense(nv, nv), &
@@ -156,7 +165,11 @@ contains
         if (.not. pattern_ok(w%mpat, nv, nv, 'mass_pattern')) return
         call problem%constraint_jacobian_pattern(w%gpat, status)
         if (.not. pattern_ok(w%gpat, nc, nv, 'constraint_jacobian_pattern')) return
-        call w%kkt%init(w%mpat, w%gpat, status, w%klu_ordering)
+        if (w%structured) then
+            call w%skkt%init(w%mpat, w%gpat, status)
+        else
+            call w%kkt%init(w%mpat, w%gpat, status, w%klu_ordering)
+        end if
         if (.not. status%ok()) then
             status%message = 'mexax: ' // status%message
             return
@@ -217,7 +230,9 @@ contains
     subroutine assemble(w, mtop, gtop, gbot)
         type(workspace_t), intent(inout) :: w
         type(block_t), intent(in) :: mtop, gtop, gbot
-        if (w%sparse) then
+        if (w%structured) then
+            call w%skkt%assemble(mtop%values, gbot%values, gtop%values)
+        else if (w%sparse) then
             call w%kkt%assemble(mtop%values, gbot%values, gtop%values)
         else
             call w%kkt%assemble(mtop%dense, gbot%dense, gtop%dense)
@@ -229,7 +244,11 @@ contains
     subroutine factor(w, status)
         type(workspace_t), intent(inout) :: w
         type(status_t), intent(out) :: status
-        call w%kkt%factor(status)
+        if (w%structured) then
+            call w%skkt%factor(status)
+        else
+            call w%kkt%factor(status)
+        end if
     end subroutine factor
 
     !> b ← K⁻¹ b with the factorisation of `factor`.
@@ -238,7 +257,11 @@ contains
         real(wp), intent(inout) :: b(:)
         type(status_t) :: lst
         ! fails only without a factorisation, which `factor` excluded
-        call w%kkt%solve(b, lst)
+        if (w%structured) then
+            call w%skkt%solve(b, lst)
+        else
+            call w%kkt%solve(b, lst)
+        end if
     end subroutine solve
 
     !> Factor the augmented matrix and solve for w%rhs; ev_stop on a singular matrix.

@@ -30,9 +30,17 @@ module flexmbs_mbs_condensed_newton
     !> `linear_solver = 'auto'` on the condensed matrices S: MUMPS when
     !> S has order >= condensed_auto_min_order and KLU's AMD analysis
     !> predicts fill (nnz(L) + nnz(U)) / nnz(S) >= condensed_auto_min_fill,
-    !> otherwise KLU (docs/linear_algebra.md, "Choosing the LU").
-    integer, parameter, public :: condensed_auto_min_order = 1000
-    real(wp), parameter, public :: condensed_auto_min_fill = 4.0_wp
+    !> otherwise KLU. flexmbs-bench-newton (1 BLAS thread; one real + one
+    !> complex factorisation, KLU (its automatic ordering) / MUMPS, with the
+    !> order of S and the predicted fill): five-body (305, 2.1) 1.0 with KLU's
+    !> solves 4x faster; coupler 4x8x4 (941, 5.2) 8.1; 6x12x6 (2321, 10.5)
+    !> 26; 5x20x5 (2600, 10.7) 18; soft arm 80x2x2 (2291, 1.8) 1.3; 320x2x2
+    !> (8771, 1.7) 0.9; cube 12^3 (6084, 8.0) 6.3; cantilever 64x8x8 (15552,
+    !> 9.0) 6.4 (docs/linear_algebra.md). MUMPS wins from a fill of about 3,
+    !> the two are even on slender bodies, and below order ~500 KLU's
+    !> cheaper solves decide.
+    integer, parameter, public :: condensed_auto_min_order = 500
+    real(wp), parameter, public :: condensed_auto_min_fill = 3.0_wp
 
     character(len=*), parameter :: who = 'condensed Newton system'
 

@@ -331,7 +331,7 @@ contains
     !> 2 count of them (a pair per mode) and room for the formulation's own.
     subroutine arpack_spectrum(jac, mass, plan, options, result, status)
         type(matrix_t), intent(in) :: jac, mass
-        type(run_plan_t), intent(in) :: plan
+        type(run_plan_t), intent(inout) :: plan
         type(modes_options_t), intent(in) :: options
         type(modes_result_t), intent(inout) :: result
         type(status_t), intent(out) :: status
@@ -339,8 +339,14 @@ contains
         integer :: wanted
         wanted = 2 * options%count + max(result%quaternions + result%constraint_values, 0)
         wanted = min(wanted, result%n - 2)
-        call new_linear_solver(plan%options%linear_solver, jac%n, jac%storage, solver, status, &
-                               ordering=plan%options%sparse_ordering, mass=mass, jac=jac)
+        ! the formulation's condensed Newton system factors σ M − J as it
+        ! factors the integrators' matrices (docs/theory.md §3.7), or ours
+        if (jac%storage == storage_sparse) &
+            call plan%problem%iteration_solver(plan%options, solver, status)
+        if (.not. status%ok()) return
+        if (.not. allocated(solver)) call new_linear_solver(plan%options%linear_solver, &
+            jac%n, jac%storage, solver, status, ordering=plan%options%sparse_ordering, &
+            mass=mass, jac=jac)
         if (.not. status%ok()) return
         call shift_invert_eigenvalues(jac, mass, options%shift, wanted, solver, &
                                       result%lambda, status)
