@@ -216,11 +216,15 @@ install: deps
 # coarse and on the fine coupler mesh: the references (two at a time), then
 # the sweeps in two processes; each sweep's log and table.
 PAPER_SWEEPS := five_body_table3 five_body_table2 five_body_figure6 five_body_table2_undamped \
+                five_body_table2_viscosity_100 five_body_table2_viscosity_10 \
                 five_body_fine_table3 five_body_fine_table2 five_body_fine_figure6 \
-                five_body_fine_table2_undamped
+                five_body_fine_table2_undamped five_body_fine_table3_window
 PAPER_REFERENCES := five_body_table3:reference five_body_table2_undamped:reference_undamped \
+                    five_body_table2_viscosity_100:reference_viscosity_100 \
+                    five_body_table2_viscosity_10:reference_viscosity_10 \
                     five_body_fine_table3:reference_fine \
-                    five_body_fine_table2_undamped:reference_fine_undamped
+                    five_body_fine_table2_undamped:reference_fine_undamped \
+                    five_body_fine_table3_window:reference_fine_window
 # x of the coupler's middle node (node 23 of its 3 x 5 x 3 grid) in y: after
 # 4 bodies x 7 coordinates and the chain's 2, its x is free coordinate 67
 MIDDLE_NODE_X := 97
@@ -259,9 +263,10 @@ paper:
 	ls results/*.png
 
 # The extremes study (inputs/paper/extremes.sh) into results/extremes/: the
-# five-body mechanism and its fine mesh; VARIANTS picks others (damped fine
-# undamped soft stiff long), VARIANTS=all runs all six.
-VARIANTS ?= damped fine
+# five-body mechanism, its fine mesh and the 16 335-coordinate coupler;
+# VARIANTS picks others (damped fine undamped soft stiff long large),
+# VARIANTS=all runs all seven.
+VARIANTS ?= damped fine large
 extremes: deps
 	$(FPM) build --profile release
 	@bin=$$($(FPM) run --profile release flexmbs --runner echo 2>/dev/null | tail -1); \

@@ -930,6 +930,8 @@ contains
     !> The condensed Newton systems (docs/theory.md §3.7) on the sparse path
     !> with newton_system = 'condensed' and a sparse LU ('auto', 'klu',
     !> 'mumps'); otherwise none, and the solvers factor ∂F/∂y's matrices.
+    !> With the condensed systems the formulation's own saddle-point systems
+    !> (projection, the outputs' multipliers) go by the structure of M.
     subroutine formulation_iteration_solver(self, options, solver, status)
         class(formulation_t), intent(inout) :: self
         type(dae_options_t), intent(in) :: options
@@ -943,6 +945,14 @@ contains
                 nq=self%nq, nv=self%nv, oq=self%oq, ov=self%ov, oa=self%oa, ol=self%ol, &
                 accelerations=self%accelerations), options%linear_solver, &
                 options%sparse_ordering))
+            ! the projection and the multipliers of the outputs solve [M Gᵀ; G 0]
+            ! by the structure of M too (theory §7.8); K is refactored afresh.
+            ! The consistent initial values, made before, keep KLU on K: the
+            ! state a run starts from is the same on both paths (an index-3
+            ! pencil's infinite eigenvalues move with its round-off:
+            ! flexmbs modes counted 272 finite of five-body's, not 266)
+            self%kkt_factored = .false.
+            call self%sp%use_structure()
         end select
     end subroutine formulation_iteration_solver
 

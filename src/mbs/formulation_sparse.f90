@@ -24,6 +24,7 @@ module flexmbs_mbs_formulation_sparse
     use flexmbs_linalg_block_assembly, only: block_assembly_t, product_pattern, &
         product_values, transpose_pattern
     use flexmbs_linalg_saddle_point, only: saddle_point_t
+    use flexmbs_linalg_structured_saddle, only: structured_saddle_t
     use flexmbs_linalg_klu, only: klu_factor_t
     use flexmbs_linalg_triplets, only: triplets_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t, mechanical_patterns_t
@@ -49,6 +50,10 @@ module flexmbs_mbs_formulation_sparse
         type(mechanical_patterns_t), allocatable :: pat
         type(block_assembly_t) :: jac, mass
         type(saddle_point_t) :: kkt
+        !> [M Gᵀ; G 0] by the structure of M instead (use_structure: with the
+        !> condensed Newton systems), set up at its first factorisation
+        logical :: structured = .false., structure_ready = .false.
+        type(structured_saddle_t) :: skkt
         ! block ids in jac
         integer :: id_tq = 0, id_t = 0, id_ggl_rq = 0, id_ggl_gt = 0
         integer :: id_va = 0, id_fq = 0, id_rq = 0, id_fv = 0, id_m = 0, id_gt = 0
@@ -79,6 +84,7 @@ module flexmbs_mbs_formulation_sparse
         procedure :: factor_kkt => sparse_factor_kkt
         procedure :: solve_kkt => sparse_solve_kkt
         procedure :: solve_mass => sparse_solve_mass
+        procedure :: use_structure => sparse_use_structure
     end type sparse_formulation_t
 
     ! formulation codes (flexmbs_mbs_formulation's values)
@@ -459,6 +465,16 @@ contains
         call mech%mass_sparse(t, q, self%m, status)
         call mech%constraint_jacobian_sparse(t, q, self%g, status)
         if (.not. status%ok()) return
+        if (self%structured) then
+            if (.not. self%structure_ready) then
+                call self%skkt%init(self%pat%mass, self%pat%constraint_v, status)
+                if (.not. status%ok()) return
+                self%structure_ready = .true.
+            end if
+            call self%skkt%assemble(self%m, self%g)
+            call self%skkt%factor(status)
+            return
+        end if
         call self%kkt%assemble(self%m, self%g)
         call self%kkt%factor(status)
     end subroutine sparse_factor_kkt
@@ -468,6 +484,18 @@ contains
         class(sparse_formulation_t), intent(inout) :: self
         real(wp), intent(inout) :: rhs(:)
         type(status_t), intent(inout) :: status
-        call self%kkt%solve(rhs, status)
+        if (self%structured) then
+            call self%skkt%solve(rhs, status)
+        else
+            call self%kkt%solve(rhs, status)
+        end if
     end subroutine sparse_solve_kkt
+
+    !> From now on [M Gᵀ; G 0] by the structure of M (flexmbs_linalg_
+    !> structured_saddle): the constant mass blocks factored once, massless
+    !> frames in a small system; the next factorisation starts it.
+    subroutine sparse_use_structure(self)
+        class(sparse_formulation_t), intent(inout) :: self
+        self%structured = .true.
+    end subroutine sparse_use_structure
 end module flexmbs_mbs_formulation_sparse
