@@ -86,6 +86,11 @@ contains
         type(status_t), intent(inout) :: status
         real(wp), intent(in), optional :: lambda(:)
         integer :: stat
+        allocate (r%w, stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, 'mexax workspace', 1_i8, storage_size(r%w) / 8)
+            return
+        end if
         call setup_workspace(r%w, problem, self%base, r%km, options%linear_solver, status, &
             options%sparse_ordering, options%classic_lu, options%newton_system == 'condensed')
         if (.not. status%ok()) return

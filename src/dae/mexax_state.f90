@@ -78,7 +78,13 @@ module flexmbs_dae_mexax_state
     !> ended, the step-size flags of ODEX and the output position. Local to
     !> the driver.
     type, public :: mexax_run_t
-        type(workspace_t) :: w
+        !> Allocatable (allocated by begin_integration): gfortran 12's
+        !> finalization wrapper of a type that holds a workspace_t component
+        !> directly frees only the first entity of each component list such
+        !> as `type(block_t) :: m0, g0, mm, gm, gn` (valgrind: g0, mm, gm, gn
+        !> and gpat leaked on every integration); for an allocatable
+        !> component it calls workspace_t's own wrapper, which frees them all.
+        type(workspace_t), allocatable :: w
         type(timer_t) :: timer
         type(status_t) :: fst     !! the failure of the attempt's last column or projection
         type(status_t) :: refusal !! the model's last refusal since an accepted step
