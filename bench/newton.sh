@@ -50,8 +50,8 @@ auto_picks() {  # SCENE LABEL
     local log="$OUT/matrices_$2.txt"
     [ -s "$log" ] || "$MATRICES" "$1" > "$log" 2>&1
     local full cond
-    full=$(grep -E '^newton +full ' "$log" | tail -1 | awk '{ print $3 }')
-    cond=$(grep -E '^newton +condensed ' "$log" | tail -1 | awk '{ print $4 }')
+    full=$(grep -E '^newton +full +auto ' "$log" | tail -1 | awk '{ print $4 }')
+    cond=$(grep -E '^newton +condensed +auto ' "$log" | tail -1 | awk '{ print $5 }')
     AUTO[$2]="$full $cond"
 }
 
@@ -62,7 +62,7 @@ if want 1; then
         label=$(basename "$s" .nml)
         "$MATRICES" "$s" > "$OUT/matrices_$label.txt" 2>&1
         sed -n '1,2p' "$OUT/matrices_$label.txt" | sed 's/^newton /  /'
-        grep -E '^newton +(full|condensed) ' "$OUT/matrices_$label.txt" | sed 's/^newton /  /'
+        grep -E '^newton +(full|condensed)[ :]' "$OUT/matrices_$label.txt" | sed 's/^newton /  /'
         auto_picks "$s" "$label"
         echo "  'auto' picks: full ${AUTO[$label]% *}, condensed ${AUTO[$label]#* }"
     done

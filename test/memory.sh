@@ -20,7 +20,7 @@ cd "$root" || exit 1
 # Suites by filter of the test driver (a substring of 'suite/test'): the
 # trailing slash selects exactly the suite of that name, fe_ the fe_* suites
 # (elements, bodies, statics, dynamics, meshes, det F, assembly).
-suites=(linalg/ radau5/ ddassl/ ida/ mexax/ fe/ fe_ mbs_system/ force_elements/ set_markers/)
+suites=(linalg/ radau5/ ddassl/ ida/ mexax/ fe/ fe_ mbs_system/ force_elements/ set_markers/ structured_saddle/)
 # A scene's end time is cut to t_start + this fraction of its span: two to
 # five steps with their Jacobian, decompositions and output. The fine
 # five-body mesh still takes about 90 s under valgrind, mostly its setup.

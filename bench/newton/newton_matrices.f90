@@ -69,8 +69,8 @@ program flexmbs_bench_newton
     if (.not. status%ok()) call fail(status%text())
     print '(a,a,a,i0,a,i0)', 'newton ', trim(path), ': n = ', problem%n, ', nnz(dF/dy) = ', &
         jac%csc%nnz
-    print '(a)', 'newton path      lu       order      nnz(A)   nnz(L+U) analyse[s] ' // &
-        'factor_r[s] factor_c[s] solve_r[s] solve_c[s]'
+    print '(a)', 'newton path      asked  used              order      nnz(A)   nnz(L+U) ' // &
+        'analyse[s] factor_r[s] factor_c[s] solve_r[s] solve_c[s]'
     do p = 1, size(paths)
         do l = 1, size(lus)
             call measure(trim(paths(p)), trim(lus(l)))
@@ -149,6 +149,9 @@ contains
             order = solver%order()
             nnz_a = solver%nonzeros()
             nnz_lu = solver%factor_nonzeros()
+            if (lu == 'auto') print '(a,i0,a,i0)', 'newton condensed: positions eliminated ', &
+                solver%eliminated(), ', the largest kinematic block with a dense LU ', &
+                solver%largest_block()
         type is (klu_solver_t)
             nnz_a = solver%nonzeros()
             nnz_lu = solver%factor_nonzeros()
@@ -156,7 +159,7 @@ contains
             nnz_a = solver%nonzeros()
             nnz_lu = solver%factor_nonzeros()
         end select
-        print '(a,a10,1x,a17,i8,2i12,5es11.3)', 'newton ', which, name, order, nnz_a, nnz_lu, &
-            t_analyse, t_real, t_complex, t_solve_r, t_solve_c
+        print '(a,a10,1x,a6,1x,a17,i8,2i12,5es11.3)', 'newton ', which, lu, name, order, &
+            nnz_a, nnz_lu, t_analyse, t_real, t_complex, t_solve_r, t_solve_c
     end subroutine measure
 end program flexmbs_bench_newton

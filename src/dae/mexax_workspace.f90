@@ -68,7 +68,7 @@ module flexmbs_dae_mexax_workspace
         !> the sparse path by the structure of M (newton_system = 'condensed'):
         !> constant mass blocks factored once, massless frames in a small system
         logical :: structured = .false.
-        type(structured_saddle_t) :: skkt
+        type(structured_saddle_t), allocatable :: skkt !! allocatable: see formulation_sparse
         real(wp), allocatable :: p(:), pp(:), pn(:), v(:), vp(:), f(:), pdot(:), gt(:)
         real(wp), allocatable :: rhs(:), acc(:), lam(:), x(:), d(:), tab(:, :)
         real(wp), allocatable :: shift(:) !! the projection's accumulated correction (v space)
@@ -166,6 +166,7 @@ contains
         call problem%constraint_jacobian_pattern(w%gpat, status)
         if (.not. pattern_ok(w%gpat, nc, nv, 'constraint_jacobian_pattern')) return
         if (w%structured) then
+            allocate (w%skkt)
             call w%skkt%init(w%mpat, w%gpat, status)
         else
             call w%kkt%init(w%mpat, w%gpat, status, w%klu_ordering)

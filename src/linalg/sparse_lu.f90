@@ -8,11 +8,8 @@
 !> KLU's symbolic analysis (AMD) for the predicted fill and takes MUMPS on
 !> large matrices that fill (the thresholds are the caller's, measured on
 !> its matrices). The real and the complex factorisation stay alive
-!> together. Every factorisation pivots afresh (KLU's `factor`, not its
-!> `refactor` with the old pivot order): on the condensed Newton matrices a
-!> reused order lost the digits that RADAU5's Newton iteration needs at
-!> rtol = 1e-13 (face_hinge, GGL: 'step size too small' at t = 0.026 with
-!> refactor, the full 0.05 s with fresh pivoting), for about 5 % more time.
+!> together; KLU refactors with its old pivot order while that stays good
+!> (flexmbs_linalg_klu).
 !>
 !> A copy made by assignment owns no KLU or MUMPS objects (see
 !> flexmbs_linalg_klu and flexmbs_linalg_mumps) and must be analysed again.
@@ -137,7 +134,7 @@ contains
         if (self%kind == sparse_lu_mumps) then
             call self%mumps%factor(values, status)
         else
-            call self%klu%factor(values, status)
+            call self%klu%refactor(values, status)
         end if
     end subroutine lu_factor_real
 
@@ -149,7 +146,7 @@ contains
         if (self%kind == sparse_lu_mumps) then
             call self%zmumps%factor(values, status)
         else
-            call self%klu%factor(values, status)
+            call self%klu%refactor(values, status)
         end if
     end subroutine lu_factor_complex
 

@@ -34,11 +34,16 @@ module flexmbs_mbs_condensed_structure
     private
 
     !> The largest component of J_qq eliminated by a dense LU of its own;
-    !> larger ones (GGL's joints on many nodes) stay in S. Quaternions are
-    !> blocks of 4; a node frame with the nodes of its set is tens to
-    !> hundreds: the dense block's cube and the fill it brings into S grow
-    !> faster than keeping its rows in the sparse LU costs.
-    integer, parameter, public :: max_eliminated_block = 16
+    !> larger ones stay in S. Quaternions are blocks of 4; GGL joins a node
+    !> frame, the nodes of its set and the bodies jointed to it: up to 48
+    !> positions in the five-body mechanism, 129 with its coupler at 5x20x5.
+    !> Kept in S, those rows with their dense coupling made KLU's factors of S 3.5x
+    !> larger there (2.5e6 against 7.1e5 entries) and its factorisation 10x
+    !> slower, and the coarse run slower than on the full matrix (1.26 s
+    !> against 0.95 s CPU); eliminated, the run costs what the full one does
+    !> and MUMPS is unchanged (flexmbs-bench-newton). A dense LU of order 512
+    !> costs about 0.1 GFlop, no more than factoring S of those meshes.
+    integer, parameter, public :: max_eliminated_block = 512
 
     !> Offsets of the formulation's blocks in y (flexmbs_mbs_formulation).
     type, public :: condensed_layout_t

@@ -52,8 +52,10 @@ module flexmbs_mbs_formulation_sparse
         type(saddle_point_t) :: kkt
         !> [M Gᵀ; G 0] by the structure of M instead (use_structure: with the
         !> condensed Newton systems), set up at its first factorisation
-        logical :: structured = .false., structure_ready = .false.
-        type(structured_saddle_t) :: skkt
+        logical :: structured = .false.
+        !> allocatable (gfortran 12's finalization wrapper frees a
+        !> non-allocatable derived-type component only in part)
+        type(structured_saddle_t), allocatable :: skkt
         ! block ids in jac
         integer :: id_tq = 0, id_t = 0, id_ggl_rq = 0, id_ggl_gt = 0
         integer :: id_va = 0, id_fq = 0, id_rq = 0, id_fv = 0, id_m = 0, id_gt = 0
@@ -466,10 +468,13 @@ contains
         call mech%constraint_jacobian_sparse(t, q, self%g, status)
         if (.not. status%ok()) return
         if (self%structured) then
-            if (.not. self%structure_ready) then
+            if (.not. allocated(self%skkt)) then
+                allocate (self%skkt)
                 call self%skkt%init(self%pat%mass, self%pat%constraint_v, status)
-                if (.not. status%ok()) return
-                self%structure_ready = .true.
+                if (.not. status%ok()) then
+                    deallocate (self%skkt)
+                    return
+                end if
             end if
             call self%skkt%assemble(self%m, self%g)
             call self%skkt%factor(status)
