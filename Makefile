@@ -294,6 +294,7 @@ bench: deps
 	$(FPM) build --profile release
 	bash bench/run.sh
 	bash bench/sparse.sh
+	bash bench/newton.sh
 	bash bench/assemblies.sh
 
 # The API documentation: FORD $(FORD_VERSION) from PyPI in its own virtual

@@ -125,7 +125,8 @@ if want 4; then
             variant "$f" inputs/five_body.nml radau5 auto \
                 "s/t_end   = 1.0/t_end = 0.02/; s/divisions = 2, 4, 2/divisions = $d/" "$path"
             r=$(run "$f")
-            per=$(ratio "${r%% *}" "$(echo $r | cut -d' ' -f2)")
+            per=$(awk -v c="${r%% *}" -v n="$(echo $r | cut -d' ' -f2)" \
+                'BEGIN { if (n > 0 && c > 0) printf "%.4f", c / n; else print "-" }')
             [ "$per" != "-" ] && echo "$nfe $per" >> "$OUT/refine_$path.txt"
             row="$row $per"
         done
@@ -179,9 +180,10 @@ if want 7; then
         perf record -q -o "$OUT/perf.data" "$BIN" run "$f" --quiet >/dev/null 2>&1
         perf report -q -i "$OUT/perf.data" --no-children --sort dso,symbol 2>/dev/null | awk '
             /%/ { p = $1; sub("%", "", p); line = $0
+                  name = line; sub(/^.*\[[.k]\] /, "", name); sub(/[ -]*$/, "", name)
                   if (line ~ /element_forces|neo_hooke|hexahedron|fe_tensor|element_contribution|flexible_body_MOD_assemble|nodal_gradient|deformation_gradient|stress_at|inverse3/) fe += p
                   else if (line ~ /klu|mumps|amd_|colamd|btf|gemm|trsm|gemv|libopenblas|libblas|liblapack|scotch|SCOTCH|pord|hypot|condensed_kernels/) lu += p
-                  else { other += p; if (p > 0.5) top = top sprintf("      %6.2f%% %s\n", p, $NF) } }
+                  else { other += p; if (p > 0.5) top = top sprintf("      %6.2f%% %s\n", p, name) } }
             END { printf "  element kernels %.1f %%, linear algebra (S, factor and solve) %.1f %%, the rest %.1f %% (goal: <= 10)\n", fe, lu, other
                   printf "    the rest, entries above 0.5 %%:\n%s", top }'
     else

@@ -30,6 +30,8 @@ module flexmbs_linalg_sparse_lu
     integer, parameter, public :: sparse_lu_klu = 1
     integer, parameter, public :: sparse_lu_mumps = 2
 
+    public :: sparse_lu_choice
+
     !> Real and complex LU factors of matrices with one pattern.
     type, public :: sparse_lu_t
         private
@@ -73,7 +75,6 @@ contains
         real(wp), intent(in), optional :: min_fill
         character(len=8) :: order
         integer :: klu_order
-        real(wp) :: lnz, unz
 
         call default_blas_threads()
         order = 'auto'
@@ -94,13 +95,9 @@ contains
         if (choice == sparse_lu_auto) then
             self%kind = sparse_lu_klu
             if (present(min_order) .and. present(min_fill)) then
-                if (n >= min_order) then
-                    call self%klu%analyse(n, colptr, rowind, status, klu_ordering_amd)
-                    if (.not. status%ok()) return
-                    call self%klu%predicted_fill(lnz, unz)
-                    self%fill = (lnz + unz) / real(max(self%nnz, 1_i8), wp)
-                    if (self%fill >= min_fill) self%kind = sparse_lu_mumps
-                end if
+                self%kind = sparse_lu_choice(n, colptr, rowind, min_order, min_fill, &
+                    self%fill, status)
+                if (.not. status%ok()) return
             end if
         end if
         select case (self%kind)
@@ -125,6 +122,29 @@ contains
             if (st%ok()) call lu%analyse(n, colptr, rowind, st)
         end subroutine analyse_mumps
     end subroutine lu_analyse
+
+    !> The rule of sparse_lu_auto: sparse_lu_mumps when n >= min_order and
+    !> KLU's symbolic analysis with AMD predicts fill (nnz(L) + nnz(U)) /
+    !> nnz(A) >= min_fill (returned; 0 when not analysed), else sparse_lu_klu.
+    !> Costs one AMD ordering, no factorisation.
+    integer function sparse_lu_choice(n, colptr, rowind, min_order, min_fill, fill, status) &
+        result(kind)
+        integer, intent(in) :: n, min_order
+        integer(i8), intent(in) :: colptr(:), rowind(:) !! 0-based CSC
+        real(wp), intent(in) :: min_fill
+        real(wp), intent(out) :: fill
+        type(status_t), intent(inout) :: status
+        type(klu_factor_t) :: probe
+        real(wp) :: lnz, unz
+        kind = sparse_lu_klu
+        fill = 0.0_wp
+        if (n < min_order) return
+        call probe%analyse(n, colptr, rowind, status, klu_ordering_amd)
+        if (.not. status%ok()) return
+        call probe%predicted_fill(lnz, unz)
+        fill = (lnz + unz) / real(max(colptr(n + 1), 1_i8), wp)
+        if (fill >= min_fill) kind = sparse_lu_mumps
+    end function sparse_lu_choice
 
     !> Factor real values (one per pattern slot).
     subroutine lu_factor_real(self, values, status)

@@ -19,9 +19,10 @@ module flexmbs_mbs_condensed_newton
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_linalg_matrix, only: matrix_t, storage_sparse
     use flexmbs_linalg_linear_solver, only: linear_solver_t, fill_nan
-    use flexmbs_linalg_sparse_lu, only: sparse_lu_t, sparse_lu_auto, sparse_lu_klu, &
-        sparse_lu_mumps
-    use flexmbs_mbs_condensed_structure, only: condensed_structure_t, condensed_layout_t
+    use flexmbs_linalg_sparse_lu, only: sparse_lu_t, sparse_lu_klu, sparse_lu_mumps, &
+        sparse_lu_choice
+    use flexmbs_mbs_condensed_structure, only: condensed_structure_t, condensed_layout_t, &
+        max_eliminated_block_klu, max_eliminated_block_mumps
     use flexmbs_mbs_condensed_kernels, only: factor_blocks, w_values, s_values, &
         condensed_solve
     implicit none
@@ -97,20 +98,58 @@ contains
         self%ordering = ordering
     end function new_condensed_solver
 
-    !> Structure, patterns and the analysis of S, once.
+    !> Structure, patterns and the analysis of S, once. The LU comes first,
+    !> decided on S with GGL's joint components kept: KLU then gets them
+    !> eliminated (max_eliminated_block_klu), MUMPS keeps them.
     subroutine condensed_init(self, mass, jac, status)
         class(condensed_solver_t), intent(inout) :: self
         type(matrix_t), intent(in) :: mass, jac
         type(status_t), intent(out) :: status
-        integer :: stat, choice, i, nr
+        integer :: kind
+        real(wp) :: fill
         if (mass%storage /= storage_sparse .or. jac%storage /= storage_sparse) then
             call status%set(status_bad_input, who // ': needs M and J in sparse storage')
             return
         end if
-        if (.not. allocated(self%st)) allocate (self%st, self%lu)
-        call self%st%build(self%lay, mass%csc, jac%csc, status)
+        if (allocated(self%st)) deallocate (self%st)
+        if (.not. allocated(self%lu)) allocate (self%lu)
+        allocate (self%st)
+        call self%st%build(self%lay, mass%csc, jac%csc, max_eliminated_block_mumps, status)
         if (.not. status%ok()) return
+        select case (trim(self%choice))
+        case ('klu')
+            kind = sparse_lu_klu
+        case ('mumps')
+            kind = sparse_lu_mumps
+        case ('auto')
+            kind = sparse_lu_choice(self%st%nk, self%st%s%colptr, self%st%s%rowind, &
+                condensed_auto_min_order, condensed_auto_min_fill, fill, status)
+            if (.not. status%ok()) return
+        case default
+            call status%set(status_bad_input, who // ": linear_solver = '" // &
+                trim(self%choice) // "': use 'auto', 'klu' or 'mumps'")
+            return
+        end select
+        if (kind == sparse_lu_klu) then
+            deallocate (self%st)
+            allocate (self%st)
+            call self%st%build(self%lay, mass%csc, jac%csc, max_eliminated_block_klu, status)
+            if (.not. status%ok()) return
+        end if
         self%n = self%lay%n
+        call allocate_values(self, jac, status)
+        if (.not. status%ok()) return
+        call self%lu%analyse(self%st%nk, self%st%s%colptr, self%st%s%rowind, kind, status, &
+            self%ordering)
+        self%refine = kind == sparse_lu_klu
+    end subroutine condensed_init
+
+    !> The value and work arrays for the structure in self%st.
+    subroutine allocate_values(self, jac, status)
+        type(condensed_solver_t), intent(inout) :: self
+        type(matrix_t), intent(in) :: jac
+        type(status_t), intent(inout) :: status
+        integer :: stat, i, nr
         associate (st => self%st)
             nr = max(st%comp_ptr(st%ncomp + 1) - 1, 1)
             allocate (self%lu_r(st%lu_size()), self%lu_z(st%lu_size()), self%piv_r(nr), &
@@ -131,23 +170,8 @@ contains
                     self%va_slot(i) = jac%csc%find(st%ov + i, st%oa + i)
                 end do
             end if
-            select case (trim(self%choice))
-            case ('klu')
-                choice = sparse_lu_klu
-            case ('mumps')
-                choice = sparse_lu_mumps
-            case ('auto')
-                choice = sparse_lu_auto
-            case default
-                call status%set(status_bad_input, who // ": linear_solver = '" // &
-                    trim(self%choice) // "': use 'auto', 'klu' or 'mumps'")
-                return
-            end select
-            call self%lu%analyse(st%nk, st%s%colptr, st%s%rowind, choice, status, &
-                self%ordering, condensed_auto_min_order, condensed_auto_min_fill)
-            self%refine = self%lu%name() == 'klu'
         end associate
-    end subroutine condensed_init
+    end subroutine allocate_values
 
     !> The blocks of J and M at this evaluation; false (status set) when the
     !> v rows do not read v' = a.

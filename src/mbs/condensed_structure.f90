@@ -12,9 +12,9 @@
 !> decomposes into the connected components of the pattern of J_qq (a
 !> coordinate without an entry is a component of its own with P = 1/c; a
 !> rigid body's quaternion is a block of 4; GGL's T ∂(Gᵀμ)/∂q joins the
-!> coordinates a nonlinear joint touches). Components larger than
-!> max_eliminated_block, or not of the kinematic form, stay among the kept
-!> unknowns K. With P = (c I − J_ee)⁻¹ per component,
+!> coordinates a nonlinear joint touches). Components larger than the
+!> caller's limit (max_eliminated_block_*), or not of the kinematic form,
+!> stay among the kept unknowns K. With P = (c I − J_ee)⁻¹ per component,
 !>
 !>     S = c M_KK − J_KK − c J_KA E_AV − J_KE P J_EK,
 !>
@@ -33,17 +33,21 @@ module flexmbs_mbs_condensed_structure
     implicit none
     private
 
-    !> The largest component of J_qq eliminated by a dense LU of its own;
-    !> larger ones stay in S. Quaternions are blocks of 4; GGL joins a node
-    !> frame, the nodes of its set and the bodies jointed to it: up to 48
-    !> positions in the five-body mechanism, 129 with its coupler at 5x20x5.
-    !> Kept in S, those rows with their dense coupling made KLU's factors of S 3.5x
-    !> larger there (2.5e6 against 7.1e5 entries) and its factorisation 10x
-    !> slower, and the coarse run slower than on the full matrix (1.26 s
-    !> against 0.95 s CPU); eliminated, the run costs what the full one does
-    !> and MUMPS is unchanged (flexmbs-bench-newton). A dense LU of order 512
-    !> costs about 0.1 GFlop, no more than factoring S of those meshes.
-    integer, parameter, public :: max_eliminated_block = 512
+    !> The largest component of J_qq eliminated by a dense LU of its own,
+    !> by the LU that factors S; larger components stay in S. Quaternions
+    !> are blocks of 4; GGL joins a node frame, the nodes of its set and the
+    !> bodies jointed to it: up to 48 positions in the five-body mechanism,
+    !> 129 with its coupler at 5x20x5, 264 at 8x32x8. Kept in S, those rows
+    !> with their dense coupling made KLU's factors of the 5x20x5 S 3.5x
+    !> larger (2.5e6 against 7.1e5 entries) and its factorisation 10x slower,
+    !> and the coarse run slower than on the full matrix (1.26 s against
+    !> 0.95 s CPU; eliminated: 0.96 s). MUMPS does better with them kept: at
+    !> 8x32x8 eliminating them cost 0.06 s more per factorisation in S's
+    !> values (the block's dense W against its neighbours' rows) and made a
+    !> 14-step RADAU5 run 9.6 s against 8.5 s (flexmbs-bench-newton, one
+    !> BLAS thread).
+    integer, parameter, public :: max_eliminated_block_klu = 512
+    integer, parameter, public :: max_eliminated_block_mumps = 16
 
     !> Offsets of the formulation's blocks in y (flexmbs_mbs_formulation).
     type, public :: condensed_layout_t
@@ -90,10 +94,11 @@ contains
     !> Index sets, blocks and patterns for the DAE mass `mass` and the
     !> Jacobian pattern `jac` (both CSC, order lay%n) of a formulation with
     !> layout `lay`. Refuses matrices that are not of the kinematic form.
-    subroutine structure_build(self, lay, mass, jac, status)
+    subroutine structure_build(self, lay, mass, jac, max_block, status)
         class(condensed_structure_t), intent(inout) :: self
         type(condensed_layout_t), intent(in) :: lay
         type(csc_matrix_t), intent(in) :: mass, jac
+        integer, intent(in) :: max_block !! the largest component eliminated
         type(status_t), intent(inout) :: status
         integer, allocatable :: comp(:), rowpos(:), colpos(:), epos(:), apos(:)
         logical, allocatable :: eliminable(:)
@@ -120,7 +125,7 @@ contains
             if (.not. status%ok()) return
         end if
         call position_components(lay, jac, comp)
-        call choose_eliminated(lay, mass, jac, comp, eliminable)
+        call choose_eliminated(lay, mass, jac, comp, max_block, eliminable)
         call index_sets(self, lay, eliminable, rowpos, colpos, epos, apos, status)
         if (.not. status%ok()) return
         call self%jee%pick(jac, epos, epos, self%ne, self%ne, status)
@@ -206,13 +211,13 @@ contains
         end function root
     end subroutine position_components
 
-    !> A component is eliminated when it is at most max_eliminated_block
-    !> large, its q rows hold no acceleration column of J, and the DAE mass
-    !> is the identity in its rows and columns.
-    subroutine choose_eliminated(lay, mass, jac, comp, eliminable)
+    !> A component is eliminated when it is at most max_block large, its q
+    !> rows hold no acceleration column of J, and the DAE mass is the
+    !> identity in its rows and columns.
+    subroutine choose_eliminated(lay, mass, jac, comp, max_block, eliminable)
         type(condensed_layout_t), intent(in) :: lay
         type(csc_matrix_t), intent(in) :: mass, jac
-        integer, intent(in) :: comp(:)
+        integer, intent(in) :: comp(:), max_block
         logical, intent(out) :: eliminable(:)
         integer, allocatable :: size_of(:)
         logical, allocatable :: fits(:)
@@ -243,7 +248,7 @@ contains
             end do
         end do
         do i = 1, lay%nq
-            eliminable(i) = fits(comp(i)) .and. size_of(comp(i)) <= max_eliminated_block
+            eliminable(i) = fits(comp(i)) .and. size_of(comp(i)) <= max_block
         end do
     contains
         logical function in_q(k)
