@@ -22,7 +22,8 @@
 #      the paper's 2.9-5 x;
 #   6. a mechanism with 16 335 FE coordinates (bench/scenes/
 #      five_body_coupler_10x44x10.nml), RADAU5 over 0.01 s, condensed;
-#   7. where the fine five-body run's time goes now (perf, when installed).
+#   7. where the fine five-body run's time goes now (perf, when installed;
+#      the scene's 1 s, the whole process).
 # BENCH_NEWTON_SECTIONS="1 4" runs those sections only.
 set -u
 cd "$(dirname "$0")/.."
@@ -135,6 +136,26 @@ if want 4; then
     done
     echo "  fitted exponents of CPU/step against n_FE: full $(slope < "$OUT/refine_full.txt")," \
          "condensed $(slope < "$OUT/refine_condensed.txt")"
+    # the per-step cost without the set-up both paths pay once (patterns,
+    # analyses): the difference of a 0.08 s and a 0.02 s run at 8x32x8
+    row=""
+    for path in full condensed; do
+        cpu=""; nst=""
+        for te in 0.02 0.08; do
+            f="$OUT/marginal_${path}_$te.nml"
+            variant "$f" inputs/five_body.nml radau5 auto \
+                "s/t_end   = 1.0/t_end = $te/; s/divisions = 2, 4, 2/divisions = 8, 32, 8/" "$path"
+            r=$(run "$f")
+            cpu="$cpu ${r%% *}"; nst="$nst $(echo $r | cut -d' ' -f2)"
+        done
+        set -- $cpu $nst
+        per=$(awk -v c1="$1" -v c2="$2" -v n1="$3" -v n2="$4" \
+            'BEGIN { if (n2 > n1) printf "%.4f", (c2 - c1) / (n2 - n1); else print "-" }')
+        echo "  8x32x8 $path: 0.02 s in $3 steps, 0.08 s in $4 steps: $per s per further step"
+        row="$row $per"
+    done
+    set -- $row
+    echo "  per further step at 8x32x8: full / condensed = $(ratio "$1" "$2")"
 fi
 
 if want 5; then
@@ -173,16 +194,17 @@ fi
 
 if want 7; then
     echo
-    echo "== 7. where the fine five-body run goes (RADAU5 + GGL, TOL 1e-6, 0.05 s, condensed)"
+    echo "== 7. where the fine five-body run goes (RADAU5 + GGL, TOL 1e-6, its 1 s, condensed;"
+    echo "     the whole process, set-up and outputs included)"
     if command -v perf >/dev/null 2>&1; then
         f="$OUT/fine_profile.nml"
-        variant "$f" inputs/five_body_fine.nml radau5 auto "s/t_end   = 1.0/t_end = 0.05/"
+        variant "$f" inputs/five_body_fine.nml radau5 auto ""
         perf record -q -o "$OUT/perf.data" "$BIN" run "$f" --quiet >/dev/null 2>&1
         perf report -q -i "$OUT/perf.data" --no-children --sort dso,symbol 2>/dev/null | awk '
             /%/ { p = $1; sub("%", "", p); line = $0
                   name = line; sub(/^.*\[[.k]\] /, "", name); sub(/[ -]*$/, "", name)
                   if (line ~ /element_forces|neo_hooke|hexahedron|fe_tensor|element_contribution|flexible_body_MOD_assemble|nodal_gradient|deformation_gradient|stress_at|inverse3/) fe += p
-                  else if (line ~ /klu|mumps|amd_|colamd|btf|gemm|trsm|gemv|libopenblas|libblas|liblapack|scotch|SCOTCH|pord|hypot|condensed_kernels/) lu += p
+                  else if (line ~ /klu|mumps|amd_|colamd|btf|gemm|trsm|gemv|libopenblas|libblas|liblapack|scotch|SCOTCH|pord|hypot|condensed_kernels|sub_block|saddle|sparse_lu/) lu += p
                   else { other += p; if (p > 0.5) top = top sprintf("      %6.2f%% %s\n", p, name) } }
             END { printf "  element kernels %.1f %%, linear algebra (S, factor and solve) %.1f %%, the rest %.1f %% (goal: <= 10)\n", fe, lu, other
                   printf "    the rest, entries above 0.5 %%:\n%s", top }'

@@ -45,7 +45,7 @@ module flexmbs_dae_ida_callbacks
         type(matrix_t) :: mass
         type(csc_matrix_t) :: jac               !! the problem's ∂F/∂y pattern and values
         type(csc_matrix_t) :: mass_csc          !! M as CSC (sparse mode)
-        !> jac_own: our solver of c_j M − ∂F/∂y, ∂F/∂y for it, and the c_j
+        !> With jac_own, our solver of c_j M − ∂F/∂y, ∂F/∂y for it, and the c_j
         !> of the last Jacobian call (the one its setup factors with)
         class(linear_solver_t), allocatable :: ls
         type(matrix_t) :: jac_matrix
@@ -108,7 +108,7 @@ contains
         end do
     end function ida_residual
 
-    !> IDALsJacFn: J = c_j M − ∂F/∂y into the dense or CSC SUNMatrix.
+    !> As IDALsJacFn, J = c_j M − ∂F/∂y into the dense or CSC SUNMatrix.
     integer(c_int) function ida_jacobian(t, cj, nv_y, nv_yp, nv_r, a_mat, user_data, &
                                          tmp1, tmp2, tmp3) result(ierr) &
         bind(C, name='flexmbs_ida_jacobian')
@@ -248,7 +248,7 @@ contains
         ierr = 0
     end function ida_weights
 
-    !> IDAErrHandlerFn: keep IDA's message for the status instead of printing it.
+    !> As IDAErrHandlerFn, keep IDA's message for the status instead of printing it.
     subroutine ida_error_handler(error_code, module, function, msg, eh_data) &
         bind(C, name='flexmbs_ida_error_handler')
         integer(c_int), value, intent(in) :: error_code

@@ -53,7 +53,7 @@ module flexmbs_dae_mexax
     ! Defined with the state; part of this module's interface.
     public :: mexax_dense_t, mexax_failed_none, mexax_failed_step, mexax_failed_projection
 
-    !> MEXAX: the settings and the results of the last integration are
+    !> The MEXAX solver: the settings and the results of the last integration are
     !> those of `mexax_engine_t`, which the phases read and write.
     type, extends(mexax_engine_t), public :: mexax_t
     contains

@@ -86,9 +86,9 @@ contains
         character(len=*), intent(in) :: linear_solver
         type(status_t), intent(out) :: status
         character(len=*), intent(in), optional :: ordering !! 'auto' | 'amd' | 'nd'
-        !> dense: the classic elimination order (options%classic_lu)
+        !> dense LU: the classic elimination order (options%classic_lu)
         logical, intent(in), optional :: classic_lu
-        !> sparse: [M Gᵀ; G 0] by the structure of M (structured_saddle_t)
+        !> sparse LU: [M Gᵀ; G 0] by the structure of M (structured_saddle_t)
         !> instead of KLU on the whole matrix
         logical, intent(in), optional :: structured
         integer :: nq, nv, nc, stat

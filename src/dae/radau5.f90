@@ -35,7 +35,7 @@ module flexmbs_dae_radau5
     public :: radau5_dense_t, radau5_native_t
     public :: radau5_controller_predictive, radau5_controller_classical
 
-    !> RADAU5: the settings (a value of 0 selects the default, as in
+    !> The RADAU5 solver: the settings (a value of 0 selects the default, as in
     !> WORK/IWORK) and the results of the last integration are those of
     !> `radau5_engine_t`, which the phases read and write.
     type, extends(radau5_engine_t), public :: radau5_t

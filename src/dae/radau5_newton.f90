@@ -24,7 +24,7 @@ module flexmbs_dae_radau5_newton
 
 contains
 
-    !> R1: a new J at (x, y); a failure ends the integration (`done`).
+    !> Block R1, a new J at (x, y); a failure ends the integration (`done`).
     subroutine jacobian_block(self, w, problem, y, stats, status)
         class(radau5_engine_t), intent(inout) :: self
         type(radau5_work_t), intent(inout) :: w
@@ -83,7 +83,7 @@ contains
         end select
     end subroutine compute_jacobian
 
-    !> R2: E1 = (γ/h) M − J and E2 = ((α + iβ)/h) M − J factored; a singular
+    !> Block R2, E1 = (γ/h) M − J and E2 = ((α + iβ)/h) M − J factored; a singular
     !> one halves h (R8) up to max_singular times in a row.
     subroutine factor_block(self, w, stats, status)
         class(radau5_engine_t), intent(inout) :: self

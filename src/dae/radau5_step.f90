@@ -26,7 +26,7 @@ module flexmbs_dae_radau5_step
 
 contains
 
-    !> R3: one attempt with the current h and factorisations; it ends
+    !> Block R3, one attempt with the current h and factorisations; it ends
     !> accepted (R4–R6), rejected (R7) or failed (R8), with the next block
     !> set, or it ends the integration (`done`, status set unless at t_end).
     subroutine attempt_block(self, w, problem, y, options, stats, status, sink)
@@ -164,7 +164,7 @@ contains
         if (ieee_is_finite(w%err)) w%err = max(w%err, err_floor)
     end subroutine weighted_error
 
-    !> R4: accept the step (projection and admissibility may still take it
+    !> Block R4, accept the step (projection and admissibility may still take it
     !> back), the dense output, the outputs; then R5/R6, or the end at t_end.
     subroutine accept_step(self, w, problem, y, options, stats, status, sink)
         class(radau5_engine_t), intent(inout) :: self
@@ -252,7 +252,7 @@ contains
         call next_step(self, w)
     end subroutine accept_step
 
-    !> R5: the next h (the last step ends at t_end); h and the LU kept when
+    !> Block R5, the next h (the last step ends at t_end); h and the LU kept when
     !> h_new/h lies in [quot1, quot2] and J converged well. R6: refactor,
     !> with a new J unless θ ≤ thet.
     subroutine next_step(self, w)
@@ -285,7 +285,7 @@ contains
         end if
     end subroutine next_step
 
-    !> R7: the error test failed; h/10 before any acceptance, else h_new.
+    !> Block R7, the error test failed; h/10 before any acceptance, else h_new.
     subroutine reject_step(self, w, stats)
         class(radau5_engine_t), intent(inout) :: self
         type(radau5_work_t), intent(inout) :: w

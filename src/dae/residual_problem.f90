@@ -105,7 +105,7 @@ contains
         call self%problem%iteration_solver(options, solver, status)
     end subroutine wrapper_iteration_solver
 
-    !> Default: every component of index 1.
+    !> By default every component of index 1.
     subroutine residual_index_classes(self, classes)
         class(residual_problem_t), intent(in) :: self
         integer, intent(out) :: classes(:)
@@ -130,14 +130,14 @@ contains
         call status%set(status_bad_input, 'residual problem: no iteration matrix')
     end subroutine residual_iteration_matrix
 
-    !> Default: every component differential.
+    !> By default every component differential.
     subroutine residual_differential_flags(self, flags)
         class(residual_problem_t), intent(in) :: self
         logical, intent(out) :: flags(:)
         flags = .true.
     end subroutine residual_differential_flags
 
-    !> Default: no multipliers (see dae_problem_t%multiplier_flags).
+    !> By default no multipliers (see dae_problem_t%multiplier_flags).
     subroutine residual_multiplier_flags(self, flags)
         class(residual_problem_t), intent(in) :: self
         logical, intent(out) :: flags(:)

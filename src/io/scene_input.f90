@@ -131,7 +131,7 @@ module flexmbs_io_scene_input
         real(wp) :: inertia_products(3)
         real(wp) :: coordinate !! initial q [rad or m]
         real(wp) :: rate !! initial q' [rad/s or m/s]
-        !> spherical: initial relative rotation and angular velocity (own frame)
+        !> For spherical, initial relative rotation and angular velocity (own frame)
         real(wp) :: rotation_axis(3)
         real(wp) :: rotation_angle
         real(wp) :: angular_rate(3)

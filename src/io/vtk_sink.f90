@@ -172,7 +172,7 @@ contains
         call write_collection(self, status)
     end subroutine vtk_output
 
-    !> 0042: four digits at least.
+    !> As 0042, four digits at least.
     pure function digits(k) result(s)
         integer, intent(in) :: k
         character(len=:), allocatable :: s

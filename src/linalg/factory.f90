@@ -41,7 +41,7 @@ contains
         integer, intent(in), optional :: lower      !! lower bandwidth for 'band'
         integer, intent(in), optional :: upper      !! upper bandwidth for 'band'
         character(len=*), intent(in), optional :: ordering !! KLU: 'auto' | 'amd' | 'nd'
-        !> dense: the classic elimination order, not LAPACK's (dense_solver_t)
+        !> dense LU: the classic elimination order, not LAPACK's (dense_solver_t)
         logical, intent(in), optional :: classic_order
         !> M (default: identity) and J with their patterns, for 'auto'
         type(matrix_t), intent(in), optional :: mass, jac

@@ -675,7 +675,7 @@ contains
         gtlq(2, 2) = lambda(1)
     end subroutine mechanical_constraint_jacobian_derivatives
 
-    !> Scleronomic: g_I = 0.
+    !> Scleronomic, g_I = 0.
     subroutine mechanical_zero_time_jacobian(self, t, q, dq, status)
         class(pendulum_mechanical_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:)

@@ -60,7 +60,7 @@ module flexmbs_run_study_record
         record_damaged = 3
 
     character(len=*), parameter :: heading = '# flexmbs sweep record'
-    !> 2: with NRJ by cause (a format-1 record is damaged: the point runs again)
+    !> Format 2, with NRJ by cause (a format-1 record is damaged: the point runs again)
     character(len=*), parameter :: record_format = '2'
     character, parameter :: nl = new_line('a')
 

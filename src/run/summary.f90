@@ -71,7 +71,7 @@ contains
 
     contains
 
-        !> names: those of the chain's links, in order
+        !> The names, those of the chain's links, in order
         function chain_lines(chain, q, names) result(lines)
             type(rigid_chain_t), intent(in) :: chain
             real(wp), intent(in) :: q(:)

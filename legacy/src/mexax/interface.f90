@@ -74,7 +74,7 @@ module flexmbs_legacy_mexax_interface
             external :: denout, fswit
         end subroutine mexax
 
-        !> MEXX: the same routine under the original's name.
+        !> As MEXX, the same routine under the original's name.
         subroutine mexx(np, nv, nl, ng, nu, fprob, t, tfin, p, v, u, a, rlam, itol, rtol, &
             atol, h, mxjob, ierr, liwk, iwk, lrwk, rwk, solout, denout, fswit)
             import :: wp, mexax_fprob_i, mexax_solout_i
