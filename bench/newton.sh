@@ -199,15 +199,35 @@ if want 7; then
     if command -v perf >/dev/null 2>&1; then
         f="$OUT/fine_profile.nml"
         variant "$f" inputs/five_body_fine.nml radau5 auto ""
-        perf record -q -o "$OUT/perf.data" "$BIN" run "$f" --quiet >/dev/null 2>&1
-        perf report -q -i "$OUT/perf.data" --no-children --sort dso,symbol 2>/dev/null | awk '
-            /%/ { p = $1; sub("%", "", p); line = $0
-                  name = line; sub(/^.*\[[.k]\] /, "", name); sub(/[ -]*$/, "", name)
-                  if (line ~ /element_forces|neo_hooke|hexahedron|fe_tensor|element_contribution|flexible_body_MOD_assemble|nodal_gradient|deformation_gradient|stress_at|inverse3/) fe += p
-                  else if (line ~ /klu|mumps|amd_|colamd|btf|gemm|trsm|gemv|libopenblas|libblas|liblapack|scotch|SCOTCH|pord|hypot|condensed_kernels|sub_block|saddle|sparse_lu/) lu += p
-                  else { other += p; if (p > 0.5) top = top sprintf("      %6.2f%% %s\n", p, name) } }
-            END { printf "  element kernels %.1f %%, linear algebra (S, factor and solve) %.1f %%, the rest %.1f %% (goal: <= 10)\n", fe, lu, other
-                  printf "    the rest, entries above 0.5 %%:\n%s", top }'
+        # each sample goes by its call stack: a memset or memcpy inside MUMPS
+        # is linear algebra, the same call in the Jacobian's assembly is not
+        perf record -q --call-graph dwarf,16384 -F 200 -o "$OUT/perf.data" \
+            "$BIN" run "$f" --quiet >/dev/null 2>&1
+        perf script -i "$OUT/perf.data" 2>/dev/null | awk -v rest="$OUT/profile_rest.txt" '
+            BEGIN { RS = ""; FS = "\n"
+                    la = "klu|mumps|amd_|colamd|btf|gemm|trsm|gemv|scotch|SCOTCH|pord|condensed_kernels|sub_block|saddle|sparse_lu|factor_kkt|solve_kkt|liblapack|libopenblas|libblas"
+                    fe = "element_forces|neo_hooke|hexahedron|fe_tensor|element_contribution|flexible_body_MOD_assemble|nodal_gradient|deformation_gradient|stress_at|inverse3"
+                    outer = "runner|plan_integrate|default_integrate|radau5_integrate|MAIN|run_scene|attempt_block|multi_output|sink_output|newton_iteration" }
+            { n++; kind = ""
+              for (i = 2; i <= NF; i++) if ($i ~ la) { kind = "la"; break }
+              if (kind == "") for (i = 2; i <= NF; i++) if ($i ~ fe) { kind = "fe"; break }
+              if (kind != "") { count[kind]++; next }
+              count["rest"]++; path = ""; depth = 0
+              # the two outermost of our own procedures below the driver loop
+              for (i = NF; i >= 2; i--) {
+                  name = $i; sub(/^[ \t]*[0-9a-f]+ /, "", name); sub(/\+0x.*/, "", name)
+                  sub(/ \(.*/, "", name)
+                  if (name ~ /flexmbs_/ && name !~ outer) {
+                      sub(/^__flexmbs_/, "", name); path = path " > " name
+                      if (++depth == 2) break } }
+              where[path == "" ? " (outside our code)" : path]++ }
+            END { if (n == 0) { print "  perf recorded no samples"; exit }
+                  printf "  %d samples: element kernels %.1f %%, linear algebra (S, factor and solve) %.1f %%, the rest %.1f %% (goal: <= 10)\n", n, 100 * count["fe"] / n, 100 * count["la"] / n, 100 * count["rest"] / n
+                  print "    the rest by where it is spent, above 0.3 %:"
+                  printf "" > rest
+                  for (w in where) if (where[w] / n > 0.003)
+                      printf "      %6.2f%%%s\n", 100 * where[w] / n, w > rest }'
+        sort -rn "$OUT/profile_rest.txt"
     else
         echo "  skipped: perf is not installed"
     fi

@@ -12,7 +12,9 @@
 # `scene/five_body`); none = all. --origins adds --track-origins=yes (where
 # an uninitialised value came from; about twice slower). Each item's
 # valgrind log is kept in build/memory/. One line per item, pass or FAIL,
-# then `N passed, M failed` last; the exit status is non-zero on failures.
+# in the order the items finish, then `N passed, M failed` last; the exit
+# status is non-zero on failures. MEMORY_JOBS items run at a time (default
+# 2, one a core here: valgrind runs a program on one thread).
 set -u
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root" || exit 1
@@ -20,7 +22,9 @@ cd "$root" || exit 1
 # Suites by filter of the test driver (a substring of 'suite/test'): the
 # trailing slash selects exactly the suite of that name, fe_ the fe_* suites
 # (elements, bodies, statics, dynamics, meshes, det F, assembly).
-suites=(linalg/ radau5/ ddassl/ ida/ mexax/ fe/ fe_ mbs_system/ force_elements/ set_markers/ structured_saddle/)
+# Longest first (under valgrind: mexax 6.5 min, fe_ 3, force_elements 2,
+# set_markers 1.4), so that the workers end about together.
+suites=(mexax/ fe_ force_elements/ set_markers/ ida/ radau5/ mbs_system/ ddassl/ structured_saddle/ fe/ linalg/)
 # A scene's end time is cut to t_start + this fraction of its span: two to
 # five steps with their Jacobian, decompositions and output. The fine
 # five-body mesh still takes about 90 s under valgrind, mostly its setup.
@@ -84,10 +88,26 @@ vg=(valgrind --tool=memcheck --error-exitcode=$vg_code --leak-check=full
     --show-leak-kinds=definite --errors-for-leak-kinds=definite
     --suppressions="$root/test/valgrind.supp" --num-callers=40 $origins)
 
-passed=0
-failed=0
-pass() { passed=$((passed + 1)); echo "pass $1 ($2 s)"; }
-fail() { failed=$((failed + 1)); echo "FAIL $1 ($2 s): $3"; }
+# Each item writes its line to stdout and to a file of its own in $results;
+# the tally reads the files once every item has ended.
+results=$work/results
+mkdir -p "$results"
+jobs_max=${MEMORY_JOBS:-2}
+items=0
+pass() { echo "pass $1 ($2 s)"; }
+fail() { echo "FAIL $1 ($2 s): $3"; }
+
+# launch NAME FUNCTION ARGS...: run the item in the background, at most
+# jobs_max at a time, its line into its result file and to stdout
+launch() {
+    local name=$1
+    shift
+    while [ "$(jobs -rp | wc -l)" -ge "$jobs_max" ]; do
+        wait -n
+    done
+    items=$((items + 1))
+    ( "$@" | tee "$results/$(printf '%03d' "$items")" ) &
+}
 
 wanted() {
     [ ${#selected[@]} -eq 0 ] && return 0
@@ -128,18 +148,17 @@ check() {
     return 1
 }
 
-for filter in "${suites[@]}"; do
-    name=suite/$filter
-    wanted "$name" || continue
+# suite FILTER: one test suite of the debug build under valgrind
+suite() {
+    local filter=$1 name=suite/$1 out line
     out=$logs/${name//\//_}.out
-    if check "$name" "$out" "$tests" "$filter"; then
-        # a filter that selects nothing would pass silently
-        if ! grep -qE '^[1-9][0-9]* passed, 0 failed$' "$out"; then
-            passed=$((passed - 1))
-            fail "$name" 0 "no test ran: $(tail -n 1 "$out")"
-        fi
+    line=$(check "$name" "$out" "$tests" "$filter")
+    # a filter that selects nothing would pass silently
+    if [ "${line%% *}" = pass ] && ! grep -qE '^[1-9][0-9]* passed, 0 failed$' "$out"; then
+        line=$(fail "$name" 0 "no test ran: $(tail -n 1 "$out")")
     fi
-done
+    echo "$line"
+}
 
 # cut SCENE COPY: the scene with its end time cut, three output times, its
 # trajectory in the work folder, and for multibody and flexible-body scenes
@@ -187,19 +206,44 @@ cut() {
         }' "$scene" >"$copy"
 }
 
-for scene in "$root"/inputs/*.nml; do
+# scene SCENE: flexmbs run on the cut copy of SCENE under valgrind
+scene() {
+    local scene=$1 base copy
     base=$(basename "$scene" .nml)
-    name=scene/$base
-    wanted "$name" || continue
-    # studies (inputs/paper/) are not scenes; a study here would be refused
-    grep -qiE '^[[:space:]]*&study' "$scene" && continue
     copy=$work/$base.nml
     if ! cut "$scene" "$copy"; then
-        fail "$name" 0 "no t_end to cut in $scene"
-        continue
+        fail "scene/$base" 0 "no t_end to cut in $scene"
+        return
     fi
-    check "$name" "$logs/$base.out" "$exe" run "$copy" --quiet
-done
+    check "scene/$base" "$logs/$base.out" "$exe" run "$copy" --quiet
+}
 
+# the fine five-body scenes (over 2 minutes each) right after the two
+# longest suites, the other scenes (seconds) last
+for filter in "${suites[@]:0:2}"; do
+    wanted "suite/$filter" && launch "suite/$filter" suite "$filter"
+done
+for scene in "$root"/inputs/*fine*.nml; do
+    wanted "scene/$(basename "$scene" .nml)" && launch "scene" scene "$scene"
+done
+for filter in "${suites[@]:2}"; do
+    wanted "suite/$filter" && launch "suite/$filter" suite "$filter"
+done
+for scene in "$root"/inputs/*.nml; do
+    [[ $scene == *fine* ]] && continue
+    base=$(basename "$scene" .nml)
+    wanted "scene/$base" || continue
+    # studies (inputs/paper/) are not scenes; a study here would be refused
+    grep -qiE '^[[:space:]]*&study' "$scene" && continue
+    launch "scene/$base" scene "$scene"
+done
+wait
+
+passed=$(cat "$results"/* 2>/dev/null | grep -c '^pass ')
+failed=$(cat "$results"/* 2>/dev/null | grep -c '^FAIL ')
+if [ $((passed + failed)) -ne "$items" ]; then
+    echo "FAIL memory: $items items launched, $((passed + failed)) reported"
+    failed=$((failed + items - passed - failed))
+fi
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]
