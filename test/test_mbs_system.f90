@@ -2,9 +2,10 @@
 !> constraint derivatives of the whole system, formulation Jacobians against
 !> differences, a spherical (heavy) pendulum's invariants, a rigid planar
 !> pendulum against the point-mass pendulum of the equivalent length, a double
-!> pendulum's energy, and the reaction of a body hanging at rest.
+!> pendulum's energy, the reaction of a body hanging at rest, and the
+!> reactions on the ground against those on the body.
 module test_mbs_system
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
@@ -16,6 +17,8 @@ module test_mbs_system
     use flexmbs_mbs_joint, only: joint_spherical, joint_revolute, joint_cylindrical, &
         joint_prismatic, joint_universal, joint_fixed
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t
+    use flexmbs_mbs_joint, only: joint_primitive
+    use flexmbs_mbs_primitive_kinds, only: primitive_distance, primitive_dot1
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &
         formulation_index2, formulation_ggl
     use test_formulation, only: difference_jacobian
@@ -37,6 +40,7 @@ contains
                  new_test('formulation_jacobians', test_formulation_jacobians), &
                  new_test('bad_input', test_bad_input), &
                  new_test('hanging_reaction', test_hanging_reaction), &
+                 new_test('ground_reactions_balance', test_ground_reactions), &
                  new_test('spherical_pendulum_invariants', test_spherical_pendulum), &
                  new_test('planar_pendulum_matches_point_mass', test_planar_pendulum), &
                  new_test('double_pendulum_energy', test_double_pendulum), &
@@ -299,7 +303,8 @@ contains
 
     !> Hanging at rest: λ from the consistent initial values; the joint holds
     !> the body up with m g (our sign: the force on the body is −C_bᵀλ), no
-    !> torque about the pivot; for either order of the markers.
+    !> torque about the pivot; the ground carries m g downwards, no torque
+    !> either; for either order of the markers.
     subroutine test_hanging_reaction(error)
         type(error_t), allocatable, intent(out) :: error
         type(mbs_system_t), target :: sys
@@ -321,14 +326,95 @@ contains
             if (allocated(error)) return
             call sys%joint_reaction(1, 0.0_wp, y(1:7), y(gen%ol + 1:gen%ol + 3), force, torque)
             side = merge(2, 1, order == 1)
-            write (msg, '(a,i0,a,3es11.3,a,es10.3)') 'order ', order, ': force on body ', &
-                force(:, side), ', |torque| ', norm2(torque(:, side))
+            write (msg, '(a,i0,a,3es11.3,a,es10.3,a,3es11.3,a,es10.3)') 'order ', order, &
+                ': force on body ', force(:, side), ', |torque| ', norm2(torque(:, side)), &
+                '; on the ground ', force(:, 3 - side), ', |torque| ', norm2(torque(:, 3 - side))
             print '(a)', '    ' // trim(msg)
             call check(error, maxval(abs(force(:, side) - expected)) <= 1.0e-12_wp * &
                        mass * g_earth .and. norm2(torque(:, side)) <= 1.0e-12_wp .and. &
-                       all(force(:, 3 - side) == 0.0_wp), trim(msg))
+                       maxval(abs(force(:, 3 - side) + expected)) <= 1.0e-12_wp * &
+                       mass * g_earth .and. norm2(torque(:, 3 - side)) <= 1.0e-12_wp, trim(msg))
         end do
     end subroutine test_hanging_reaction
+
+    !> Every joint kind and two primitives between the ground and a body,
+    !> the ground's marker first and second, at random orientations and
+    !> multipliers: the joint's rows depend only on the relative pose of its
+    !> markers, so what it exerts on the two sides balances, F_i + F_j = 0
+    !> and n_i + n_j + (x_j − x_i) × F_j = 0 about marker i (scalar rows
+    !> anywhere; the spherical part's vector rows where it is closed). The
+    !> ground's side must carry its share, not zeros.
+    subroutine test_ground_reactions(error)
+        type(error_t), allocatable, intent(out) :: error
+        integer, parameter :: kinds(8) = [joint_spherical, joint_revolute, joint_cylindrical, &
+            joint_prismatic, joint_universal, joint_fixed, joint_primitive, joint_primitive]
+        integer, parameter :: primitives(8) = [0, 0, 0, 0, 0, 0, primitive_distance, &
+            primitive_dot1]
+        type(mbs_system_t) :: sys
+        type(status_t) :: status
+        type(random_state_t) :: rng
+        type(marker_t) :: m(2)
+        type(mbs_joint_t) :: joint
+        real(wp) :: q(7), force(3, 2), torque(3, 2), lambda(6), xi(3), xj(3), axes(3, 3)
+        real(wp) :: worst, scale, d
+        integer :: k, ground_side, trial, body_side
+        character(len=200) :: msg
+        rng%s = 71_i8
+        worst = 0.0_wp
+        do k = 1, size(kinds)
+            do ground_side = 1, 2
+                body_side = 3 - ground_side
+                m(ground_side) = random_marker(rng, 0)
+                m(body_side) = random_marker(rng, 1)
+                joint = mbs_joint_t(kinds(k), 1, 2)
+                if (kinds(k) == joint_primitive) then
+                    joint%primitive = primitives(k)
+                    joint%axis_i = 3
+                    joint%axis_j = 1
+                end if
+                sys = new_mbs_system([test_body(1.5_wp, 0.05_wp)], m, [joint], &
+                                     gravity=[0.0_wp, 0.0_wp, -g_earth], status=status)
+                call check(error, status%ok(), 'joint kind ' // trim(itoa(k)) // ': ' // &
+                           status%text())
+                if (allocated(error)) return
+                do trial = 1, 3
+                    q(1:3) = random_vector(rng, 3, -0.5_wp, 0.5_wp)
+                    q(4:7) = random_quaternion(rng)
+                    ! a spherical part's rows are a vector, x_j − x_i: its
+                    ! moments balance where it is closed, so the body is put
+                    ! where its marker meets the ground's
+                    if (any(kinds(k) == [joint_spherical, joint_revolute, joint_universal, &
+                                         joint_fixed])) q(1:3) = m(ground_side)%position &
+                        - matmul(rotation_matrix(q(4:7)), m(body_side)%position)
+                    lambda = random_vector(rng, 6, -2.0_wp, 2.0_wp)
+                    call sys%joint_reaction(1, 0.1_wp, q, lambda(1:sys%nc), force, torque)
+                    call sys%marker_pose(1, q, xi, axes)
+                    call sys%marker_pose(2, q, xj, axes)
+                    scale = max(norm2(force(:, body_side)), norm2(torque(:, body_side)))
+                    d = max(maxval(abs(force(:, 1) + force(:, 2))), &
+                            maxval(abs(torque(:, 1) + torque(:, 2) + cross(xj - xi, force(:, 2)))))
+                    write (msg, '(a,i0,a,i0,a,es10.3,a,es10.3,a,2es10.3)') 'joint kind ', k, &
+                        ', ground side ', ground_side, ': imbalance ', d, ' of ', scale, &
+                        ', |F|, |n| on the ground ', norm2(force(:, ground_side)), &
+                        norm2(torque(:, ground_side))
+                    ! a ground side that took nothing would balance only a body
+                    ! side that takes nothing: both sides must carry the load
+                    call check(error, scale > 1.0e-3_wp .and. d <= 1.0e-12_wp * scale .and. &
+                               norm2(force(:, ground_side)) + norm2(torque(:, ground_side)) &
+                               > 1.0e-3_wp, trim(msg))
+                    if (allocated(error)) return
+                    worst = max(worst, d / scale)
+                end do
+            end do
+        end do
+        print '(4x,a,es9.2)', 'ground and body reactions: largest relative imbalance ', worst
+    contains
+        pure function itoa(i) result(text)
+            integer, intent(in) :: i
+            character(len=12) :: text
+            write (text, '(i0)') i
+        end function itoa
+    end subroutine test_ground_reactions
 
     !> The heavy spherical pendulum with RADAU5 in GGL form: energy and the
     !> vertical angular momentum about the pivot are conserved, ‖c‖ stays at

@@ -20,7 +20,7 @@
 !> and, with constraints in a formulation, reaction_force and
 !> reaction_torque on marker i's body (from the multipliers consistent with
 !> q and v), reaction_force_j and reaction_torque_j on marker j's
-!> (as the HDF5 file's /joints; zero on the ground); field data joint_names
+!> (as the HDF5 file's /joints; on the ground its bearing load); field data joint_names
 !> — 'joints/NAME', 'joints/NAME (node N)' for an attached node, or
 !> 'drivers/NAME', the HDF5 groups — and joint_types). Field data belongs to
 !> the data set, before its piece: VTK reads none inside a piece.

@@ -36,7 +36,9 @@
 !> the joint's columns of G for that body; it is reported as the force F
 !> (global) and the torque n (global) about the marker's origin that the
 !> joint exerts on the body. A body hanging at rest from a spherical joint
-!> is held up: F = −m g (upwards, for gravity g).
+!> is held up: F = −m g (upwards, for gravity g). On the ground (a marker
+!> of body 0) it is the load the joint puts on the ground, the bearing
+!> load: for the hanging body F = m g, downwards.
 module flexmbs_mbs_system
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input

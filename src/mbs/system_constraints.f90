@@ -220,12 +220,11 @@ contains
     !> The force and torque joint k exerts on the body of marker i (column 1)
     !> and of marker j (column 2), global components, the torque about the
     !> marker's origin: the generalised force −C_bᵀλ_k of the equations of
-    !> motion M v' = f − Gᵀλ (module header). A ground side reports zeros
-    !> (the ground's share is the opposite of the body's for joints whose
-    !> markers' origins coincide). A chain link's share is the generalised
-    !> force along the marker's own displacement and rotation
-    !> (marker_frame_reaction), since its columns of G are the chain's joint
-    !> coordinates.
+    !> motion M v' = f − Gᵀλ (module header). On the ground, which has no
+    !> columns in G, and on a chain link, whose columns are the chain's joint
+    !> coordinates, it is the generalised force along the marker frame's own
+    !> displacement and rotation (marker_frame_reaction): on the ground the
+    !> bearing load, for a massless joint −F_j and the matching torque.
     module procedure system_joint_reaction
         real(wp) :: ct(max_rows)
         real(wp) :: gen(6), a(3, 3)
@@ -239,8 +238,9 @@ contains
             do side = 1, 2
                 mk = merge(jt%marker_i, jt%marker_j, side == 1)
                 call marker_offsets(self, mk, b, iq, iv)
-                if (b == 0) cycle
-                if (self%markers(mk)%chain > 0) then
+                ! the ground (no coordinates) and a chain link: along the
+                ! marker frame's own displacement and rotation
+                if (b == 0 .or. self%markers(mk)%chain > 0) then
                     gen = marker_frame_reaction(self, k, t, q, lambda(r0 + 1:r0 + nr), side)
                     force(:, side) = gen(1:3)
                     torque(:, side) = gen(4:6)
