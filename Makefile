@@ -1,10 +1,11 @@
 # flexmbs — `make run` and `make test` set up a fresh Debian machine, build and run.
 #
-#   make run     install what is missing, build (release), run the main example
+#   make run     install what is missing, build (release), run the main example; the
+#                executable is then also build/bin/flexmbs (a link to the release build)
 #   make test    install what is missing, build (debug, bounds checks), run every suite
 #   make bench   install what is missing, build (release), run the benchmarks
 #   make paper   the paper's studies on the five-body mechanism (coarse and fine coupler
-#                mesh, about 20 min) into results/
+#                mesh, about 12 min) into results/
 #   make extremes  every solver at extreme tolerances, materials and times
 #   make check-memory  install valgrind if missing, build (debug), run the numerical
 #                suites and every scene of inputs/ (cut to a few steps) under valgrind
@@ -121,14 +122,22 @@ deps:
 	    { echo "could not install fpm" >&2; exit 1; }; \
 	fi
 
+# build/bin/flexmbs links the release executable (whose folder name fpm
+# derives from the flags), so that a user can put build/bin on PATH.
 build: deps
 	$(FPM) build --profile release
+	@mkdir -p $(BUILD)/bin
+	@exe=$$($(FPM) run --profile release flexmbs --runner echo 2>/dev/null | tail -1); \
+	    [ -x "$$exe" ] || { echo "make build: no release executable (got '$$exe')" >&2; exit 1; }; \
+	    ln -sfn "$$(readlink -f "$$exe")" $(BUILD)/bin/flexmbs
 
 build-debug: deps
 	$(FPM) build --profile debug
 
 run: build
-	$(FPM) run --profile release flexmbs -- run $(MAIN_INPUT)
+	$(BUILD)/bin/flexmbs run $(MAIN_INPUT)
+	@echo "flexmbs is $(BUILD)/bin/flexmbs; to run it as 'flexmbs':"
+	@echo "    export PATH=\"$(BUILD)/bin:\$$PATH\""
 
 # Root suites, then the classic fixed-form drivers linked against the
 # installed library exactly as a user links them, the example programs of
