@@ -196,59 +196,69 @@ contains
 
     ! ------------------------------------------------ the same forms on dual numbers
 
-    !> c (6).
-    pure function value_d(f, r, p, x) result(c)
+    ! Every form below is affine in x and ẋ at fixed p and ω′: a pass that
+    ! seeds only nodes lo..hi (not the body) needs their terms alone, which
+    ! makes the passes of a set of n nodes O(n), not O(n²). Their values are
+    ! then partial; only the derivatives are used.
+
+    !> c (6), the terms of nodes lo..hi.
+    pure function value_d(f, r, p, x, lo, hi) result(c)
         type(node_frame_t), intent(in) :: f
         type(dual_t), intent(in) :: r(3), p(4), x(:, :)
+        integer, intent(in) :: lo, hi
         type(dual_t) :: c(node_frame_rows), rm(3, 3)
         integer :: a
         rm = rotation_matrix_d(p)
         c(1:3) = -r
         c(4:6) = 0.0_wp
-        do a = 1, size(f%nodes)
+        do a = lo, hi
             c(1:3) = c(1:3) + f%weight * x(:, a)
             c(4:6) = c(4:6) + f%weight * cross_d(matmul(rm, f%s(:, a)), x(:, a))
         end do
     end function value_d
 
-    !> The hand-coded G v (6).
-    pure function rate_d(f, p, x, rd, wb, xd) result(c)
+    !> The hand-coded G v (6), the terms of nodes lo..hi.
+    pure function rate_d(f, p, x, rd, wb, xd, lo, hi) result(c)
         type(node_frame_t), intent(in) :: f
         type(dual_t), intent(in) :: p(4), x(:, :), rd(3), wb(3), xd(:, :)
+        integer, intent(in) :: lo, hi
         type(dual_t) :: c(node_frame_rows), rm(3, 3), w(3), y(3)
         integer :: a
         rm = rotation_matrix_d(p)
         w = matmul(rm, wb)
         c(1:3) = -rd
         c(4:6) = 0.0_wp
-        do a = 1, size(f%nodes)
+        do a = lo, hi
             y = matmul(rm, f%s(:, a))
             c(1:3) = c(1:3) + f%weight * xd(:, a)
             c(4:6) = c(4:6) + f%weight * (cross_d(cross_d(w, y), x(:, a)) + cross_d(y, xd(:, a)))
         end do
     end function rate_d
 
-    !> The hand-coded γ (6).
-    pure function gamma_d(f, p, x, wb, xd) result(c)
+    !> The hand-coded γ (6), the terms of nodes lo..hi.
+    pure function gamma_d(f, p, x, wb, xd, lo, hi) result(c)
         type(node_frame_t), intent(in) :: f
         type(dual_t), intent(in) :: p(4), x(:, :), wb(3), xd(:, :)
+        integer, intent(in) :: lo, hi
         type(dual_t) :: c(node_frame_rows), rm(3, 3), w(3), wy(3)
         integer :: a
         rm = rotation_matrix_d(p)
         w = matmul(rm, wb)
         c = 0.0_wp
-        do a = 1, size(f%nodes)
+        do a = lo, hi
             wy = cross_d(w, matmul(rm, f%s(:, a)))
             c(4:6) = c(4:6) + f%weight * (cross_d(cross_d(w, wy), x(:, a)) &
                                           + 2.0_wp * cross_d(wy, xd(:, a)))
         end do
     end function gamma_d
 
-    !> Gᵀλ (6 + 3n, velocity-space local order) from the hand-coded G.
-    pure function gtl_d(f, p, x, lam) result(g)
+    !> Gᵀλ (6 + 3n, velocity-space local order) from the hand-coded G, the
+    !> terms of nodes lo..hi (the rows of the other nodes 0).
+    pure function gtl_d(f, p, x, lam, lo, hi) result(g)
         type(node_frame_t), intent(in) :: f
         type(dual_t), intent(in) :: p(4), x(:, :)
         real(wp), intent(in) :: lam(node_frame_rows)
+        integer, intent(in) :: lo, hi
         type(dual_t) :: g(body_nv + 3 * size(f%nodes)), rm(3, 3), am(3, 3), tau, y(3), &
             art(3), lrot(3)
         integer :: a, j
@@ -257,7 +267,8 @@ contains
         do j = 1, 3
             am(:, j) = 0.0_wp
         end do
-        do a = 1, size(f%nodes)
+        g = 0.0_wp
+        do a = lo, hi
             do j = 1, 3
                 am(:, j) = am(:, j) + (f%weight * f%s(j, a)) * x(:, a)
             end do
@@ -270,7 +281,7 @@ contains
         art = matmul(am, transpose_times(rm, lam(4:6)))
         g(1:3) = -lam(1:3)
         g(4:6) = -transpose_times(rm, tau * lam(4:6) - art)
-        do a = 1, size(f%nodes)
+        do a = lo, hi
             y = matmul(rm, f%s(:, a))
             g(body_nv + 3 * a - 2:body_nv + 3 * a) = f%weight * (lam(1:3) + cross_d(lrot, y))
         end do
@@ -305,6 +316,21 @@ contains
         passes = max(1, (size(f%nodes) + pass_nodes - 1) / pass_nodes)
     end function passes
 
+    !> The nodes whose terms pass k needs: all in the first (it seeds the
+    !> body), else its own.
+    pure integer function first(f, k)
+        type(node_frame_t), intent(in) :: f
+        integer, intent(in) :: k
+        first = merge(1, (k - 1) * pass_nodes + 1, k == 1)
+        if (size(f%nodes) == 0) first = 1
+    end function first
+
+    pure integer function last(f, k)
+        type(node_frame_t), intent(in) :: f
+        integer, intent(in) :: k
+        last = merge(size(f%nodes), min(size(f%nodes), k * pass_nodes), k == 1)
+    end function last
+
     !> Dual positions for pass k: seeds the body (first pass only) and the
     !> pass's nodes, in position space (unit vectors) or along the velocity
     !> space (T e_l: the quaternion's tangents for ω′); cols(d) is the local
@@ -321,7 +347,8 @@ contains
         call gather(f, q, rr, pr, xr)
         r = rr
         p = pr
-        do a = 1, size(f%nodes)
+        ! the nodes the pass's forms read (the others stay unset)
+        do a = first(f, k), last(f, k)
             x(:, a) = xr(:, a)
         end do
         nd = 0
@@ -368,7 +395,7 @@ contains
         call gather_rates(f, v, rr, wr, xr)
         rd = rr
         wb = wr
-        do a = 1, size(f%nodes)
+        do a = first(f, k), last(f, k)
             xd(:, a) = xr(:, a)
         end do
         nd = 0
@@ -415,7 +442,7 @@ contains
         block = 0.0_wp
         do k = 1, passes(f)
             call seed_positions(f, q, k, position_space, r, p, x, cols, nd)
-            call scatter(value_d(f, r, p, x), cols, nd, block)
+            call scatter(value_d(f, r, p, x, first(f, k), last(f, k)), cols, nd, block)
         end do
     end subroutine frame_jacobian_ad
 
@@ -439,7 +466,7 @@ contains
             x(:, a)%der(1) = xdr(:, a)
             xd(:, a) = xdr(:, a)
         end do
-        c = rate_d(f, p, x, rd, wb, xd)
+        c = rate_d(f, p, x, rd, wb, xd, 1, size(f%nodes))
         do i = 1, node_frame_rows
             gamma(i) = c(i)%der(1)
         end do
@@ -462,7 +489,8 @@ contains
         block = 0.0_wp
         do k = 1, passes(f)
             call seed_positions(f, q, k, .true., r, p, x, cols, nd)
-            call scatter(rate_d(f, p, x, rd, wb, xd), cols, nd, block)
+            call scatter(rate_d(f, p, x, rd, wb, xd, first(f, k), last(f, k)), cols, nd, &
+                         block)
         end do
     end subroutine frame_rate_q
 
@@ -476,7 +504,7 @@ contains
         block = 0.0_wp
         do k = 1, passes(f)
             call seed_positions(f, q, k, .true., r, p, x, cols, nd)
-            call scatter(gtl_d(f, p, x, lam), cols, nd, block)
+            call scatter(gtl_d(f, p, x, lam, first(f, k), last(f, k)), cols, nd, block)
         end do
     end subroutine frame_gtl_q
 
@@ -498,7 +526,7 @@ contains
         end do
         do k = 1, passes(f)
             call seed_positions(f, q, k, .true., r, p, x, cols, nd)
-            call scatter(gamma_d(f, p, x, wb, xd), cols, nd, gq)
+            call scatter(gamma_d(f, p, x, wb, xd, first(f, k), last(f, k)), cols, nd, gq)
         end do
         p = pr
         do a = 1, size(f%nodes)
@@ -506,7 +534,7 @@ contains
         end do
         do k = 1, passes(f)
             call seed_velocities(f, v, k, rd, wb, xd, cols, nd)
-            call scatter(gamma_d(f, p, x, wb, xd), cols, nd, gv)
+            call scatter(gamma_d(f, p, x, wb, xd, first(f, k), last(f, k)), cols, nd, gv)
         end do
     end subroutine frame_curvature_qv
 end module flexmbs_mbs_node_frame
