@@ -97,11 +97,9 @@ items=0
 pass() { echo "pass $1 ($2 s)"; }
 fail() { echo "FAIL $1 ($2 s): $3"; }
 
-# launch NAME FUNCTION ARGS...: run the item in the background, at most
+# launch FUNCTION ARGS...: run the item in the background, at most
 # jobs_max at a time, its line into its result file and to stdout
 launch() {
-    local name=$1
-    shift
     while [ "$(jobs -rp | wc -l)" -ge "$jobs_max" ]; do
         wait -n
     done
@@ -218,24 +216,27 @@ scene() {
     check "scene/$base" "$logs/$base.out" "$exe" run "$copy" --quiet
 }
 
+# launch_scene SCENE: a scene of inputs/ when selected (studies are not
+# scenes; a study here would be refused)
+launch_scene() {
+    wanted "scene/$(basename "$1" .nml)" || return 0
+    grep -qiE '^[[:space:]]*&study' "$1" && return 0
+    launch scene "$1"
+}
+
 # the fine five-body scenes (over 2 minutes each) right after the two
 # longest suites, the other scenes (seconds) last
 for filter in "${suites[@]:0:2}"; do
-    wanted "suite/$filter" && launch "suite/$filter" suite "$filter"
+    wanted "suite/$filter" && launch suite "$filter"
 done
 for scene in "$root"/inputs/*fine*.nml; do
-    wanted "scene/$(basename "$scene" .nml)" && launch "scene" scene "$scene"
+    launch_scene "$scene"
 done
 for filter in "${suites[@]:2}"; do
-    wanted "suite/$filter" && launch "suite/$filter" suite "$filter"
+    wanted "suite/$filter" && launch suite "$filter"
 done
 for scene in "$root"/inputs/*.nml; do
-    [[ $scene == *fine* ]] && continue
-    base=$(basename "$scene" .nml)
-    wanted "scene/$base" || continue
-    # studies (inputs/paper/) are not scenes; a study here would be refused
-    grep -qiE '^[[:space:]]*&study' "$scene" && continue
-    launch "scene/$base" scene "$scene"
+    [[ $scene == *fine* ]] || launch_scene "$scene"
 done
 wait
 

@@ -7,6 +7,7 @@
 module test_mbs_system
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t
+    use flexmbs_core_text, only: int_text
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_radau5, only: radau5_t
@@ -15,9 +16,8 @@ module test_mbs_system
     use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle, cross
     use flexmbs_mbs_rigid_body, only: rigid_body_t
     use flexmbs_mbs_joint, only: joint_spherical, joint_revolute, joint_cylindrical, &
-        joint_prismatic, joint_universal, joint_fixed
+        joint_prismatic, joint_universal, joint_fixed, joint_primitive
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t
-    use flexmbs_mbs_joint, only: joint_primitive
     use flexmbs_mbs_primitive_kinds, only: primitive_distance, primitive_dot1
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &
         formulation_index2, formulation_ggl
@@ -374,7 +374,7 @@ contains
                 end if
                 sys = new_mbs_system([test_body(1.5_wp, 0.05_wp)], m, [joint], &
                                      gravity=[0.0_wp, 0.0_wp, -g_earth], status=status)
-                call check(error, status%ok(), 'joint kind ' // trim(itoa(k)) // ': ' // &
+                call check(error, status%ok(), 'joint kind ' // int_text(k) // ': ' // &
                            status%text())
                 if (allocated(error)) return
                 do trial = 1, 3
@@ -408,12 +408,6 @@ contains
             end do
         end do
         print '(4x,a,es9.2)', 'ground and body reactions: largest relative imbalance ', worst
-    contains
-        pure function itoa(i) result(text)
-            integer, intent(in) :: i
-            character(len=12) :: text
-            write (text, '(i0)') i
-        end function itoa
     end subroutine test_ground_reactions
 
     !> The heavy spherical pendulum with RADAU5 in GGL form: energy and the

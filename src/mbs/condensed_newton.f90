@@ -98,9 +98,9 @@ contains
         self%ordering = ordering
     end function new_condensed_solver
 
-    !> Structure, patterns and the analysis of S, once. The LU comes first,
-    !> decided on S with GGL's joint components kept: KLU then gets them
-    !> eliminated (max_eliminated_block_klu), MUMPS keeps them.
+    !> Structure, patterns and the analysis of S, once. The LU comes first;
+    !> 'auto' decides on S with GGL's joint components kept. KLU then gets
+    !> them eliminated (max_eliminated_block_klu), MUMPS keeps them.
     subroutine condensed_init(self, mass, jac, status)
         class(condensed_solver_t), intent(inout) :: self
         type(matrix_t), intent(in) :: mass, jac
@@ -111,29 +111,24 @@ contains
             call status%set(status_bad_input, who // ': needs M and J in sparse storage')
             return
         end if
-        if (allocated(self%st)) deallocate (self%st)
-        if (.not. allocated(self%lu)) allocate (self%lu)
-        allocate (self%st)
-        call self%st%build(self%lay, mass%csc, jac%csc, max_eliminated_block_mumps, status)
-        if (.not. status%ok()) return
         select case (trim(self%choice))
         case ('klu')
             kind = sparse_lu_klu
-        case ('mumps')
+        case ('mumps', 'auto')
             kind = sparse_lu_mumps
-        case ('auto')
-            kind = sparse_lu_choice(self%st%nk, self%st%s%colptr, self%st%s%rowind, &
-                condensed_auto_min_order, condensed_auto_min_fill, fill, status)
-            if (.not. status%ok()) return
         case default
             call status%set(status_bad_input, who // ": linear_solver = '" // &
                 trim(self%choice) // "': use 'auto', 'klu' or 'mumps'")
             return
         end select
-        if (kind == sparse_lu_klu) then
-            deallocate (self%st)
-            allocate (self%st)
-            call self%st%build(self%lay, mass%csc, jac%csc, max_eliminated_block_klu, status)
+        if (.not. allocated(self%lu)) allocate (self%lu)
+        call build_structure(kind)
+        if (.not. status%ok()) return
+        if (trim(self%choice) == 'auto') then
+            kind = sparse_lu_choice(self%st%nk, self%st%s%colptr, self%st%s%rowind, &
+                condensed_auto_min_order, condensed_auto_min_fill, fill, status)
+            if (.not. status%ok()) return
+            if (kind == sparse_lu_klu) call build_structure(kind)
             if (.not. status%ok()) return
         end if
         self%n = self%lay%n
@@ -142,6 +137,15 @@ contains
         call self%lu%analyse(self%st%nk, self%st%s%colptr, self%st%s%rowind, kind, status, &
             self%ordering)
         self%refine = kind == sparse_lu_klu
+    contains
+        !> self%st for the LU `lu_kind`: its limit on the blocks eliminated
+        subroutine build_structure(lu_kind)
+            integer, intent(in) :: lu_kind
+            if (allocated(self%st)) deallocate (self%st)
+            allocate (self%st)
+            call self%st%build(self%lay, mass%csc, jac%csc, merge(max_eliminated_block_klu, &
+                max_eliminated_block_mumps, lu_kind == sparse_lu_klu), status)
+        end subroutine build_structure
     end subroutine condensed_init
 
     !> The value and work arrays for the structure in self%st.

@@ -318,11 +318,9 @@ contains
 
     !> The nodes whose terms pass k needs: all in the first (it seeds the
     !> body), else its own.
-    pure integer function first(f, k)
-        type(node_frame_t), intent(in) :: f
+    pure integer function first(k)
         integer, intent(in) :: k
         first = merge(1, (k - 1) * pass_nodes + 1, k == 1)
-        if (size(f%nodes) == 0) first = 1
     end function first
 
     pure integer function last(f, k)
@@ -348,7 +346,7 @@ contains
         r = rr
         p = pr
         ! the nodes the pass's forms read (the others stay unset)
-        do a = first(f, k), last(f, k)
+        do a = first(k), last(f, k)
             x(:, a) = xr(:, a)
         end do
         nd = 0
@@ -395,7 +393,7 @@ contains
         call gather_rates(f, v, rr, wr, xr)
         rd = rr
         wb = wr
-        do a = first(f, k), last(f, k)
+        do a = first(k), last(f, k)
             xd(:, a) = xr(:, a)
         end do
         nd = 0
@@ -442,7 +440,7 @@ contains
         block = 0.0_wp
         do k = 1, passes(f)
             call seed_positions(f, q, k, position_space, r, p, x, cols, nd)
-            call scatter(value_d(f, r, p, x, first(f, k), last(f, k)), cols, nd, block)
+            call scatter(value_d(f, r, p, x, first(k), last(f, k)), cols, nd, block)
         end do
     end subroutine frame_jacobian_ad
 
@@ -489,7 +487,7 @@ contains
         block = 0.0_wp
         do k = 1, passes(f)
             call seed_positions(f, q, k, .true., r, p, x, cols, nd)
-            call scatter(rate_d(f, p, x, rd, wb, xd, first(f, k), last(f, k)), cols, nd, &
+            call scatter(rate_d(f, p, x, rd, wb, xd, first(k), last(f, k)), cols, nd, &
                          block)
         end do
     end subroutine frame_rate_q
@@ -504,7 +502,7 @@ contains
         block = 0.0_wp
         do k = 1, passes(f)
             call seed_positions(f, q, k, .true., r, p, x, cols, nd)
-            call scatter(gtl_d(f, p, x, lam, first(f, k), last(f, k)), cols, nd, block)
+            call scatter(gtl_d(f, p, x, lam, first(k), last(f, k)), cols, nd, block)
         end do
     end subroutine frame_gtl_q
 
@@ -526,7 +524,7 @@ contains
         end do
         do k = 1, passes(f)
             call seed_positions(f, q, k, .true., r, p, x, cols, nd)
-            call scatter(gamma_d(f, p, x, wb, xd, first(f, k), last(f, k)), cols, nd, gq)
+            call scatter(gamma_d(f, p, x, wb, xd, first(k), last(f, k)), cols, nd, gq)
         end do
         p = pr
         do a = 1, size(f%nodes)
@@ -534,7 +532,7 @@ contains
         end do
         do k = 1, passes(f)
             call seed_velocities(f, v, k, rd, wb, xd, cols, nd)
-            call scatter(gamma_d(f, p, x, wb, xd, first(f, k), last(f, k)), cols, nd, gv)
+            call scatter(gamma_d(f, p, x, wb, xd, first(k), last(f, k)), cols, nd, gv)
         end do
     end subroutine frame_curvature_qv
 end module flexmbs_mbs_node_frame
