@@ -521,6 +521,8 @@ contains
         integer :: k, n
         logical :: bodies
         write (output_unit, '(a)') result%solver_name // ': ' // result%stats%summary()
+        if (allocated(result%stats%linear_solver)) &
+            write (output_unit, '(a)') 'linear solver: ' // result%stats%linear_solver
         n = size(result%y)
         write (output_unit, '(a,es23.15)') 't =', result%t
         bodies = .false.

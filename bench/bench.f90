@@ -79,7 +79,7 @@ program flexmbs_bench
     use flexmbs_linalg_matrix, only: matrix_t, storage_sparse, storage_identity
     use flexmbs_linalg_shifted_pattern, only: shifted_pattern_t
     use flexmbs_linalg_klu, only: klu_factor_t, klu_ordering_amd, klu_ordering_nd, &
-        klu_part_real
+        klu_ordering_name, klu_part_real
     use flexmbs_linalg_mumps, only: mumps_real_t
     use flexmbs_linalg_linear_solver, only: linear_solver_t
     use flexmbs_linalg_factory, only: new_linear_solver, predicted_fill_ratio
@@ -548,7 +548,7 @@ contains
         end do
         if (m < 3) then
             solver = 'klu'
-            ordering = trim(merge('amd', 'nd ', klu%ordering_used() == klu_ordering_amd))
+            ordering = klu_ordering_name(klu%ordering_used())
             lnz = real(klu%factor_nonzeros(klu_part_real), wp)
             unz = 0.0_wp
         else

@@ -16,7 +16,8 @@ variant() {
         sed -i "s/^&solver/\&solver\n    name = '$3'\n    linear_solver = '$4'$system/" "$1"
 }
 
-# run FILE -> "CPU NST PEAK_KB NFE" (CPU, NST and NFE from the statistics line)
+# run FILE -> "CPU NST PEAK_KB NFE LU" (CPU, NST and NFE from the statistics
+# line, LU the factorisation named by the line after it: klu, mumps, dense, ...)
 run() {
     local line peak=-
     if [ -n "${TIME:-}" ]; then
@@ -27,10 +28,12 @@ run() {
     fi
     local stats
     stats=$(echo "$line" | grep -E '^[a-z0-9]+: NST=' | tail -1)
-    [ -n "$stats" ] || { echo "failed - - -"; return; }
+    [ -n "$stats" ] || { echo "failed - - - -"; return; }
+    local lu
+    lu=$(echo "$line" | sed -n 's/^linear solver: \(condensed \)\{0,1\}\([a-z]*\).*/\2/p' | tail -1)
     echo "$(echo "$stats" | sed 's/.*CPU=\([0-9.]*\).*/\1/') \
 $(echo "$stats" | sed 's/.*NST=\([0-9]*\).*/\1/') $peak \
-$(echo "$stats" | sed 's/.* NFE=\([0-9]*\).*/\1/')"
+$(echo "$stats" | sed 's/.* NFE=\([0-9]*\).*/\1/') ${lu:--}"
 }
 
 best_cpu() {  # FILE REPS -> the run with the least CPU ("CPU NST PEAK NFE")

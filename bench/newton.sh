@@ -44,6 +44,12 @@ bash bench/scenes/meshes.sh || exit 1
 
 want() { [[ "$SECTIONS" == *" $1 "* ]]; }
 
+# CPU per step of a run's "CPU NST ..." ("-" when it failed)
+per_step() {
+    awk -v c="${1%% *}" -v n="$(echo $1 | cut -d' ' -f2)" \
+        'BEGIN { if (n > 0 && c > 0) printf "%.4f", c / n; else print "-" }'
+}
+
 # the LU 'auto' picks on each path of SCENE (from flexmbs-bench-newton's rows),
 # as "full_lu condensed_lu" (klu | mumps)
 declare -A AUTO
@@ -113,49 +119,60 @@ fi
 
 if want 4; then
     echo
-    echo "== 4. 3-D refinement of the coupler (RADAU5 + GGL, TOL 1e-6, 0.02 s, 'auto')"
-    echo "  divisions      n_FE  full CPU/step[s]  condensed CPU/step[s]  full/condensed"
+    echo "== 4. 3-D refinement of the coupler (RADAU5 + GGL, TOL 1e-6, 0.02 s; n_output = 2: the"
+    echo "     steps' cost, not that of 101 records, whose reactions cost both paths alike)"
+    echo "  divisions      n_FE  path       LU     CPU/step[s]   (* = 'auto' picks it)"
     : > "$OUT/refine_full.txt"
     : > "$OUT/refine_condensed.txt"
     for d in "2, 4, 2" "3, 6, 3" "4, 8, 4" "6, 12, 6" "8, 16, 8" "8, 32, 8"; do
         set -- ${d//,/}
         nfe=$(( 3 * ($1 + 1) * ($2 + 1) * ($3 + 1) ))
-        row=""
+        declare -A PER=()
         for path in full condensed; do
-            f="$OUT/refine_$1x$2x$3_$path.nml"
+            # 'auto' first: the statistics name the LU it took; the other LU after
+            f="$OUT/refine_$1x$2x$3_${path}_auto.nml"
             variant "$f" inputs/five_body.nml radau5 auto \
-                "s/t_end   = 1.0/t_end = 0.02/; s/divisions = 2, 4, 2/divisions = $d/" "$path"
+                "s/t_end   = 1.0/t_end = 0.02/; s/divisions = 2, 4, 2/divisions = $d/; s/n_output = 101/n_output = 2/" "$path"
             r=$(run "$f")
-            per=$(awk -v c="${r%% *}" -v n="$(echo $r | cut -d' ' -f2)" \
-                'BEGIN { if (n > 0 && c > 0) printf "%.4f", c / n; else print "-" }')
-            [ "$per" != "-" ] && echo "$nfe $per" >> "$OUT/refine_$path.txt"
-            row="$row $per"
+            picked=$(echo $r | cut -d' ' -f5)
+            PER[$path$picked]=$(per_step "$r")
+            other=$([ "$picked" = klu ] && echo mumps || echo klu)
+            f="$OUT/refine_$1x$2x$3_${path}_$other.nml"
+            variant "$f" inputs/five_body.nml radau5 "$other" \
+                "s/t_end   = 1.0/t_end = 0.02/; s/divisions = 2, 4, 2/divisions = $d/; s/n_output = 101/n_output = 2/" "$path"
+            PER[$path$other]=$(per_step "$(run "$f")")
+            for ls in klu mumps; do
+                printf "  %-12s %6d  %-10s %-6s %11s %s\n" "${d//, /x}" "$nfe" "$path" "$ls" \
+                    "${PER[$path$ls]}" "$([ "$ls" = "$picked" ] && echo '*')"
+            done
+            [ "${PER[$path$picked]}" != "-" ] && echo "$nfe ${PER[$path$picked]}" >> "$OUT/refine_$path.txt"
+            PER[${path}auto]=${PER[$path$picked]}
         done
-        set -- $row
-        printf "  %-12s %6d %17s %22s %15s\n" "${d//, /x}" "$nfe" "$1" "$2" "$(ratio "$1" "$2")"
+        echo "  ${d//, /x} with 'auto': full / condensed = $(ratio "${PER[fullauto]}" "${PER[condensedauto]}")"
     done
-    echo "  fitted exponents of CPU/step against n_FE: full $(slope < "$OUT/refine_full.txt")," \
+    echo "  fitted exponents of CPU/step ('auto') against n_FE: full $(slope < "$OUT/refine_full.txt")," \
          "condensed $(slope < "$OUT/refine_condensed.txt")"
     # the per-step cost without the set-up both paths pay once (patterns,
-    # analyses): the difference of a 0.08 s and a 0.02 s run at 8x32x8
+    # analyses, the first factorisations): the difference of a 0.1 s and a
+    # 0.02 s run at 8x32x8
     row=""
     for path in full condensed; do
         cpu=""; nst=""
-        for te in 0.02 0.08; do
+        for te in 0.02 0.1; do
             f="$OUT/marginal_${path}_$te.nml"
             variant "$f" inputs/five_body.nml radau5 auto \
-                "s/t_end   = 1.0/t_end = $te/; s/divisions = 2, 4, 2/divisions = 8, 32, 8/" "$path"
+                "s/t_end   = 1.0/t_end = $te/; s/divisions = 2, 4, 2/divisions = 8, 32, 8/; s/n_output = 101/n_output = 2/" "$path"
             r=$(run "$f")
             cpu="$cpu ${r%% *}"; nst="$nst $(echo $r | cut -d' ' -f2)"
         done
         set -- $cpu $nst
         per=$(awk -v c1="$1" -v c2="$2" -v n1="$3" -v n2="$4" \
             'BEGIN { if (n2 > n1) printf "%.4f", (c2 - c1) / (n2 - n1); else print "-" }')
-        echo "  8x32x8 $path: 0.02 s in $3 steps, 0.08 s in $4 steps: $per s per further step"
+        echo "  8x32x8 $path ('auto'): 0.02 s in $3 steps, 0.1 s in $4 steps: $per s per further step"
         row="$row $per"
     done
     set -- $row
-    echo "  per further step at 8x32x8: full / condensed = $(ratio "$1" "$2")"
+    echo "  per further step at 8x32x8: full / condensed = $(ratio "$1" "$2") (goal >= 8)"
 fi
 
 if want 5; then

@@ -126,6 +126,11 @@ printf '%s\n' "&simulation problem = 'flexible_body', t_end = 0.01 /" \
     "&material youngs_modulus = 7e5, density = 920 /" \
     "&output file = './in/../in/bar.mesh' /" > mesh_clobber.nml
 untouched output-is-mesh-file "is the mesh file" in/bar.mesh run mesh_clobber.nml --quiet
+# a missing mesh file: the path tried (resolved against the scene's folder) and the line
+printf '%s\n' "&simulation problem = 'flexible_body', t_end = 0.01 /" "" \
+    "&flexible_body mesh_file = 'nowhere/bar.mesh', fixed = 'clamp' /" \
+    "&material youngs_modulus = 7e5, density = 920 /" "&output file = '../out/m.h5' /" > in/no_mesh.nml
+bad missing-mesh-file "in/no_mesh.nml: &flexible_body: mesh_file = 'in/nowhere/bar.mesh': in/nowhere/bar.mesh: no such file (line 3)" in/no_mesh.nml
 
 # inertia tensors a body can have: positive definite, principal moments
 # satisfying the triangle inequalities (a chain link's was not checked)
@@ -179,6 +184,9 @@ values = [int(a[c]) for c in causes]
 assert sum(values) == int(a['NRJ']) == 37, values
 assert values == [8, 0, 29, 0, 0, 0, 0], values
 assert 'refusal' not in a
+t = h5py.File(sys.argv[1], 'r')['time']
+assert t.attrs['unit'] == 's', t.attrs.get('unit')
+assert 'description' in t.attrs
 PY
 ); then pass hdf5-rejection-causes; else fail hdf5-rejection-causes "$problem"; fi
 printf '%s\n&solver rtol = 1e-4, atol = 1e-4, h0 = 1e-6 /\n%s\n' "$sim" \
@@ -308,6 +316,40 @@ done
 # gfortran's note on the floating-point flags still raised)
 errors=$("$exe" run five_radau5.nml --quiet 2>&1 >/dev/null)
 if [ -z "$errors" ]; then pass quiet-success; else fail quiet-success "$errors"; fi
+
+# What factored the Newton matrices, printed and in the file's attribute
+# linear_solver, as 'auto' decides (docs/linear_algebra.md): the five-body's
+# condensed matrix S has order 221 < 500, so KLU; the full path's 547
+# unknowns have fill < 10, KLU; IDA's full path is SUNDIALS' KLU; van der
+# Pol has 2 unknowns, dense; MEXAX factors its augmented systems by the
+# structure of M; MUMPS when asked, with the ordering its analysis used.
+linear_solver_case() {  # NAME SCENE EXPECTED [SED]
+    sed -e "s/^&output/\&output file = 'out\/ls.h5',/" -e "${4:-}" "$2" > "ls_$1.nml"
+    rm -f out/ls.h5
+    check "linear-solver-$1" 0 "linear solver: $3" run "ls_$1.nml" --quiet
+    if [ -z "$problem" ]; then
+        problem=$(/usr/bin/python3 - out/ls.h5 "$3" 2>&1 <<'PY'
+import sys, h5py
+got = h5py.File(sys.argv[1], 'r').attrs['linear_solver']
+got = got.decode() if isinstance(got, bytes) else got
+if not got.startswith(sys.argv[2]):
+    print(f"attribute linear_solver = {got!r}, expected {sys.argv[2]!r}...")
+PY
+        )
+    fi
+    if [ -n "$problem" ]; then fail "linear-solver-$1" "$problem"; else pass "linear-solver-$1"; fi
+}
+short="s/t_end   = 1.0 /t_end   = 0.01 /"
+linear_solver_case condensed "$root/inputs/five_body.nml" "condensed klu, ordering amd" "$short"
+linear_solver_case condensed-mumps "$root/inputs/five_body.nml" "condensed mumps, ordering " \
+    "$short; s/^&solver/\&solver linear_solver = 'mumps',/"
+linear_solver_case full "$root/inputs/five_body.nml" "klu, ordering amd" \
+    "$short; s/^&solver/\&solver newton_system = 'full',/"
+linear_solver_case ida-full "$root/inputs/five_body.nml" "klu (SUNDIALS)" \
+    "$short; s/name = 'radau5'/name = 'ida'/; s/^&solver/\&solver newton_system = 'full',/"
+linear_solver_case mexax "$root/inputs/five_body.nml" "structured [M Gt; G 0]" \
+    "$short; s/name = 'radau5'/name = 'mexax'/"
+linear_solver_case dense "$root/inputs/van_der_pol.nml" "dense" "s/t_end *= *[0-9.e+]*/t_end = 0.1/"
 
 # Studies: a reference with its cross-check, a sweep against it, bad input
 sed -e "s#scene               = '../four_bar.nml'#scene = '$root/inputs/four_bar.nml'#" \

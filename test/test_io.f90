@@ -253,7 +253,8 @@ contains
         call check(error, status%code == status_bad_input, 'code')
         call expect(error, status, 'in.nml: &solvers: unknown group (did you mean ''solver''?) ' &
                     // '(known: &simulation, &solver, &output, &flexible_body, &material, ' // &
-                    '&multibody, &rigid_body, &marker, &joint, &driver, &rigid_chain; &study in ' &
+                    '&multibody, &rigid_body, &marker, &joint, &driver, &force, &rigid_chain; ' &
+                    // '&study in ' &
                     // 'study files) (line 3)')
     end subroutine test_unknown_group
 

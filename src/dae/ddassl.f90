@@ -381,6 +381,7 @@ contains
         stats%rejections = self%rejections
         call stats%rejections%annotate(status)
         stats%t_reached = t
+        if (allocated(self%work%ls)) stats%linear_solver = self%work%ls%description()
         if (allocated(self%warning)) stats%warning = self%warning
         self%k_last = self%work%kold
         self%k_next = self%work%k

@@ -25,7 +25,7 @@ module flexmbs_dae_ida_state
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_rejections, only: cause_model_refused
-    use flexmbs_dae_ida_callbacks, only: callback_data_t
+    use flexmbs_dae_ida_callbacks, only: callback_data_t, jac_own, jac_sparse
     use flexmbs_dae_ida_observer, only: observed_rejections
     use flexmbs_dae_sink, only: dense_output_t
     use flexmbs_dae_solver, only: dae_solver_t
@@ -220,6 +220,14 @@ contains
         ! netf by the error test, the ncfn failed solves by the observer's causes
         stats%rejections = observed_rejections(w%data%observer, self%native%netf, &
             w%data%refusal)
+        ! ours behind the SUNLinearSolver, else SUNDIALS' own
+        if (w%data%jac_mode == jac_own .and. allocated(w%data%ls)) then
+            stats%linear_solver = w%data%ls%description()
+        else if (w%data%jac_mode == jac_sparse) then
+            stats%linear_solver = 'klu (SUNDIALS)'
+        else
+            stats%linear_solver = 'dense (SUNDIALS)'
+        end if
     end subroutine collect_statistics
 
     real(wp) function ieee_nan()

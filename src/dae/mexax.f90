@@ -38,7 +38,7 @@ module flexmbs_dae_mexax
     use flexmbs_dae_sink, only: sink_t
     use flexmbs_dae_mexax_control, only: mexax_base_midpoint, mexax_base_euler, &
         mexax_max_columns
-    use flexmbs_dae_mexax_workspace, only: workspace_t, mexax_native_t, mexax_auto_klu_order, &
+    use flexmbs_dae_mexax_workspace, only: workspace_t, workspace_linear_solver, mexax_native_t, mexax_auto_klu_order, &
         setup_workspace, ev_ok
     use flexmbs_dae_mexax_tableau, only: start_point, base_column, extrapolate_column
     use flexmbs_dae_mexax_state, only: mexax_engine_t, mexax_run_t, mexax_dense_t, &
@@ -200,6 +200,7 @@ contains
         stats%ndec = self%native%ndec
         stats%nsol = self%native%nsol
         stats%t_reached = r%t
+        if (allocated(r%w)) stats%linear_solver = workspace_linear_solver(r%w)
         stats%cpu = r%timer%cpu()
         stats%wall = r%timer%wall()
         call stats%rejections%annotate(status)

@@ -19,7 +19,7 @@ module flexmbs_dae_mexax_workspace
     use flexmbs_dae_mexax_control, only: control_t
     implicit none
     private
-    public :: setup_workspace, eval_block, copy_block, assemble, factor, &
+    public :: workspace_linear_solver, setup_workspace, eval_block, copy_block, assemble, factor, &
         solve, factor_solve, user_failed, block_times, rms
 
     !> linear_solver = 'auto' factors [M Gᵀ; G 0] with KLU from this order
@@ -75,6 +75,19 @@ module flexmbs_dae_mexax_workspace
     end type workspace_t
 
 contains
+
+    !> What factors the augmented systems, as the statistics report it.
+    function workspace_linear_solver(w) result(text)
+        type(workspace_t), intent(in) :: w
+        character(len=:), allocatable :: text
+        if (w%structured) then
+            text = 'structured [M Gt; G 0] (mass blocks, klu)'
+        else if (w%sparse) then
+            text = 'klu [M Gt; G 0]'
+        else
+            text = 'dense [M Gt; G 0]'
+        end if
+    end function workspace_linear_solver
 
     !> Allocate the workspace for `km` columns and set up the linear solver
     !> of the augmented system ('auto' | 'dense' | 'klu').

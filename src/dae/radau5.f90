@@ -125,6 +125,7 @@ contains
         stats%ndec = self%native%ndec
         stats%nsol = self%native%nsol + self%nsol_error
         stats%t_reached = w%x
+        if (allocated(w%ls)) stats%linear_solver = w%ls%description()
         if (self%h_opt == 0.0_wp) self%h_opt = w%hopt
         stats%cpu = w%timer%cpu()
         stats%wall = w%timer%wall()

@@ -27,6 +27,11 @@ module flexmbs_dae_stats
         !> What the caller should know although the run succeeded (e.g. a
         !> formulation the solver is not made for); empty when none.
         character(len=:), allocatable :: warning
+        !> What factored the iteration matrices, as the linear solver's
+        !> description() gives it ('condensed mumps, ordering scotch', 'klu,
+        !> ordering amd', 'dense'): what linear_solver = 'auto' chose.
+        !> Empty when the solver factors nothing of ours.
+        character(len=:), allocatable :: linear_solver
     contains
         procedure :: reset => stats_reset
         procedure :: summary => stats_summary
@@ -41,6 +46,7 @@ contains
         self%cpu = 0.0_wp; self%wall = 0.0_wp; self%t_reached = 0.0_wp; self%h_last = 0.0_wp
         self%rejections = rejections_t()
         if (allocated(self%warning)) deallocate (self%warning)
+        if (allocated(self%linear_solver)) deallocate (self%linear_solver)
     end subroutine stats_reset
 
     !> One line: 'NST=... NAC=... NRJ=... ...', NRJ followed by its causes

@@ -181,6 +181,11 @@ contains
         self%is_open = .true.
         call create_series(self%file, 'time', 0, time_chunk, self%time_dset, err)
         if (check(err, 'create /time')) return
+        ! the unit and meaning, as every named series has them
+        call write_string_attribute(self%time_dset, 'unit', 's', err)
+        if (err >= 0) call write_string_attribute(self%time_dset, 'description', &
+            'the time of each record (row of /y and of every series)', err)
+        if (check(err, 'write the attributes of /time')) return
         per_chunk = max(1, min(time_chunk, chunk_bytes / (8 * n)))
         call create_series(self%file, 'y', n, per_chunk, self%y_dset, err)
         if (check(err, 'create /y')) return
@@ -392,6 +397,8 @@ contains
         call put_real('CPU', stats%cpu)
         call put_real('WALL', stats%wall)
         call put_real('t_reached', stats%t_reached)
+        if (allocated(stats%linear_solver) .and. err >= 0) &
+            call write_string_attribute(self%file, 'linear_solver', stats%linear_solver, err)
         if (present(solver) .and. err >= 0) &
             call write_string_attribute(self%file, 'solver', solver, err)
         if (present(outcome) .and. err >= 0) &

@@ -80,9 +80,8 @@ contains
             skip = .false.
             if (g == 0) then
                 call errors%add('&' // excerpt(group) // ': unknown group' // &
-                    did_you_mean(group, group_names) // ' (known: &simulation, &solver, &
-                    &&output, &flexible_body, &material, &multibody, &rigid_body, &marker, &
-                    &&joint, &driver, &rigid_chain; &study in study files)', line)
+                    did_you_mean(group, group_names) // ' (known: ' // known_groups() // &
+                    '; &study in study files)', line)
                 skip = .true.
                 instance = 1
             else
@@ -550,4 +549,17 @@ contains
         is_space = c == ' ' .or. c == achar(9) .or. c == achar(13)
     end function is_space
 
+
+    !> The scene groups of the schema, '&simulation, &solver, ...' (the
+    !> study's own group left out): the list cannot fall behind the schema.
+    function known_groups() result(text)
+        character(len=:), allocatable :: text
+        integer :: g
+        text = ''
+        do g = 1, size(group_names)
+            if (group_names(g) == 'study') cycle
+            if (len(text) > 0) text = text // ', '
+            text = text // '&' // trim(group_names(g))
+        end do
+    end function known_groups
 end module flexmbs_io_scene_lexer

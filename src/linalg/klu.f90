@@ -79,7 +79,7 @@ module flexmbs_linalg_klu
         final :: klu_final
     end type klu_factor_t
 
-    public :: klu_refactor_degrade_ratio
+    public :: klu_refactor_degrade_ratio, klu_ordering_name
 
     interface
         function shim_create() bind(C, name='flexmbs_klu_create') result(handle)
@@ -251,6 +251,18 @@ contains
         self%n = n
         self%nnz = colptr(n + 1)
     end subroutine klu_analyse
+
+    !> 'amd' or 'nd' for klu_ordering_amd or _nd, '' for anything else (-1:
+    !> not analysed).
+    pure function klu_ordering_name(code) result(name)
+        integer, intent(in) :: code
+        character(len=:), allocatable :: name
+        select case (code)
+        case (klu_ordering_amd); name = 'amd'
+        case (klu_ordering_nd); name = 'nd'
+        case default; name = ''
+        end select
+    end function klu_ordering_name
 
     !> The ordering the last analysis used: klu_ordering_amd or _nd (-1: none).
     integer function klu_ordering_used(self)

@@ -14,7 +14,8 @@ module flexmbs_linalg_klu_solver
     use flexmbs_linalg_matrix, only: matrix_t
     use flexmbs_linalg_linear_solver, only: linear_solver_t, fill_nan
     use flexmbs_linalg_shifted_pattern, only: shifted_pattern_t
-    use flexmbs_linalg_klu, only: klu_factor_t, klu_stats_t, klu_ordering_auto, klu_part_real
+    use flexmbs_linalg_klu, only: klu_factor_t, klu_stats_t, klu_ordering_auto, klu_part_real, &
+        klu_ordering_name
     implicit none
     private
 
@@ -36,6 +37,7 @@ module flexmbs_linalg_klu_solver
         procedure :: solve_real => klu_solver_solve_real
         procedure :: solve_complex => klu_solver_solve_complex
         procedure :: name => klu_solver_name
+        procedure :: ordering_used => klu_solver_ordering
         procedure :: stats => klu_solver_stats
         procedure :: nonzeros => klu_solver_nonzeros
         procedure :: factor_nonzeros => klu_solver_factor_nonzeros
@@ -107,6 +109,13 @@ contains
         character(len=:), allocatable :: name
         name = 'klu'
     end function klu_solver_name
+
+    !> The ordering of the analysis: 'amd' or 'nd' ('' before it).
+    function klu_solver_ordering(self) result(name)
+        class(klu_solver_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = klu_ordering_name(self%lu%ordering_used())
+    end function klu_solver_ordering
 
     !> KLU statistics of the real (klu_part_real) or complex
     !> (klu_part_complex) factorisation.

@@ -70,6 +70,8 @@ module flexmbs_linalg_linear_solver
         procedure(solve_real_i), deferred :: solve_real
         procedure(solve_complex_i), deferred :: solve_complex
         procedure(name_i), deferred :: name
+        procedure :: ordering_used => linear_solver_ordering
+        procedure :: description => linear_solver_description
     end type linear_solver_t
 
     abstract interface
@@ -117,6 +119,24 @@ module flexmbs_linalg_linear_solver
     end interface
 
 contains
+
+    !> The fill-reducing ordering of a sparse factorisation once analysed
+    !> ('amd', 'nd', 'scotch', ...); empty for solvers without one.
+    function linear_solver_ordering(self) result(name)
+        class(linear_solver_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = ''
+    end function linear_solver_ordering
+
+    !> What factors the matrices, as runs report it: the name, and the
+    !> ordering when there is one ('condensed mumps, ordering scotch').
+    function linear_solver_description(self) result(text)
+        class(linear_solver_t), intent(in) :: self
+        character(len=:), allocatable :: text, order
+        text = self%name()
+        order = self%ordering_used()
+        if (len(order) > 0) text = text // ', ordering ' // order
+    end function linear_solver_description
 
     subroutine fill_nan_real(b)
         real(wp), intent(out) :: b(:)

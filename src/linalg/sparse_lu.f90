@@ -19,7 +19,7 @@ module flexmbs_linalg_sparse_lu
     use flexmbs_core_threads, only: default_blas_threads
     use flexmbs_linalg_linear_solver, only: fill_nan
     use flexmbs_linalg_klu, only: klu_factor_t, klu_ordering_auto, klu_ordering_amd, &
-        klu_ordering_nd, klu_part_real
+        klu_ordering_nd, klu_part_real, klu_ordering_name
     use flexmbs_linalg_mumps, only: mumps_real_t, mumps_complex_t, mumps_factor_t, &
         mumps_ordering_auto, mumps_ordering_amd, mumps_ordering_scotch
     implicit none
@@ -51,6 +51,7 @@ module flexmbs_linalg_sparse_lu
         procedure, private :: solve_complex => lu_solve_complex
         generic :: solve => solve_real, solve_complex
         procedure :: name => lu_name
+        procedure :: ordering_used => lu_ordering
         procedure :: order => lu_order
         procedure :: nonzeros => lu_nonzeros
         procedure :: predicted_fill => lu_predicted_fill
@@ -203,6 +204,17 @@ contains
         name = merge('mumps', 'klu  ', self%kind == sparse_lu_mumps)
         name = trim(name)
     end function lu_name
+
+    !> The ordering of the analysis ('amd', 'nd', 'scotch', ...).
+    function lu_ordering(self) result(name)
+        class(sparse_lu_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        if (self%kind == sparse_lu_mumps) then
+            name = self%mumps%ordering_used()
+        else
+            name = klu_ordering_name(self%klu%ordering_used())
+        end if
+    end function lu_ordering
 
     pure integer function lu_order(self)
         class(sparse_lu_t), intent(in) :: self

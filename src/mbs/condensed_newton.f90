@@ -76,6 +76,7 @@ module flexmbs_mbs_condensed_newton
         procedure :: solve_real => condensed_solve_real
         procedure :: solve_complex => condensed_solve_complex
         procedure :: name => condensed_name
+        procedure :: ordering_used => condensed_ordering
         procedure :: order => condensed_order
         procedure :: eliminated => condensed_eliminated
         procedure :: largest_block => condensed_largest_block
@@ -265,6 +266,14 @@ contains
         name = 'condensed'
         if (allocated(self%lu)) name = 'condensed ' // self%lu%name()
     end function condensed_name
+
+    !> The ordering of S's analysis.
+    function condensed_ordering(self) result(name)
+        class(condensed_solver_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = ''
+        if (allocated(self%lu)) name = self%lu%ordering_used()
+    end function condensed_ordering
 
     !> Order of S.
     pure integer function condensed_order(self)

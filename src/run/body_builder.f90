@@ -53,8 +53,10 @@ contains
             if (len_trim(b%mesh_file) > 0) then
                 call read_mesh(trim(b%mesh_file), mesh, status)
                 if (.not. status%ok()) then
+                    ! the path as resolved against the scene's folder, and where
                     call status%set(status_bad_input, where // 'mesh_file = ''' // &
-                        trim(b%mesh_file) // ''': ' // status%text())
+                        trim(b%mesh_file) // ''': ' // status%text() // ' (line ' // &
+                        int_text(b%line) // ')')
                     return
                 end if
                 if (mesh%nnode_element /= nnode_element) then
