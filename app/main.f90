@@ -13,6 +13,7 @@
 !>                 [--no-run] [--force]        eigenvalues of the linearised scene and the
 !>                                            BDF sectors at the step sizes of a BDF run
 !>   flexmbs scene-reference                  every group and variable of a scene, as Markdown
+!>   flexmbs COMMAND --help                   the usage of one command (app/help_text)
 !>   flexmbs --help | --version
 !>
 !> Exit codes: 0 success, 2 bad input (nothing written), 3 solver failure
@@ -47,6 +48,7 @@ program flexmbs_main
     use flexmbs_app_parallel_sweep, only: run_points_in_processes
     use flexmbs_app_slurm_submit, only: submit_study
     use flexmbs_app_modes_command, only: modes_command
+    use flexmbs_app_help_text, only: has_command_usage, write_usage, write_command_usage
     use flexmbs_run_modes, only: modes_options_t
     implicit none
 
@@ -68,13 +70,23 @@ program flexmbs_main
 
     nargs = command_argument_count()
     if (nargs == 0) then
-        call usage(error_unit)
+        call write_usage(error_unit)
         call finish(exit_bad_input)
     end if
     command = argument(1)
+    ! a command's --help wins over everything else on its line, even over
+    ! a missing file: who asks for help may not know what the command needs
+    if (has_command_usage(command)) then
+        do i = 2, nargs
+            if (argument(i) == '--help' .or. argument(i) == '-h') then
+                call write_command_usage(command, output_unit)
+                call finish(exit_ok)
+            end if
+        end do
+    end if
     select case (command)
     case ('--help', '-h', 'help')
-        call usage(output_unit)
+        call write_usage(output_unit)
         call finish(exit_ok)
     case ('--version', '-V')
         write (output_unit, '(a)') 'flexmbs ' // version
@@ -114,9 +126,6 @@ program flexmbs_main
             else if (command == 'sweep' .and. arg == '--submit') then
                 submit = .true.
                 slurm_only = arg
-            else if (arg == '--help' .or. arg == '-h') then
-                call usage(output_unit)
-                call finish(exit_ok)
             else if (arg(1:min(1, len(arg))) == '-') then
                 call fail_usage('unknown option ''' // arg // '''')
             else if (len(file) > 0) then
@@ -405,9 +414,6 @@ contains
             i = i + 1
             arg = argument(i)
             select case (arg)
-            case ('--help', '-h')
-                call usage(output_unit)
-                call finish(exit_ok)
             case ('--force')
                 force = .true.
             case ('--no-run')
@@ -615,94 +621,18 @@ contains
         end if
     end function signal_exit
 
+    !> A bad command line: the message, and where the usage is (the
+    !> command's own when the command is known).
     subroutine fail_usage(message)
         character(len=*), intent(in) :: message
         write (error_unit, '(a)') 'flexmbs: ' // message
-        write (error_unit, '(a)') 'try ''flexmbs --help'''
+        if (has_command_usage(command)) then
+            write (error_unit, '(a)') 'try ''flexmbs ' // command // ' --help'''
+        else
+            write (error_unit, '(a)') 'try ''flexmbs --help'''
+        end if
         call finish(exit_bad_input)
     end subroutine fail_usage
-
-    subroutine usage(unit)
-        integer, intent(in) :: unit
-        write (unit, '(a)') 'flexmbs ' // version // &
-            ' - flexible multibody dynamics and stiff DAE solvers', &
-            '', &
-            'usage:', &
-            '  flexmbs run FILE.nml [--quiet] [--force] [--verbose]', &
-            '                                          run the scene described by FILE.nml;', &
-            '                                          --verbose: the whole final state too', &
-            '  flexmbs reference STUDY.nml [--quiet] [--force]', &
-            '                                          integrate the study''s scene at tight', &
-            '                                          tolerance, cross-check, keep in HDF5', &
-            '  flexmbs sweep STUDY.nml [-j N] [--quiet] [--force]', &
-            '                                          run the study''s grid of solvers and', &
-            '                                          tolerances, ERR against the reference;', &
-            '                                          -j N: N processes at a time, each', &
-            '                                          point''s record kept in STUDY_points/', &
-            '  flexmbs sweep STUDY.nml --point K       run grid point K alone, its record', &
-            '                                          into the results folder', &
-            '  flexmbs sweep STUDY.nml --merge         the table from the records there;', &
-            '                                          lists the points missing or failed', &
-            '                                          and the commands that run only those', &
-            '  flexmbs sweep STUDY.nml --slurm [--chunk K] [--partition P] [--time T]', &
-            '                                [--mem M] [--submit]', &
-            '                                          write a Slurm job array (one task per', &
-            '                                          K points) and a merge job into the', &
-            '                                          results folder; --submit submits both', &
-            '                                          (the merge after the array), else the', &
-            '                                          sbatch commands are shown', &
-            '  flexmbs columns FILE.h5 COLUMN [COLUMN ...]', &
-            '                                          t and the columns of a result, as text:', &
-            '                                          K (component K of /y), BODY/QUANTITY/', &
-            '                                          COMPONENT (''rocker/position/z'',', &
-            '                                          ''motor/reaction_torque/z''), or a node', &
-            '                                          (''coupler/node 23/x'', ''.../velocity/x'')', &
-            '  flexmbs modes FILE.nml [--time T] [--count K] [--shift S]', &
-            '                         [--method auto|dense|arpack] [--output P] [--no-run]', &
-            '                                          eigenvalues of the scene''s DAE pencil', &
-            '                                          (dF/dy, M) linearised at t_start (or', &
-            '                                          T): the K lowest modes (default 10)', &
-            '                                          with frequency and damping, and per', &
-            '                                          BDF order the stiff modes outside its', &
-            '                                          A(alpha) sector at the step sizes a', &
-            '                                          BDF run of the scene took at that order', &
-            '                                          (--no-run: no run); every eigenvalue in', &
-            '                                          P.csv, a plot in P.png (gnuplot); P is', &
-            '                                          the scene without .nml, then _modes;', &
-            '                                          dense QZ up to 2000 unknowns, else', &
-            '                                          ARPACK around the shift S (default', &
-            '                                          -1 1/s) (docs/modes.md)', &
-            '  flexmbs scene-reference                 every group and variable of a scene', &
-            '                                          file: type, unit, default, range, as', &
-            '                                          Markdown (docs/scene_reference.md)', &
-            '  flexmbs --help                          show this text', &
-            '  flexmbs --version                       show the version', &
-            '', &
-            'FILE.nml holds the namelist groups &simulation, &solver and &output,', &
-            'and for a flexible body &flexible_body with one or more &material;', &
-            'for rigid bodies and joints &multibody, &rigid_body, &marker, &joint, &driver,', &
-            '&force, and any number of &flexible_body groups (each &material naming its', &
-            'body); for chains in relative coordinates &rigid_chain (a tree each)', &
-            '(docs/scene_reference.md or flexmbs scene-reference: every variable,', &
-            'its type, unit and default; docs/user_guide.md: how to use them).', &
-            'STUDY.nml holds one &study group naming a scene file and the grid.', &
-            'Paths in a scene or study file are relative to that file''s folder;', &
-            'every error of a file is listed, one per line.', &
-            '--quiet turns the progress display on standard error off.', &
-            'An output never replaces an input, and two outputs of a run are never one', &
-            'file. A file already at an output''s path is replaced only when it is', &
-            'flexmbs''s own of that kind (an HDF5 result, a ParaView file, a table);', &
-            '--force replaces anything else too.', &
-            '', &
-            'The results folder of a study is <study name>_points/ beside its table, or', &
-            'beside the study file when it names no table (docs/studies_on_a_cluster.md).', &
-            '', &
-            'exit codes: 0 success, 2 bad input (no output written),', &
-            '            3 solver failure (outputs kept); sweep --merge and -j: a point', &
-            '            has no current record (no table written), 4 I/O error,', &
-            '            130 / 143 stopped by SIGINT / SIGTERM after the current step', &
-            '            (outputs flushed and closed; a second signal ends it at once)'
-    end subroutine usage
 
     !> The scene reference on standard output.
     subroutine scene_reference()

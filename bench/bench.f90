@@ -8,6 +8,10 @@
 !>   flexmbs-bench assembly hex8|hex27 NDOF
 !>   flexmbs-bench ad fourbar|slidercrank
 !>   flexmbs-bench sparse_lu hex NX NY NZ | sparse_lu rd1d|rd2d N
+!>   flexmbs-bench --help
+!>
+!> Wrong or missing arguments: a message and the usage on standard error,
+!> exit 2; a run that cannot be set up: its reason there, exit 1.
 !>
 !> INTEGRATOR: a solver of the catalogue (radau5 | ddassl | ida | mexax),
 !> or NAME-p2 (maximal BDF order 2) or NAME-euler (MEXAX's half-explicit
@@ -48,6 +52,7 @@
 !> = 'auto'` picks from it.
 !> bench/run.sh runs the grid of configurations; these are figures, not tests.
 program flexmbs_bench
+    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, reason_max_steps
@@ -62,7 +67,7 @@ program flexmbs_bench
     use flexmbs_problems_reaction_diffusion, only: reaction_diffusion_t
     use flexmbs_problems_pendulum, only: pendulum_t, pendulum_reference
     use flexmbs_io_namelist, only: scene_input_t, parse_scene
-    use flexmbs_run_catalogue, only: solvers, solver_radau5, solver_choices
+    use flexmbs_run_catalogue, only: solvers, solver_radau5, solver_choices, solver_id
     use flexmbs_run_solver_factory, only: new_solver
     use flexmbs_run_plan, only: run_plan_t, make_plan
     use flexmbs_fe_hexahedron, only: hex8, hex27
@@ -94,7 +99,7 @@ program flexmbs_bench
 
     character(len=32) :: integrator_name, problem_name, solver_name, arg
     character(len=256) :: reference_file
-    integer :: npar, max_steps, ios
+    integer :: npar, max_steps, ios, nargs, i
     real(wp) :: rtol, t, t_end, err
     real(wp), allocatable :: y(:), y_ref(:)
     logical, allocatable :: mask(:)
@@ -108,40 +113,37 @@ program flexmbs_bench
     character(len=16) :: outcome
     integer :: n_row   !! unknowns reported in the row
 
-    if (command_argument_count() == 3) then
-        call get_command_argument(1, integrator_name)
-        if (integrator_name == 'assembly') then
-            call run_assembly()
+    nargs = command_argument_count()
+    do i = 1, nargs
+        call get_command_argument(i, arg)
+        if (arg == '--help' .or. arg == '-h') then
+            call usage(output_unit)
             stop
         end if
-    end if
-    if (command_argument_count() >= 3) then
-        call get_command_argument(1, integrator_name)
-        if (integrator_name == 'sparse_lu') then
-            call run_sparse_lu()
-            stop
-        end if
-    end if
-    if (command_argument_count() == 2) then
-        call get_command_argument(1, integrator_name)
-        if (integrator_name == 'ad') then
-            call run_ad()
-            stop
-        end if
-    end if
-    if (command_argument_count() < 4) then
-        write (*, '(a)') 'usage: flexmbs-bench ' // solver_choices // '[-p2|-euler] ' &
-            // 'vdp|rd1d|rd2d|pend3|pend2|pendggl|pendmech|chain N dense|klu|band|auto ' // &
-            '[MAX_STEPS] [RTOL] [REFERENCE]', &
-            '       flexmbs-bench reference PROBLEM N FILE [RTOL]', &
-            '       flexmbs-bench assembly hex8|hex27 NDOF', &
-            '       flexmbs-bench sparse_lu hex NX NY NZ | rd1d N | rd2d N'
-        error stop 2
-    end if
+    end do
+    if (nargs == 0) call bad_arguments('no arguments')
     call get_command_argument(1, integrator_name)
+    select case (integrator_name)
+    case ('assembly')
+        if (nargs /= 3) call bad_arguments('assembly takes hex8|hex27 NDOF')
+        call run_assembly()
+        stop
+    case ('sparse_lu')
+        call run_sparse_lu()
+        stop
+    case ('ad')
+        if (nargs /= 2) call bad_arguments('ad takes fourbar|slidercrank')
+        call run_ad()
+        stop
+    case ('reference')
+        if (nargs < 4 .or. nargs > 5) call bad_arguments('reference takes PROBLEM N FILE &
+            &[RTOL]')
+    case default
+        if (nargs < 4 .or. nargs > 7) call bad_arguments('a run takes INTEGRATOR PROBLEM N &
+            &SOLVER [MAX_STEPS] [RTOL] [REFERENCE]')
+    end select
     call get_command_argument(2, problem_name)
-    call get_command_argument(3, arg)
-    read (arg, *) npar
+    npar = whole_argument(3, 'N')
     call get_command_argument(4, solver_name)
     max_steps = 100000
     rtol = 1.0e-6_wp
@@ -151,20 +153,11 @@ program flexmbs_bench
         solver_name = 'auto'
         rtol = 1.0e-10_wp
         max_steps = 10000000
-        if (command_argument_count() >= 5) then
-            call get_command_argument(5, arg)
-            read (arg, *) rtol
-        end if
+        if (nargs >= 5) rtol = tolerance_argument(5, 'RTOL')
     else
-        if (command_argument_count() >= 5) then
-            call get_command_argument(5, arg)
-            read (arg, *) max_steps
-        end if
-        if (command_argument_count() >= 6) then
-            call get_command_argument(6, arg)
-            read (arg, *) rtol
-        end if
-        if (command_argument_count() >= 7) call get_command_argument(7, reference_file)
+        if (nargs >= 5) max_steps = whole_argument(5, 'MAX_STEPS')
+        if (nargs >= 6) rtol = tolerance_argument(6, 'RTOL')
+        if (nargs >= 7) call get_command_argument(7, reference_file)
     end if
 
     if (problem_name == 'chain') then
@@ -193,6 +186,67 @@ program flexmbs_bench
 
 contains
 
+    !> The forms of the command line, on `unit`.
+    subroutine usage(unit)
+        integer, intent(in) :: unit
+        write (unit, '(a)') 'usage: flexmbs-bench INTEGRATOR PROBLEM N SOLVER [MAX_STEPS] [RTOL] &
+            &[REFERENCE]', &
+            '       flexmbs-bench reference PROBLEM N FILE [RTOL]', &
+            '       flexmbs-bench assembly hex8|hex27 NDOF', &
+            '       flexmbs-bench ad fourbar|slidercrank', &
+            '       flexmbs-bench sparse_lu hex NX NY NZ | sparse_lu rd1d|rd2d N', &
+            '       flexmbs-bench --help', &
+            'INTEGRATOR: ' // solver_choices // ', or NAME-p2 (maximal BDF order 2) or &
+            &NAME-euler', &
+            '  (the half-explicit Euler base step)', &
+            'PROBLEM: vdp|rd1d|rd2d|pend3|pend2|pendggl|pendmech|chain; N: unknowns for rd1d,', &
+            '  grid points per side for rd2d, bars for chain, ignored otherwise', &
+            'SOLVER: the linear solver, dense|klu|band|auto', &
+            'MAX_STEPS: default 100000; RTOL (= atol): default 1e-6, 1e-10 for reference;', &
+            '  REFERENCE: a file that the reference form wrote', &
+            'One row of figures on standard output (bench/bench.f90 says which);', &
+            'bench/run.sh runs the grid of configurations.'
+    end subroutine usage
+
+    !> A wrong command line: `message` and the usage on standard error,
+    !> exit 2 (quietly: no STOP line, no backtrace).
+    subroutine bad_arguments(message)
+        character(len=*), intent(in) :: message
+        write (error_unit, '(a)') 'flexmbs-bench: ' // message
+        call usage(error_unit)
+        stop 2, quiet=.true.
+    end subroutine bad_arguments
+
+    !> A run that cannot be set up: why, on standard error, exit 1.
+    subroutine give_up(message)
+        character(len=*), intent(in) :: message
+        write (error_unit, '(a)') 'flexmbs-bench: ' // message
+        stop 1, quiet=.true.
+    end subroutine give_up
+
+    !> Argument `k`, a whole number >= 1 (`what` names it in the message).
+    integer function whole_argument(k, what) result(value)
+        integer, intent(in) :: k
+        character(len=*), intent(in) :: what
+        call get_command_argument(k, arg)
+        read (arg, *, iostat=ios) value
+        if (ios /= 0 .or. verify(trim(arg), '+0123456789') /= 0 .or. value < 1) &
+            call bad_arguments(what // ' = ''' // trim(arg) // ''': needs a whole number >= 1')
+    end function whole_argument
+
+    !> Argument `k`, a positive number (`what` names it in the message).
+    real(wp) function tolerance_argument(k, what) result(value)
+        integer, intent(in) :: k
+        character(len=*), intent(in) :: what
+        call get_command_argument(k, arg)
+        read (arg, *, iostat=ios) value
+        if (ios /= 0 .or. len_trim(arg) == 0) then
+            call bad_arguments(what // ' = ''' // trim(arg) // ''': needs a number')
+        else if (.not. value > 0.0_wp) then
+            call bad_arguments(what // ' = ''' // trim(arg) // ''': needs a number > 0')
+        end if
+    end function tolerance_argument
+
     !> The run's outcome from its status: done, capped (max_steps) or
     !> failed (the reason to standard error).
     subroutine set_outcome()
@@ -220,19 +274,18 @@ contains
             return
         end if
         dash = index(integrator, '-')
-        if (dash == 0) then
-            name = integrator
-            return
-        end if
-        name = integrator(1:dash - 1)
+        name = integrator
+        if (dash > 0) name = integrator(1:dash - 1)
+        if (solver_id(name) == 0) call bad_arguments('unknown integrator ''' // integrator // &
+            '''')
+        if (dash == 0) return
         select case (integrator(dash + 1:))
         case ('p2')
             settings = ', pmax = 2'
         case ('euler')
             settings = ', mexax_base = ''euler'''
         case default
-            write (*, '(a)') 'unknown variant ' // integrator(dash:)
-            error stop 2
+            call bad_arguments('unknown variant ''' // integrator(dash:) // '''')
         end select
     end subroutine solver_of
 
@@ -266,8 +319,7 @@ contains
             if (name == 'pendggl') simulation = 'problem = ''pendulum'', t_end = 3, &
                 &pendulum_angle = 1, pendulum_formulation = ''ggl'''
         case default
-            write (*, '(a)') 'unknown problem ' // name
-            error stop 2
+            call bad_arguments('unknown problem ''' // name // '''')
         end select
         text = '&simulation ' // simulation // ' /' // nl // '&solver name = ''' // solver // &
             ''', rtol = ' // trim(rtol_text) // ', atol = ' // trim(rtol_text) // &
@@ -311,10 +363,7 @@ contains
         type(status_t) :: st
         call solver_of(trim(integrator_name), name, settings)
         call new_solver(name, solver, st)
-        if (.not. st%ok()) then
-            write (*, '(a)') st%text()
-            error stop 2
-        end if
+        if (.not. st%ok()) call give_up(st%text())
         select type (solver)
         type is (mexax_t)
             if (index(settings, 'euler') > 0) solver%base = mexax_base_euler
@@ -324,10 +373,7 @@ contains
         call pendulum_chain_initial(chain, q, v, lam)
         formulation = new_formulation(chain, formulation_index2, q, constant_mass=.true., &
             status=st, sparse=solver_name /= 'dense')
-        if (.not. st%ok()) then
-            write (*, '(a)') 'chain: ' // st%text()
-            error stop 1
-        end if
+        if (.not. st%ok()) call give_up('chain: ' // st%text())
         y = [q, v, lam]
         t_end = 1.0_wp
         if (npar == 8) y_ref = chain_anchor_t1
@@ -348,10 +394,7 @@ contains
     !> y(t_end) of the reference run, one value a line after n.
     subroutine write_reference()
         integer :: unit, i
-        if (outcome /= 'done') then
-            write (0, '(a)') 'reference run did not reach t_end; no file written'
-            error stop 1
-        end if
+        if (outcome /= 'done') call give_up('reference run did not reach t_end; no file written')
         open (newunit=unit, file=trim(reference_file), action='write', status='replace')
         write (unit, '(i0)') plan%problem%n
         write (unit, '(es25.17e3)') (y(i), i=1, size(y))
@@ -402,9 +445,10 @@ contains
         real(wp) :: mem0, mem1, t_tangent, t_force
         integer :: kind, m, p, ndof, repeats, threads
         call get_command_argument(2, arg)
-        kind = merge(hex8, hex27, trim(arg) == 'hex8')
-        call get_command_argument(3, arg)
-        read (arg, *) ndof
+        if (arg /= 'hex8' .and. arg /= 'hex27') call bad_arguments('assembly ' // trim(arg) // &
+            ': use hex8 or hex27')
+        kind = merge(hex8, hex27, arg == 'hex8')
+        ndof = whole_argument(3, 'NDOF')
         ! m³ elements, (p m + 1)² (p m) free nodes with the xmin face clamped
         p = merge(1, 2, kind == hex8)
         m = max(1, nint((ndof / 3.0_wp)**(1.0_wp / 3) / p))
@@ -413,10 +457,7 @@ contains
         if (status%ok()) call box_mesh(mesh, kind, [m, m, m], [1.0_wp, 1.0_wp, 1.0_wp], status)
         if (status%ok()) call mesh%node_set('xmin', fixed, status)
         if (status%ok()) call new_flexible_body(body, mesh, [mat], fixed, status)
-        if (.not. status%ok()) then
-            write (*, '(a)') 'assembly: ' // status%text()
-            error stop 1
-        end if
+        if (.not. status%ok()) call give_up('assembly: ' // status%text())
         q = body%free_positions()
         allocate (v(body%nv), source=0.01_wp, k(body%nv))
         q = q * 1.01_wp   ! a uniform stretch: every element works
@@ -449,17 +490,18 @@ contains
         integer :: nx, ny, nz, n, m
         character(len=24) :: mesh
         call get_command_argument(2, problem_name)
-        call get_command_argument(3, arg)
-        read (arg, *) nx
+        if (.not. (problem_name == 'hex' .and. nargs == 5 .or. (problem_name == 'rd1d' .or. &
+            problem_name == 'rd2d') .and. nargs == 3)) call bad_arguments('sparse_lu takes &
+            &hex NX NY NZ, rd1d N or rd2d N')
         if (problem_name == 'hex') then
-            call get_command_argument(4, arg)
-            read (arg, *) ny
-            call get_command_argument(5, arg)
-            read (arg, *) nz
+            nx = whole_argument(3, 'NX')
+            ny = whole_argument(4, 'NY')
+            nz = whole_argument(5, 'NZ')
             write (mesh, '("hex",i0,"x",i0,"x",i0)') nx, ny, nz
             call node_graph_jacobian(nx, ny, nz, dofs, jac, status)
             if (status%ok()) call node_graph_mass(jac%n, mass, status)
         else
+            nx = whole_argument(3, 'N')
             write (mesh, '(a,"-",i0)') trim(problem_name), nx
             ! the Brusselator as a scene makes it, at its initial value
             integrator_name = 'reference'
@@ -481,10 +523,7 @@ contains
         if (status%ok()) call predicted_fill_ratio(jac, fill, status, mass)
         if (status%ok()) call new_linear_solver('auto', n, storage_sparse, auto, status, &
             mass=mass, jac=jac)
-        if (.not. status%ok()) then
-            write (*, '(a)') 'sparse_lu: ' // status%text()
-            error stop 1
-        end if
+        if (.not. status%ok()) call give_up('sparse_lu: ' // status%text())
         allocate (values(pattern%nonzeros()))
         call pattern%gather(mass, jac)
         call pattern%real_values(1.0_wp, values)
@@ -578,14 +617,13 @@ contains
         integer :: mech, m, i, calls, runs, batch
         integer(8) :: c0, c1, rate
         call get_command_argument(2, problem_name)
+        if (problem_name /= 'fourbar' .and. problem_name /= 'slidercrank') &
+            call bad_arguments('ad ' // trim(problem_name) // ': use fourbar or slidercrank')
         mech = merge(mechanism_four_bar, mechanism_slider_crank, problem_name == 'fourbar')
         call new_solver(solvers(solver_radau5)%name, radau5, status)
         do m = 1, 3
             call new_mechanism(mech, sys, q0, status, trim(modes(m)))
-            if (.not. status%ok()) then
-                write (*, '(a)') 'ad: ' // status%text()
-                error stop 1
-            end if
+            if (.not. status%ok()) call give_up('ad: ' // status%text())
             allocate (c(sys%nc), g(sys%nc, sys%nv), cq(sys%nc, sys%nq), ct(sys%nc), gam(sys%nc))
             v0 = 0.1_wp
             ! best of 5 batches (the least disturbed by the rest of the machine)

@@ -159,6 +159,86 @@ if grep -nE '\.\./shared|shared/docs|(ALGORITHMS|PAPER|DESIGN|STYLE)\.md' \
 else pass docs-self-contained; fi
 
 expect help 0 "usage:" --help
+expect help-names-command-help 0 "flexmbs COMMAND --help" --help
+
+# command_help NAME PATTERN OPTIONS ARGS...: a command's own usage
+# (app/help_text): exit 0, on standard output only, PATTERN in it, a line
+# of its own for each of the space-separated OPTIONS, and not the overview
+# of `flexmbs --help` (whose first line no command's usage has)
+command_help() {
+    local name=$1 pattern=$2 options=$3
+    shift 3
+    local out rc option
+    out=$("$exe" "$@" 2>help.err)
+    rc=$?
+    problem=""
+    if [ "$rc" -ne 0 ]; then problem="exit $rc: $(cat help.err)"
+    elif [ -s help.err ]; then problem="standard error: $(cat help.err)"
+    elif ! grep -qF -- "$pattern" <<<"$out"; then problem="output lacks '$pattern': $out"
+    elif grep -qF -- "- flexible multibody dynamics and stiff DAE solvers" <<<"$out"; then
+        problem="the overview of flexmbs --help, not the command's usage"
+    fi
+    for option in $options; do
+        [ -z "$problem" ] && ! grep -qE -- "^  (-[a-z], )?$option( |\$)" <<<"$out" &&
+            problem="no line for option $option: $out"
+    done
+    if [ -n "$problem" ]; then fail "$name" "$problem"; else pass "$name"; fi
+}
+command_help help-run "usage: flexmbs run FILE.nml" "--quiet --verbose --force --help" \
+    run --help
+command_help help-run-short "usage: flexmbs run FILE.nml" "" run -h
+# --help wins over the other arguments, a missing file, a missing value
+command_help help-run-among-arguments "usage: flexmbs run FILE.nml" "" run --quiet --help x.nml
+command_help help-reference "usage: flexmbs reference STUDY.nml" "--quiet --force --help" \
+    reference --help
+command_help help-sweep "usage: flexmbs sweep STUDY.nml" \
+    "--quiet --force -j --point --merge --slurm --chunk --partition --time --mem --submit --help" \
+    sweep --help
+command_help help-sweep-missing-value "usage: flexmbs sweep STUDY.nml" "" sweep --chunk --help
+command_help help-columns "usage: flexmbs columns FILE.h5 COLUMN" "--help" columns --help
+command_help help-columns-with-file "usage: flexmbs columns FILE.h5 COLUMN" "" columns r.h5 -h
+command_help help-modes-own "usage: flexmbs modes FILE.nml" \
+    "--time --count --method --shift --output --no-run --force --help" modes --help
+command_help help-scene-reference "usage: flexmbs scene-reference" "--help" \
+    scene-reference --help
+expect scene-reference-argument 2 "try 'flexmbs scene-reference --help'" scene-reference x
+expect unknown-option-names-command-help 2 "try 'flexmbs run --help'" run x.nml --loud
+
+# flexmbs-bench (an fpm example, bench/bench.f90, built beside flexmbs):
+# a wrong command line gives its usage on standard error and exit 2, no
+# backtrace; --help the usage on standard output and exit 0
+bench=$(dirname "$(readlink -f "$exe")")/../example/flexmbs-bench
+# bench_args NAME CODE ARGS...
+bench_args() {
+    local name=$1 code=$2
+    shift 2
+    local rc
+    problem=""
+    if [ ! -x "$bench" ]; then
+        fail "$name" "no flexmbs-bench beside $exe ($bench)"
+        return
+    fi
+    "$bench" "$@" > bench.out 2> bench.err
+    rc=$?
+    local usage=bench.err quiet=bench.out
+    [ "$code" -eq 0 ] && usage=bench.out quiet=bench.err
+    if [ "$rc" -ne "$code" ]; then problem="exit $rc, expected $code: $(cat bench.err)"
+    elif ! grep -q '^usage: flexmbs-bench' "$usage"; then
+        problem="no usage in $usage: $(cat bench.out bench.err)"
+    elif [ -s "$quiet" ]; then problem="$quiet is not empty: $(cat "$quiet")"
+    elif grep -qiE 'backtrace|error termination|error stop|runtime error' bench.err; then
+        problem="$(cat bench.err)"
+    fi
+    if [ -n "$problem" ]; then fail "$name" "$problem"; else pass "$name"; fi
+}
+bench_args bench-no-arguments 2
+bench_args bench-too-few-arguments 2 radau5 vdp 2
+bench_args bench-not-a-number 2 radau5 vdp x dense
+bench_args bench-unknown-problem 2 radau5 vdpp 2 dense
+bench_args bench-unknown-integrator 2 fly vdp 2 dense
+bench_args bench-bad-tolerance 2 radau5 vdp 2 dense 100 -1
+bench_args bench-sparse-lu-short 2 sparse_lu hex 3
+bench_args bench-help 0 --help
 expect version 0 "flexmbs 0." --version
 # the version its files carry (core/version) is fpm.toml's
 expect version-is-fpm-toml 0 "flexmbs $(sed -n 's/^version = "\(.*\)"/\1/p' "$root/fpm.toml")" \

@@ -9,7 +9,9 @@
 - the README stays a short entry point (at most 250 lines);
 - docs/README.md lists every page of docs/;
 - with the executable: docs/scene_reference.md is what
-  `flexmbs scene-reference` prints from the schema, and the help names it.
+  `flexmbs scene-reference` prints from the schema, and the help names it;
+  every command the documentation or `flexmbs --help` names has a usage of
+  its own (`flexmbs COMMAND --help`: exit 0, `usage: flexmbs COMMAND`).
 
 The last line is `N passed, M failed`; the exit status is non-zero on
 failures.
@@ -59,6 +61,53 @@ def outside_fences(text):
             continue
         if not fence:
             yield line
+
+
+def inside_fences(text):
+    """The lines of a Markdown text that are in code blocks."""
+    fence = False
+    for line in text.split('\n'):
+        if line.lstrip().startswith('```'):
+            fence = not fence
+        elif fence:
+            yield line
+
+
+# a command as the documentation writes it: in code, `flexmbs WORD`, or a
+# line of a code block that starts with it (after a shell prompt)
+CODE_COMMAND = re.compile(r'`flexmbs ([a-z][a-z-]*)')
+BLOCK_COMMAND = re.compile(r'^\s*(?:\$ )?flexmbs ([a-z][a-z-]*)')
+HELP_COMMAND = re.compile(r'^  flexmbs ([a-z][a-z-]*)', re.M)
+
+
+def documented_commands(files):
+    """The flexmbs commands the pages name, each with a page naming it."""
+    found = {}
+    for path in files:
+        with open(path, encoding='utf-8') as f:
+            text = f.read()
+        names = set(CODE_COMMAND.findall(text))
+        names.update(m.group(1) for m in map(BLOCK_COMMAND.match, inside_fences(text)) if m)
+        for name in names:
+            found.setdefault(name, os.path.relpath(path, ROOT))
+    return found
+
+
+def command_help_problems(exe, files, usage):
+    """Each command named by the pages or the overview has its own usage."""
+    named = documented_commands(files)
+    for name in HELP_COMMAND.findall(usage):
+        named.setdefault(name, '`flexmbs --help`')
+    problems = []
+    for name, where in sorted(named.items()):
+        run = subprocess.run([exe, name, '--help'], capture_output=True, text=True)
+        if (run.returncode != 0 or run.stderr
+                or not run.stdout.startswith('usage: flexmbs ' + name)):
+            problems.append('%s names `flexmbs %s`, whose --help gives exit %d and %r'
+                            % (where, name, run.returncode, (run.stderr or run.stdout)[:80]))
+    if not named:
+        problems.append('no command found in the pages')
+    return problems
 
 
 def slug(heading):
@@ -144,6 +193,7 @@ def main():
         usage = subprocess.run([exe, '--help'], capture_output=True, text=True).stdout
         check('help-names-the-reference', [] if 'docs/scene_reference.md' in usage
               else ['--help does not name docs/scene_reference.md'])
+        check('every-command-has-its-help', command_help_problems(exe, files, usage))
 
     print('%d passed, %d failed' % (passed, failed))
     return 1 if failed else 0
