@@ -142,9 +142,11 @@ contains
             'Run the scene described by FILE.nml: read and check the whole file first', &
             '(every error listed, nothing written), integrate it, write the outputs it', &
             'names (the HDF5 trajectory, a statistics table, ParaView files), and print', &
-            'the statistics line and the end state on standard output: the bodies by', &
-            'name, the energy and the constraint drift for a scene with bodies, the', &
-            'state y (at most 12 components) for one without (docs/user_guide.md).', &
+            'the statistics line, the linear solver that factored the Newton matrices', &
+            '(what linear_solver = ''auto'' chose) and the end state on standard', &
+            'output: the bodies by name, the energy and the constraint drift for a', &
+            'scene with bodies, the state y (at most 12 components) for one without', &
+            '(docs/user_guide.md).', &
             '', &
             'options:', &
             quiet_text, &
