@@ -618,6 +618,11 @@ contains
         call check(error, index(progress%line(), '50.0 %') > 0, 'percent: ' // progress%line())
         call check(error, index(progress%line(), 'steps 10') > 0, 'steps')
         call check(error, index(progress%line(), 'rejected 2') > 0, 'rejected')
+        ! half the simulated time in 75 s: as long again to go
+        call check(error, index(progress%line(75.0_wp), 'elapsed 1:15  left ~1:15') > 0, &
+            'elapsed and left: ' // progress%line(75.0_wp))
+        call check(error, index(progress%line(3725.0_wp), 'elapsed 1:02:05  left ~1:02:05') &
+            > 0, 'hours: ' // progress%line(3725.0_wp))
         call progress%watch(ida)
         call check(error, index(progress%line(), 'rejected') == 0, 'no counts, no rejections')
         call progress%watch(radau5)
@@ -626,6 +631,7 @@ contains
         text = read_text(path)
         call check(error, text(1:1) == achar(13), 'redrawn with a carriage return')
         call check(error, index(text, 't =  1.00000E+00 s') > 0, 'time shown: ' // text)
+        call check(error, index(text, 'elapsed ') > 0, 'elapsed shown: ' // text)
         call delete(path)
         progress = new_progress(0.0_wp, 2.0_wp, quiet=.true., unit=unit)
         call check(error, .not. progress%wants_steps(), 'quiet display wants nothing')

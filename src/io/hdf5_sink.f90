@@ -10,15 +10,20 @@
 !>   attributes on / creator ('flexmbs 0.1.0'), flexmbs_version, created (ISO
 !>                   8601), input_text, solver, outcome, NST ... NPRJ, CPU,
 !>                   WALL, t_reached
-!> Each record is written and the file flushed at once, so a run that
-!> fails or is interrupted leaves a file that opens without repair; the
-!> number of complete records is the length of /time (written last).
+!> Records are held in memory and written in batches (flexmbs_io_hdf5_series):
+!> when a batch is full (batch_bytes), when flush_interval seconds of wall
+!> time have passed since the last write, and when the run ends in any way
+!> it can report (finish, statistics, close: also after a solver failure or
+!> SIGINT/SIGTERM). Each batch ends with /time and a flush, so a file whose
+!> writer was killed outright (SIGKILL, power) opens without repair and
+!> misses at most the records of the last interval; the number of complete
+!> records is the length of /time.
 !> The file uses HDF5's default (not 'latest') library-version bounds.
 !> An input text too large for a compact attribute goes to the scalar
 !> string dataset /input_text instead.
 module flexmbs_io_hdf5_sink
     use hdf5
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_io_error, status_bad_input
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_stats, only: dae_stats_t
@@ -26,7 +31,8 @@ module flexmbs_io_hdf5_sink
     use flexmbs_core_version, only: creator, version
     use flexmbs_io_record_values, only: record_values_t
     use flexmbs_io_hdf5_text, only: read_string_attribute, write_string_attribute, &
-        string_type, utf8_string_type, group_creating, delete_attribute
+        string_type, utf8_string_type, delete_attribute, group_creating
+    use flexmbs_io_hdf5_series, only: series_batch_t, create_series
     use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_char, c_null_char
     implicit none
     private
@@ -39,19 +45,26 @@ module flexmbs_io_hdf5_sink
     !> Target bytes of one chunk of /y (records per chunk = this / (8 n)).
     integer, parameter :: chunk_bytes = 65536
     integer, parameter :: time_chunk = 1024
+    !> Memory for the records held between two writes (all series together),
+    !> and the most records one batch holds.
+    integer, parameter :: batch_bytes = 16 * 1024 * 1024
+    integer, parameter :: max_batch_records = 1000000
+    !> Wall seconds after which held records are written even if the batch
+    !> is not full: what a killed run may lose.
+    real(wp), parameter, public :: flush_interval = 1.0_wp
 
     !> A named slice y(first:last) written as its own dataset.
     type :: block_t
         character(len=:), allocatable :: name
         integer :: first = 0, last = 0
-        integer(hid_t) :: dset = -1
+        type(series_batch_t) :: batch
     end type block_t
 
     !> A series computed from each record (add_series).
     type :: series_t
         character(len=:), allocatable :: path
         integer :: rows = 0, columns = 1
-        integer(hid_t) :: dset = -1
+        type(series_batch_t) :: batch
         class(record_values_t), allocatable :: source
         real(wp), allocatable :: buffer(:)  !! one record's values
     end type series_t
@@ -59,10 +72,14 @@ module flexmbs_io_hdf5_sink
     type, extends(sink_t), public :: hdf5_sink_t
         character(len=:), allocatable :: path
         integer :: n = 0                 !! length of y
-        integer :: records = 0           !! records written so far
+        integer :: records = 0           !! records written to the file so far
+        integer :: pending = 0           !! records held, not yet written
+        integer :: capacity = 0          !! records a batch holds (set at the first)
+        integer(i8) :: last_write = 0    !! system_clock count of the last write
         logical :: every_step = .false.  !! record accepted steps instead of output times
         logical :: is_open = .false.
-        integer(hid_t) :: file = -1, time_dset = -1, y_dset = -1
+        integer(hid_t) :: file = -1
+        type(series_batch_t) :: time_batch, y_batch
         type(block_t), allocatable :: blocks(:)
         type(series_t), allocatable :: series(:)
     contains
@@ -179,15 +196,17 @@ contains
         call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%file, err)
         if (check(err, 'create the file')) return
         self%is_open = .true.
-        call create_series(self%file, 'time', 0, time_chunk, self%time_dset, err)
+        self%pending = 0
+        self%capacity = 0
+        call create_series(self%file, 'time', 0, time_chunk, self%time_batch, err)
         if (check(err, 'create /time')) return
         ! the unit and meaning, as every named series has them
-        call write_string_attribute(self%time_dset, 'unit', 's', err)
-        if (err >= 0) call write_string_attribute(self%time_dset, 'description', &
+        call write_string_attribute(self%time_batch%dset, 'unit', 's', err)
+        if (err >= 0) call write_string_attribute(self%time_batch%dset, 'description', &
             'the time of each record (row of /y and of every series)', err)
         if (check(err, 'write the attributes of /time')) return
         per_chunk = max(1, min(time_chunk, chunk_bytes / (8 * n)))
-        call create_series(self%file, 'y', n, per_chunk, self%y_dset, err)
+        call create_series(self%file, 'y', n, per_chunk, self%y_batch, err)
         if (check(err, 'create /y')) return
         call write_string_attribute(self%file, 'creator', creator, err)
         if (err >= 0) call write_string_attribute(self%file, 'flexmbs_version', version, err)
@@ -234,7 +253,7 @@ contains
             call status%set(status_bad_input, 'HDF5 sink: add_block before create')
             return
         end if
-        if (self%records > 0) then
+        if (self%records + self%pending > 0) then
             call status%set(status_bad_input, self%path // ': block /' // name // &
                 ' added after records were written')
             return
@@ -254,7 +273,7 @@ contains
         block%first = first
         block%last = last
         call create_series(self%file, name, m, max(1, min(time_chunk, chunk_bytes / (8 * m))), &
-                           block%dset, err)
+                           block%batch, err)
         if (err < 0) then
             call status%set(status_io_error, self%path // ': HDF5 cannot create /' // name)
             return
@@ -302,7 +321,7 @@ contains
         integer, intent(in), optional :: columns
         type(series_t), allocatable :: grown(:)
         integer :: err, k
-        if (.not. self%is_open .or. self%records > 0 .or. rows < 1) then
+        if (.not. self%is_open .or. self%records + self%pending > 0 .or. rows < 1) then
             call status%set(status_bad_input, 'HDF5 sink: series /' // path // &
                 ' needs an open file without records and rows >= 1')
             return
@@ -321,11 +340,11 @@ contains
             allocate (s%source, source=source)
             allocate (s%buffer(rows * s%columns))
             call create_series(self%file, path, rows, max(1, min(time_chunk, &
-                chunk_bytes / (8 * rows * s%columns))), s%dset, err, groups=.true., &
+                chunk_bytes / (8 * rows * s%columns))), s%batch, err, groups=.true., &
                 columns=s%columns)
-            if (err >= 0) call write_string_attribute(s%dset, 'unit', unit, err)
+            if (err >= 0) call write_string_attribute(s%batch%dset, 'unit', unit, err)
             if (err >= 0 .and. present(description)) &
-                call write_string_attribute(s%dset, 'description', description, err)
+                call write_string_attribute(s%batch%dset, 'description', description, err)
         end associate
         if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot create /' // &
                                      path)
@@ -340,22 +359,24 @@ contains
         call move_alloc(from%path, to%path)
         to%rows = from%rows
         to%columns = from%columns
-        to%dset = from%dset
+        to%batch = from%batch
         call move_alloc(from%source, to%source)
         call move_alloc(from%buffer, to%buffer)
     end subroutine move_series
 
 
 
-    !> Flush what is written; the file stays open for the statistics.
+    !> Write the records held and flush; the file stays open for the
+    !> statistics.
     subroutine sink_finish(self, status)
         class(hdf5_sink_t), intent(inout) :: self
         type(status_t), intent(inout) :: status
         integer :: err
         if (.not. self%is_open) return
-        call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, err)
+        call write_pending(self, err)
+        if (err >= 0) call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, err)
         if (err < 0 .and. status%ok()) &
-            call status%set(status_io_error, self%path // ': HDF5 cannot flush')
+            call status%set(status_io_error, self%path // ': HDF5 cannot write the last records')
     end subroutine sink_finish
 
 
@@ -375,7 +396,8 @@ contains
             call status%set(status_bad_input, 'HDF5 sink: write_statistics before create')
             return
         end if
-        err = 0
+        ! records still held go first: a caller may skip `finish`
+        call write_pending(self, err)
         call put_int('NST', stats%nst)
         call put_int('NAC', stats%nac)
         call put_int('NRJ', stats%nrj)
@@ -442,33 +464,29 @@ contains
         type(status_t), intent(out) :: status
         integer :: err, worst, i
         if (.not. self%is_open) return
-        worst = 0
+        call write_pending(self, worst)
+        worst = min(worst, 0)
         if (allocated(self%blocks)) then
             do i = 1, size(self%blocks)
-                call h5dclose_f(self%blocks(i)%dset, err)
+                call self%blocks(i)%batch%close(err)
                 worst = min(worst, err)
             end do
         end if
         if (allocated(self%series)) then
             do i = 1, size(self%series)
-                if (self%series(i)%dset < 0) cycle
-                call h5dclose_f(self%series(i)%dset, err)
+                call self%series(i)%batch%close(err)
                 worst = min(worst, err)
             end do
             deallocate (self%series)
         end if
-        err = 0
-        if (self%y_dset >= 0) call h5dclose_f(self%y_dset, err)
+        call self%y_batch%close(err)
         worst = min(worst, err)
-        err = 0
-        if (self%time_dset >= 0) call h5dclose_f(self%time_dset, err)
+        call self%time_batch%close(err)
         worst = min(worst, err)
         call h5fclose_f(self%file, err)
         worst = min(worst, err)
         self%is_open = .false.
         self%file = -1
-        self%y_dset = -1
-        self%time_dset = -1
         if (worst < 0) call status%set(status_io_error, self%path // ': HDF5 cannot close')
     end subroutine sink_close
 
@@ -511,12 +529,15 @@ contains
     ! ------------------------------------------------------------------
 
 
-    !> Append one record: /y and the blocks first, /time last, then flush.
+    !> Hold one record (the series evaluated now, at its t and y); write the
+    !> batch when it is full or flush_interval has passed since the last
+    !> write.
     subroutine append(self, t, y, status)
         class(hdf5_sink_t), intent(inout) :: self
         real(wp), intent(in) :: t, y(:)
         type(status_t), intent(inout) :: status
         integer :: err, i
+        integer(i8) :: now, rate
         if (.not. status%ok()) return
         if (.not. self%is_open) then
             call status%set(status_bad_input, 'HDF5 sink: record before create')
@@ -526,122 +547,120 @@ contains
             call status%set(status_bad_input, self%path // ': record of wrong length')
             return
         end if
-        call write_column(self%y_dset, self%n, self%records, y, err)
+        if (self%capacity == 0) then
+            call reserve_batches(self, status)
+            if (.not. status%ok()) return
+        end if
+        call self%y_batch%add(y)
         do i = 1, size(self%blocks)
-            if (err < 0) exit
             associate (b => self%blocks(i))
-                call write_column(b%dset, b%last - b%first + 1, self%records, &
-                                  y(b%first:b%last), err)
+                call b%batch%add(y(b%first:b%last))
             end associate
         end do
         do i = 1, size(self%series)
-            if (err < 0) exit
             associate (sr => self%series(i))
                 call sr%source%evaluate(t, y, sr%buffer, status)
-                if (.not. status%ok()) return
-                call write_column(sr%dset, sr%rows, self%records, sr%buffer, err, sr%columns)
+                if (.not. status%ok()) then
+                    call drop_record(self)
+                    return
+                end if
+                call sr%batch%add(sr%buffer)
             end associate
         end do
-        if (err >= 0) call write_column(self%time_dset, 0, self%records, [t], err)
-        if (err >= 0) call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, err)
-        if (err < 0) then
-            call status%set(status_io_error, self%path // ': HDF5 cannot append a record')
-            return
-        end if
-        self%records = self%records + 1
+        call self%time_batch%add([t])
+        self%pending = self%pending + 1
+        call system_clock(now, rate)
+        if (self%pending < self%capacity .and. &
+            real(now - self%last_write, wp) < flush_interval * real(rate, wp)) return
+        call write_pending(self, err)
+        if (err < 0) call status%set(status_io_error, self%path // &
+                                     ': HDF5 cannot append the records held')
     end subroutine append
 
-    !> An empty extendible dataset: (0) for m = 0, else (m, 0), chunked.
-    subroutine create_series(file, name, m, per_chunk, dset, err, groups, columns)
-        integer(hid_t), intent(in) :: file
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: m, per_chunk
-        integer(hid_t), intent(out) :: dset
+    !> Forget the record being added (a series could not be evaluated): the
+    !> series already given it drop it again, so every series stays aligned.
+    subroutine drop_record(self)
+        class(hdf5_sink_t), intent(inout) :: self
+        integer :: i
+        if (self%y_batch%count > self%pending) self%y_batch%count = self%pending
+        do i = 1, size(self%blocks)
+            self%blocks(i)%batch%count = min(self%blocks(i)%batch%count, self%pending)
+        end do
+        do i = 1, size(self%series)
+            self%series(i)%batch%count = min(self%series(i)%batch%count, self%pending)
+        end do
+    end subroutine drop_record
+
+    !> The batch capacity from the values of a record (all series known now:
+    !> none is added after the first record), and the room for it.
+    subroutine reserve_batches(self, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        type(status_t), intent(inout) :: status
+        integer :: i, stat, worst
+        real(wp) :: values
+        integer(i8) :: rate
+        values = real(self%y_batch%width() + self%time_batch%width(), wp)
+        do i = 1, size(self%blocks)
+            values = values + real(self%blocks(i)%batch%width(), wp)
+        end do
+        do i = 1, size(self%series)
+            values = values + real(self%series(i)%batch%width(), wp)
+        end do
+        self%capacity = int(max(1.0_wp, min(real(max_batch_records, wp), &
+            real(batch_bytes, wp) / (8.0_wp * values))))
+        call self%y_batch%reserve(self%capacity, worst)
+        call self%time_batch%reserve(self%capacity, stat)
+        worst = max(worst, stat)
+        do i = 1, size(self%blocks)
+            call self%blocks(i)%batch%reserve(self%capacity, stat)
+            worst = max(worst, stat)
+        end do
+        do i = 1, size(self%series)
+            call self%series(i)%batch%reserve(self%capacity, stat)
+            worst = max(worst, stat)
+        end do
+        if (worst /= 0) then
+            self%capacity = 0
+            call status%set(status_io_error, self%path // ': no memory for the records &
+                &held between two writes (' // bytes_held(values) // ')')
+            return
+        end if
+        call system_clock(self%last_write, rate)
+    contains
+        function bytes_held(per_record) result(text)
+            real(wp), intent(in) :: per_record
+            character(len=:), allocatable :: text
+            character(len=32) :: buf
+            write (buf, '(es9.2,a)') 8.0_wp * per_record * self%capacity, ' bytes'
+            text = trim(adjustl(buf))
+        end function bytes_held
+    end subroutine reserve_batches
+
+    !> Write the records held: /y, the blocks and series first, /time last,
+    !> then flush, so that /time never counts a record not wholly written.
+    subroutine write_pending(self, err)
+        class(hdf5_sink_t), intent(inout) :: self
         integer, intent(out) :: err
-        logical, intent(in), optional :: groups !! create the groups of a path
-        integer, intent(in), optional :: columns !! > 1: (m, columns, records)
-        integer(hid_t) :: space, plist, lcpl
-        integer(hsize_t) :: dims(3), maxdims(3), chunk(3)
-        integer :: rank, close_err, nc
-        nc = 1
-        if (present(columns)) nc = columns
-        if (m == 0) then
-            rank = 1
-            dims(1) = 0
-            maxdims(1) = H5S_UNLIMITED_F
-            chunk(1) = int(per_chunk, hsize_t)
-        else if (nc > 1) then
-            rank = 3
-            dims = [int(m, hsize_t), int(nc, hsize_t), 0_hsize_t]
-            maxdims = [int(m, hsize_t), int(nc, hsize_t), H5S_UNLIMITED_F]
-            chunk = [int(m, hsize_t), int(nc, hsize_t), int(per_chunk, hsize_t)]
-        else
-            rank = 2
-            dims(1:2) = [int(m, hsize_t), 0_hsize_t]
-            maxdims(1:2) = [int(m, hsize_t), H5S_UNLIMITED_F]
-            chunk(1:2) = [int(m, hsize_t), int(per_chunk, hsize_t)]
-        end if
-        dset = -1
-        call h5screate_simple_f(rank, dims(1:rank), space, err, maxdims(1:rank))
+        integer :: i
+        integer(i8) :: rate
+        err = 0
+        if (self%pending == 0) return
+        call self%y_batch%write_pending(self%records, err)
+        do i = 1, size(self%blocks)
+            if (err < 0) exit
+            call self%blocks(i)%batch%write_pending(self%records, err)
+        end do
+        do i = 1, size(self%series)
+            if (err < 0) exit
+            call self%series(i)%batch%write_pending(self%records, err)
+        end do
+        if (err >= 0) call self%time_batch%write_pending(self%records, err)
+        if (err >= 0) call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, err)
         if (err < 0) return
-        call h5pcreate_f(H5P_DATASET_CREATE_F, plist, err)
-        if (err >= 0) call h5pset_chunk_f(plist, rank, chunk(1:rank), err)
-        lcpl = H5P_DEFAULT_F
-        if (present(groups)) then
-            if (groups .and. err >= 0) call group_creating(lcpl, err)
-        end if
-        if (err >= 0) call h5dcreate_f(file, name, H5T_NATIVE_DOUBLE, space, dset, err, plist, &
-                                       lcpl_id=lcpl)
-        if (lcpl /= H5P_DEFAULT_F) call h5pclose_f(lcpl, close_err)
-        if (err >= 0) call h5pclose_f(plist, err)
-        if (err >= 0) call h5sclose_f(space, err)
-    end subroutine create_series
-
-    !> Extend a series by one record at position `k` (0-based) and write it.
-    subroutine write_column(dset, m, k, values, err, columns)
-        integer(hid_t), intent(in) :: dset
-        integer, intent(in) :: m, k  !! m = 0 for the 1-D /time
-        real(wp), intent(in) :: values(:)
-        integer, intent(out) :: err
-        integer, intent(in), optional :: columns !! > 1: a (m, columns) record
-        integer(hid_t) :: filespace, memspace
-        integer(hsize_t) :: size_new(3), offset(3), count(3)
-        integer :: rank, nc
-        nc = 1
-        if (present(columns)) nc = columns
-        if (m == 0) then
-            rank = 1
-            size_new(1) = int(k + 1, hsize_t)
-            offset(1) = int(k, hsize_t)
-            count(1) = 1
-        else if (nc > 1) then
-            rank = 3
-            size_new = [int(m, hsize_t), int(nc, hsize_t), int(k + 1, hsize_t)]
-            offset = [0_hsize_t, 0_hsize_t, int(k, hsize_t)]
-            count = [int(m, hsize_t), int(nc, hsize_t), 1_hsize_t]
-        else
-            rank = 2
-            size_new(1:2) = [int(m, hsize_t), int(k + 1, hsize_t)]
-            offset(1:2) = [0_hsize_t, int(k, hsize_t)]
-            count(1:2) = [int(m, hsize_t), 1_hsize_t]
-        end if
-        call h5dset_extent_f(dset, size_new(1:rank), err)
-        if (err < 0) return
-        call h5dget_space_f(dset, filespace, err)
-        if (err < 0) return
-        call h5sselect_hyperslab_f(filespace, H5S_SELECT_SET_F, offset(1:rank), &
-                                   count(1:rank), err)
-        if (err >= 0) call h5screate_simple_f(rank, count(1:rank), memspace, err)
-        if (err >= 0) then
-            call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, count(1:rank), err, &
-                            mem_space_id=memspace, file_space_id=filespace)
-            call h5sclose_f(memspace, err)
-        end if
-        call h5sclose_f(filespace, err)
-    end subroutine write_column
-
-
-
+        self%records = self%records + self%pending
+        self%pending = 0
+        call system_clock(self%last_write, rate)
+    end subroutine write_pending
 
     !> Initialise the Fortran HDF5 library once and silence its own error
     !> printing: every failure is reported through status_t instead.

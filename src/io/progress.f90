@@ -1,5 +1,8 @@
 !> A progress line on standard error: simulated time, percentage, steps
-!> and rejections, redrawn in place with a carriage return.
+!> and rejections, the wall time elapsed and an estimate of the time left
+!> (the elapsed time scaled by the simulated time still to go: steps grow
+!> or shrink as the solution does, so it is a guess that firms up as the
+!> run goes), redrawn in place with a carriage return.
 !>
 !> It is silent when standard error is not a terminal (logs and pipes get
 !> no '\r' clutter) or when the user asked for quiet. Redraws are limited
@@ -121,12 +124,14 @@ contains
         self%drawn = .false.
     end subroutine progress_finish
 
-    !> The text of the line as it stands.
-    function progress_line(self) result(line)
+    !> The text of the line as it stands; `elapsed` (wall seconds) instead
+    !> of the display's own clock (tests).
+    function progress_line(self, elapsed) result(line)
         class(progress_t), intent(in) :: self
+        real(wp), intent(in), optional :: elapsed
         character(len=:), allocatable :: line
         character(len=160) :: buf
-        real(wp) :: percent, span
+        real(wp) :: percent, span, seconds
         integer :: attempted, accepted
         span = self%t_end - self%t_start
         percent = 100.0_wp
@@ -142,7 +147,31 @@ contains
                 line = line // trim(buf)
             end if
         end if
+        if (present(elapsed)) then
+            seconds = elapsed
+        else
+            seconds = self%clock%wall()
+        end if
+        line = line // '  elapsed ' // duration_text(seconds)
+        ! nothing to scale before the first step, nothing left at the end
+        if (percent > 0.0_wp .and. percent < 100.0_wp) line = line // '  left ~' // &
+            duration_text(seconds * (100.0_wp - percent) / percent)
     end function progress_line
+
+    !> Wall seconds as m:ss, or h:mm:ss from an hour on.
+    pure function duration_text(seconds) result(text)
+        real(wp), intent(in) :: seconds
+        character(len=:), allocatable :: text
+        character(len=32) :: buf
+        integer :: s
+        s = nint(max(0.0_wp, min(seconds, 1.0e8_wp)))
+        if (s < 3600) then
+            write (buf, '(i0,a,i2.2)') s / 60, ':', mod(s, 60)
+        else
+            write (buf, '(i0,a,i2.2,a,i2.2)') s / 3600, ':', mod(s, 3600) / 60, ':', mod(s, 60)
+        end if
+        text = trim(buf)
+    end function duration_text
 
     subroutine draw(self, force)
         class(progress_t), intent(inout) :: self
