@@ -45,9 +45,11 @@ records() {
 # What is wrong with run.h5 after the run ended (empty when nothing): it
 # opens, /time is finite, strictly increasing, has >= 3 records, and ends
 # before t_end = 1; with ATTRIBUTE, the root attribute's text contains TEXT
-# and the statistics (NST) are there.
+# and the statistics (NST) are there. A check that raises (a dataset
+# missing, say) or exits non-zero is a problem too, not a silent pass.
 inspect() {
-    "$py" - "$@" <<'EOF'
+    local text rc
+    text=$("$py" - "$@" 2> inspect.err <<'EOF'
 import math, sys
 import h5py
 try:
@@ -74,6 +76,13 @@ elif len(sys.argv) > 2:
     elif 'NST' not in f.attrs:
         print('no statistics (NST) on the root')
 EOF
+)
+    rc=$?
+    if [ "$rc" -ne 0 ]; then
+        echo "the check of run.h5 failed (exit $rc): ${text:+$text; }$(tail -n 1 inspect.err)"
+    elif [ -n "$text" ]; then
+        echo "$text"
+    fi
 }
 
 # signal NAME SIGNAL CODE [PATTERN...]: start the run, wait for 3 records,

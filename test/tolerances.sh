@@ -5,14 +5,19 @@
 # must finish with exit 0 and nothing on standard error. Its positions (/q;
 # van der Pol: /y) at the output times are compared with RADAU5's at 1e-13:
 # ERR = max over components and times of |error| / (TOL |y_ref| + TOL).
-# From 1e-6 to 1e-10 ERR <= 10; at 1e-2 and 1e-4 (where the largest
-# componentwise error of the five-body's coupler nodes reaches 19 TOL) and
-# at 1e-12 (where the reference's own error shows: DDASSL and IDA agree
-# with each other there) ERR <= 100. The error must fall as the tolerance
-# tightens (1e-4 against 1e-10). Below 1e-8 both stopped at t0 with
-# "corrector failed repeatedly" on the multibody scenes until the
-# multipliers' Newton corrections counted as h^(k-1) delta. A table of
-# ERR is printed.
+# From 1e-6 to 1e-10 ERR <= 10; at 1e-2 ERR <= 10 as well and at 1e-4
+# ERR <= 40, about twice the largest measured (the five-body's coupler
+# nodes: 4.2 / 3.9 TOL at 1e-2, 18.5 / 19.1 TOL at 1e-4 for DDASSL / IDA;
+# every other scene at most 0.61 TOL at both; the fine undamped mesh, run
+# by hand as docs/testing.md says: 4.2 / 3.9 and 0.026 / 0.21). An output
+# of zeros has ERR = |y_ref| / (TOL (|y_ref| + 1)), up to 1/TOL = 100 at
+# 1e-2, so a bound of 100 there let it pass; at 10 any component above
+# 0.11 fails it. At 1e-12 (where the reference's own error shows: DDASSL
+# and IDA agree with each other there; van der Pol 96) ERR <= 100. The
+# error must fall as the tolerance tightens (1e-4 against 1e-10). Below
+# 1e-8 both stopped at t0 with "corrector failed repeatedly" on the
+# multibody scenes until the multipliers' Newton corrections counted as
+# h^(k-1) delta. A table of ERR is printed.
 #
 #   bash test/tolerances.sh [path/to/flexmbs]
 #
@@ -70,8 +75,10 @@ import sys
 import h5py
 import numpy as np
 
-# ERR allowed: 10 from 1e-6 to 1e-10, 100 at the loose ends and at 1e-12
-BOUNDS = {'1e-2': 100.0, '1e-4': 100.0, '1e-12': 100.0}
+# ERR allowed: 10 from 1e-6 to 1e-10 and at 1e-2 (measured at most 4.2,
+# five_body), 40 at 1e-4 (measured at most 19.1, five_body), 100 at 1e-12
+# (the reference's own error; measured at most 96, van der Pol)
+BOUNDS = {'1e-2': 10.0, '1e-4': 40.0, '1e-12': 100.0}
 tolerances = sys.argv[1].split()
 reference_tolerance = sys.argv[2]
 runs = sys.argv[3:]
