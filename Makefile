@@ -305,6 +305,7 @@ bench: deps
 	bash bench/sparse.sh
 	bash bench/newton.sh
 	bash bench/assemblies.sh
+	bash bench/output.sh
 
 # The API documentation: FORD $(FORD_VERSION) from PyPI in its own virtual
 # environment (installed once), its settings in fpm.toml's [extra.ford]

@@ -856,6 +856,24 @@ untouched study-table-is-reference "&study: table: './ref.md' is an input of the
 sed -e "s/n_output *= *[0-9]*/n_output = 1000000000/" "$root/inputs/five_body.nml" > many_outputs.nml
 bad output-beyond-disk "&output: n_output = 1000000000: the HDF5 file 'many_outputs.h5' would need ~" \
     many_outputs.nml
+# one that fits but holds gigabytes is announced before the run, size and
+# time (the fine five-body: ~12 000 values a record, 3.7 GB at least); the
+# run is stopped once it has said so
+sed -e "s/n_output *= *[0-9]*/n_output = 40000/" -e "s#^&output#\&output file = 'out/big.h5',#" \
+    -e "s#mesh_file = '\([^/']\)#mesh_file = '$root/inputs/\1#" "$root/inputs/five_body_fine.nml" \
+    > big_output.nml
+"$exe" run big_output.nml --quiet > /dev/null 2> big_output.err &
+big=$!
+for _ in $(seq 150); do
+    grep -q "will hold at least" big_output.err 2>/dev/null && break
+    kill -0 "$big" 2>/dev/null || break
+    sleep 0.1
+done
+kill -KILL "$big" 2>/dev/null; wait "$big" 2>/dev/null
+if grep -qE "big_output.nml: &output: n_output = 40000: the HDF5 file '.*out/big.h5' will hold at least [0-9.]+ GB; writing it alone takes about [0-9]+ s" big_output.err
+then pass large-output-announced
+else fail large-output-announced "standard error: $(head -c 400 big_output.err)"; fi
+rm -f out/big.h5
 
 # issue 16's remaining defects, each as the user met it:
 # an output grid beyond memory died in an allocation

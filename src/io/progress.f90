@@ -50,7 +50,7 @@ module flexmbs_io_progress
         procedure :: line => progress_line
     end type progress_t
 
-    public :: new_progress, stderr_is_terminal
+    public :: new_progress, stderr_is_terminal, announce
 
 contains
 
@@ -72,6 +72,14 @@ contains
         end if
         call progress%clock%start()
     end function new_progress
+
+    !> A line a user must read before a long wait (an output of gigabytes),
+    !> on standard error, terminal or not, quiet or not.
+    subroutine announce(text)
+        character(len=*), intent(in) :: text
+        write (error_unit, '(a)') 'flexmbs: ' // text
+        flush (error_unit)
+    end subroutine announce
 
     !> True when file descriptor 2 is a terminal.
     logical function stderr_is_terminal()

@@ -18,7 +18,7 @@ module flexmbs_run_runner
     use flexmbs_io_namelist, only: scene_input_t
     use flexmbs_io_scene_schema, only: len_name
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
-    use flexmbs_io_progress, only: progress_t, new_progress
+    use flexmbs_io_progress, only: progress_t, new_progress, announce
     use flexmbs_io_multi_sink, only: multi_sink_t
     use flexmbs_io_signal_sink, only: signal_sink_t
     use flexmbs_io_table, only: new_stats_row, write_table
@@ -67,6 +67,13 @@ module flexmbs_run_runner
 
     public :: run_scene
 
+    !> An output from this size on is announced before the run, with the
+    !> time its writing alone takes at output_bytes_per_second (what the
+    !> writer reached here, bench/output.sh: about 150 MB/s for a small
+    !> state on a local disk).
+    real(wp), parameter :: large_output_bytes = 2.0e9_wp
+    real(wp), parameter :: output_bytes_per_second = 1.5e8_wp
+
 contains
 
     !> The HDF5 file of n_output records (y, its blocks and the time) must
@@ -88,11 +95,20 @@ contains
         end do
         bytes = 8.0_wp * real(per_record, wp) * real(scene%n_output, wp)
         free = free_space(scene%output_file(1:index(scene%output_file, '/', back=.true.)))
-        if (free >= 0 .and. bytes > real(free, wp)) call status%set(status_bad_input, &
-            scene%path // ': &output: n_output = ' // int_text(scene%n_output) // ': the &
-            &HDF5 file ''' // scene%output_file // ''' would need ~' // bytes_text(bytes) // &
-            ' (' // int_text(per_record) // ' values a record); its file system has ' // &
-            bytes_text(real(free, wp)) // ' free')
+        if (free >= 0 .and. bytes > real(free, wp)) then
+            call status%set(status_bad_input, &
+                scene%path // ': &output: n_output = ' // int_text(scene%n_output) // ': the &
+                &HDF5 file ''' // scene%output_file // ''' would need ~' // bytes_text(bytes) // &
+                ' (' // int_text(per_record) // ' values a record); its file system has ' // &
+                bytes_text(real(free, wp)) // ' free')
+        else if (bytes >= large_output_bytes) then
+            ! it fits, but a user should know before waiting for it
+            call announce(scene%path // ': &output: n_output = ' // int_text(scene%n_output) // &
+                ': the HDF5 file ''' // scene%output_file // ''' will hold at least ' // &
+                bytes_text(bytes) // '; writing it alone takes about ' // &
+                int_text(nint(bytes / output_bytes_per_second)) // ' s at ' // &
+                bytes_text(output_bytes_per_second) // '/s (docs/output.md)')
+        end if
     end subroutine check_output_size
 
     !> Run a validated scene: build, check, create the outputs, integrate,
