@@ -127,7 +127,7 @@ if want 4; then
     for d in "2, 4, 2" "3, 6, 3" "4, 8, 4" "6, 12, 6" "8, 16, 8" "8, 32, 8"; do
         set -- ${d//,/}
         nfe=$(( 3 * ($1 + 1) * ($2 + 1) * ($3 + 1) ))
-        declare -A PER=()
+        declare -A PER=([fullklu]=- [fullmumps]=- [condensedklu]=- [condensedmumps]=-)
         for path in full condensed; do
             # 'auto' first: the statistics name the LU it took; the other LU after
             f="$OUT/refine_$1x$2x$3_${path}_auto.nml"
@@ -135,6 +135,7 @@ if want 4; then
                 "s/t_end   = 1.0/t_end = 0.02/; s/divisions = 2, 4, 2/divisions = $d/; s/n_output = 101/n_output = 2/" "$path"
             r=$(run "$f")
             picked=$(echo $r | cut -d' ' -f5)
+            [ "$picked" = mumps ] || picked=klu   # a failed run names none
             PER[$path$picked]=$(per_step "$r")
             other=$([ "$picked" = klu ] && echo mumps || echo klu)
             f="$OUT/refine_$1x$2x$3_${path}_$other.nml"

@@ -7,8 +7,9 @@
 # value in a model or solver is a solver failure, exit 3, anyway). Then the
 # named series of every multibody result (/bodies, /joints, /drivers,
 # /flexible) are checked against its /y, and `flexmbs columns` by name
-# against them (test/result_names.py), and the five-body result read by
-# name and unit (test/five_body_names.py).
+# against them (test/result_names.py), the five-body result read by name
+# and unit (test/five_body_names.py), and every dataset that is zero at
+# every record explained by physics (test/zero_datasets.py).
 #
 #   bash test/examples.sh [path/to/flexmbs]
 #
@@ -88,6 +89,11 @@ for h5 in *.h5; do
     relay result_names/ < <("$py" "$root/test/result_names.py" "$h5" "$exe" 2>&1 ||
                             echo "FAIL $h5: result_names.py failed")
 done
+
+# No silent zeros: a dataset zero at every record must be so by physics,
+# each case with its reason (test/zero_datasets.py)
+relay "" < <("$py" "$root/test/zero_datasets.py" *.h5 2>&1 ||
+             echo "FAIL zero_datasets: test/zero_datasets.py found a failure or failed")
 
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

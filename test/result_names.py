@@ -177,7 +177,12 @@ if 'monitor' in f:
     if 'energy' not in f or not np.array_equal(f['energy'][:], f['monitor'][:, 3]) or \
             f['energy'].attrs.get('unit') != 'J':
         problems.append('/energy is not the monitor\'s energy in J')
-    if 'drift' not in f or not np.array_equal(f['drift'][:], f['monitor'][:, 1:3]):
+    if 'drift_note' in f.attrs:
+        # no constraints: no /drift, the note says so, the monitor's columns are 0
+        if 'drift' in f or np.any(f['monitor'][:, 1:3]) or \
+                'no constraints' not in str(f.attrs['drift_note']):
+            problems.append('/drift left out, but the scene has constraints or no note')
+    elif 'drift' not in f or not np.array_equal(f['drift'][:], f['monitor'][:, 1:3]):
         problems.append('/drift is not the monitor\'s drift')
 report(name + '/energy-and-drift', '; '.join(problems))
 

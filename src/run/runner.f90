@@ -214,7 +214,7 @@ contains
         result%has_energy = result%has_energy .and. status%ok()
 
         if (monitor%records > 0) then
-            result%has_drift = .true.
+            result%has_drift = monitor%formulation%nc > 0
             result%drift_end = monitor%table(2:3, monitor%records)
             result%monitor_energy = [monitor%table(4, 1), monitor%table(4, monitor%records)]
             result%has_monitor_energy = .not. any(ieee_is_nan(result%monitor_energy))
@@ -233,12 +233,18 @@ contains
                 if (io_status%ok()) call h5%annotate('energy', 'unit', 'J', io_status)
                 if (io_status%ok()) call h5%annotate('energy', 'description', 'kinetic plus &
                     &potential energy at each record of /time', io_status)
-                if (io_status%ok()) call h5%write_matrix('drift', drift, io_status)
-                if (io_status%ok()) call h5%annotate('drift', 'unit', 'm or 1; m/s or rad/s', &
-                    io_status)
-                if (io_status%ok()) call h5%annotate('drift', 'description', '|g|_inf and &
-                    &|G v + g_I|_inf at each record (the rows of g are lengths or direction &
-                    &cosines)', io_status)
+                if (monitor%formulation%nc == 0) then
+                    ! nothing to drift: said, not written as zeros
+                    if (io_status%ok()) call h5%write_text('drift_note', 'no /drift: the &
+                        &scene has no constraints (its /monitor drift columns are 0)', io_status)
+                else
+                    if (io_status%ok()) call h5%write_matrix('drift', drift, io_status)
+                    if (io_status%ok()) call h5%annotate('drift', 'unit', &
+                        'm or 1; m/s or rad/s', io_status)
+                    if (io_status%ok()) call h5%annotate('drift', 'description', '|g|_inf and &
+                        &|G v + g_I|_inf at each record (the rows of g are lengths or &
+                        &direction cosines)', io_status)
+                end if
                 if (io_status%ok() .and. size(monitor%reactions, 1) > 0) then
                     call h5%write_matrix('reactions', &
                         monitor%reactions(:, 1:monitor%records), io_status)
