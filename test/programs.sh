@@ -76,6 +76,17 @@ if out=$("$py" examples/plot_result.py "$work/rigid_flexible.h5" "$work/plot.png
 else
     fail "plot-by-name" "$out"
 fi
+# quantities named as the file names them, with a component; a name the
+# file lacks is refused, naming it
+if out=$("$py" examples/plot_result.py "$work/rigid_flexible.h5" 'link/position/y' \
+        'bar/von_mises' energy "$work/plot2.png" 2>&1) && [ -s "$work/plot2.png" ] &&
+    ! bad=$("$py" examples/plot_result.py "$work/rigid_flexible.h5" 'link/nowhere' \
+        "$work/plot3.png" 2>&1) && grep -q "no quantity 'link/nowhere'" <<<"$bad" &&
+    [ ! -e "$work/plot3.png" ]; then
+    pass "plot-quantities-by-name"
+else
+    fail "plot-quantities-by-name" "$out ${bad:-}"
+fi
 
 # The shared library: the program names libflexmbs.so (not the archive's
 # objects) and finds it in the install through the rpath of flexmbs-shared.
