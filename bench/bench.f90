@@ -19,7 +19,7 @@
 !> PROBLEM: vdp | rd1d | rd2d | pend3 | pend2 | pendggl | pendmech (the
 !> index-2 pendulum, for MEXAX's mechanical form) (N: unknowns for rd1d,
 !> grid points per side for rd2d, ignored otherwise); and chain (N bars,
-!> the chain of ALGORITHMS.md §8, no scene's problem: its index-2
+!> the chain of MEXAX's published test (docs/solvers.md), no scene's problem: its index-2
 !> formulation; ERR over (x1, y1, φ1) at t = 1 against the original's
 !> TOL 1e-11 values for N = 8, none otherwise); SOLVER: dense |
 !> klu | band | auto. ERR is eq. (13) of `paper_error` at t_end with
@@ -350,7 +350,7 @@ contains
         end select
     end subroutine make_plan_for
 
-    !> The chain of N bars (ALGORITHMS.md §8; no scene offers it) to t = 1,
+    !> The chain of N bars (MEXAX's published test, docs/solvers.md; no scene offers it) to t = 1,
     !> through the common interface: the catalogue's solver integrates the
     !> mechanical problem with its index-2 formulation (MEXAX the mechanical
     !> form itself); ERR over (x1, y1, φ1) against the original's values for

@@ -58,7 +58,7 @@ for integ in radau5 ddassl ddassl-p2 ida; do
     run $integ pend3 2 dense
 done
 # MEXAX integrates the mechanical form of the same pendulum directly, and
-# the planar chain of ALGORITHMS.md §8 (8 bars: ERR against the original's
+# the planar chain, MEXAX's published test (docs/solvers.md) (8 bars: ERR against the original's
 # reference; 100 and 1000 bars: dense against KLU on [M Gᵀ; G 0]).
 for integ in mexax mexax-euler; do
     run $integ pendmech 2 dense

@@ -15,7 +15,7 @@ contains
                  new_test('root_condition_confirms_angles', test_locus)]
     end function collect_bdf_stability
 
-    !> Within 1e-3 degrees of ALGORITHMS.md §5 (the paper truncates to
+    !> Within 1e-3 degrees of docs/theory.md §10 (the paper truncates to
     !> 90, 90, 86, 73, 51); minimising θ as tabulated.
     subroutine test_angles(error)
         type(error_t), allocatable, intent(out) :: error

@@ -81,7 +81,7 @@ module test_ddassl
         procedure :: output => sink_output
     end type output_sink_t
 
-    ! ALGORITHMS.md §8: the original DDASSL on Robertson, differenced PD.
+    ! docs/solvers.md's anchor: the original DDASSL on Robertson, differenced PD.
     integer, parameter :: anchor_nst = 382, anchor_nre = 566, anchor_nje = 80
     integer, parameter :: anchor_netf = 14, anchor_ncfn = 3
     real(wp), parameter :: anchor_band = 0.15_wp !! issue 3: within ±15 %

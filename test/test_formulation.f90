@@ -97,7 +97,7 @@ contains
     end subroutine test_match_hand_written
 
     !> The acceleration layout (q, v, a, λ[, μ]): analytic Jacobian against
-    !> central differences of F; the classes of ALGORITHMS.md §6.
+    !> central differences of F; the classes of docs/theory.md §3.2.
     subroutine test_acceleration_jacobian(error)
         type(error_t), allocatable, intent(out) :: error
         type(pendulum_mechanical_t), target :: mech
@@ -313,7 +313,7 @@ contains
             y(8) == 0.0_wp, 'y'' or μ wrong')
     end subroutine test_consistent_initial
 
-    !> Drift (ALGORITHMS.md §6, paper sec. 5.1) on a 64 s run at rtol 1e-6
+    !> Drift (docs/theory.md §3, paper sec. 5.1) on a 64 s run at rtol 1e-6
     !> (about 30 periods): max |g| over the last half of [0, T] for T = 8,
     !> 16, 32, 64 gives growth exponents; index 1 ≈ 2, index 2 ≈ 1; GGL and
     !> projection keep |g| at tolerance level without growth.

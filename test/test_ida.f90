@@ -139,7 +139,7 @@ contains
         end do
     end subroutine test_vdp_sweep
 
-    !> DESIGN.md: NST = nst + netf + ncfn, NAC = nst, NFE = nre, NFE_JAC =
+    !> docs/solvers.md, the common counters: NST = nst + netf + ncfn, NAC = nst, NFE = nre, NFE_JAC =
     !> nreLS, NJE = nje, NDEC = nsetups, NSOL = nni; IDA's own differences
     !> (jacobian = 'fd') show up in NFE_JAC only.
     subroutine test_statistics(error)

@@ -656,7 +656,7 @@ contains
         call run_scene(scene, .true., result, status)
         call check(error, status%ok(), 'run: ' // status%text())
         if (allocated(error)) return
-        ! the RADAU5 anchor of ALGORITHMS.md §8
+        ! the RADAU5 anchor of docs/solvers.md
         call check_close(error, result%y(1), 1.706161101_wp, 1e-6_wp, 'y1(2)')
         call check_close(error, result%y(2), -0.8928074777_wp, 1e-6_wp, 'y2(2)')
         call check(error, result%stats%nst == 275, 'NST')

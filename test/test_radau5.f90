@@ -148,7 +148,7 @@ contains
         call check(error, status%ok(), 'integration failed: ' // status%text())
         call check_close(error, y(1), 1.706161101_wp, 1e-9_wp, 'y1(2)')
         call check_close(error, y(2), -0.8928074777_wp, 1e-9_wp, 'y2(2)')
-        ! ALGORITHMS.md §8 anchor: the original's counters, exactly.
+        ! The anchor of docs/solvers.md: the original's counters, exactly.
         call check(error, solver%native%nfcn == 2218, 'NFCN /= 2218')
         call check(error, solver%native%njac == 161, 'NJAC /= 161')
         call check(error, solver%native%nstep == 275, 'NSTEP /= 275')

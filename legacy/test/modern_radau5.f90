@@ -1,6 +1,6 @@
 !> A modern caller of the classic face: callbacks are module procedures
 !> checked against `flexmbs_legacy_radau5_interface`; the van der Pol
-!> anchor (ALGORITHMS.md §8) must come out as from a fixed-form program.
+!> anchor (docs/solvers.md) must come out as from a fixed-form program.
 module modern_radau5_callbacks
     use flexmbs_core_kinds, only: wp
     implicit none

@@ -24,7 +24,7 @@ module flexmbs_dae_mexax_control
     integer, parameter :: euler_sequence(mexax_max_columns) = &
         [2, 3, 4, 5, 6, 8, 10, 12, 16, 20, 24, 30]
     ! Safety factors and limits of the column step sizes: the original's
-    ! values (ALGORITHMS.md §3.4), for both bases. SAFE2, FAC1 and FAC2 are
+    ! values (docs/theory.md §7.3), for both bases. SAFE2, FAC1 and FAC2 are
     ! SEULEX's; ODEX has 0.94, 0.02, 4; SAFE1 is 0.65 in ODEX, 0.6 in SEULEX.
     real(wp), parameter :: safe1 = 0.8_wp, safe2 = 0.93_wp
     real(wp), parameter :: fac1 = 0.1_wp, fac2 = 4.0_wp
@@ -35,7 +35,7 @@ module flexmbs_dae_mexax_control
     ! Divergence of the tableau: err_j ≥ max(4 err_{j−1}, 1), j > 2
     ! (ODEX and SEULEX alike).
     real(wp), parameter :: divergence_ratio = 4.0_wp
-    ! The work of column 1 is n_1 + this (ALGORITHMS.md §3.4; ODEX: 1).
+    ! The work of column 1 is n_1 + this (docs/theory.md §7.3; ODEX: 1).
     integer, parameter :: work_offset = 4
     ! Start column from −0.6 log10(tol) + 1.5, with tol = rtol (ODEX, (M)) or
     ! rtol + atol (SEULEX, (E)); (E) within [3, KDMAX − 2] (SEULEX).
