@@ -88,7 +88,8 @@ contains
             'An output never replaces an input, and two outputs of a run are never one', &
             'file. A file already at an output''s path is replaced only when it is', &
             'flexmbs''s own of that kind (an HDF5 result, a ParaView file, a table);', &
-            '--force replaces anything else too.', &
+            '--force replaces anything else too. A sweep refuses a reference made from', &
+            'another version of its study (exit 2); --force uses it, the table says so.', &
             '', &
             results_folder_text, &
             '', &
@@ -172,7 +173,7 @@ contains
     subroutine sweep_usage(unit)
         integer, intent(in) :: unit
         write (unit, '(a)') 'usage: flexmbs sweep STUDY.nml [-j N] [--quiet] [--force]', &
-            '       flexmbs sweep STUDY.nml --point K', &
+            '       flexmbs sweep STUDY.nml --point K [--force]', &
             '       flexmbs sweep STUDY.nml --merge [--force]', &
             '       flexmbs sweep STUDY.nml --slurm [--chunk K] [--partition P] [--time T]', &
             '                               [--mem M] [--submit] [--force]', &
@@ -183,10 +184,19 @@ contains
             '(docs/studies.md). -j, --point, --merge and --slurm split the grid into', &
             'records, one per point; only one of them at a time.', &
             results_folder_text, &
+            'Each first compares the reference''s fingerprint with what `flexmbs', &
+            'reference STUDY.nml` would make of the study now (the scene''s settings', &
+            'and mesh, t_start, t_end, the output times, the reference''s solver and', &
+            'tolerance) and refuses a stale reference (exit 2, nothing written),', &
+            'naming what differs.', &
             '', &
             'options:', &
             quiet_text, &
-            force_text, &
+            '  --force           use a stale reference (or one without a fingerprint)', &
+            '                    if its output times are the scene''s: the table says so', &
+            '                    (-j and --slurm pass --force on to the points and the', &
+            '                    merge); and replace any file at the table''s path, not', &
+            '                    only flexmbs''s own', &
             '  -j N              the points in N processes at a time (each', &
             '                    flexmbs sweep STUDY.nml --point K), then the merge', &
             '  --point K         grid point K alone (1 .. the grid''s size, in the', &

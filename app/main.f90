@@ -7,6 +7,7 @@
 !>   flexmbs sweep STUDY.nml --merge          the table from the records there
 !>   flexmbs sweep STUDY.nml --slurm [--chunk K] [--partition P] [--time T] [--mem M] [--submit]
 !>                                            a Slurm job array and merge job for the study
+!>   (every sweep refuses a stale reference, run/reference_fingerprint; --force uses it)
 !>   flexmbs columns FILE.h5 COLUMN [COLUMN ...]  t and columns of a result as text
 !>                                        (COLUMN: a number of /y, or rocker/position/z ...)
 !>   flexmbs modes FILE.nml [--time T] [--count K] [--shift S] [--method M] [--output P]
@@ -150,10 +151,11 @@ program flexmbs_main
             if (len(file) == 0) call fail_usage('sweep needs a study file')
             call check_sweep_modes()
             if (point > 0) then
-                call sweep_point(file, point)
+                call sweep_point(file, point, force)
             else if (merging) then
                 call sweep_merge(file, force)
             else if (slurm) then
+                cluster%force = force
                 call sweep_slurm(file, cluster, submit, force)
             else if (jobs > 1) then
                 call sweep_parallel(file, jobs, force)
@@ -276,11 +278,12 @@ contains
         type(study_input_t) :: study
         type(status_t) :: status
         type(sweep_run_t), allocatable :: runs(:)
+        character(len=:), allocatable :: stale
         call read_study(path, study, status)
         if (.not. status%ok()) call stop_on(status)
-        call run_sweep(study, quiet, runs, status, force)
+        call run_sweep(study, quiet, runs, status, force, stale)
         if (allocated(runs)) then
-            call print_runs(runs, study)
+            call print_runs(runs, study, stale)
             if (len(study%table) > 0 .and. status%ok()) &
                 write (output_unit, '(a)') 'table: ' // study%table
         end if
@@ -288,10 +291,12 @@ contains
         call finish(exit_ok)
     end subroutine sweep
 
-    !> A line per run, the table in the study's layout, the count.
-    subroutine print_runs(runs, study)
+    !> A line per run, the table in the study's layout, its note (a stale
+    !> reference used with --force), the count.
+    subroutine print_runs(runs, study, note)
         type(sweep_run_t), intent(in) :: runs(:)
         type(study_input_t), intent(in) :: study
+        character(len=*), intent(in) :: note
         type(stats_row_t), allocatable :: rows(:)
         integer :: k
         do k = 1, size(runs)
@@ -300,6 +305,7 @@ contains
         rows = runs%row
         write (output_unit, '(a)', advance='no') layout_text(rows, table_markdown, &
             trim(study%layout))
+        if (len(note) > 0) write (output_unit, '(a)') note
         write (output_unit, '(i0,a,i0,a)') count(runs%ok), ' runs finished, ', &
             count(.not. runs%ok), ' failed'
     end subroutine print_runs
@@ -318,8 +324,8 @@ contains
         if (.not. status%ok()) call stop_on(status)
         call prepare_points(study, npoints, folder, status, force)
         if (.not. status%ok()) call stop_on(status)
-        call run_points_in_processes(this_program(), path, npoints, folder, jobs, problems, &
-                                     status)
+        call run_points_in_processes(this_program(), path, npoints, folder, jobs, force, &
+                                     problems, status)
         if (len(problems) > 0) call say(problems(1:len(problems) - 1))
         if (.not. status%ok()) call stop_on(status)
         call merge_and_report(study, force)
@@ -348,7 +354,7 @@ contains
         character(len=:), allocatable :: report
         call merge_records(study, merged, status, force)
         if (.not. status%ok()) call stop_on(status)
-        call print_runs(merged%runs, study)
+        call print_runs(merged%runs, study, merged%stale_reference)
         if (merged%table_written) write (output_unit, '(a)') 'table: ' // study%table
         write (output_unit, '(a)') 'records: ' // merged%folder
         report = merge_report(merged, study, this_program())
@@ -368,17 +374,20 @@ contains
         logical, intent(in) :: submit, force
         type(study_input_t) :: study
         type(status_t) :: status
-        character(len=:), allocatable :: folder, array, merge, array_id, merge_id
+        character(len=:), allocatable :: folder, array, merge, array_id, merge_id, stale
         integer :: npoints
+        stale = ''
         call check_slurm_options(options, status)
         if (status%ok()) call read_study(path, study, status)
-        if (status%ok()) call prepare_points(study, npoints, folder, status, force)
+        if (status%ok()) call prepare_points(study, npoints, folder, status, force, stale)
         if (status%ok()) call write_slurm_scripts(study, this_program(), folder, npoints, &
                                                   options, array, merge, status)
         if (.not. status%ok()) call stop_on(status)
         write (output_unit, '(a)') 'job array: ' // array // ' (' // int_text(npoints) // &
             ' points in ' // int_text(array_task_count(npoints, options%chunk)) // ' tasks)', &
             'merge job: ' // merge
+        ! the tasks and the merge job use the stale reference too (--force)
+        if (len(stale) > 0) write (output_unit, '(a)') stale
         if (.not. submit) then
             write (output_unit, '(a)') 'submit with:', &
                 '  jobid=$(sbatch --parsable ' // shell_word(array) // ')', &
@@ -500,16 +509,17 @@ contains
 
     !> One point of a study's grid (a parallel sweep's process, a Slurm
     !> task): its record into the results folder, its line here.
-    subroutine sweep_point(path, k)
+    subroutine sweep_point(path, k, force)
         character(len=*), intent(in) :: path
         integer, intent(in) :: k
+        logical, intent(in) :: force
         type(study_input_t) :: study
         type(status_t) :: status
         type(sweep_run_t) :: run
         character(len=:), allocatable :: record
         call read_study(path, study, status)
         if (.not. status%ok()) call stop_on(status)
-        call run_sweep_point(study, k, run, record, status)
+        call run_sweep_point(study, k, run, record, status, force)
         if (.not. status%ok()) call stop_on(status)
         write (output_unit, '(a)') run%summary, 'record: ' // record
         call finish(exit_ok)

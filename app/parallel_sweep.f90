@@ -28,13 +28,15 @@ module flexmbs_app_parallel_sweep
 contains
 
     !> Points 1 .. npoints of the study `study_path` by `exe`, `jobs` at a
-    !> time; `problems` gets a line per point that ended without its
+    !> time, with --force when `force` (a stale reference used all the
+    !> same); `problems` gets a line per point that ended without its
     !> record (its exit status and log). status_signal when a signal
     !> stopped the sweep; an I/O error when an old record cannot be removed.
-    subroutine run_points_in_processes(exe, study_path, npoints, folder, jobs, problems, &
-                                       status)
+    subroutine run_points_in_processes(exe, study_path, npoints, folder, jobs, force, &
+                                       problems, status)
         character(len=*), intent(in) :: exe, study_path, folder
         integer, intent(in) :: npoints, jobs
+        logical, intent(in) :: force
         character(len=:), allocatable, intent(out) :: problems
         type(status_t), intent(out) :: status
         integer :: pids(max(jobs, 1)), points(max(jobs, 1))
@@ -45,9 +47,10 @@ contains
         character(len=:), allocatable :: args(:)
 
         problems = ''
-        ! exe sweep STUDY --point K --quiet
-        allocate (character(len=max(len(exe), len(study_path), 12)) :: args(6))
-        args(:) = [character(len=12) :: '', 'sweep', '', '--point', '', '--quiet']
+        ! exe sweep STUDY --point K --quiet [--force]
+        allocate (character(len=max(len(exe), len(study_path), 12)) :: args(merge(7, 6, force)))
+        args(1:6) = [character(len=12) :: '', 'sweep', '', '--point', '', '--quiet']
+        if (force) args(7) = '--force'
         args(1) = exe
         args(3) = study_path
         ! a record left from an earlier sweep must not stand for this one

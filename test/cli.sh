@@ -508,8 +508,78 @@ expect study-reference-no-folder 2 "the folder 'nodir' does not exist" reference
     --quiet
 printf "&study scene = '%s/inputs/four_bar.nml', reference_file = 'none.h5' /\n" "$root" \
     > no_reference.nml
-expect study-no-reference 2 "no reference file (make it with 'flexmbs reference' first)" \
+expect study-no-reference 2 "no reference file (make it with flexmbs reference no_reference.nml first)" \
     sweep no_reference.nml --quiet
+
+# A reference carries the fingerprint of what made it (the scene's settings,
+# its mesh, t_start, t_end, the output times, the reference's solver and
+# tolerance): every kind of sweep refuses one of another study (exit 2,
+# nothing written), naming what differs and the command that remakes it;
+# --force uses it and the table says so.
+cp "$root/inputs/four_bar.nml" fp_scene.nml
+printf "&study scene = 'fp_scene.nml', table = 'fp.md', reference_tolerance = 1e-6,
+  check_solver = 'none', solvers = 'radau5', stabilisations = 'ggl', tolerances = 1e-3, 1e-4 /\n" \
+    > fp.nml
+expect fingerprint-reference 0 "written: fp_reference.h5" reference fp.nml --quiet
+expect fingerprint-unchanged 0 "2 runs finished, 0 failed" sweep fp.nml --quiet
+rm -f fp.md
+# the motor twice as fast (and a comment, which changes nothing)
+sed -i -e 's/coefficients = 0.3, 6.283185307179586/coefficients = 0.3, 12.566370614359172/' \
+    -e '1s/^/! twice as fast\n/' fp_scene.nml
+# refused: sweep PATTERN ARGS...: exit 2, PATTERN and the command, no table,
+# no record, no Slurm script
+refused() {
+    local name=$1 pattern=$2
+    shift 2
+    rm -rf fp_points fp.md
+    check "$name" 2 "$pattern" sweep fp.nml "$@"
+    if [ -z "$problem" ] && ! grep -qF "remake it: flexmbs reference fp.nml (or use it as it is: --force)" <<<"$output"; then
+        problem="no command that remakes it: $output"
+    elif [ -z "$problem" ] && { [ -e fp.md ] || compgen -G "fp_points/*" > /dev/null; }; then
+        problem="written: $(ls fp.md fp_points 2>&1)"
+    fi
+    if [ -n "$problem" ]; then fail "$name" "$problem"; else pass "$name"; fi
+}
+scene_changed="what differs: the scene text (after defaults): &driver(1) coefficients = 0.3, 6.283185307179586, 0, 0 in the reference, 0.3, 12.566370614359172, 0, 0 now"
+refused fingerprint-scene "fp_reference.h5 was not made from the study as it is now; $scene_changed" --quiet
+refused fingerprint-point "$scene_changed" --point 1 --quiet
+refused fingerprint-merge "$scene_changed" --merge
+refused fingerprint-slurm "$scene_changed" --slurm
+refused fingerprint-jobs "$scene_changed" -j 2 --quiet
+note="note: the reference fp_reference.h5 is stale (it differs in the scene text), used as it is (--force)"
+check fingerprint-force 0 "$note" sweep fp.nml --quiet --force
+if [ -z "$problem" ] && ! grep -qxF "$note" fp.md; then problem="fp.md lacks the note: $(cat fp.md)"; fi
+if [ -n "$problem" ]; then fail fingerprint-force "$problem"; else pass fingerprint-force; fi
+check fingerprint-force-jobs 0 "$note" sweep fp.nml -j 2 --quiet --force
+if [ -z "$problem" ] && ! grep -q "2 runs finished, 0 failed" <<<"$output"; then problem="$output"; fi
+if [ -n "$problem" ]; then fail fingerprint-force-jobs "$problem"; else pass fingerprint-force-jobs; fi
+expect fingerprint-force-slurm 0 "$note" sweep fp.nml --slurm --force
+if grep -q -- '--point "$k" --quiet --force ' fp_points/array.sbatch && grep -q -- ' --merge --force$' \
+    fp_points/merge.sbatch; then pass fingerprint-force-slurm-scripts
+else fail fingerprint-force-slurm-scripts "$(cat fp_points/*.sbatch)"; fi
+# another t_end: refused, and with --force too, since the output times differ
+cp "$root/inputs/four_bar.nml" fp_scene.nml
+sed -i 's/t_end   = 1.0 /t_end   = 0.5 /' fp_scene.nml
+refused fingerprint-t-end "what differs: t_end (1 in the reference, 0.5 now); the output times (101 from 0 to 1 s in the reference, 101 from 0 to 0.5 s now)" --quiet
+check fingerprint-t-end-force 2 "the output times of the scene (101 from 0 to 0.5 s) are not those of the reference fp_reference.h5 (101 from 0 to 1 s)" \
+    sweep fp.nml --quiet --force
+if [ -n "$problem" ]; then fail fingerprint-t-end-force "$problem"; else pass fingerprint-t-end-force; fi
+# the reference's tolerance is part of it
+cp "$root/inputs/four_bar.nml" fp_scene.nml
+sed -i 's/reference_tolerance = 1e-6/reference_tolerance = 1e-7/' fp.nml
+refused fingerprint-tolerance "what differs: reference_tolerance (1E-6 in the reference, 1E-7 now)" --quiet
+sed -i 's/reference_tolerance = 1e-7/reference_tolerance = 1e-6/' fp.nml
+expect fingerprint-restored 0 "2 runs finished, 0 failed" sweep fp.nml --quiet
+# a reference of an older flexmbs, without a fingerprint
+/usr/bin/python3 - fp_reference.h5 <<'PY'
+import sys, h5py
+a = h5py.File(sys.argv[1], 'r+').attrs
+for k in ('reference_fingerprint', 'reference_fingerprint_parts', 'reference_scene_settings'):
+    del a[k]
+PY
+refused fingerprint-none "fp_reference.h5 has no fingerprint: it predates reference fingerprints" --quiet
+expect fingerprint-none-force 0 "note: the reference fp_reference.h5 is stale (predates reference fingerprints), used as it is (--force)" \
+    sweep fp.nml --quiet --force
 
 # Points alone, merges and Slurm scripts (docs/studies_on_a_cluster.md).
 # The -j 2 sweep above left every point's record in study_points/.
@@ -524,7 +594,8 @@ expect sweep-point 0 "record: study_points/point_2.rec" sweep study.nml --point 
 expect sweep-point-beyond 2 "study.nml: --point 7: the grid has points 1 .. 6" \
     sweep study.nml --point 7
 # a study without records: every point missing, the commands for each, exit 3
-cp study.nml empty.nml
+# (its reference is study.nml's: the same scene, solver and tolerance)
+sed "s/^&study/\&study reference_file = 'study_reference.h5',/" study.nml > empty.nml
 check sweep-merge-empty 3 "missing: 6 of 6 points have no current record in empty_points: 1-6" \
     sweep empty.nml --merge
 for k in 1 2 3 4 5 6; do

@@ -4,17 +4,20 @@
 !> alone into records that merge into the same table; records read back,
 !> stale, damaged, missing and failed ones in a merge; SHA-256 against
 !> FIPS 180 test vectors; how a job array's tasks share the points; the
-!> Slurm options and scripts.
+!> Slurm options and scripts; a reference's fingerprint, and every kind of
+!> sweep refusing a stale reference.
 module test_study
     use flexmbs_core_kinds, only: wp
-    use flexmbs_core_status, only: status_t
+    use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_text, only: int_text
     use flexmbs_core_files, only: delete_file, read_text_file, make_folder
     use flexmbs_core_sha256, only: sha256_hex
     use flexmbs_io_namelist, only: study_input_t, parse_study, parse_scene, scene_input_t, &
         read_study
     use flexmbs_run_study, only: make_reference, run_sweep, read_reference, sweep_run_t, &
-        run_sweep_point, read_study_scene
+        run_sweep_point, read_study_scene, prepare_points
+    use flexmbs_io_scene_settings, only: scene_settings
+    use flexmbs_run_reference_fingerprint, only: reference_print_t, reference_print
     use flexmbs_run_study_grid, only: sweep_point_t, sweep_points, array_spec, &
         array_task_count, task_first_points, task_last_point, point_list_text
     use flexmbs_run_study_results, only: results_folder, make_results_folder, record_path
@@ -42,6 +45,9 @@ contains
                  new_test('record_round_trip', test_record), &
                  new_test('merge_missing_failed_stale', test_merge), &
                  new_test('array_chunks', test_chunks), &
+                 new_test('scene_settings', test_settings), &
+                 new_test('reference_fingerprint', test_fingerprint), &
+                 new_test('shared_references', test_shared_references), &
                  new_test('slurm_options_and_scripts', test_slurm)]
     end function collect_study
 
@@ -327,8 +333,11 @@ contains
         call execute_command_line('mkdir -p ' // dir)
         call write_text(dir // 'm.nml', '&study scene = ''../../../inputs/four_bar.nml'', ' // &
             'solvers = ''radau5'', ''ddassl'', stabilisations = ''ggl'', tolerances = 1e-3, ' // &
-            '1e-4, pmax = 2, table = ''m.md'' /' // nl)
+            '1e-4, pmax = 2, table = ''m.md'', reference_tolerance = 1e-5, ' // &
+            'check_solver = ''none'' /' // nl)
         call read_study(dir // 'm.nml', study, status)
+        ! a merge checks the reference first (run/reference_fingerprint)
+        if (status%ok()) call make_reference(study, .true., report, status)
         if (status%ok()) call read_study_scene(study, base, status)
         if (status%ok()) call study_fingerprint(study, base, print, status)
         if (status%ok()) call make_results_folder(study, folder, status)
@@ -483,6 +492,130 @@ contains
                    shell_word('a b') == '''a b''' .and. &
                    shell_word('it''s') == '''it''\''''s''', 'shell words')
     end subroutine test_slurm
+
+    !> The scene's settings (io/scene_settings) read alike however written
+    !> (comments, order, spelling of numbers, quotes, the case of a choice),
+    !> with the defaults of what is left out, and differ in a changed value.
+    subroutine test_settings(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=24), parameter :: omit(1) = [character(len=24) :: 'output/*']
+        character(len=:), allocatable :: a, b, c
+        a = scene_settings('&simulation problem = ''van_der_pol'', t_end = 1.0, vdp_eps = 1e-3 /' &
+                           // nl // '&output n_output = 11 /', omit)
+        b = scene_settings('! the same' // nl // '&simulation vdp_eps=0.001, t_end=1.,' // nl // &
+                           '  problem = "VAN_DER_POL" /', omit)
+        c = scene_settings('&simulation problem = ''van_der_pol'', t_end = 1.0, vdp_eps = 2e-3 /', &
+                           omit)
+        call check(error, a == b, 'the same scene, written otherwise: ' // nl // a // nl // b)
+        call check(error, a /= c .and. index(c, '&simulation vdp_eps = 0.002' // nl) > 0 .and. &
+                   index(a, '&simulation vdp_eps = 0.001' // nl) > 0, 'a changed value: ' // c)
+        call check(error, index(a, '&simulation vdp_y1 = 2' // nl) > 0 .and. &
+                   index(a, '&simulation t_end = 1' // nl) > 0 .and. index(a, '&output') == 0, &
+                   'defaults, and &output left out: ' // a)
+    end subroutine test_settings
+
+    !> A reference of the four-bar over 0.1 s, then its scene changed (the
+    !> motor twice as fast): a sweep, a point, a merge and the points of a
+    !> parallel or Slurm sweep refuse it as bad input, naming the variable
+    !> and the command that remakes it, and write nothing; with force the
+    !> sweep runs and says the reference is stale. Another t_end is named too.
+    subroutine test_fingerprint(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), parameter :: dir = 'build/test-study/fingerprint/'
+        character(len=*), parameter :: speed = '6.283185307179586'
+        type(study_input_t) :: study
+        type(status_t) :: status
+        type(sweep_run_t), allocatable :: runs(:)
+        type(sweep_run_t) :: one
+        type(merged_t) :: merged
+        character(len=:), allocatable :: scene, log, stale, record, folder, why
+        logical :: exists
+        integer :: at, npoints
+        call execute_command_line('mkdir -p ' // dir)
+        call read_text_file('inputs/four_bar.nml', scene, status)
+        call check(error, status%ok() .and. index(scene, speed) > 0, 'four_bar.nml: ' // &
+                   status%text())
+        if (allocated(error)) return
+        call write_text(dir // 'scene.nml', scene)
+        call write_text(dir // 'f.nml', '&study scene = ''scene.nml'', t_end = 0.1, ' // &
+            'reference_tolerance = 1e-5, check_solver = ''none'', solvers = ''radau5'', ' // &
+            'stabilisations = ''ggl'', tolerances = 1e-3 /' // nl)
+        call read_study(dir // 'f.nml', study, status)
+        if (status%ok()) call make_reference(study, .true., log, status)
+        if (status%ok()) call run_sweep(study, .true., runs, status, stale=stale)
+        call check(error, status%ok() .and. stale == '', 'unchanged: ' // status%text())
+        if (allocated(error)) return
+        at = index(scene, speed)
+        call write_text(dir // 'scene.nml', scene(1:at - 1) // '12.566370614359172' // &
+                        scene(at + len(speed):))
+        why = 'what differs: the scene text (after defaults): &driver(1) coefficients = 0.3, ' &
+            // speed // ', 0, 0 in the reference, 0.3, 12.566370614359172, 0, 0 now' // nl // &
+            'remake it: flexmbs reference ' // dir // 'f.nml (or use it as it is: --force)'
+        call run_sweep(study, .true., runs, status)
+        call refused('sweep', .not. allocated(runs))
+        folder = dir // 'f_points'
+        exists = delete_file(record_path(folder, 1))
+        call run_sweep_point(study, 1, one, record, status)
+        inquire (file=record_path(folder, 1), exist=exists)
+        call refused('--point', .not. exists)
+        call merge_records(study, merged, status)
+        call refused('--merge', .true.)
+        call prepare_points(study, npoints, record, status)
+        call refused('-j and --slurm', npoints == 0)
+        call run_sweep(study, .true., runs, status, force=.true., stale=stale)
+        call check(error, status%ok() .and. stale == 'note: the reference ' // dir // &
+                   'f_reference.h5 is stale (it differs in the scene text), used as it is &
+                   &(--force)', 'forced: ' // status%text() // ' / ' // stale)
+        call write_text(dir // 'scene.nml', scene)
+        call write_text(dir // 'f.nml', '&study scene = ''scene.nml'', t_end = 0.05, ' // &
+            'reference_tolerance = 1e-5, check_solver = ''none'', solvers = ''radau5'', ' // &
+            'stabilisations = ''ggl'', tolerances = 1e-3 /' // nl)
+        call read_study(dir // 'f.nml', study, status)
+        call run_sweep(study, .true., runs, status)
+        call check(error, status%code == status_bad_input .and. index(status%text(), &
+                   'what differs: t_end (0.1 in the reference, 0.05 now); the output times &
+                   &(101 from 0 to 0.1 s in the reference, 101 from 0 to 0.05 s now)') > 0, &
+                   'another t_end: ' // status%text())
+
+    contains
+
+        !> The last status refused the stale reference (and `nothing`: wrote nothing).
+        subroutine refused(what, nothing)
+            character(len=*), intent(in) :: what
+            logical, intent(in) :: nothing
+            call check(error, status%code == status_bad_input .and. &
+                       index(status%text(), why) > 0 .and. nothing, what // ': ' // &
+                       status%text())
+        end subroutine refused
+    end subroutine test_fingerprint
+
+    !> The paper's studies that share a reference file (make paper makes it
+    !> by the first, sweeps all) have the same fingerprint: their sweeps
+    !> take it.
+    subroutine test_shared_references(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), parameter :: groups(2, 3) = reshape([character(len=24) :: &
+            'five_body_table3', 'five_body_fine_table3', 'five_body_table2', &
+            'five_body_fine_table2', 'five_body_figure6', 'five_body_fine_figure6'], [2, 3])
+        type(study_input_t) :: study
+        type(scene_input_t) :: base
+        type(reference_print_t) :: first, print
+        type(status_t) :: status
+        integer :: g, k
+        do g = 1, size(groups, 1)
+            do k = 1, size(groups, 2)
+                call read_study('inputs/paper/' // trim(groups(g, k)) // '.nml', study, status)
+                if (status%ok()) call read_study_scene(study, base, status)
+                if (status%ok()) call reference_print(study, base, print, status)
+                call check(error, status%ok(), trim(groups(g, k)) // ': ' // status%text())
+                if (allocated(error)) return
+                if (k == 1) first = print
+                call check(error, print%digest == first%digest, trim(groups(g, k)) // &
+                           ' has another fingerprint than ' // trim(groups(g, 1)) // ': ' // &
+                           print%parts // ' / ' // first%parts)
+            end do
+        end do
+    end subroutine test_shared_references
 
     !> A file of `text` (replaced).
     subroutine write_text(path, text)

@@ -3,7 +3,7 @@ module flexmbs_core_text
     use flexmbs_core_kinds, only: wp
     implicit none
     private
-    public :: real_text, int_text, lower, excerpt, nearest
+    public :: real_text, exact_text, int_text, lower, excerpt, nearest
 
 contains
 
@@ -15,6 +15,46 @@ contains
         write (buf, '(es14.6)') x
         text = trim(adjustl(buf))
     end function real_text
+
+    !> x with as few significant digits (15, 16 or 17) as read back to its
+    !> very bits, trailing zeros dropped, positional from 1e-4 to 1e16:
+    !> 0.3 is '0.3', 2*pi '6.283185307179586', 1e-8 '1E-8'. For texts that
+    !> are compared (fingerprints) and still read well.
+    pure function exact_text(x) result(text)
+        real(wp), intent(in) :: x
+        character(len=:), allocatable :: text
+        character(len=40) :: buf
+        character(len=16) :: form
+        character(len=:), allocatable :: sign, digits
+        real(wp) :: back
+        integer :: n, ios, e, exponent
+        do n = 15, 17
+            write (form, '(a,i0,a)') '(es40.', n - 1, 'e3)'
+            write (buf, form) x
+            read (buf, *, iostat=ios) back
+            if (ios == 0 .and. back == x) exit
+        end do
+        text = trim(adjustl(buf))
+        e = index(text, 'E')
+        if (e == 0) return              ! not a number: as written
+        read (text(e + 1:), *) exponent
+        sign = ''
+        if (text(1:1) == '-') sign = '-'
+        ! the significant digits, trailing zeros dropped (at least one kept)
+        digits = text(len(sign) + 1:len(sign) + 1) // text(len(sign) + 3:e - 1)
+        digits = digits(1:max(1, verify(digits, '0', back=.true.)))
+        if (exponent < -4 .or. exponent >= 16) then
+            text = sign // digits(1:1)
+            if (len(digits) > 1) text = text // '.' // digits(2:)
+            text = text // 'E' // int_text(exponent)
+        else if (exponent < 0) then
+            text = sign // '0.' // repeat('0', -exponent - 1) // digits
+        else if (len(digits) <= exponent + 1) then
+            text = sign // digits // repeat('0', exponent + 1 - len(digits))
+        else
+            text = sign // digits(1:exponent + 1) // '.' // digits(exponent + 2:)
+        end if
+    end function exact_text
 
     !> i without blanks.
     pure function int_text(i) result(text)

@@ -9,8 +9,8 @@ module flexmbs_io_hdf5_text
     implicit none
     private
 
-    public :: read_string_attribute, write_string_attribute, delete_attribute, string_type, &
-        utf8_string_type, group_creating, path_name
+    public :: read_string_attribute, read_stored_text, write_string_attribute, &
+        delete_attribute, string_type, utf8_string_type, group_creating, path_name
 
     interface
         !> The length of a C string (a variable-length HDF5 string read back).
@@ -89,6 +89,43 @@ contains
             close_err = int(h5_free_memory(pointer(1)))
         end subroutine read_variable
     end subroutine read_string_attribute
+
+    !> A text of the file `file` as hdf5_sink_t%write_text stores it: the
+    !> attribute `name`, or the dataset /name when the attribute says the
+    !> text is there (a text too long for an attribute). err < 0 when
+    !> neither reads.
+    subroutine read_stored_text(file, name, text, err)
+        integer(hid_t), intent(in) :: file
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable, intent(out) :: text
+        integer, intent(out) :: err
+        integer(hid_t) :: dset, file_type, mem_type
+        integer(size_t) :: length
+        integer :: close_err, stat
+        logical :: exists
+        text = ''
+        ! asked first: HDF5 would print its error stack for a missing one
+        call h5aexists_f(file, name, exists, err)
+        if (err >= 0 .and. .not. exists) err = -1
+        if (err < 0) return
+        call read_string_attribute(file, name, text, err)
+        if (err < 0 .or. text /= 'stored in dataset /' // name) return
+        call h5dopen_f(file, name, dset, err)
+        if (err < 0) return
+        call h5dget_type_f(dset, file_type, err)
+        if (err >= 0) call h5tget_size_f(file_type, length, err)
+        if (err >= 0) call string_type(int(length), mem_type, err)
+        if (err >= 0) then
+            deallocate (text)
+            allocate (character(len=max(int(length), 1)) :: text, stat=stat)
+            if (stat /= 0) err = -1
+            if (err >= 0) call h5dread_f(dset, mem_type, text, [1_hsize_t], err)
+            call h5tclose_f(mem_type, close_err)
+        end if
+        if (err >= 0) call h5tclose_f(file_type, close_err)
+        call h5dclose_f(dset, close_err)
+        if (err < 0) text = ''
+    end subroutine read_stored_text
 
     !> A scalar string attribute, variable-length UTF-8 (h5py reads a str),
     !> replacing one of that name.

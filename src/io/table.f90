@@ -245,13 +245,16 @@ contains
     end function render
 
     !> Write the table to `path` in the format of its extension; `reasons`
-    !> adds NRJ by cause (default: the paper's columns only).
-    subroutine write_table(path, rows, status, layout, reasons)
+    !> adds NRJ by cause (default: the paper's columns only); a `note` (not
+    !> '') is a line after the table (CSV and LaTeX: a comment), such as
+    !> that the reference was stale and used all the same.
+    subroutine write_table(path, rows, status, layout, reasons, note)
         character(len=*), intent(in) :: path
         type(stats_row_t), intent(in) :: rows(:)
         type(status_t), intent(out) :: status
         character(len=*), intent(in), optional :: layout !! layout_text's; default 'table3'
         logical, intent(in), optional :: reasons
+        character(len=*), intent(in), optional :: note
         integer :: format, unit, ios
         character(len=256) :: msg
         format = table_format(path)
@@ -268,6 +271,9 @@ contains
                 write (unit, iostat=ios, iomsg=msg) layout_text(rows, format, layout, reasons)
             else
                 write (unit, iostat=ios, iomsg=msg) table_text(rows, format, reasons)
+            end if
+            if (present(note) .and. ios == 0) then
+                if (len(note) > 0) write (unit, iostat=ios, iomsg=msg) note_line(note, format)
             end if
             close (unit)
         end if
@@ -294,6 +300,19 @@ contains
         line = opening(format) // written_by
         if (format == table_markdown) line = line // ' -->'
     end function comment
+
+    !> A note after a table: in Markdown a paragraph of its own (shown),
+    !> in CSV and LaTeX a comment (read by no program).
+    function note_line(note, format) result(line)
+        character(len=*), intent(in) :: note
+        integer, intent(in) :: format
+        character(len=:), allocatable :: line
+        if (format == table_markdown) then
+            line = new_line('a') // note // new_line('a')
+        else
+            line = opening(format) // note // new_line('a')
+        end if
+    end function note_line
 
     !> How a comment opens in the format (Markdown: an HTML comment, hidden
     !> when rendered; CSV: '#', which gnuplot and numpy skip; LaTeX: '%').

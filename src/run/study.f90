@@ -5,7 +5,10 @@
 !> trajectory file (/time, /y, /q) with its provenance: the study and scene
 !> files, the solver and tolerance, the cross-check (a second solver at
 !> `check_tolerance` and the ERR between the two), and, as every result file,
-!> the flexmbs version and the date (attributes).
+!> the flexmbs version and the date (attributes); and the fingerprint of
+!> what made it (run/reference_fingerprint), which every sweep compares with
+!> what `flexmbs reference` would make of the study now before it runs: a
+!> stale reference is bad input unless forced, and then the table says so.
 !>
 !> A sweep runs the grid solvers × stabilisations × tolerances × p_max
 !> (DDASSL only) × derivative sources (multibody scenes only), each at
@@ -15,8 +18,10 @@
 !> formulation, 'ggl' GGL (eq. 10), 'projection' index 2 with coordinate
 !> projection (eqs. 11-12); MEXAX always projects internally and runs once
 !> per tolerance ('projection'). A run that fails is a row with ERR '-' and
-!> the reason on its summary line. CPU in the table is normalised to the
-!> row `cpu_reference` (the paper's Tables 2 and 3 normalise to one run).
+!> the reason on its summary line; a run whose output times or size are not
+!> the reference's stops the sweep as bad input (ERR cannot be measured).
+!> CPU in the table is normalised to the row `cpu_reference` (the paper's
+!> Tables 2 and 3 normalise to one run).
 !>
 !> A point of the grid can also run alone (`sweep --point K`, the process
 !> of a parallel sweep or a Slurm array task): its record goes into the
@@ -43,6 +48,9 @@ module flexmbs_run_study
     use flexmbs_run_study_results, only: make_results_folder, record_path
     use flexmbs_run_study_record, only: sweep_run_t, fingerprint_t, study_fingerprint, &
         write_record
+    use flexmbs_run_reference_fingerprint, only: reference_print_t, reference_print, &
+        write_reference_print, check_reference_print, check_reference_times, remake_command, &
+        same_times
     implicit none
     private
 
@@ -162,6 +170,7 @@ contains
         type(record_sink_t) :: rec, rec_check
         type(hdf5_sink_t) :: h5
         type(status_t) :: close_status
+        type(reference_print_t) :: print
         character(len=:), allocatable :: check_text
         real(wp) :: err
         integer :: k
@@ -171,6 +180,8 @@ contains
         if (.not. status%ok()) return
         call check_study_output(study, base, 'reference_file', study%reference_file, &
                                 output_hdf5, given(force), status)
+        ! what it is made from, before the runs: a sweep compares it with its own
+        if (status%ok()) call reference_print(study, base, print, status)
         if (.not. status%ok()) return
         call one_run('reference', trim(study%reference_solver), study%reference_tolerance, &
                      ref, rec)
@@ -210,6 +221,7 @@ contains
         if (status%ok()) call h5%write_text('reference_tolerance', &
                                             real_text(study%reference_tolerance), status)
         if (status%ok()) call h5%write_text('check', check_text, status)
+        if (status%ok()) call write_reference_print(h5, print, status)
         if (status%ok()) call h5%write_statistics(ref%stats, status, ref%solver_name, 'ok')
         call h5%close(close_status)
         if (status%ok()) status = close_status
@@ -292,27 +304,38 @@ contains
     !> one after the other in this process; the table written when the
     !> study names one. A parallel sweep runs the points in processes of
     !> their own (app/) and merges their records (run/study_merge).
-    subroutine run_sweep(study, quiet, runs, status, force)
+    subroutine run_sweep(study, quiet, runs, status, force, stale)
         type(study_input_t), intent(in) :: study
         logical, intent(in) :: quiet
         type(sweep_run_t), allocatable, intent(out) :: runs(:)
         type(status_t), intent(out) :: status
-        !> replace a file at the table's path that is not flexmbs's own
+        !> use a stale reference (run/reference_fingerprint), replace a file
+        !> at the table's path that is not flexmbs's own
         logical, intent(in), optional :: force
+        !> '', or with force what is stale about the reference (the table's note)
+        character(len=:), allocatable, intent(out), optional :: stale
         type(scene_input_t) :: base
         type(sweep_point_t), allocatable :: points(:)
         type(stats_row_t), allocatable :: rows(:)
         real(wp), allocatable :: t_ref(:), y_ref(:, :)
+        character(len=:), allocatable :: note, refused
         integer :: k
 
-        call prepare_sweep(study, base, t_ref, y_ref, points, status)
+        call prepare_sweep(study, base, t_ref, y_ref, points, note, status, force)
+        if (present(stale)) stale = note
         if (.not. status%ok()) return
         if (len(study%table) > 0) call check_study_output(study, base, 'table', study%table, &
                                                           output_table, given(force), status)
         if (.not. status%ok()) return
         allocate (runs(size(points)))
         do k = 1, size(points)
-            runs(k) = point_run(base, points(k), t_ref, y_ref, quiet)
+            runs(k) = point_run(base, points(k), t_ref, y_ref, quiet, refused)
+            if (len(refused) > 0) then
+                ! bad input, as a stale reference: no rows, no table
+                deallocate (runs)
+                call status%set(status_bad_input, refusal_text(study, k, refused))
+                return
+            end if
             if (signal_pending()) then
                 ! the runs so far, the interrupted one last; no table
                 runs = runs(1:k)
@@ -328,40 +351,52 @@ contains
         end if
         rows = runs%row
         if (len(study%table) > 0) call write_table(study%table, rows, status, &
-                                                   trim(study%layout), study%reasons)
+                                                   trim(study%layout), study%reasons, note)
     end subroutine run_sweep
 
     !> What every sweep starts from: the study's scene with the sweep's step
-    !> limit (not the reference's), the reference, the grid's points.
-    subroutine prepare_sweep(study, base, t_ref, y_ref, points, status)
+    !> limit (not the reference's), the reference, checked to be the one
+    !> `flexmbs reference` would make of the study now (`stale` says why
+    !> not, with `force`), at the scene's output times, and the grid's points.
+    subroutine prepare_sweep(study, base, t_ref, y_ref, points, stale, status, force)
         type(study_input_t), intent(in) :: study
         type(scene_input_t), intent(out) :: base
         real(wp), allocatable, intent(out) :: t_ref(:), y_ref(:, :)
         type(sweep_point_t), allocatable, intent(out) :: points(:)
+        character(len=:), allocatable, intent(out) :: stale
         type(status_t), intent(out) :: status
+        logical, intent(in), optional :: force
+        type(reference_print_t) :: now
+        stale = ''
         call read_study_scene(study, base, status)
+        if (status%ok()) call reference_print(study, base, now, status)
+        if (status%ok()) call check_reference_print(study, now, given(force), stale, status)
+        if (status%ok()) call read_reference(study%reference_file, t_ref, y_ref, status)
+        if (status%ok()) call check_reference_times(study, base, t_ref, status)
         if (.not. status%ok()) return
         if (study%max_steps > 0) base%max_steps = study%max_steps
-        call read_reference(study%reference_file, t_ref, y_ref, status)
-        if (.not. status%ok()) return
         call sweep_points(study, base, points)
     end subroutine prepare_sweep
 
     !> What a sweep whose points run elsewhere checks first, as a serial
     !> sweep does before its first run (the scene, the reference, the
     !> table's path), and the results folder, created when missing:
-    !> `npoints` points, their records to go into `folder`.
-    subroutine prepare_points(study, npoints, folder, status, force)
+    !> `npoints` points, their records to go into `folder`; `stale` as
+    !> run_sweep's.
+    subroutine prepare_points(study, npoints, folder, status, force, stale)
         type(study_input_t), intent(in) :: study
         integer, intent(out) :: npoints
         character(len=:), allocatable, intent(out) :: folder
         type(status_t), intent(out) :: status
         logical, intent(in), optional :: force
+        character(len=:), allocatable, intent(out), optional :: stale
         type(scene_input_t) :: base
         type(sweep_point_t), allocatable :: points(:)
         real(wp), allocatable :: t_ref(:), y_ref(:, :)
+        character(len=:), allocatable :: note
         npoints = 0
-        call prepare_sweep(study, base, t_ref, y_ref, points, status)
+        call prepare_sweep(study, base, t_ref, y_ref, points, note, status, force)
+        if (present(stale)) stale = note
         if (.not. status%ok()) return
         if (len(study%table) > 0) call check_study_output(study, base, 'table', study%table, &
                                                           output_table, given(force), status)
@@ -372,19 +407,21 @@ contains
 
     !> Point k of the study's grid alone (`sweep --point K`): its record
     !> into the results folder (`record`, its path), written whole or not
-    !> at all; none when a signal stopped the run (status_signal).
-    subroutine run_sweep_point(study, k, run, record, status)
+    !> at all; none when a signal stopped the run (status_signal), nor when
+    !> the reference is stale (bad input; `force` uses it all the same).
+    subroutine run_sweep_point(study, k, run, record, status, force)
         type(study_input_t), intent(in) :: study
         integer, intent(in) :: k
         type(sweep_run_t), intent(out) :: run
         character(len=:), allocatable, intent(out) :: record
         type(status_t), intent(out) :: status
+        logical, intent(in), optional :: force
         type(scene_input_t) :: base
         type(sweep_point_t), allocatable :: points(:)
         type(fingerprint_t) :: print
         real(wp), allocatable :: t_ref(:), y_ref(:, :)
-        character(len=:), allocatable :: folder
-        call prepare_sweep(study, base, t_ref, y_ref, points, status)
+        character(len=:), allocatable :: folder, stale, refused
+        call prepare_sweep(study, base, t_ref, y_ref, points, stale, status, force)
         if (.not. status%ok()) return
         if (k < 1 .or. k > size(points)) then
             call status%set(status_bad_input, study%path // ': --point ' // int_text(k) // &
@@ -396,7 +433,12 @@ contains
         if (status%ok()) call make_results_folder(study, folder, status)
         if (.not. status%ok()) return
         record = record_path(folder, k)
-        run = point_run(base, points(k), t_ref, y_ref, .true.)
+        run = point_run(base, points(k), t_ref, y_ref, .true., refused)
+        if (len(refused) > 0) then
+            call status%set(status_bad_input, refusal_text(study, k, refused) // &
+                '; no record written')
+            return
+        end if
         if (signal_pending()) then
             call status%set(status_signal, study%path // ': point ' // int_text(k) // &
                 ': stopped by ' // signal_name(caught_signal()) // '; no record written', &
@@ -406,12 +448,27 @@ contains
         call write_record(record, k, points(k), print, run, status)
     end subroutine run_sweep_point
 
-    !> One point of the grid against the reference.
-    function point_run(base, point, t_ref, y_ref, quiet) result(run)
+    !> Why a sweep stops at grid point k whose run cannot be measured
+    !> against the reference (`why`, point_run's), and how to go on.
+    function refusal_text(study, k, why) result(text)
+        type(study_input_t), intent(in) :: study
+        integer, intent(in) :: k
+        character(len=*), intent(in) :: why
+        character(len=:), allocatable :: text
+        text = study%path // ': grid point ' // int_text(k) // ': ' // why // ' (' // &
+            study%reference_file // '): ERR cannot be measured' // new_line('a') // &
+            'remake it: ' // remake_command(study)
+    end function refusal_text
+
+    !> One point of the grid against the reference; `refused` says why a
+    !> run's outputs cannot be compared with the reference's, '' when they
+    !> can (a failed run is a row that says why).
+    function point_run(base, point, t_ref, y_ref, quiet, refused) result(run)
         type(scene_input_t), intent(in) :: base
         type(sweep_point_t), intent(in) :: point
         real(wp), intent(in) :: t_ref(:), y_ref(:, :)
         logical, intent(in) :: quiet
+        character(len=:), allocatable, intent(out) :: refused
         type(sweep_run_t) :: run
         type(scene_input_t) :: scene
         type(run_result_t) :: result
@@ -432,19 +489,11 @@ contains
         call run_scene(scene, quiet, result, run_status, rec)
         run%ok = run_status%ok()
         err = -1.0_wp
+        refused = ''
         if (run%ok) then
-            if (rec%records /= size(t_ref) .or. size(y_ref, 1) < result%q_last) then
-                run%ok = .false.
-                call run_status%set(status_bad_input, 'output times or size differ from &
-                    &the reference (was it made from this scene?)')
-            else if (maxval(abs(rec%t(1:rec%records) - t_ref)) > &
-                     1.0e-12_wp * max(1.0_wp, maxval(abs(t_ref)))) then
-                run%ok = .false.
-                call run_status%set(status_bad_input, 'output times differ from the reference')
-            else
-                err = series_error(rec%y(result%q_first:result%q_last, 1:rec%records), &
-                                   y_ref(result%q_first:result%q_last, :), tol)
-            end if
+            refused = outputs_refused(rec, result%q_last, t_ref, y_ref)
+            if (len(refused) == 0) err = series_error(rec%y(result%q_first:result%q_last, &
+                1:rec%records), y_ref(result%q_first:result%q_last, :), tol)
         end if
         run%row = new_stats_row(label, tol, stab_label, result%stats)
         run%row%err = err
@@ -462,6 +511,25 @@ contains
                 run_status%text() // '; ' // result%stats%summary()
         end if
     end function point_run
+
+    !> Why a run's outputs (`rec`, positions up to q_last) cannot be
+    !> compared with the reference's at its times: '' when they can.
+    function outputs_refused(rec, q_last, t_ref, y_ref) result(why)
+        type(record_sink_t), intent(in) :: rec
+        integer, intent(in) :: q_last
+        real(wp), intent(in) :: t_ref(:), y_ref(:, :)
+        character(len=:), allocatable :: why
+        why = ''
+        if (rec%records /= size(t_ref)) then
+            why = 'the run has ' // int_text(rec%records) // ' output records, the reference ' &
+                // int_text(size(t_ref))
+        else if (size(y_ref, 1) < q_last) then
+            why = 'the run has ' // int_text(q_last) // ' positions, the reference ' // &
+                int_text(size(y_ref, 1)) // ' components'
+        else if (.not. same_times(rec%t(1:rec%records), t_ref)) then
+            why = 'the output times of the run are not the reference''s'
+        end if
+    end function outputs_refused
 
     !> An optional flag's value, false when absent.
     pure logical function given(flag)

@@ -7,6 +7,8 @@
 !> table file is written only when no point is missing, so that it always
 !> holds the whole study; what is missing is listed with the commands that
 !> run only those points (here, and with the Slurm script when there is one).
+!> As every sweep, a merge first checks that the reference is the one
+!> `flexmbs reference` would make of the study now (run/reference_fingerprint).
 module flexmbs_run_study_merge
     use flexmbs_core_status, only: status_t
     use flexmbs_core_text, only: int_text
@@ -21,6 +23,8 @@ module flexmbs_run_study_merge
     use flexmbs_run_study_record, only: sweep_run_t, fingerprint_t, study_fingerprint, &
         read_record, record_missing, record_current, record_stale, record_damaged
     use flexmbs_run_study_slurm, only: shell_word
+    use flexmbs_run_reference_fingerprint, only: reference_print_t, reference_print, &
+        check_reference_print
     implicit none
     private
 
@@ -34,6 +38,8 @@ module flexmbs_run_study_merge
         integer, allocatable :: failed(:)             !! points whose run failed
         !> a line per stale or damaged record, and per failed run: why
         character(len=:), allocatable :: notes
+        !> '', or with --force that the reference is stale (the table's note)
+        character(len=:), allocatable :: stale_reference
         logical :: table_written = .false.
     contains
         procedure :: complete => merged_complete
@@ -47,17 +53,19 @@ contains
 
     !> The records of the study's results folder (module header); the
     !> table written (`table_written`) when the study names one and none is
-    !> missing. `status` is not ok only when the study, its scene or the
-    !> table's path is wrong: missing points are in `merged`.
+    !> missing. `status` is not ok only when the study, its scene, its
+    !> reference or the table's path is wrong: missing points are in `merged`.
     subroutine merge_records(study, merged, status, force)
         type(study_input_t), intent(in) :: study
         type(merged_t), intent(out) :: merged
         type(status_t), intent(out) :: status
-        !> replace a file at the table's path that is not flexmbs's own
+        !> use a stale reference, replace a file at the table's path that is
+        !> not flexmbs's own
         logical, intent(in), optional :: force
         type(scene_input_t) :: base
         type(sweep_point_t), allocatable :: points(:)
         type(fingerprint_t) :: print
+        type(reference_print_t) :: now
         type(sweep_run_t), allocatable :: runs(:)
         type(stats_row_t), allocatable :: rows(:)
         logical, allocatable :: current(:)
@@ -67,7 +75,11 @@ contains
 
         forced = .false.
         if (present(force)) forced = force
+        merged%stale_reference = ''
         call read_study_scene(study, base, status)
+        if (status%ok()) call reference_print(study, base, now, status)
+        if (status%ok()) call check_reference_print(study, now, forced, &
+                                                    merged%stale_reference, status)
         if (status%ok()) call study_fingerprint(study, base, print, status)
         if (.not. status%ok()) return
         if (len(study%table) > 0) call check_study_output(study, base, 'table', study%table, &
@@ -110,7 +122,8 @@ contains
         end if
         if (merged%complete() .and. len(study%table) > 0) then
             rows = merged%runs%row
-            call write_table(study%table, rows, status, trim(study%layout), study%reasons)
+            call write_table(study%table, rows, status, trim(study%layout), study%reasons, &
+                             merged%stale_reference)
             merged%table_written = status%ok()
         end if
     end subroutine merge_records

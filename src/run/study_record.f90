@@ -64,11 +64,13 @@ module flexmbs_run_study_record
     character(len=*), parameter :: record_format = '2'
     character, parameter :: nl = new_line('a')
 
-    type :: pair_t
+    !> One `key = value` line of a record (or of a reference's fingerprint).
+    type, public :: pair_t
         character(len=:), allocatable :: key, value
     end type pair_t
 
-    public :: study_fingerprint, record_text, write_record, read_record
+    public :: study_fingerprint, mesh_digest, record_text, write_record, read_record, &
+        split_pairs, pair_value
 
 contains
 
@@ -78,13 +80,23 @@ contains
         type(scene_input_t), intent(in) :: base
         type(fingerprint_t), intent(out) :: print
         type(status_t), intent(out) :: status
-        character(len=:), allocatable :: text, meshes
-        integer :: b
+        character(len=:), allocatable :: text
         call read_text_file(study%path, text, status)
         if (.not. status%ok()) return
         print%study = sha256_hex(text)
         print%scene = sha256_hex(base%text)
-        ! the mesh files' texts one after the other (one file: its hash alone)
+        call mesh_digest(base, print%mesh, status)
+    end subroutine study_fingerprint
+
+    !> SHA-256 of the texts of the scene's mesh files one after the other
+    !> (one file: its hash alone); '-' when the scene names none.
+    subroutine mesh_digest(base, digest, status)
+        type(scene_input_t), intent(in) :: base
+        character(len=64), intent(out) :: digest
+        type(status_t), intent(out) :: status
+        character(len=:), allocatable :: text, meshes
+        integer :: b
+        digest = '-'
         meshes = ''
         do b = 1, size(base%bodies)
             if (len_trim(base%bodies(b)%mesh_file) == 0) cycle
@@ -92,8 +104,8 @@ contains
             if (.not. status%ok()) return
             meshes = meshes // text
         end do
-        if (any(len_trim(base%bodies%mesh_file) > 0)) print%mesh = sha256_hex(meshes)
-    end subroutine study_fingerprint
+        if (any(len_trim(base%bodies%mesh_file) > 0)) digest = sha256_hex(meshes)
+    end subroutine mesh_digest
 
     !> The record of grid point k (module header).
     function record_text(k, point, print, run) result(text)
@@ -233,16 +245,24 @@ contains
         function value_of(key) result(value)
             character(len=*), intent(in) :: key
             character(len=:), allocatable :: value
-            integer :: i
-            value = ''
-            do i = 1, size(pairs)
-                if (pairs(i)%key == key) then
-                    value = pairs(i)%value
-                    return
-                end if
-            end do
+            value = pair_value(pairs, key)
         end function value_of
     end subroutine read_record
+
+    !> The value of `key` among `pairs` (the first one), '' when none has it.
+    function pair_value(pairs, key) result(value)
+        type(pair_t), intent(in) :: pairs(:)
+        character(len=*), intent(in) :: key
+        character(len=:), allocatable :: value
+        integer :: i
+        value = ''
+        do i = 1, size(pairs)
+            if (pairs(i)%key == key) then
+                value = pairs(i)%value
+                return
+            end if
+        end do
+    end function pair_value
 
     !> The `key = value` lines of a text (others are left out).
     subroutine split_pairs(text, pairs)

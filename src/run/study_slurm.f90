@@ -19,10 +19,12 @@ module flexmbs_run_study_slurm
     private
 
     !> `--chunk`, `--partition`, `--time`, `--mem` ('' = not given: the
-    !> cluster's default).
+    !> cluster's default); `force`: the tasks and the merge job run with
+    !> --force (a stale reference used all the same, run/reference_fingerprint).
     type, public :: slurm_options_t
         integer :: chunk = 1
         character(len=:), allocatable :: partition, time, mem
+        logical :: force = .false.
     end type slurm_options_t
 
     public :: check_slurm_options, slurm_time_valid, array_script_text, merge_script_text, &
@@ -121,7 +123,8 @@ contains
             'export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1' // nl // &
             'status=0' // nl // &
             'for ((k = first; k <= last; k++)); do' // nl // &
-            '    "$exe" sweep "$study" --point "$k" --quiet || status=$?' // nl // &
+            '    "$exe" sweep "$study" --point "$k" --quiet' // forced(options) // &
+            ' || status=$?' // nl // &
             '    # stopped by a signal (scancel, the time limit): no further point' // nl // &
             '    [ "$status" -gt 128 ] && exit "$status"' // nl // &
             'done' // nl // &
@@ -144,7 +147,7 @@ contains
             '#SBATCH --output=' // folder // '/slurm_merge_%j.out' // nl // &
             sbatch_options(options) // &
             'exec ' // shell_quoted(exe) // ' sweep ' // shell_quoted(study_path) // &
-            ' --merge' // nl
+            ' --merge' // forced(options) // nl
     end function merge_script_text
 
     !> Both scripts into the results folder `folder` (which exists) for a
@@ -174,6 +177,14 @@ contains
         if (status%ok()) call write_file_atomically(merge, merge_script_text(exe, study_path, &
                                                     where, options, name), status)
     end subroutine write_slurm_scripts
+
+    !> ' --force' when the scripts pass it on, else ''.
+    pure function forced(options) result(text)
+        type(slurm_options_t), intent(in) :: options
+        character(len=:), allocatable :: text
+        text = merge(' --force', '        ', options%force)
+        text = trim(text)
+    end function forced
 
     !> The #SBATCH lines of the options given, and one CPU per task.
     function sbatch_options(options) result(text)
