@@ -60,6 +60,9 @@ module flexmbs_io_hdf5_sink
         character(len=:), allocatable :: path
         integer :: n = 0                 !! length of y
         integer :: records = 0           !! records written so far
+        !> the time of each record so far, times(1:records) (for the XDMF
+        !> file written beside the result)
+        real(wp), allocatable, private :: times(:)
         logical :: every_step = .false.  !! record accepted steps instead of output times
         logical :: is_open = .false.
         integer(hid_t) :: file = -1, time_dset = -1, y_dset = -1
@@ -83,6 +86,7 @@ module flexmbs_io_hdf5_sink
         procedure :: write_integer_list => sink_write_integer_list
         generic :: write_integers => write_integer_matrix, write_integer_list
         procedure :: close => sink_close
+        procedure :: record_times => sink_record_times
     end type hdf5_sink_t
 
     logical, save :: library_open = .false.
@@ -548,8 +552,32 @@ contains
             call status%set(status_io_error, self%path // ': HDF5 cannot append a record')
             return
         end if
+        call keep_time(self, t)
         self%records = self%records + 1
     end subroutine append
+
+    !> times(records + 1) = t, the array grown by doubling (every_step
+    !> records many).
+    subroutine keep_time(self, t)
+        class(hdf5_sink_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), allocatable :: grown(:)
+        if (.not. allocated(self%times)) allocate (self%times(64))
+        if (self%records >= size(self%times)) then
+            allocate (grown(2 * size(self%times)))
+            grown(1:self%records) = self%times(1:self%records)
+            call move_alloc(grown, self%times)
+        end if
+        self%times(self%records + 1) = t
+    end subroutine keep_time
+
+    !> The time of every complete record (the values of /time).
+    function sink_record_times(self) result(times)
+        class(hdf5_sink_t), intent(in) :: self
+        real(wp), allocatable :: times(:)
+        allocate (times(self%records))
+        if (self%records > 0) times = self%times(1:self%records)
+    end function sink_record_times
 
     !> An empty extendible dataset: (0) for m = 0, else (m, 0), chunked.
     subroutine create_series(file, name, m, per_chunk, dset, err, groups, columns)
