@@ -25,6 +25,10 @@ BUILD        := $(CURDIR)/build
 VENV         := $(BUILD)/venv
 FORD_VERSION := 7.0.13
 FORD_VENV    := $(BUILD)/ford-venv
+# meshio and VTK from PyPI for test/vtk_files.py, beside the system's h5py
+# and numpy (python3-h5py; --system-site-packages)
+PY_VENV      := $(BUILD)/py-venv
+PY_PACKAGES  := meshio==5.3.5 vtk==9.7.2
 # One set of flags for every fpm call: changing them makes fpm rebuild everything.
 # MUMPS's Fortran headers (dmumps_struc.h, ...) are in /usr/include, which
 # gfortran does not search for INCLUDE lines; the sequential library's
@@ -94,7 +98,7 @@ define install_shared_library
 endef
 
 .PHONY: run test bench paper extremes check-memory deps build build-debug install legacy-test \
-        docs clean help
+        docs clean help py-venv
 
 help:
 	@echo "make run | make test | make bench | make paper | make check-memory |" \
@@ -146,7 +150,8 @@ run: build
 # (test/dependency.sh, test/fpm_dependency/), the architecture's rules
 # on the sources (test/layers.py), then the command-line
 # checks of test/cli.sh, the documentation's links and generated scene
-# reference (test/docs.py), the signals of test/kill.sh (python3-h5py reads
+# reference (test/docs.py), the ParaView and XDMF files read by VTK and
+# meshio (test/vtk_files.py, in $(PY_VENV)), the signals of test/kill.sh (python3-h5py reads
 # the files they leave), every example scene with empty standard error
 # (test/examples.sh), DDASSL and IDA from 1e-2 to 1e-12 on the scenes
 # against RADAU5 (test/tolerances.sh) and the fuzzer of the scene input (test/fuzz, about
@@ -169,6 +174,9 @@ test: deps
 	@set -o pipefail; python3 test/docs.py \
 	    "$$($(FPM) run --profile debug --runner echo flexmbs 2>/dev/null | tail -n 1)" 2>&1 \
 	    | tee $(BUILD)/test-docs.log; echo "exit $$?" >> $(BUILD)/test-docs.log
+	@set -o pipefail; { $(MAKE) --no-print-directory py-venv && $(PY_VENV)/bin/python \
+	    test/vtk_files.py "$$($(FPM) run --profile debug --runner echo flexmbs 2>/dev/null \
+	    | tail -n 1)"; } 2>&1 | tee $(BUILD)/test-vtk.log; echo "exit $$?" >> $(BUILD)/test-vtk.log
 	@set -o pipefail; FPM="$(FPM)" bash test/kill.sh 2>&1 | tee $(BUILD)/test-kill.log; \
 	    echo "exit $$?" >> $(BUILD)/test-kill.log
 	@set -o pipefail; FPM="$(FPM)" bash test/examples.sh 2>&1 | tee $(BUILD)/test-examples.log; \
@@ -179,7 +187,7 @@ test: deps
 	    echo "exit $$?" >> $(BUILD)/test-fuzz.log
 	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log \
 	    $(BUILD)/test-programs.log $(BUILD)/test-dependency.log $(BUILD)/test-layers.log \
-	    $(BUILD)/test-cli.log $(BUILD)/test-docs.log $(BUILD)/test-kill.log \
+	    $(BUILD)/test-cli.log $(BUILD)/test-docs.log $(BUILD)/test-vtk.log $(BUILD)/test-kill.log \
 	    $(BUILD)/test-examples.log $(BUILD)/test-tolerances.log $(BUILD)/test-fuzz.log
 
 PROFILE     ?= debug
@@ -306,6 +314,19 @@ bench: deps
 	bash bench/newton.sh
 	bash bench/assemblies.sh
 	bash bench/output.sh
+
+# The Python environment of test/vtk_files.py: $(PY_PACKAGES) from PyPI
+# (installed once) over the system's Python with its h5py and numpy.
+py-venv:
+	@if ! $(PY_VENV)/bin/python -c 'import h5py, meshio, vtk' 2>/dev/null || \
+	    [ "$$($(PY_VENV)/bin/python -c 'import meshio, vtk; \
+	        print(meshio.__version__, vtk.vtkVersion.GetVTKVersion())' 2>/dev/null)" \
+	        != "$$(echo '$(PY_PACKAGES)' | sed 's/[a-z]*==//g')" ]; then \
+	    echo "installing $(PY_PACKAGES) into $(PY_VENV)"; \
+	    /usr/bin/python3 -m venv --system-site-packages $(PY_VENV) && \
+	    $(PY_VENV)/bin/pip install --quiet $(PY_PACKAGES) \
+	        || { echo "could not install $(PY_PACKAGES)" >&2; exit 1; }; \
+	fi
 
 # The API documentation: FORD $(FORD_VERSION) from PyPI in its own virtual
 # environment (installed once), its settings in fpm.toml's [extra.ford]

@@ -203,6 +203,8 @@ contains
             write (error_unit, '(a)') 'flexmbs: statistics so far: ' // result%stats%summary()
             if (result%hdf5_written) write (error_unit, '(a)') &
                 'flexmbs: trajectory up to there kept in ' // scene%output_file
+            if (len(result%xdmf_file) > 0) write (error_unit, '(a)') &
+                'flexmbs: its records for ParaView (XDMF): ' // result%xdmf_file
             if (status%code == status_signal) call finish(signal_exit(status))
             call finish(exit_solver)
         case default
@@ -571,6 +573,8 @@ contains
         end if
         if (len(scene%output_file) > 0) write (output_unit, '(a)') &
             'trajectory: ' // scene%output_file
+        if (len(result%xdmf_file) > 0) write (output_unit, '(a)') &
+            'for ParaView (XDMF): ' // result%xdmf_file
         if (len_trim(scene%table) > 0) write (output_unit, '(a)') 'table: ' // trim(scene%table)
     end subroutine report
 

@@ -382,6 +382,8 @@ bad output-no-folder "&output: file = 'no/such/dir/x.h5': the folder 'no/such/di
     no_folder.nml
 printf "%s\n&output vtk = 'nodir/p', file = 'none' /\n" "$sim" > no_vtk_folder.nml
 bad vtk-no-folder "&output: vtk = 'nodir/p': the folder 'nodir/' does not exist" no_vtk_folder.nml
+printf "%s\n&output vtk = 'p', vtk_format = 'raw', file = 'none' /\n" "$sim" > vtk_format.nml
+bad vtk-format-choices "&output: vtk_format = 'raw': must be 'binary' or 'ascii'" vtk_format.nml
 printf "%s\n&output file = '/dev/full' /\n" "$sim" > io_error.nml
 expect io-error 4 "/dev/full: HDF5 cannot create the file" run io_error.nml --quiet --force
 mkdir -p out/folder
@@ -685,8 +687,10 @@ os.execv(sys.argv[1], sys.argv[1:])' "$exe" sweep sig.nml -j 2 --quiet > sig.out
     fi
 done
 
-# ParaView output of a flexible body beside a rigid one
-sed -e "s/t_end   = 0.5 /t_end   = 0.02 /" -e "s#^&output#\&output vtk = 'out/vis', file = 'none',#" \
+# ParaView output of a flexible body beside a rigid one (as text: the checks
+# below read the XML; test/vtk_files.py reads the binary default with VTK)
+sed -e "s/t_end   = 0.5 /t_end   = 0.02 /" \
+    -e "s#^&output#\&output vtk = 'out/vis', vtk_format = 'ascii', file = 'none',#" \
     -e "s/n_output = 51/n_output = 3/" "$root/inputs/rigid_flexible_pendulum.nml" > vis.nml
 expect vtk-run 0 "radau5: NST=" run vis.nml --quiet
 if [ -f out/vis_0002.vtu ] && [ -f out/vis_bodies_0002.vtu ] && [ -f out/vis_joints_0002.vtu ] && \
@@ -701,16 +705,17 @@ expect vtk-chain-run 0 "radau5: NST=" run chain_vtk.nml --quiet
 if grep -q 'NumberOfPoints="3" NumberOfCells="3"' out/chain_bodies_0001.vtu 2>/dev/null; then
     pass vtk-chain-links
 else fail vtk-chain-links "$(head -c 300 out/chain_bodies_0001.vtu 2>/dev/null)"; fi
-# the bodies by name: field data body_names (a VTK string array: character
-# codes, 0 after each name) and point data body_id; 'link' is 108 105 110 107
-if grep -q 'Name="body_names" NumberOfTuples="1"' out/vis_bodies_0002.vtu 2>/dev/null &&
+# the bodies by name: field data body_names (a UInt8 array, which meshio
+# reads: character codes, 0 after each name) and point data body_id; 'link'
+# is 108 105 110 107
+if grep -q 'type="UInt8" Name="body_names" NumberOfTuples="5"' out/vis_bodies_0002.vtu 2>/dev/null &&
     grep -qx ' 108 105 110 107 0' out/vis_bodies_0002.vtu && grep -q 'Name="body_id"' \
     out/vis_bodies_0002.vtu; then pass vtk-bodies-named
 else fail vtk-bodies-named "$(grep -A2 FieldData out/vis_bodies_0002.vtu 2>/dev/null)"; fi
 # the .pvd's times are the HDF5 file's /time to the last bit (17 digits: at t_end =
 # 0.011 and 4 outputs, 0.0036666666666666666 needs all of them)
 sed -e "s/t_end   = 0.5 /t_end   = 0.011 /" \
-    -e "s#^&output#\&output vtk = 'out/vt', file = 'out/vt.h5',#" \
+    -e "s#^&output#\&output vtk = 'out/vt', vtk_format = 'ascii', file = 'out/vt.h5',#" \
     -e "s/n_output = 51/n_output = 4/" "$root/inputs/rigid_flexible_pendulum.nml" > vt.nml
 expect vtk-times-run 0 "radau5: NST=" run vt.nml --quiet
 if /usr/bin/python3 - out/vt.pvd out/vt.h5 <<'PY'
@@ -743,12 +748,14 @@ assert elements == list(range(1, len(cells) + 1)), elements
 PY
 ); then pass vtk-node-ids-are-hdf5-nodes
 else fail vtk-node-ids-are-hdf5-nodes "$problem"; fi
-# two flexible bodies (inputs/two_soft_links.nml): a piece each in the mesh
-# file, in the order of field data flexible_names, cell data flexible_id the
-# body's number; each piece's points are its body's reference_nodes +
-# displacement in the HDF5 file's /flexible/NAME
+# two flexible bodies (inputs/two_soft_links.nml): one piece in the mesh
+# file (meshio reads the cells of one piece only), the bodies one after the
+# other in the order of field data flexible_names, cell data flexible_id the
+# body's number, node_id and element_id numbered in each body; each body's
+# points are its reference_nodes + displacement in the HDF5 file's
+# /flexible/NAME, its cells its connectivity after the points before it
 sed -e "s/t_end   = 0.2 /t_end   = 0.02 /" \
-    -e "s#^&output#\&output vtk = 'out/tsl', file = 'out/tsl.h5',#" \
+    -e "s#^&output#\&output vtk = 'out/tsl', vtk_format = 'ascii', file = 'out/tsl.h5',#" \
     -e "s/n_output = 21/n_output = 3/" "$root/inputs/two_soft_links.nml" > tsl.nml
 expect vtk-two-flexible-run 0 "radau5: NST=" run tsl.nml --quiet
 if problem=$(/usr/bin/python3 - out/tsl.h5 out/tsl_0002.vtu 2>&1 <<'PY'
@@ -760,15 +767,24 @@ codes = [int(c) for c in grid.find('FieldData/DataArray').text.split()]
 names = ''.join(chr(c) if c else '\n' for c in codes).split()
 assert names == ['upper', 'lower'], names
 pieces = grid.findall('Piece')
-assert len(pieces) == 2, len(pieces)
-for k, (name, piece) in enumerate(zip(names, pieces), start=1):
+assert len(pieces) == 1, len(pieces)
+piece = pieces[0]
+arrays = {a.get('Name'): np.array(a.text.split(), float) for a in piece.iter('DataArray')
+          if a.get('Name')}
+x = np.array(piece.find('Points/DataArray').text.split(), float).reshape(-1, 3)
+cells = arrays['connectivity'].reshape(-1, 8)
+points = elements = 0
+for k, name in enumerate(names, start=1):
     body = f['flexible/' + name]
     x_h5 = body['reference_nodes'][:] + body['displacement'][2]
-    x = np.array(piece.find('Points/DataArray').text.split(), float).reshape(-1, 3)
-    assert np.abs(x - x_h5).max() < 1e-12, (name, np.abs(x - x_h5).max())
-    arrays = {a.get('Name'): a for a in piece.iter('DataArray') if a.get('Name')}
-    ids = set(int(v) for v in arrays['flexible_id'].text.split())
-    assert ids == {k}, (name, ids)
+    n, ne = len(x_h5), len(body['connectivity'])
+    assert np.abs(x[points:points + n] - x_h5).max() < 1e-12, (name, np.abs(x - x_h5).max())
+    assert (arrays['node_id'][points:points + n] == np.arange(1, n + 1)).all(), name
+    assert (arrays['flexible_id'][elements:elements + ne] == k).all(), name
+    assert (arrays['element_id'][elements:elements + ne] == np.arange(1, ne + 1)).all(), name
+    assert (cells[elements:elements + ne] == body['connectivity'][:] - 1 + points).all(), name
+    points, elements = points + n, elements + ne
+assert (points, elements) == (len(x), len(cells)), (points, elements)
 assert np.abs(f['flexible/lower/displacement'][2]).max() > 1e-4, 'the lower link did not move'
 PY
 ); then pass vtk-two-flexible-bodies
@@ -777,7 +793,7 @@ else fail vtk-two-flexible-bodies "$problem"; fi
 # marker i, by name; the points against the markers computed from the HDF5 file's
 # bodies (position + R s), the fixed pivots, the reactions against /joints
 sed -e "s/t_end   = 1.0 /t_end   = 0.2 /" \
-    -e "s#^&output#\&output vtk = 'out/fbj', file = 'out/fbj.h5',#" \
+    -e "s#^&output#\&output vtk = 'out/fbj', vtk_format = 'ascii', file = 'out/fbj.h5',#" \
     -e "s/n_output = 101/n_output = 3/" "$root/inputs/four_bar.nml" > fbj.nml
 expect vtk-joints-run 0 "radau5: NST=" run fbj.nml --quiet
 if problem=$(/usr/bin/python3 - out/fbj.pvd out/fbj.h5 2>&1 <<'PY'
@@ -910,6 +926,18 @@ rm -f out/vis_0001.vtu
 echo "<VTKFile/>" > out/vis_joints_0001.vtu
 untouched vtk-foreign-joints-piece "&output: vtk: 'out/vis_joints_0001.vtu' exists and is not a ParaView file written by flexmbs" \
     out/vis_joints_0001.vtu run vis.nml --quiet
+# the XDMF file beside an HDF5 result with a flexible body is an output as
+# well: a foreign file there is refused and kept, --force replaces it, a
+# later run its own; one that would be the scene file is refused
+sed -e "s#file = 'none'#file = 'out/vx.h5'#" vis.nml > vx.nml
+echo "<Xdmf/>" > out/vx.xdmf
+untouched xdmf-foreign "&output: file (its XDMF file): 'out/vx.xdmf' exists and is not an XDMF file written by flexmbs" \
+    out/vx.xdmf run vx.nml --quiet
+expect xdmf-forced 0 "for ParaView (XDMF): out/vx.xdmf" run vx.nml --quiet --force
+expect xdmf-replaced 0 "for ParaView (XDMF): out/vx.xdmf" run vx.nml --quiet
+sed -e "s#file = 'none'#file = 'self.h5'#" vis.nml > self.xdmf
+untouched xdmf-is-the-scene "&output: file (its XDMF file): 'self.xdmf' is the scene file itself" \
+    self.xdmf run self.xdmf --quiet
 echo "notes" > study_reference.h5
 untouched study-reference-foreign "&study: reference_file: 'study_reference.h5' exists and is not an HDF5 file" \
     study_reference.h5 reference study.nml --quiet

@@ -23,6 +23,7 @@ module test_io
     use flexmbs_run_solver_factory, only: build_solver
     use flexmbs_dae_ida, only: ida_t
     use flexmbs_run_runner, only: run_result_t, run_scene
+    use flexmbs_io_xdmf_file, only: xdmf_beside
     use flexmbs_run_problem_factory, only: build_problem, block_spec_t
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
@@ -1023,6 +1024,10 @@ contains
             if (allocated(error)) return
             call read_series(h5, time, y, q, nst, error)
             call delete(h5)
+            ! the XDMF file beside the result (a flexible body), said and removed
+            call check(error, result%xdmf_file == xdmf_beside(h5), trim(solvers(s)) // &
+                       ': XDMF file ''' // result%xdmf_file // '''')
+            call delete(xdmf_beside(h5))
             if (allocated(error)) return
             call check(error, all(shape(q) == [nq, 5]) .and. all(q == y(1:nq, :)), &
                        trim(solvers(s)) // ': /q is y(1:nq) at 5 times')

@@ -100,6 +100,7 @@ module flexmbs_io_hdf5_sink
         procedure :: write_integer_list => sink_write_integer_list
         generic :: write_integers => write_integer_matrix, write_integer_list
         procedure :: close => sink_close
+        procedure :: record_times => sink_record_times
     end type hdf5_sink_t
 
     logical, save :: library_open = .false.
@@ -457,6 +458,50 @@ contains
             if (err >= 0) call h5sclose_f(space, err)
         end subroutine put_real
     end subroutine sink_write_statistics
+
+    !> The rows (from 0) and times of the records an index of the file lists
+    !> (the XDMF file): every record when there are at most `most`, else
+    !> every k-th (k the least that keeps them to `most`) and the last.
+    !> Read back from /time (the records held are written first; HDF5 counts
+    !> the selected elements from 1 in Fortran); call
+    !> before `close`. `total` is the number of records.
+    subroutine sink_record_times(self, most, rows, times, total, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        integer, intent(in) :: most
+        integer, allocatable, intent(out) :: rows(:)
+        real(wp), allocatable, intent(out) :: times(:)
+        integer, intent(out) :: total
+        type(status_t), intent(inout) :: status
+        integer(hid_t) :: filespace, memspace
+        integer :: err, stride, n, j, close_err
+        total = 0
+        allocate (rows(0), times(0))
+        if (.not. self%is_open) return
+        call write_pending(self, err)
+        if (err < 0) then
+            call status%set(status_io_error, self%path // ': HDF5 cannot write the last records')
+            return
+        end if
+        total = self%records
+        if (total == 0) return
+        stride = max(1, (total + most - 1) / max(most, 1))
+        n = (total - 1) / stride + 1
+        rows = [((j - 1) * stride, j = 1, n)]
+        if (rows(n) /= total - 1) rows = [rows, total - 1]
+        deallocate (times)
+        allocate (times(size(rows)))
+        call h5dget_space_f(self%time_batch%dset, filespace, err)
+        if (err >= 0) call h5sselect_elements_f(filespace, H5S_SELECT_SET_F, 1, &
+            size(rows, kind=size_t), reshape(int(rows, hsize_t) + 1_hsize_t, [1, size(rows)]), err)
+        if (err >= 0) call h5screate_simple_f(1, [size(rows, kind=hsize_t)], memspace, err)
+        if (err >= 0) then
+            call h5dread_f(self%time_batch%dset, H5T_NATIVE_DOUBLE, times, &
+                [size(rows, kind=hsize_t)], err, mem_space_id=memspace, file_space_id=filespace)
+            call h5sclose_f(memspace, close_err)
+        end if
+        call h5sclose_f(filespace, close_err)
+        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot read /time')
+    end subroutine sink_record_times
 
     !> Close every dataset and the file. Safe to call twice.
     subroutine sink_close(self, status)

@@ -2,8 +2,8 @@
 !> before anything is computed: an output is never an input of the run,
 !> two outputs of a run are never one file, and a file already there is
 !> replaced only when it is a result of the same kind written by flexmbs —
-!> an HDF5 file with the root attribute creator = 'flexmbs ...', a ParaView
-!> or table file headed by the comment 'written by flexmbs ...', a PNG plot
+!> an HDF5 file with the root attribute creator = 'flexmbs ...', a ParaView,
+!> XDMF or table file headed by the comment 'written by flexmbs ...', a PNG plot
 !> beside a table of flexmbs (io/spectrum_file) — anything
 !> else only when the user says `--force`. Paths are compared as files
 !> (device and inode) and, for files not yet written, as absolute paths
@@ -14,7 +14,7 @@ module flexmbs_io_output_files
     use flexmbs_core_files, only: same_file, same_path, file_kind, file_missing, file_folder, &
         file_fifo, file_device, file_other
     use flexmbs_io_hdf5_sink, only: hdf5_result_check
-    use flexmbs_io_vtk_sink, only: vtk_file_ours
+    use flexmbs_io_vtu_file, only: xml_file_ours
     use flexmbs_io_table, only: table_file_ours
     use flexmbs_io_spectrum_file, only: spectrum_plot_ours
     use flexmbs_io_scene_input, only: scene_input_t
@@ -23,7 +23,7 @@ module flexmbs_io_output_files
 
     !> Kinds of output: what a file there must be to be replaced.
     integer, parameter, public :: output_hdf5 = 1, output_vtk = 2, output_table = 3, &
-        output_plot = 4
+        output_plot = 4, output_xdmf = 5
 
     !> A file of a run and how messages name it: an output
     !> ('&output: file', kind output_*) or an input ('the scene file itself').
@@ -135,8 +135,12 @@ contains
                 case (output_hdf5)
                     call hdf5_result_check(out%path, ours, reason)
                 case (output_vtk)
-                    ours = vtk_file_ours(out%path)
+                    ours = xml_file_ours(out%path)
                     reason = 'is not a ParaView file written by flexmbs (no comment ' // &
+                        '''written by flexmbs'' on its second line)'
+                case (output_xdmf)
+                    ours = xml_file_ours(out%path)
+                    reason = 'is not an XDMF file written by flexmbs (no comment ' // &
                         '''written by flexmbs'' on its second line)'
                 case (output_plot)
                     ours = spectrum_plot_ours(out%path)

@@ -199,6 +199,8 @@ module flexmbs_io_scene_input
         !> ParaView files PREFIX_NNNN.vtu, PREFIX_bodies_NNNN.vtu, PREFIX_joints_NNNN.vtu and
         !> PREFIX.pvd ('' = none; flexmbs_io_vtk_sink)
         character(len=len_path) :: vtk
+        !> 'binary' (the .vtu arrays as base64 appended data) or 'ascii' (text)
+        character(len=len_name) :: vtk_format
         ! &flexible_body and &material
         type(body_input_t), allocatable :: bodies(:)  !! the &flexible_body groups, in order
         type(material_input_t), allocatable :: materials(:) !! in the order given

@@ -145,6 +145,8 @@ contains
         call get(e, g, 'progress', scene%progress)
         call get(e, g, 'reasons', scene%reasons)
         call get(e, g, 'vtk', scene%vtk)
+        call get(e, g, 'vtk_format', scene%vtk_format)
+        scene%vtk_format = lower(scene%vtk_format)
     end subroutine read_output
 
     subroutine read_body(e, scene)

@@ -134,6 +134,9 @@ module flexmbs_io_scene_schema
             doc='progress display on standard error'), &
         var_spec_t('output', 'vtk', kind_string, &
             doc='ParaView files PREFIX.pvd, PREFIX_NNNN.vtu, PREFIX_bodies|joints_NNNN.vtu'), &
+        var_spec_t('output', 'vtk_format', kind_string, default='binary', &
+            choices='binary|ascii', &
+            doc='the .vtu files'' arrays: binary (appended, base64) or text'), &
         var_spec_t('flexible_body', 'name', kind_string, default='body', &
             doc='unique name (default: body; body N when there are several)'), &
         var_spec_t('flexible_body', 'element', kind_string, default='hex8', &

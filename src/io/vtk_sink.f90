@@ -1,11 +1,11 @@
 !> ParaView output: at every output time, the flexible bodies' meshes as an
-!> XML unstructured grid (`PREFIX_NNNN.vtu`, a piece per flexible body:
-!> current node positions, the hexahedra in VTK order — hex8 cell type 12,
-!> hex27 type 29 —, point data displacement, velocity and node_id
-!> (flexmbs's node number in its body, from 1: the piece's point k - 1 is
-!> node k), cell data Cauchy stress (xx, yy, zz, xy, yz, xz), its von Mises
-!> value, element_id and flexible_id, the body's number in field data
-!> flexible_names), the rigid bodies (`PREFIX_bodies_NNNN.vtu`:
+!> XML unstructured grid (`PREFIX_NNNN.vtu`, one piece, the flexible bodies
+!> one after the other: current node positions, the hexahedra in VTK order
+!> — hex8 cell type 12, hex27 type 29 —, point data displacement, velocity
+!> and node_id (flexmbs's node number in its body, from 1: with one body
+!> point k - 1 is node k), cell data Cauchy stress (xx, yy, zz, xy, yz,
+!> xz), its von Mises value, element_id (in its body) and flexible_id, the
+!> body's number in field data flexible_names), the rigid bodies (`PREFIX_bodies_NNNN.vtu`:
 !> one vertex per body at its centre of mass, the bodies in absolute
 !> coordinates first, then the chains' links; point data the body's three
 !> axes and body_id, field data body_names) and a multibody system's joints
@@ -23,19 +23,22 @@
 !> (as the HDF5 file's /joints; on the ground its bearing load); field data joint_names
 !> — 'joints/NAME', 'joints/NAME (node N)' for an attached node, or
 !> 'drivers/NAME', the HDF5 groups — and joint_types). Field data belongs to
-!> the data set, before its piece: VTK reads none inside a piece.
+!> the data set, before its piece: VTK reads none inside a piece. The names
+!> are UInt8 arrays of their bytes, each name followed by a 0, as meshio
+!> reads no String arrays. The arrays are binary (base64 appended data)
+!> unless `binary` is false (text); flexmbs_io_vtu_file writes either.
 !> The files are listed with their times in `PREFIX.pvd` (part 0 the mesh, part
 !> 1 the bodies, part 2 the joints). The .pvd is rewritten after every
 !> record, so a run that stops keeps a collection ParaView opens. Every
 !> file's second line is the comment '<!-- written by flexmbs 0.1.0 -->'
-!> (vtk_file_ours).
+!> (flexmbs_io_vtu_file's xml_file_ours).
 module flexmbs_io_vtk_sink
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_io_error
     use flexmbs_core_text, only: int_text
-    use flexmbs_core_version, only: written_by, is_written_by
-    use flexmbs_core_files, only: read_first_lines
+    use flexmbs_core_version, only: written_by
+    use flexmbs_io_vtu_file, only: vtu_file_t, open_vtu, comment_opening, comment_closing
     use flexmbs_dae_sink, only: sink_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_mbs_rotation, only: rotation_matrix
@@ -75,15 +78,12 @@ module flexmbs_io_vtk_sink
         character(len=80), allocatable :: joint_names(:) !! 'joints/NAME', 'drivers/NAME'
         integer :: records = 0
         real(wp), allocatable :: times(:)
+        !> the .vtu arrays binary (base64 appended data), else text
+        logical :: binary = .true.
     contains
         procedure :: output => vtk_output
         procedure :: pieces => vtk_pieces
     end type vtk_sink_t
-
-    !> The XML comment that marks flexmbs's files.
-    character(len=*), parameter :: comment_opening = '<!-- ', comment_closing = ' -->'
-
-    public :: vtk_file_ours
 
 contains
 
@@ -116,17 +116,6 @@ contains
             end if
         end do
     end function vtk_pieces
-
-    !> Whether `path` is a ParaView file of flexmbs (its marking comment on
-    !> the second line, after the XML declaration).
-    logical function vtk_file_ours(path)
-        character(len=*), intent(in) :: path
-        character(len=256) :: lines(2)
-        integer :: count
-        call read_first_lines(path, lines, count)
-        vtk_file_ours = .false.
-        if (count == 2) vtk_file_ours = is_written_by(lines(2), comment_opening)
-    end function vtk_file_ours
 
     !> PREFIX_NNNN.vtu, the mesh at record k
     pure function mesh_piece(prefix, k) result(path)
@@ -180,100 +169,125 @@ contains
         if (len(s) < 4) s = repeat('0', 4 - len(s)) // s
     end function digits
 
-    !> The mesh file: a piece per flexible body, the names as field data.
+    !> The mesh file: the flexible bodies one after the other in one piece
+    !> (meshio 5.3.5 keeps the cells of a file's last piece only), the
+    !> names as field data.
     subroutine write_meshes(self, y, path, status)
         class(vtk_sink_t), intent(inout) :: self
         real(wp), intent(in) :: y(:)
         character(len=*), intent(in) :: path
         type(status_t), intent(inout) :: status
+        type(vtu_file_t) :: file
         character(len=32) :: names(size(self%flexible))
-        integer :: unit, b
-        call open_grid(path, unit, status)
-        if (.not. status%ok()) return
-        names = self%flexible%name
-        write (unit, '(a)') '<FieldData>'
-        call write_strings(unit, 'flexible_names', names)
-        write (unit, '(a)') '</FieldData>'
-        do b = 1, size(self%flexible)
-            call write_mesh_piece(self%flexible(b), b, y, unit, path, status)
-            if (.not. status%ok()) exit
-        end do
-        call close_grid(unit, path, status)
-    end subroutine write_meshes
-
-    !> Flexible body `id`'s piece of the mesh file.
-    subroutine write_mesh_piece(flexible, id, y, unit, path, status)
-        type(vtk_flexible_t), intent(in) :: flexible
-        integer, intent(in) :: id, unit
-        real(wp), intent(in) :: y(:)
-        character(len=*), intent(in) :: path
-        type(status_t), intent(inout) :: status
         real(wp), allocatable :: x(:, :), v(:, :), sigma(:, :), mises(:)
-        type(status_t) :: stress_status
-        integer :: n, ne, nn, i, j, celltype, stat
-        associate (body => flexible%body, mesh => flexible%body%mesh, oq => flexible%oq, &
-                   ov => flexible%ov)
-            n = mesh%node_count()
-            ne = mesh%element_count()
-            nn = size(mesh%connectivity, 1)
-            allocate (x(3, n), v(3, n), sigma(6, ne), mises(ne), stat=stat)
-            if (stat /= 0) then
-                call out_of_memory(status, path // ': node and element fields', &
-                    6_i8 * n + 7_i8 * ne, 8)
-                return
-            end if
-            x = mesh%x
-            v = 0.0_wp
-            do i = 1, n
-                do j = 1, 3
-                    if (body%dof(j, i) == 0) cycle
-                    x(j, i) = y(oq + body%dof(j, i))
-                    v(j, i) = y(ov + body%dof(j, i))
+        integer, allocatable :: points(:), ends(:), types(:), node_id(:), element_id(:), &
+            flexible_id(:)
+        integer :: b, n, ne, nc, stat
+        names = self%flexible%name
+        n = 0
+        ne = 0
+        nc = 0
+        do b = 1, size(self%flexible)
+            associate (mesh => self%flexible(b)%body%mesh)
+                n = n + mesh%node_count()
+                ne = ne + mesh%element_count()
+                nc = nc + size(mesh%connectivity)
+            end associate
+        end do
+        allocate (x(3, n), v(3, n), sigma(6, ne), mises(ne), points(nc), ends(ne), &
+                  types(ne), node_id(n), element_id(ne), flexible_id(ne), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, path // ': node and element fields', &
+                8_i8 * n + 11_i8 * ne + nc, 8)
+            return
+        end if
+        n = 0
+        ne = 0
+        nc = 0
+        do b = 1, size(self%flexible)
+            call body_fields(self%flexible(b), b, y)
+        end do
+        call open_vtu(file, path, self%binary, status)
+        if (.not. status%ok()) return
+        call file%line('<FieldData>')
+        call file%names('flexible_names', names)
+        call file%line('</FieldData>')
+        call file%begin_piece(x, ne)
+        call file%cells(points, ends, types)
+        call file%line('<PointData Vectors="displacement">')
+        call file%reals('displacement', x - reference())
+        call file%reals('velocity', v)
+        ! flexmbs's node and element numbers in their body (from 1), beside
+        ! VTK's ids (from 0, over all bodies)
+        call file%integers('node_id', node_id)
+        call file%line('</PointData>')
+        call file%line('<CellData Scalars="von_mises">')
+        call file%reals('stress', sigma)
+        call file%reals('von_mises', reshape(mises, [1, ne]))
+        call file%integers('element_id', element_id)
+        call file%integers('flexible_id', flexible_id)
+        call file%line('</CellData>')
+        call file%line('</Piece>')
+        call file%close(status)
+
+    contains
+
+        !> Body `id`'s points, cells and fields after the n nodes, ne
+        !> elements and nc connectivity entries of the bodies before it.
+        subroutine body_fields(flexible, id, y)
+            type(vtk_flexible_t), intent(in) :: flexible
+            integer, intent(in) :: id
+            real(wp), intent(in) :: y(:)
+            type(status_t) :: stress_status
+            integer :: i, j, k, nn, m, me
+            associate (body => flexible%body, mesh => flexible%body%mesh, &
+                       oq => flexible%oq, ov => flexible%ov)
+                m = mesh%node_count()
+                me = mesh%element_count()
+                nn = size(mesh%connectivity, 1)
+                x(:, n + 1:n + m) = mesh%x
+                v(:, n + 1:n + m) = 0.0_wp
+                do i = 1, m
+                    do j = 1, 3
+                        if (body%dof(j, i) == 0) cycle
+                        x(j, n + i) = y(oq + body%dof(j, i))
+                        v(j, n + i) = y(ov + body%dof(j, i))
+                    end do
                 end do
+                call body%element_stress(y(oq + 1:oq + body%nq), y(ov + 1:ov + body%nv), &
+                    sigma(:, ne + 1:ne + me), mises(ne + 1:ne + me), stress_status)
+                if (.not. stress_status%ok()) then
+                    sigma(:, ne + 1:ne + me) = 0.0_wp
+                    mises(ne + 1:ne + me) = 0.0_wp
+                end if
+                do k = 1, me
+                    points(nc + 1:nc + nn) = mesh%connectivity(:, k) + n
+                    nc = nc + nn
+                    ends(ne + k) = nc
+                end do
+                ! hex8: VTK_HEXAHEDRON (12), hex27: VTK_TRIQUADRATIC_HEXAHEDRON (29)
+                types(ne + 1:ne + me) = merge(12, 29, nn == 8)
+                node_id(n + 1:n + m) = [(i, i=1, m)]
+                element_id(ne + 1:ne + me) = [(k, k=1, me)]
+                flexible_id(ne + 1:ne + me) = id
+                n = n + m
+                ne = ne + me
+            end associate
+        end subroutine body_fields
+
+        !> The bodies' reference positions, as x.
+        function reference() result(x0)
+            real(wp) :: x0(3, size(x, 2))
+            integer :: b, m
+            m = 0
+            do b = 1, size(self%flexible)
+                associate (mesh => self%flexible(b)%body%mesh)
+                    x0(:, m + 1:m + mesh%node_count()) = mesh%x
+                    m = m + mesh%node_count()
+                end associate
             end do
-            call body%element_stress(y(oq + 1:oq + body%nq), &
-                                     y(ov + 1:ov + body%nv), sigma, mises, &
-                                     stress_status)
-            if (.not. stress_status%ok()) then
-                sigma = 0.0_wp
-                mises = 0.0_wp
-            end if
-            celltype = merge(12, 29, nn == 8)
-            call begin_piece(unit, n, ne)
-            write (unit, '(3es24.15e3)') x
-            write (unit, '(a)') '</DataArray></Points>'
-            write (unit, '(a)') '<Cells><DataArray type="Int64" Name="connectivity" ' // &
-                'format="ascii">'
-            do i = 1, ne
-                write (unit, '(*(1x,i0))') mesh%connectivity(:, i) - 1
-            end do
-            write (unit, '(a)') '</DataArray><DataArray type="Int64" Name="offsets" ' // &
-                'format="ascii">'
-            write (unit, '(*(1x,i0))') (nn * i, i=1, ne)
-            write (unit, '(a)') '</DataArray><DataArray type="UInt8" Name="types" ' // &
-                'format="ascii">'
-            write (unit, '(*(1x,i0))') (celltype, i=1, ne)
-            write (unit, '(a)') '</DataArray></Cells>'
-            write (unit, '(a)') '<PointData Vectors="displacement">'
-            call write_vectors(unit, 'displacement', x - mesh%x)
-            call write_vectors(unit, 'velocity', v)
-            ! flexmbs's node and element numbers (from 1), beside VTK's ids (from 0)
-            call write_integers(unit, 'node_id', [(i, i=1, n)])
-            write (unit, '(a)') '</PointData>'
-            write (unit, '(a)') '<CellData Scalars="von_mises">'
-            write (unit, '(a)') '<DataArray type="Float64" Name="stress" ' // &
-                'NumberOfComponents="6" format="ascii">'
-            write (unit, '(6es24.15e3)') sigma
-            write (unit, '(a)') '</DataArray>'
-            write (unit, '(a)') '<DataArray type="Float64" Name="von_mises" format="ascii">'
-            write (unit, '(es24.15e3)') mises
-            write (unit, '(a)') '</DataArray>'
-            call write_integers(unit, 'element_id', [(i, i=1, ne)])
-            call write_integers(unit, 'flexible_id', [(id, i=1, ne)])
-            write (unit, '(a)') '</CellData>'
-            write (unit, '(a)') '</Piece>'
-        end associate
-    end subroutine write_mesh_piece
+        end function reference
+    end subroutine write_meshes
 
     subroutine write_bodies(self, y, path, status)
         class(vtk_sink_t), intent(inout) :: self
@@ -282,7 +296,8 @@ contains
         type(status_t), intent(inout) :: status
         real(wp) :: a(3, 3), centre(3, self%bodies + links(self)), &
             axes(3, 3, self%bodies + links(self))
-        integer :: unit, b, k, n, f
+        type(vtu_file_t) :: file
+        integer :: b, k, n, f
         n = self%bodies + links(self)
         do b = 1, self%bodies
             centre(:, b) = y(7 * b - 6:7 * b - 4)
@@ -301,27 +316,26 @@ contains
                 end do
             end do
         end if
-        call open_grid(path, unit, status)
+        call open_vtu(file, path, self%binary, status)
         if (.not. status%ok()) return
         ! the names: field data of the data set (VTK reads none in a piece)
         if (allocated(self%names)) then
             if (size(self%names) >= n) then
-                write (unit, '(a)') '<FieldData>'
-                call write_strings(unit, 'body_names', self%names(1:n))
-                write (unit, '(a)') '</FieldData>'
+                call file%line('<FieldData>')
+                call file%names('body_names', self%names(1:n))
+                call file%line('</FieldData>')
             end if
         end if
-        call begin_piece(unit, n, n)
-        write (unit, '(3es24.15e3)') centre
-        call write_vertices(unit, n)
-        write (unit, '(a)') '<PointData>'
+        call file%begin_piece(centre, n)
+        call file%cells([(b, b=1, n)], [(b, b=1, n)], [(1, b=1, n)])
+        call file%line('<PointData>')
         do k = 1, 3
-            call write_vectors(unit, 'axis_' // achar(iachar('x') + k - 1), axes(:, k, :))
+            call file%reals('axis_' // achar(iachar('x') + k - 1), axes(:, k, :))
         end do
         ! which body a point is: its number, and the names in the field data
-        call write_integers(unit, 'body_id', [(b, b=1, n)])
-        write (unit, '(a)') '</PointData></Piece>'
-        call close_grid(unit, path, status)
+        call file%integers('body_id', [(b, b=1, n)])
+        call file%line('</PointData></Piece>')
+        call file%close(status)
     end subroutine write_bodies
 
     !> The joints' file (module header): a vertex per joint at marker i.
@@ -335,7 +349,8 @@ contains
             lambda(self%system%nc)
         character(len=32) :: types(joints(self))
         character(len=80) :: names(joints(self))
-        integer :: unit, k, n
+        type(vtu_file_t) :: file
+        integer :: k, n
         logical :: reactions
         n = joints(self)
         reactions = associated(self%formulation)
@@ -363,28 +378,28 @@ contains
                 end if
             end do
         end associate
-        call open_grid(path, unit, status)
+        call open_vtu(file, path, self%binary, status)
         if (.not. status%ok()) return
-        write (unit, '(a)') '<FieldData>'
-        call write_strings(unit, 'joint_names', names)
-        call write_strings(unit, 'joint_types', types)
-        write (unit, '(a)') '</FieldData>'
-        call begin_piece(unit, n, n)
-        write (unit, '(3es24.15e3)') xi
-        call write_vertices(unit, n)
-        write (unit, '(a)') '<PointData Vectors="axis">'
-        call write_integers(unit, 'joint_id', [(k, k=1, n)])
-        call write_integers(unit, 'joint_type', [(self%system%joints(k)%joint%kind, k=1, n)])
-        call write_vectors(unit, 'axis', axis)
-        call write_vectors(unit, 'marker_j_offset', offset)
+        call file%line('<FieldData>')
+        call file%names('joint_names', names)
+        call file%names('joint_types', types)
+        call file%line('</FieldData>')
+        call file%begin_piece(xi, n)
+        ! a vertex (VTK_VERTEX) per joint
+        call file%cells([(k, k=1, n)], [(k, k=1, n)], [(1, k=1, n)])
+        call file%line('<PointData Vectors="axis">')
+        call file%integers('joint_id', [(k, k=1, n)])
+        call file%integers('joint_type', [(self%system%joints(k)%joint%kind, k=1, n)])
+        call file%reals('axis', axis)
+        call file%reals('marker_j_offset', offset)
         if (reactions) then
-            call write_vectors(unit, 'reaction_force', force(:, 1, :))
-            call write_vectors(unit, 'reaction_torque', torque(:, 1, :))
-            call write_vectors(unit, 'reaction_force_j', force(:, 2, :))
-            call write_vectors(unit, 'reaction_torque_j', torque(:, 2, :))
+            call file%reals('reaction_force', force(:, 1, :))
+            call file%reals('reaction_torque', torque(:, 1, :))
+            call file%reals('reaction_force_j', force(:, 2, :))
+            call file%reals('reaction_torque_j', torque(:, 2, :))
         end if
-        write (unit, '(a)') '</PointData></Piece>'
-        call close_grid(unit, path, status)
+        call file%line('</PointData></Piece>')
+        call file%close(status)
     end subroutine write_joints
 
     !> Which of marker i's axes is a joint's axis: z (flexmbs_mbs_joint's
@@ -408,63 +423,6 @@ contains
         if (associated(self%system)) joints = size(self%system%joints)
     end function joints
 
-    !> The cells of n points, a vertex (type 1) each, after the points.
-    subroutine write_vertices(unit, n)
-        integer, intent(in) :: unit, n
-        integer :: b
-        write (unit, '(a)') '</DataArray></Points>'
-        write (unit, '(a)') '<Cells><DataArray type="Int64" Name="connectivity" format="ascii">'
-        write (unit, '(*(1x,i0))') (b - 1, b=1, n)
-        write (unit, '(a)') '</DataArray><DataArray type="Int64" Name="offsets" format="ascii">'
-        write (unit, '(*(1x,i0))') (b, b=1, n)
-        write (unit, '(a)') '</DataArray><DataArray type="UInt8" Name="types" format="ascii">'
-        write (unit, '(*(1x,i0))') (1, b=1, n)
-        write (unit, '(a)') '</DataArray></Cells>'
-    end subroutine write_vertices
-
-    subroutine write_integers(unit, name, values)
-        integer, intent(in) :: unit, values(:)
-        character(len=*), intent(in) :: name
-        write (unit, '(a)') '<DataArray type="Int32" Name="' // name // '" format="ascii">'
-        write (unit, '(*(1x,i0))') values
-        write (unit, '(a)') '</DataArray>'
-    end subroutine write_integers
-
-    !> A vector per point (the columns of `values`).
-    subroutine write_vectors(unit, name, values)
-        integer, intent(in) :: unit
-        character(len=*), intent(in) :: name
-        real(wp), intent(in) :: values(:, :)
-        write (unit, '(a)') '<DataArray type="Float64" Name="' // name // &
-            '" NumberOfComponents="3" format="ascii">'
-        write (unit, '(3es24.15e3)') values
-        write (unit, '(a)') '</DataArray>'
-    end subroutine write_vectors
-
-    !> A VTK string array in ASCII: each name's character codes, then 0.
-    subroutine write_strings(unit, name, names)
-        integer, intent(in) :: unit
-        character(len=*), intent(in) :: name, names(:)
-        integer :: b, k
-        write (unit, '(a)') '<DataArray type="String" Name="' // name // &
-            '" NumberOfTuples="' // int_text(size(names)) // '" format="ascii">'
-        do b = 1, size(names)
-            write (unit, '(*(1x,i0))') (iachar(names(b)(k:k)), k=1, len_trim(names(b))), 0
-        end do
-        write (unit, '(a)') '</DataArray>'
-    end subroutine write_strings
-
-    !> The end of the file, after its pieces.
-    subroutine close_grid(unit, path, status)
-        integer, intent(in) :: unit
-        character(len=*), intent(in) :: path
-        type(status_t), intent(inout) :: status
-        integer :: ios
-        write (unit, '(a)') '</UnstructuredGrid></VTKFile>'
-        close (unit, iostat=ios)
-        if (ios /= 0) call status%set(status_io_error, path // ': cannot close')
-    end subroutine close_grid
-
     !> Whether there are flexible bodies to draw.
     pure logical function meshes(self)
         class(vtk_sink_t), intent(in) :: self
@@ -482,34 +440,6 @@ contains
             links = links + size(self%chains(f)%bodies)
         end do
     end function links
-
-    !> Open an unstructured-grid file and write up to its data set's field
-    !> data (begin_piece follows).
-    subroutine open_grid(path, unit, status)
-        character(len=*), intent(in) :: path
-        integer, intent(out) :: unit
-        type(status_t), intent(inout) :: status
-        integer :: ios
-        open (newunit=unit, file=path, action='write', status='replace', iostat=ios)
-        if (ios /= 0) then
-            call status%set(status_io_error, path // ': cannot write the ParaView file')
-            return
-        end if
-        write (unit, '(a)') '<?xml version="1.0"?>'
-        write (unit, '(a)') comment_opening // written_by // comment_closing
-        write (unit, '(a)') '<VTKFile type="UnstructuredGrid" version="0.1" ' // &
-            'byte_order="LittleEndian">'
-        write (unit, '(a)') '<UnstructuredGrid>'
-    end subroutine open_grid
-
-    !> The piece's opening, up to its points' values.
-    subroutine begin_piece(unit, npoints, ncells)
-        integer, intent(in) :: unit, npoints, ncells
-        write (unit, '(a)') '<Piece NumberOfPoints="' // int_text(npoints) // &
-            '" NumberOfCells="' // int_text(ncells) // '">'
-        write (unit, '(a)') '<Points><DataArray type="Float64" NumberOfComponents="3" ' // &
-            'format="ascii">'
-    end subroutine begin_piece
 
     !> PREFIX.pvd: every record so far, file names relative to the .pvd.
     subroutine write_collection(self, status)

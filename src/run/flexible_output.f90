@@ -11,6 +11,7 @@ module flexmbs_run_flexible_output
     use flexmbs_io_record_values, only: record_values_t
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_hdf5_text, only: path_name
+    use flexmbs_io_xdmf_file, only: xdmf_body_t
     implicit none
     private
 
@@ -46,7 +47,7 @@ module flexmbs_run_flexible_output
         procedure :: evaluate => energy_evaluate
     end type energy_values_t
 
-    public :: add_flexible
+    public :: add_flexible, xdmf_body
 
 contains
 
@@ -182,6 +183,19 @@ contains
             values(2) = body%kinetic_energy(y(self%ov + 1:self%ov + body%nv))
         end associate
     end subroutine energy_evaluate
+
+    !> The body as add_flexible stores it, for the XDMF file beside the
+    !> HDF5 result (io/xdmf_file).
+    function xdmf_body(body, name) result(xdmf)
+        type(flexible_body_t), intent(in) :: body
+        character(len=*), intent(in) :: name
+        type(xdmf_body_t) :: xdmf
+        xdmf%name = trim(name)
+        xdmf%group = 'flexible/' // path_name(name)
+        xdmf%nodes = body%mesh%node_count()
+        xdmf%elements = body%mesh%element_count()
+        xdmf%element_nodes = body%mesh%nnode_element
+    end function xdmf_body
 
     pure function element_type(nodes) result(name)
         integer, intent(in) :: nodes

@@ -24,7 +24,9 @@ module flexmbs_run_runner
     use flexmbs_io_table, only: new_stats_row, write_table
     use flexmbs_io_vtk_sink, only: vtk_sink_t
     use flexmbs_io_output_files, only: named_path_t, named_path, check_output_paths, &
-        output_hdf5, output_vtk, output_table, scene_inputs
+        output_hdf5, output_vtk, output_table, output_xdmf, scene_inputs
+    use flexmbs_io_xdmf_file, only: xdmf_body_t, xdmf_beside, write_xdmf, xdmf_most_records
+    use flexmbs_run_flexible_output, only: xdmf_body
     use flexmbs_run_problem_factory, only: block_spec_t
     use flexmbs_run_plan, only: run_plan_t, make_plan, scene_stab
     use flexmbs_run_monitor_sink, only: monitor_sink_t
@@ -43,6 +45,8 @@ module flexmbs_run_runner
         type(dae_stats_t) :: stats
         character(len=:), allocatable :: solver_name
         logical :: hdf5_written = .false.     !! an HDF5 file was created (and kept)
+        !> the XDMF file written beside it (flexible bodies), '' for none
+        character(len=:), allocatable :: xdmf_file
         !> A flexible body: strain, kinetic and total energy (with the
         !> potential of gravity and loads) at the start and at the end [J].
         logical :: has_energy = .false.
@@ -135,8 +139,11 @@ contains
         type(status_t) :: io_status
         integer :: i
         character(len=:), allocatable :: outcome
-        real(wp), allocatable :: y_start(:), energy(:), drift(:, :)
+        real(wp), allocatable :: y_start(:), energy(:), drift(:, :), xdmf_times(:)
+        integer, allocatable :: xdmf_rows(:)
+        integer :: xdmf_records
 
+        result%xdmf_file = ''
         call make_plan(scene, plan, status)
         if (.not. status%ok()) return
         result%y = plan%y0
@@ -258,12 +265,21 @@ contains
             if (.not. status%ok()) outcome = status%text()
             call h5%write_statistics(result%stats, io_status, result%solver_name, outcome)
             if (status%ok() .and. .not. io_status%ok()) status = io_status
+            ! the records the XDMF file lists, read back before the file closes
+            if (xdmf_wanted(scene)) call h5%record_times(xdmf_most_records, xdmf_rows, &
+                                                         xdmf_times, xdmf_records, io_status)
+            if (status%ok() .and. .not. io_status%ok()) status = io_status
             call h5%close(io_status)
             if (status%ok() .and. .not. io_status%ok()) status = io_status
             ! A solver that refused its input computed nothing: leave no file.
             if (status%code == status_bad_input .and. h5%records == 0) then
                 call delete_file(scene%output_file)
                 result%hdf5_written = .false.
+            end if
+            ! the records there are, also after a failure
+            if (result%hdf5_written .and. xdmf_wanted(scene)) then
+                call write_xdmf_beside(io_status)
+                if (status%ok() .and. .not. io_status%ok()) status = io_status
             end if
         end if
         if (len_trim(scene%table) > 0 .and. status%code /= status_bad_input) then
@@ -280,6 +296,7 @@ contains
         subroutine setup_vtk()
             integer :: k
             vtk%prefix = trim(scene%vtk)
+            vtk%binary = scene%vtk_format /= 'ascii'
             if (.not. allocated(plan%mechanical)) then
                 call status%set(status_bad_input, scene%path // ': &output: vtk: problem = ''' &
                     // trim(scene%problem) // ''' has no bodies to draw')
@@ -325,6 +342,32 @@ contains
                     // trim(scene%problem) // ''' has no bodies to draw')
             end select
         end subroutine setup_vtk
+
+        !> The XDMF file beside the closed HDF5 file: its flexible bodies and
+        !> the times of its records (io/xdmf_file).
+        subroutine write_xdmf_beside(io_status)
+            type(status_t), intent(inout) :: io_status
+            type(xdmf_body_t), allocatable :: bodies(:)
+            integer :: k
+            call io_status%clear()
+            if (.not. allocated(plan%mechanical)) return
+            select type (m => plan%mechanical)
+            type is (flexible_body_t)
+                allocate (bodies(1))
+                bodies(1) = xdmf_body(m, scene%bodies(1)%name)
+            type is (mbs_system_t)
+                allocate (bodies(size(m%flex)))
+                do k = 1, size(m%flex)
+                    bodies(k) = xdmf_body(m%flex(k), scene%bodies(k)%name)
+                end do
+            class default
+                return
+            end select
+            if (size(bodies) == 0) return
+            call write_xdmf(xdmf_beside(scene%output_file), scene%output_file, bodies, &
+                            xdmf_rows, xdmf_times, xdmf_records, io_status)
+            if (io_status%ok()) result%xdmf_file = xdmf_beside(scene%output_file)
+        end subroutine write_xdmf_beside
 
         !> The scene's rigid bodies, the node frames after them, then the
         !> chains' links, by name (the ParaView bodies' names).
@@ -389,9 +432,11 @@ contains
         inputs = scene_inputs(scene)
         allocate (character(len=0) :: pieces(0))
         if (len_trim(scene%vtk) > 0) pieces = vtk%pieces(records)
-        allocate (outputs(3 + size(pieces)))
+        allocate (outputs(4 + size(pieces)))
         n = 0
         if (len(scene%output_file) > 0) call add(scene%output_file, 'file', output_hdf5)
+        if (xdmf_wanted(scene)) call add(xdmf_beside(scene%output_file), &
+            'file (its XDMF file)', output_xdmf)
         if (len_trim(scene%table) > 0) call add(trim(scene%table), 'table', output_table)
         if (len_trim(scene%vtk) > 0) call add(trim(scene%vtk) // '.pvd', 'vtk', output_vtk)
         do k = 1, size(pieces)
@@ -407,6 +452,13 @@ contains
             outputs(n) = named_path(path, '&output: ' // name, kind)
         end subroutine add
     end subroutine check_outputs
+
+    !> Whether an XDMF file goes beside the HDF5 file: the scene has
+    !> flexible bodies (/flexible/<name>/ in the file).
+    logical function xdmf_wanted(scene)
+        type(scene_input_t), intent(in) :: scene
+        xdmf_wanted = len(scene%output_file) > 0 .and. scene%has_body()
+    end function xdmf_wanted
 
     subroutine delete_file(path)
         character(len=*), intent(in) :: path
