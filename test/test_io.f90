@@ -61,6 +61,7 @@ contains
                  new_test('table_rejection_causes', test_table_reasons), &
                  new_test('hdf5_round_trip', test_hdf5_round_trip), &
                  new_test('hdf5_every_step', test_hdf5_every_step), &
+                 new_test('hdf5_batches_and_record_times', test_hdf5_batches), &
                  new_test('hdf5_unwritable_path', test_hdf5_unwritable), &
                  new_test('progress_line', test_progress), &
                  new_test('output_files_replace', test_output_files), &
@@ -487,6 +488,47 @@ contains
                    'stored in dataset /big_text', 'large text moved to a dataset')
         call delete(path)
     end subroutine test_hdf5_round_trip
+
+    !> Records held in memory reach the file by `finish` (and at the latest a
+    !> second after the last write, not tested: it would wait); the times an
+    !> index lists, read back: all up to `most`, else one in k and the last.
+    subroutine test_hdf5_batches(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(hdf5_sink_t) :: sink
+        type(status_t) :: status
+        character(len=:), allocatable :: path
+        real(wp), allocatable :: time(:), y(:, :), q(:, :), times(:)
+        integer, allocatable :: rows(:)
+        integer :: k, nst, total
+        path = scratch('batches.h5')
+        call sink%create(path, 2, status)
+        do k = 0, 24
+            call sink%output(0.1_wp * k, [real(k, wp), -real(k, wp)], status)
+        end do
+        call check(error, status%ok(), 'output: ' // status%text())
+        call sink%record_times(10, rows, times, total, status)
+        call check(error, status%ok(), 'record_times: ' // status%text())
+        if (allocated(error)) return
+        ! 25 records, at most 10 listed: one in 3 (0, 3, ..., 24), 24 being the last
+        call check(error, total == 25, 'total')
+        call check(error, all(rows == [(3 * k, k = 0, 8)]), 'rows: one in 3 and the last')
+        call check(error, all(abs(times - 0.1_wp * rows) <= 1e-15_wp), 'times read back')
+        call sink%record_times(100, rows, times, total, status)
+        call check(error, size(rows) == 25 .and. rows(25) == 24, 'every record when few')
+        call sink%output(2.6_wp, [26.0_wp, -26.0_wp], status)
+        call sink%record_times(12, rows, times, total, status)
+        ! 26 records, at most 12: one in 3 (0 .. 24) and the last, 25
+        call check(error, total == 26 .and. rows(size(rows)) == 25 .and. rows(size(rows) - 1) &
+            == 24, 'the last added')
+        call sink%finish(status)
+        call sink%close(status)
+        call check(error, status%ok(), 'close: ' // status%text())
+        call read_series(path, time, y, q, nst, error)
+        if (allocated(error)) return
+        call check(error, size(time) == 26 .and. all(y(1, :) == -y(2, :)) .and. &
+            y(1, 26) == 26.0_wp, 'every record in the file')
+        call delete(path)
+    end subroutine test_hdf5_batches
 
     subroutine test_hdf5_every_step(error)
         type(error_t), allocatable, intent(out) :: error

@@ -77,8 +77,8 @@ contains
         call put(comment_opening // written_by // comment_closing)
         call put('<Xdmf Version="2.0">')
         if (size(rows) < records) call put(comment_opening // int_text(size(rows)) // &
-            ' of the ' // int_text(records) // ' records listed: every ' // &
-            int_text(rows(min(2, size(rows))) - rows(1)) // '-th and the last' // comment_closing)
+            ' of the ' // int_text(records) // ' records listed: one in ' // &
+            int_text(rows(min(2, size(rows))) - rows(1)) // ' and the last' // comment_closing)
         call put('<Domain>')
         if (size(times) == 0) then
             call put('<Grid Name="flexible bodies" GridType="Collection" ' // &
