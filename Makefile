@@ -171,7 +171,7 @@ test: deps
 	    echo "exit $$?" >> $(BUILD)/test-layers.log
 	@set -o pipefail; FPM="$(FPM)" bash test/cli.sh 2>&1 | tee $(BUILD)/test-cli.log; \
 	    echo "exit $$?" >> $(BUILD)/test-cli.log
-	@set -o pipefail; python3 test/docs.py \
+	@set -o pipefail; FLEXMBS_PKGCONFIG=$(PREFIX_DEBUG)/lib/pkgconfig python3 test/docs.py \
 	    "$$($(FPM) run --profile debug --runner echo flexmbs 2>/dev/null | tail -n 1)" 2>&1 \
 	    | tee $(BUILD)/test-docs.log; echo "exit $$?" >> $(BUILD)/test-docs.log
 	@set -o pipefail; { $(MAKE) --no-print-directory py-venv && $(PY_VENV)/bin/python \

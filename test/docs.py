@@ -11,7 +11,10 @@
 - with the executable: docs/scene_reference.md is what
   `flexmbs scene-reference` prints from the schema, and the help names it;
   every command the documentation or `flexmbs --help` names has a usage of
-  its own (`flexmbs COMMAND --help`: exit 0, `usage: flexmbs COMMAND`).
+  its own (`flexmbs COMMAND --help`: exit 0, `usage: flexmbs COMMAND`);
+- with FLEXMBS_PKGCONFIG naming the folder of an installed flexmbs.pc (make
+  test installs one first): docs/packaging.md gives the number of system
+  libraries its link line names.
 
 The last line is `N passed, M failed`; the exit status is non-zero on
 failures.
@@ -195,8 +198,31 @@ def main():
               else ['--help does not name docs/scene_reference.md'])
         check('every-command-has-its-help', command_help_problems(exe, files, usage))
 
+    pc_dir = os.environ.get('FLEXMBS_PKGCONFIG')
+    if pc_dir:
+        check('packaging-library-count', library_count_problems(pc_dir))
+
     print('%d passed, %d failed' % (passed, failed))
     return 1 if failed else 0
+
+
+def library_count_problems(pc_dir):
+    """docs/packaging.md's 'followed by the N system libraries' against the
+    -l flags of `pkg-config --libs flexmbs` in pc_dir."""
+    env = dict(os.environ, PKG_CONFIG_PATH=pc_dir)
+    run = subprocess.run(['pkg-config', '--libs', 'flexmbs'], capture_output=True, text=True,
+                         env=env)
+    if run.returncode != 0:
+        return ['pkg-config --libs flexmbs in %s failed: %s' % (pc_dir, run.stderr.strip())]
+    libraries = [w for w in run.stdout.split() if w.startswith('-l')]
+    with open(os.path.join(ROOT, 'docs', 'packaging.md'), encoding='utf-8') as f:
+        said = re.search(r'followed by the (\d+) system libraries', f.read())
+    if not said:
+        return ["docs/packaging.md no longer says 'followed by the N system libraries'"]
+    if int(said.group(1)) != len(libraries):
+        return ['docs/packaging.md says %s system libraries, pkg-config names %d'
+                % (said.group(1), len(libraries))]
+    return []
 
 
 if __name__ == '__main__':
