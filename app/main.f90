@@ -87,6 +87,13 @@ program flexmbs_main
     end if
     select case (command)
     case ('--help', '-h', 'help')
+        ! `flexmbs help run` and `flexmbs --help run` as `flexmbs run --help`
+        if (nargs >= 2) then
+            if (has_command_usage(argument(2))) then
+                call write_command_usage(argument(2), output_unit)
+                call finish(exit_ok)
+            end if
+        end if
         call write_usage(output_unit)
         call finish(exit_ok)
     case ('--version', '-V')

@@ -163,6 +163,9 @@ else pass docs-self-contained; fi
 
 expect help 0 "usage:" --help
 expect help-names-command-help 0 "flexmbs COMMAND --help" --help
+# `flexmbs help COMMAND` and `flexmbs --help COMMAND` give the command's usage
+expect help-command-first 0 "usage: flexmbs columns FILE.h5 COLUMN" help columns
+expect help-option-first 0 "usage: flexmbs sweep" --help sweep
 
 # command_help NAME PATTERN OPTIONS ARGS...: a command's own usage
 # (app/help_text): exit 0, on standard output only, PATTERN in it, a line
