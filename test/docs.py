@@ -102,6 +102,13 @@ def command_help_problems(exe, files, usage):
     for name in HELP_COMMAND.findall(usage):
         named.setdefault(name, '`flexmbs --help`')
     problems = []
+    # `flexmbs help COMMAND` is the help itself, not a command: it must give
+    # the command's usage, checked on one command
+    if named.pop('help', None):
+        run = subprocess.run([exe, 'help', 'run'], capture_output=True, text=True)
+        if run.returncode != 0 or not run.stdout.startswith('usage: flexmbs run'):
+            problems.append('`flexmbs help run` gives exit %d and %r'
+                            % (run.returncode, (run.stderr or run.stdout)[:80]))
     for name, where in sorted(named.items()):
         run = subprocess.run([exe, name, '--help'], capture_output=True, text=True)
         if (run.returncode != 0 or run.stderr
