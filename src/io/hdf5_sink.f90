@@ -627,7 +627,7 @@ contains
     subroutine drop_record(self)
         class(hdf5_sink_t), intent(inout) :: self
         integer :: i
-        if (self%y_batch%count > self%pending) self%y_batch%count = self%pending
+        self%y_batch%count = min(self%y_batch%count, self%pending)
         do i = 1, size(self%blocks)
             self%blocks(i)%batch%count = min(self%blocks(i)%batch%count, self%pending)
         end do

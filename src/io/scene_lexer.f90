@@ -125,25 +125,7 @@ contains
         previous_line = 0
         do
             call skip_blank(clean, pos, line)
-            if (pos > n) then
-                if (.not. skip) call errors%add('&' // group // ': not closed by ''/''', line)
-                return
-            end if
-            if (clean(pos:pos) == '/') then
-                pos = pos + 1
-                return
-            end if
-            if (clean(pos:pos) == '&') then
-                p = pos + 1
-                word = lower(name_word(clean, p))
-                if (word == 'end') then
-                    pos = p
-                    return
-                end if
-                if (.not. skip) call errors%add('&' // group // ': not closed by ''/'' before &' &
-                    // excerpt(word), line)
-                return
-            end if
+            if (group_ended(clean, pos, line, group, skip, errors)) return
             if (clean(pos:pos) == ',' .and. len(previous) > 0) then
                 pos = pos + 1
                 cycle
@@ -242,22 +224,9 @@ contains
                 bad = .true.
             end if
             value = joined(items(1:nitems))
-            if (.not. (skip .or. bad) .and. spec > 0) then
-                if (schema(spec)%count == 1 .and. nitems > 1) then
-                    call errors%add('&' // group // ': ' // name // ' = ' // excerpt(value) // &
-                        ': one value only', vline)
-                    bad = .true.
-                else if (schema(spec)%kind /= kind_string .and. .not. schema(spec)%list .and. &
-                         nitems /= schema(spec)%count) then
-                    call errors%add('&' // group // ': ' // name // ' = ' // excerpt(value) // &
-                        ': needs ' // int_text(schema(spec)%count) // ' values', vline)
-                    bad = .true.
-                else if (nitems > schema(spec)%count) then
-                    call errors%add('&' // group // ': ' // name // ' = ' // excerpt(value) // &
-                        ': at most ' // int_text(schema(spec)%count) // ' values', vline)
-                    bad = .true.
-                end if
-            end if
+            if (.not. (skip .or. bad) .and. spec > 0) &
+                call check_count(spec, nitems, '&' // group // ': ' // name // ' = ' // &
+                                 excerpt(value), vline, errors, bad)
             if (.not. skip .and. spec > 0 .and. .not. duplicate) then
                 if (nentries == size(entries)) entries = [entries, entries]
                 nentries = nentries + 1
@@ -270,6 +239,63 @@ contains
             previous = name
         end do
     end subroutine read_group_body
+
+    !> At pos (blanks skipped): the group's end, '/' or '&end' (pos moves
+    !> past it), or what ends it too early: the text's end or another
+    !> group's '&' (an error unless `skip`).
+    logical function group_ended(clean, pos, line, group, skip, errors) result(ended)
+        character(len=*), intent(in) :: clean, group
+        integer, intent(inout) :: pos
+        integer, intent(in) :: line
+        logical, intent(in) :: skip
+        type(input_errors_t), intent(inout) :: errors
+        character(len=:), allocatable :: word
+        integer :: p
+        ended = .true.
+        if (pos > len(clean)) then
+            if (.not. skip) call errors%add('&' // group // ': not closed by ''/''', line)
+            return
+        end if
+        if (clean(pos:pos) == '/') then
+            pos = pos + 1
+            return
+        end if
+        if (clean(pos:pos) == '&') then
+            p = pos + 1
+            word = lower(name_word(clean, p))
+            if (word == 'end') then
+                pos = p
+                return
+            end if
+            if (.not. skip) call errors%add('&' // group // ': not closed by ''/'' before &' &
+                // excerpt(word), line)
+            return
+        end if
+        ended = .false.
+    end function group_ended
+
+    !> The number of values of variable `spec` against the schema: one for a
+    !> scalar, exactly `count` for a fixed-size vector, at most `count` for a
+    !> list or string vector. `what` is '&group: name = value'.
+    subroutine check_count(spec, nitems, what, vline, errors, bad)
+        integer, intent(in) :: spec, nitems, vline
+        character(len=*), intent(in) :: what
+        type(input_errors_t), intent(inout) :: errors
+        logical, intent(inout) :: bad
+        if (schema(spec)%count == 1 .and. nitems > 1) then
+            call errors%add(what // ': one value only', vline)
+            bad = .true.
+        else if (schema(spec)%kind /= kind_string .and. .not. schema(spec)%list .and. &
+                 nitems /= schema(spec)%count) then
+            call errors%add(what // ': needs ' // int_text(schema(spec)%count) // ' values', &
+                            vline)
+            bad = .true.
+        else if (nitems > schema(spec)%count) then
+            call errors%add(what // ': at most ' // int_text(schema(spec)%count) // ' values', &
+                            vline)
+            bad = .true.
+        end if
+    end subroutine check_count
 
     !> text(pos:pos) is '=' (false past the end).
     pure logical function equals_at(text, pos)

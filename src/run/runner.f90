@@ -137,9 +137,8 @@ contains
         type(signal_sink_t), target :: signals
         type(multi_sink_t) :: sinks
         type(status_t) :: io_status
-        integer :: i
         character(len=:), allocatable :: outcome
-        real(wp), allocatable :: y_start(:), energy(:), drift(:, :), xdmf_times(:)
+        real(wp), allocatable :: y_start(:), xdmf_times(:)
         integer, allocatable :: xdmf_rows(:)
         integer :: xdmf_records
 
@@ -155,7 +154,7 @@ contains
 
         ! ParaView output is checked before any file is created
         if (len_trim(scene%vtk) > 0) then
-            call setup_vtk()
+            call setup_vtk(vtk, plan, scene, status)
             if (.not. status%ok()) return
         end if
         ! which files the run may write; checked before any file is created
@@ -164,26 +163,7 @@ contains
         call check_output_size(scene, plan%problem%n, plan%blocks, status)
         if (.not. status%ok()) return
         if (len(scene%output_file) > 0) then
-            call h5%create(scene%output_file, plan%problem%n, status, input_text=scene%text, &
-                           every_step=scene%every_step)
-            if (.not. status%ok()) then
-                call h5%close(io_status)
-                return
-            end if
-            result%hdf5_written = .true.
-            do i = 1, size(plan%blocks)
-                call h5%add_block(plan%blocks(i)%name, plan%blocks(i)%first, &
-                                  plan%blocks(i)%last, status)
-                if (.not. status%ok()) return
-            end do
-            call add_named_output(h5, plan, scene, status)
-            if (.not. status%ok()) return
-            call h5%write_text('problem', trim(scene%problem), status)
-            if (status%ok()) call h5%write_text('title', trim(scene%title), status)
-            if (status%ok()) call h5%write_text('input_file', scene%path, status)
-            if (status%ok() .and. allocated(result%assembly)) call h5%write_text('assembly', &
-                'moves of the initial assembly from the given positions: ' // &
-                result%assembly, status)
+            call create_hdf5(h5, plan, scene, result, status)
             if (.not. status%ok()) return
             call sinks%attach(h5)
         end if
@@ -229,36 +209,7 @@ contains
         result%summary = state_summary(plan, scene, result%y)
         if (h5%is_open) then
             if (monitor%records > 0) then
-                call h5%write_matrix('monitor', monitor%table(:, 1:monitor%records), io_status)
-                if (io_status%ok()) call h5%write_text('monitor_columns', &
-                    't, |g|_inf, |G v + g_I|_inf, energy [J]', io_status)
-                ! the same by name, with units
-                ! contiguous copies: HDF5 writes whole arrays
-                energy = monitor%table(4, 1:monitor%records)
-                drift = monitor%table(2:3, 1:monitor%records)
-                if (io_status%ok()) call h5%write_vector('energy', energy, io_status)
-                if (io_status%ok()) call h5%annotate('energy', 'unit', 'J', io_status)
-                if (io_status%ok()) call h5%annotate('energy', 'description', 'kinetic plus &
-                    &potential energy at each record of /time', io_status)
-                if (monitor%formulation%nc == 0) then
-                    ! nothing to drift: said, not written as zeros
-                    if (io_status%ok()) call h5%write_text('drift_note', 'no /drift: the &
-                        &scene has no constraints (its /monitor drift columns are 0)', io_status)
-                else
-                    if (io_status%ok()) call h5%write_matrix('drift', drift, io_status)
-                    if (io_status%ok()) call h5%annotate('drift', 'unit', &
-                        'm or 1; m/s or rad/s', io_status)
-                    if (io_status%ok()) call h5%annotate('drift', 'description', '|g|_inf and &
-                        &|G v + g_I|_inf at each record (the rows of g are lengths or &
-                        &direction cosines)', io_status)
-                end if
-                if (io_status%ok() .and. size(monitor%reactions, 1) > 0) then
-                    call h5%write_matrix('reactions', &
-                        monitor%reactions(:, 1:monitor%records), io_status)
-                    if (io_status%ok()) call h5%write_text('reactions_columns', 'per joint &
-                        &of the system: force and torque on the body of marker i, then of &
-                        &marker j (N, N m; global; torque about the marker)', io_status)
-                end if
+                call write_monitor(h5, monitor, io_status)
                 if (status%ok() .and. .not. io_status%ok()) status = io_status
             end if
             outcome = 'ok'
@@ -278,7 +229,8 @@ contains
             end if
             ! the records there are, also after a failure
             if (result%hdf5_written .and. xdmf_wanted(scene)) then
-                call write_xdmf_beside(io_status)
+                call write_xdmf_beside(plan, scene, xdmf_rows, xdmf_times, xdmf_records, &
+                                       result, io_status)
                 if (status%ok() .and. .not. io_status%ok()) status = io_status
             end if
         end if
@@ -289,109 +241,6 @@ contains
         end if
 
     contains
-
-        !> ParaView output of the flexible bodies, the rigid bodies and the
-        !> joints (y starts with q in every layout: the bodies' (r, p), then v
-        !> behind q).
-        subroutine setup_vtk()
-            integer :: k
-            vtk%prefix = trim(scene%vtk)
-            vtk%binary = scene%vtk_format /= 'ascii'
-            if (.not. allocated(plan%mechanical)) then
-                call status%set(status_bad_input, scene%path // ': &output: vtk: problem = ''' &
-                    // trim(scene%problem) // ''' has no bodies to draw')
-                return
-            end if
-            select type (m => plan%mechanical)
-            type is (flexible_body_t)
-                allocate (vtk%flexible(1))
-                vtk%flexible(1)%body => m
-                vtk%flexible(1)%ov = m%nq
-                vtk%flexible(1)%name = scene%bodies(1)%name
-            type is (mbs_system_t)
-                vtk%bodies = size(m%rigid%bodies)
-                vtk%names = body_names(size(m%rigid%bodies))
-                if (size(m%chains) > 0) then
-                    vtk%chains => m%chains
-                    vtk%chain_q = m%chain_q
-                end if
-                allocate (vtk%flexible(size(m%flex)))
-                do k = 1, size(m%flex)
-                    vtk%flexible(k)%body => m%flex(k)
-                    vtk%flexible(k)%name = scene%bodies(k)%name
-                    vtk%flexible(k)%oq = m%flex_q(k)
-                    vtk%flexible(k)%ov = m%nq + m%flex_v(k)
-                    select type (p => plan%problem)
-                    type is (formulation_t)
-                        vtk%flexible(k)%oq = p%oq + m%flex_q(k)
-                        vtk%flexible(k)%ov = p%ov + m%flex_v(k)
-                    end select
-                end do
-                if (size(m%joints) > 0) then
-                    vtk%system => m
-                    if (allocated(plan%joint_names)) vtk%joint_names = plan%joint_names
-                    ! the reactions need a formulation's multipliers (consistent with q, v)
-                    select type (p => plan%problem)
-                    type is (formulation_t)
-                        vtk%system_q = p%oq
-                        if (p%nc > 0) vtk%formulation => p
-                    end select
-                end if
-            class default
-                call status%set(status_bad_input, scene%path // ': &output: vtk: problem = ''' &
-                    // trim(scene%problem) // ''' has no bodies to draw')
-            end select
-        end subroutine setup_vtk
-
-        !> The XDMF file beside the closed HDF5 file: its flexible bodies and
-        !> the times of its records (io/xdmf_file).
-        subroutine write_xdmf_beside(io_status)
-            type(status_t), intent(inout) :: io_status
-            type(xdmf_body_t), allocatable :: bodies(:)
-            integer :: k
-            call io_status%clear()
-            if (.not. allocated(plan%mechanical)) return
-            select type (m => plan%mechanical)
-            type is (flexible_body_t)
-                allocate (bodies(1))
-                bodies(1) = xdmf_body(m, scene%bodies(1)%name)
-            type is (mbs_system_t)
-                allocate (bodies(size(m%flex)))
-                do k = 1, size(m%flex)
-                    bodies(k) = xdmf_body(m%flex(k), scene%bodies(k)%name)
-                end do
-            class default
-                return
-            end select
-            if (size(bodies) == 0) return
-            call write_xdmf(xdmf_beside(scene%output_file), scene%output_file, bodies, &
-                            xdmf_rows, xdmf_times, xdmf_records, io_status)
-            if (io_status%ok()) result%xdmf_file = xdmf_beside(scene%output_file)
-        end subroutine write_xdmf_beside
-
-        !> The scene's rigid bodies, the node frames after them, then the
-        !> chains' links, by name (the ParaView bodies' names).
-        function body_names(n) result(names)
-            integer, intent(in) :: n  !! rigid bodies, node frames included
-            character(len=len_name), allocatable :: names(:)
-            integer :: i, k
-            allocate (names(n + size(scene%chain)))
-            do i = 1, n
-                if (i <= size(scene%rigid_bodies)) then
-                    names(i) = scene%rigid_bodies(i)%name
-                else
-                    names(i) = 'node frame ' // int_text(i - size(scene%rigid_bodies))
-                end if
-            end do
-            ! the chains' links, chain by chain (one chain per tree)
-            k = n
-            do i = 1, tree_count(scene)
-                associate (tree => link_names(scene, i))
-                    names(k + 1:k + size(tree)) = tree
-                    k = k + size(tree)
-                end associate
-            end do
-        end function body_names
 
         logical function force_given()
             force_given = .false.
@@ -415,6 +264,190 @@ contains
             end select
         end subroutine record_energy
     end subroutine run_scene
+
+    !> The HDF5 file of the run: y's blocks, the named series, the scene's
+    !> texts. `result%hdf5_written` once it exists.
+    subroutine create_hdf5(h5, plan, scene, result, status)
+        type(hdf5_sink_t), intent(inout) :: h5
+        type(run_plan_t), intent(in), target :: plan
+        type(scene_input_t), intent(in) :: scene
+        type(run_result_t), intent(inout) :: result
+        type(status_t), intent(out) :: status
+        type(status_t) :: io_status
+        integer :: i
+        call h5%create(scene%output_file, plan%problem%n, status, input_text=scene%text, &
+                       every_step=scene%every_step)
+        if (.not. status%ok()) then
+            call h5%close(io_status)
+            return
+        end if
+        result%hdf5_written = .true.
+        do i = 1, size(plan%blocks)
+            call h5%add_block(plan%blocks(i)%name, plan%blocks(i)%first, &
+                              plan%blocks(i)%last, status)
+            if (.not. status%ok()) return
+        end do
+        call add_named_output(h5, plan, scene, status)
+        if (.not. status%ok()) return
+        call h5%write_text('problem', trim(scene%problem), status)
+        if (status%ok()) call h5%write_text('title', trim(scene%title), status)
+        if (status%ok()) call h5%write_text('input_file', scene%path, status)
+        if (status%ok() .and. allocated(result%assembly)) call h5%write_text('assembly', &
+            'moves of the initial assembly from the given positions: ' // &
+            result%assembly, status)
+    end subroutine create_hdf5
+
+    !> The monitor's table, and the energy, drift (or the note why there is
+    !> none) and reactions by name, into the open HDF5 file.
+    subroutine write_monitor(h5, monitor, io_status)
+        type(hdf5_sink_t), intent(inout) :: h5
+        type(monitor_sink_t), intent(in) :: monitor
+        type(status_t), intent(out) :: io_status
+        real(wp), allocatable :: energy(:), drift(:, :)
+        call h5%write_matrix('monitor', monitor%table(:, 1:monitor%records), io_status)
+        if (io_status%ok()) call h5%write_text('monitor_columns', &
+            't, |g|_inf, |G v + g_I|_inf, energy [J]', io_status)
+        ! the same by name, with units
+        ! contiguous copies: HDF5 writes whole arrays
+        energy = monitor%table(4, 1:monitor%records)
+        drift = monitor%table(2:3, 1:monitor%records)
+        if (io_status%ok()) call h5%write_vector('energy', energy, io_status)
+        if (io_status%ok()) call h5%annotate('energy', 'unit', 'J', io_status)
+        if (io_status%ok()) call h5%annotate('energy', 'description', 'kinetic plus &
+            &potential energy at each record of /time', io_status)
+        if (monitor%formulation%nc == 0) then
+            ! nothing to drift: said, not written as zeros
+            if (io_status%ok()) call h5%write_text('drift_note', 'no /drift: the &
+                &scene has no constraints (its /monitor drift columns are 0)', io_status)
+        else
+            if (io_status%ok()) call h5%write_matrix('drift', drift, io_status)
+            if (io_status%ok()) call h5%annotate('drift', 'unit', &
+                'm or 1; m/s or rad/s', io_status)
+            if (io_status%ok()) call h5%annotate('drift', 'description', '|g|_inf and &
+                &|G v + g_I|_inf at each record (the rows of g are lengths or &
+                &direction cosines)', io_status)
+        end if
+        if (io_status%ok() .and. size(monitor%reactions, 1) > 0) then
+            call h5%write_matrix('reactions', &
+                monitor%reactions(:, 1:monitor%records), io_status)
+            if (io_status%ok()) call h5%write_text('reactions_columns', 'per joint &
+                &of the system: force and torque on the body of marker i, then of &
+                &marker j (N, N m; global; torque about the marker)', io_status)
+        end if
+    end subroutine write_monitor
+
+    !> ParaView output of the flexible bodies, the rigid bodies and the
+    !> joints (y starts with q in every layout: the bodies' (r, p), then v
+    !> behind q).
+    subroutine setup_vtk(vtk, plan, scene, status)
+        type(vtk_sink_t), intent(inout) :: vtk
+        type(run_plan_t), intent(in), target :: plan
+        type(scene_input_t), intent(in) :: scene
+        type(status_t), intent(inout) :: status
+        integer :: k
+        vtk%prefix = trim(scene%vtk)
+        vtk%binary = scene%vtk_format /= 'ascii'
+        if (.not. allocated(plan%mechanical)) then
+            call status%set(status_bad_input, scene%path // ': &output: vtk: problem = ''' &
+                // trim(scene%problem) // ''' has no bodies to draw')
+            return
+        end if
+        select type (m => plan%mechanical)
+        type is (flexible_body_t)
+            allocate (vtk%flexible(1))
+            vtk%flexible(1)%body => m
+            vtk%flexible(1)%ov = m%nq
+            vtk%flexible(1)%name = scene%bodies(1)%name
+        type is (mbs_system_t)
+            vtk%bodies = size(m%rigid%bodies)
+            vtk%names = body_names(scene, size(m%rigid%bodies))
+            if (size(m%chains) > 0) then
+                vtk%chains => m%chains
+                vtk%chain_q = m%chain_q
+            end if
+            allocate (vtk%flexible(size(m%flex)))
+            do k = 1, size(m%flex)
+                vtk%flexible(k)%body => m%flex(k)
+                vtk%flexible(k)%name = scene%bodies(k)%name
+                vtk%flexible(k)%oq = m%flex_q(k)
+                vtk%flexible(k)%ov = m%nq + m%flex_v(k)
+                select type (p => plan%problem)
+                type is (formulation_t)
+                    vtk%flexible(k)%oq = p%oq + m%flex_q(k)
+                    vtk%flexible(k)%ov = p%ov + m%flex_v(k)
+                end select
+            end do
+            if (size(m%joints) > 0) then
+                vtk%system => m
+                if (allocated(plan%joint_names)) vtk%joint_names = plan%joint_names
+                ! the reactions need a formulation's multipliers (consistent with q, v)
+                select type (p => plan%problem)
+                type is (formulation_t)
+                    vtk%system_q = p%oq
+                    if (p%nc > 0) vtk%formulation => p
+                end select
+            end if
+        class default
+            call status%set(status_bad_input, scene%path // ': &output: vtk: problem = ''' &
+                // trim(scene%problem) // ''' has no bodies to draw')
+        end select
+    end subroutine setup_vtk
+
+    !> The XDMF file beside the closed HDF5 file: its flexible bodies and
+    !> the times of its records (io/xdmf_file).
+    subroutine write_xdmf_beside(plan, scene, rows, times, records, result, io_status)
+        type(run_plan_t), intent(in), target :: plan
+        type(scene_input_t), intent(in) :: scene
+        integer, intent(in) :: rows(:), records   !! the records listed, of all
+        real(wp), intent(in) :: times(:)
+        type(run_result_t), intent(inout) :: result
+        type(status_t), intent(inout) :: io_status
+        type(xdmf_body_t), allocatable :: bodies(:)
+        integer :: k
+        call io_status%clear()
+        if (.not. allocated(plan%mechanical)) return
+        select type (m => plan%mechanical)
+        type is (flexible_body_t)
+            allocate (bodies(1))
+            bodies(1) = xdmf_body(m, scene%bodies(1)%name)
+        type is (mbs_system_t)
+            allocate (bodies(size(m%flex)))
+            do k = 1, size(m%flex)
+                bodies(k) = xdmf_body(m%flex(k), scene%bodies(k)%name)
+            end do
+        class default
+            return
+        end select
+        if (size(bodies) == 0) return
+        call write_xdmf(xdmf_beside(scene%output_file), scene%output_file, bodies, &
+                        rows, times, records, io_status)
+        if (io_status%ok()) result%xdmf_file = xdmf_beside(scene%output_file)
+    end subroutine write_xdmf_beside
+
+    !> The scene's rigid bodies, the node frames after them, then the
+    !> chains' links, by name (the ParaView bodies' names).
+    function body_names(scene, n) result(names)
+        type(scene_input_t), intent(in) :: scene
+        integer, intent(in) :: n  !! rigid bodies, node frames included
+        character(len=len_name), allocatable :: names(:)
+        integer :: i, k
+        allocate (names(n + size(scene%chain)))
+        do i = 1, n
+            if (i <= size(scene%rigid_bodies)) then
+                names(i) = scene%rigid_bodies(i)%name
+            else
+                names(i) = 'node frame ' // int_text(i - size(scene%rigid_bodies))
+            end if
+        end do
+        ! the chains' links, chain by chain (one chain per tree)
+        k = n
+        do i = 1, tree_count(scene)
+            associate (tree => link_names(scene, i))
+                names(k + 1:k + size(tree)) = tree
+                k = k + size(tree)
+            end associate
+        end do
+    end function body_names
 
     !> The run's outputs (the HDF5 file, the table, the ParaView collection
     !> and the pieces of its `records` records) against its inputs (the
