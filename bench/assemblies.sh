@@ -21,6 +21,7 @@ BIN=$($FPM run --profile release flexmbs --runner echo 2>/dev/null | tail -1)
 OUT=build/bench/assemblies
 mkdir -p "$OUT"
 export OPENBLAS_NUM_THREADS=1
+. bench/lib.sh
 
 # bar NAME N X0 [CLAMP] -> a &flexible_body of N x 2 x 2 elements, 0.025 m each
 # (CLAMP = 1: fixed at xmin when it starts at x = 0)
@@ -74,7 +75,7 @@ at() {
 # per_step FILE -> "CPU/step NST" of one run (CPU from the statistics line)
 per_step() {
     local line cpu nst
-    line=$("$BIN" run "$1" --quiet 2>&1 | grep -E '^[a-z0-9]+: NST=' | tail -1)
+    line=$(in_scene_folder "$1" "$(realpath "$BIN")" run "$(basename "$1")" --quiet 2>&1 | grep -E '^[a-z0-9]+: NST=' | tail -1)
     [ -n "$line" ] || { echo "failed -"; return; }
     cpu=$(echo "$line" | sed 's/.*CPU=\([0-9.]*\).*/\1/')
     nst=$(echo "$line" | sed 's/.*NST=\([0-9]*\).*/\1/')

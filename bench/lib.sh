@@ -16,15 +16,25 @@ variant() {
         sed -i "s/^&solver/\&solver\n    name = '$3'\n    linear_solver = '$4'$system/" "$1"
 }
 
+# in_scene_folder SCENE COMMAND...: COMMAND run from SCENE's folder, where a
+# scene without &output file writes its result (the working folder), not
+# the repository's top
+in_scene_folder() {
+    local scene=$1
+    shift
+    (cd "$(dirname "$scene")" && "$@")
+}
+
 # run FILE -> "CPU NST PEAK_KB NFE LU" (CPU, NST and NFE from the statistics
 # line, LU the factorisation named by the line after it: klu, mumps, dense, ...)
 run() {
     local line peak=-
     if [ -n "${TIME:-}" ]; then
-        line=$("$TIME" -f "PEAK %M" "$BIN" run "$1" --quiet 2>&1)
+        line=$(in_scene_folder "$1" "$TIME" -f "PEAK %M" "$(realpath "$BIN")" run \
+            "$(basename "$1")" --quiet 2>&1)
         peak=$(echo "$line" | sed -n 's/^PEAK //p')
     else
-        line=$("$BIN" run "$1" --quiet 2>&1)
+        line=$(in_scene_folder "$1" "$(realpath "$BIN")" run "$(basename "$1")" --quiet 2>&1)
     fi
     local stats
     stats=$(echo "$line" | grep -E '^[a-z0-9]+: NST=' | tail -1)

@@ -15,7 +15,7 @@
 #      SUNDIALS' own KLU, with MUMPS ours behind its SUNLinearSolver;)
 #   4. 3-D refinement of the five-body coupler (RADAU5, 2x4x2 .. 8x32x8, 0.02 s):
 #      CPU per step of both paths and their fitted exponents (goal: the
-#      condensed path 8 x cheaper per step at 8x32x8);
+#      condensed path 8 x cheaper per step at 8x32x8; 'auto' best of 3);
 #   5. MEXAX on the five-body mechanism at 1e-6 (coarse 1 s, fine 0.2 s)
 #      against DDASSL: CPU per function evaluation against DDASSL's CPU per
 #      residual (goal: at most 3 x), and the total against DDASSL's beside
@@ -121,7 +121,8 @@ if want 4; then
     echo
     echo "== 4. 3-D refinement of the coupler (RADAU5 + GGL, TOL 1e-6, 0.02 s; n_output = 2: the"
     echo "     steps' cost, not that of 101 records, whose reactions cost both paths alike)"
-    echo "  divisions      n_FE  path       LU     CPU/step[s]   (* = 'auto' picks it)"
+    echo "  divisions      n_FE  path       LU     CPU/step[s]   (* = 'auto' picks it: best of 3 runs;"
+    echo "                                                         the other LU: one run)"
     : > "$OUT/refine_full.txt"
     : > "$OUT/refine_condensed.txt"
     for d in "2, 4, 2" "3, 6, 3" "4, 8, 4" "6, 12, 6" "8, 16, 8" "8, 32, 8"; do
@@ -133,7 +134,7 @@ if want 4; then
             f="$OUT/refine_$1x$2x$3_${path}_auto.nml"
             variant "$f" inputs/five_body.nml radau5 auto \
                 "s/t_end   = 1.0/t_end = 0.02/; s/divisions = 2, 4, 2/divisions = $d/; s/n_output = 101/n_output = 2/" "$path"
-            r=$(run "$f")
+            r=$(best_cpu "$f" 3)
             picked=$(echo $r | cut -d' ' -f5)
             [ "$picked" = mumps ] || picked=klu   # a failed run names none
             PER[$path$picked]=$(per_step "$r")
@@ -155,7 +156,7 @@ if want 4; then
          "condensed $(slope < "$OUT/refine_condensed.txt")"
     # the per-step cost without the set-up both paths pay once (patterns,
     # analyses, the first factorisations): the difference of a 0.1 s and a
-    # 0.02 s run at 8x32x8
+    # 0.02 s run at 8x32x8 (best of 3 each)
     row=""
     for path in full condensed; do
         cpu=""; nst=""
@@ -163,7 +164,7 @@ if want 4; then
             f="$OUT/marginal_${path}_$te.nml"
             variant "$f" inputs/five_body.nml radau5 auto \
                 "s/t_end   = 1.0/t_end = $te/; s/divisions = 2, 4, 2/divisions = 8, 32, 8/; s/n_output = 101/n_output = 2/" "$path"
-            r=$(run "$f")
+            r=$(best_cpu "$f" 3)
             cpu="$cpu ${r%% *}"; nst="$nst $(echo $r | cut -d' ' -f2)"
         done
         set -- $cpu $nst
@@ -219,8 +220,9 @@ if want 7; then
         variant "$f" inputs/five_body_fine.nml radau5 auto ""
         # each sample goes by its call stack: a memset or memcpy inside MUMPS
         # is linear algebra, the same call in the Jacobian's assembly is not
-        perf record -q --call-graph dwarf,16384 -F 200 -o "$OUT/perf.data" \
-            "$BIN" run "$f" --quiet >/dev/null 2>&1
+        in_scene_folder "$f" perf record -q --call-graph dwarf,16384 -F 200 \
+            -o "$(realpath "$OUT")/perf.data" "$(realpath "$BIN")" run "$(basename "$f")" \
+            --quiet >/dev/null 2>&1
         perf script -i "$OUT/perf.data" 2>/dev/null | awk -v rest="$OUT/profile_rest.txt" '
             BEGIN { RS = ""; FS = "\n"
                     la = "klu|mumps|amd_|colamd|btf|gemm|trsm|gemv|scotch|SCOTCH|pord|condensed_kernels|sub_block|saddle|sparse_lu|factor_kkt|solve_kkt|liblapack|libopenblas|libblas"

@@ -20,6 +20,7 @@ contains
     function collect_linalg() result(tests)
         type(test_case_t), allocatable :: tests(:)
         tests = [new_test('csc_duplicates_summed', test_csc_duplicates), &
+                 new_test('csc_many_duplicates_rectangular', test_csc_many), &
                  new_test('dense_real_complex_shift', test_dense_shift), &
                  new_test('classic_lu', test_classic_lu), &
                  new_test('block_assembly', test_block_assembly), &
@@ -48,6 +49,53 @@ contains
         call a%matvec(x, y)
         call check(error, all(abs(y - matmul(d, x)) <= 1e-14_wp), 'matvec')
     end subroutine test_csc_duplicates
+
+    !> 4000 triplets in random order on 7 x 5 and 5 x 7 matrices, most of them
+    !> duplicates: rows strictly ascending in every column, each triplet mapped
+    !> to its slot, and the values equal to the dense sum of the triplets.
+    subroutine test_csc_many(error)
+        type(error_t), allocatable, intent(out) :: error
+        integer, parameter :: nt = 4000
+        integer :: rows(nt), cols(nt), k, j, shape(2, 2), m
+        integer(i8) :: p
+        integer(i8) :: seed
+        real(wp) :: v(nt)
+        real(wp), allocatable :: d(:, :), ref(:, :)
+        type(csc_matrix_t) :: a
+        type(status_t) :: status
+        logical :: sorted
+        shape = reshape([7, 5, 5, 7], [2, 2])
+        do m = 1, 2
+            seed = 12345
+            do k = 1, nt
+                seed = mod(1103515245_i8 * seed + 12345_i8, 2147483648_i8)
+                rows(k) = 1 + int(mod(seed, int(shape(1, m), i8)))
+                seed = mod(1103515245_i8 * seed + 12345_i8, 2147483648_i8)
+                cols(k) = 1 + int(mod(seed / 7, int(shape(2, m), i8)))
+                v(k) = real(k, wp)
+            end do
+            call a%build(shape(1, m), shape(2, m), rows, cols, status)
+            call check(error, status%ok(), 'build: ' // status%text())
+            if (allocated(error)) return
+            sorted = .true.
+            do j = 1, shape(2, m)
+                do p = a%colptr(j) + 2, a%colptr(j + 1)
+                    sorted = sorted .and. a%rowind(p) > a%rowind(p - 1)
+                end do
+            end do
+            call check(error, sorted, 'rows strictly ascending in each column')
+            call a%fill(v)
+            allocate (d(shape(1, m), shape(2, m)), ref(shape(1, m), shape(2, m)))
+            call a%to_dense(d)
+            ref = 0.0_wp
+            do k = 1, nt
+                ref(rows(k), cols(k)) = ref(rows(k), cols(k)) + v(k)
+            end do
+            call check(error, all(d == ref), 'values are the sums of the triplets')
+            call check(error, a%nnz == count(ref /= 0.0_wp), 'one slot per position')
+            deallocate (d, ref)
+        end do
+    end subroutine test_csc_many
 
     subroutine test_dense_shift(error)
         type(error_t), allocatable, intent(out) :: error

@@ -43,6 +43,7 @@ contains
                  new_test('several_right_hand_sides', test_several_rhs), &
                  new_test('error_analysis_estimates', test_error_analysis), &
                  new_test('misuse_reported', test_misuse), &
+                 new_test('small_workspace_grows', test_workspace), &
                  new_test('auto_picks_mumps_on_3d_klu_on_slender', test_auto)]
     end function collect_mumps
 
@@ -388,6 +389,58 @@ contains
         acc = lu%accuracy()
         call check(error, .not. acc%available, 'no estimates without error analysis')
     end subroutine test_error_analysis
+
+    !> A workspace WK_USER far below MUMPS's estimate grows on error -9 until
+    !> the factorisation fits (real and complex), then stays: refactoring
+    !> reuses it. The solutions agree with dense LU.
+    subroutine test_workspace(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(matrix_t) :: jac, mass
+        type(mumps_real_t) :: lu
+        type(mumps_complex_t) :: zlu
+        type(dense_solver_t) :: dense
+        type(status_t) :: status
+        real(wp), allocatable :: x(:), xd(:)
+        complex(wp), allocatable :: z(:)
+        complex(wp), parameter :: factor = (1.0_wp, 2.0_wp)
+        integer(i8) :: grown
+        character(len=120) :: msg
+
+        call node_graph_jacobian(5, 5, 5, 3, jac, status, seed=3)
+        if (status%ok()) call node_graph_mass(jac%n, mass, status)
+        if (status%ok()) call dense%init(mass, jac, status)
+        if (status%ok()) call dense%factor_real(0.0_wp, mass, jac, status)
+        call check(error, status%ok(), 'node graph, dense LU of -J: ' // status%text())
+        if (allocated(error)) return
+        xd = rhs(jac%n, 2)
+        call dense%solve_real(xd)
+
+        call lu%configure(status, workspace=1000_i8)
+        call lu%analyse(jac%n, jac%csc%colptr, jac%csc%rowind, status)
+        call lu%factor(-jac%csc%values, status)
+        call check(error, status%ok(), 'real factor from 1000 entries: ' // status%text())
+        if (allocated(error)) return
+        grown = lu%workspace_entries()
+        write (msg, '(a,i0,a,i0)') 'workspace ', grown, ', factor entries ', &
+            lu%factor_nonzeros()
+        call check(error, grown > 1000 .and. grown >= lu%factor_nonzeros(), trim(msg))
+        call lu%factor(-2.0_wp * jac%csc%values, status)
+        call check(error, status%ok() .and. lu%workspace_entries() == grown, &
+            'refactor keeps the workspace: ' // trim(msg))
+        x = rhs(jac%n, 2)
+        call lu%solve(x, status)
+        call check_close(error, reldiff(2.0_wp * x, xd), 0.0_wp, agree_tol, 'real solution')
+
+        call zlu%configure(status, workspace=1000_i8)
+        call zlu%analyse(jac%n, jac%csc%colptr, jac%csc%rowind, status)
+        call zlu%factor(-factor * jac%csc%values, status)
+        call check(error, status%ok() .and. zlu%workspace_entries() > 1000, &
+            'complex factor from 1000 entries: ' // status%text())
+        z = cmplx(rhs(jac%n, 2), 0.0_wp, kind=wp)
+        call zlu%solve(z, status)
+        call check_close(error, zreldiff(factor * z, cmplx(xd, 0.0_wp, kind=wp)), 0.0_wp, &
+            agree_tol, 'complex solution')
+    end subroutine test_workspace
 
     !> Misuse gives bad-input statuses naming what is wrong.
     subroutine test_misuse(error)

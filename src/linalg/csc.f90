@@ -40,8 +40,8 @@ contains
         integer, intent(in) :: nrow, ncol      !! matrix shape
         integer, intent(in) :: rows(:), cols(:) !! 1-based triplet positions
         type(status_t), intent(out) :: status
-        integer(i8), allocatable :: count(:), start(:), tmp_row(:), tmp_k(:)
-        integer(i8) :: k, nt, p, q
+        integer(i8), allocatable :: count(:), start(:), tmp_row(:), tmp_k(:), by_row(:)
+        integer(i8) :: k, nt, p
         integer :: j, i, stat
         character(len=160) :: msg
 
@@ -60,12 +60,29 @@ contains
         end do
         self%nrow = nrow
         self%ncol = ncol
-        ! Bucket triplets by column (counting sort), keeping triplet numbers.
-        allocate (count(ncol + 1), start(ncol + 1), tmp_row(nt), tmp_k(nt), stat=stat)
+        ! Two stable counting sorts, by row and then by column, leave each
+        ! column's rows ascending in O(triplets + nrow + ncol): a column of
+        ! an assembled FE pattern holds hundreds of duplicates, which an
+        ! insertion sort per column paid for quadratically.
+        allocate (count(max(nrow, ncol) + 1), start(ncol + 1), tmp_row(nt), tmp_k(nt), &
+                  by_row(nt), stat=stat)
         if (stat /= 0) then
-            call out_of_memory(status, 'sparse pattern work arrays', 2 * (ncol + 1_i8 + nt), 8)
+            call out_of_memory(status, 'sparse pattern work arrays', 3 * nt + ncol + &
+                               max(nrow, ncol) + 2_i8, 8)
             return
         end if
+        count = 0
+        do k = 1, nt
+            count(rows(k) + 1) = count(rows(k) + 1) + 1
+        end do
+        count(1) = 1
+        do i = 1, nrow
+            count(i + 1) = count(i + 1) + count(i)
+        end do
+        do k = 1, nt
+            by_row(count(rows(k))) = k
+            count(rows(k)) = count(rows(k)) + 1
+        end do
         count = 0
         do k = 1, nt
             count(cols(k) + 1) = count(cols(k) + 1) + 1
@@ -75,23 +92,12 @@ contains
             start(j + 1) = start(j) + count(j + 1)
         end do
         count(:ncol) = start(:ncol)
-        do k = 1, nt
+        do p = 1, nt
+            k = by_row(p)
             j = cols(k)
             tmp_row(count(j)) = rows(k)
             tmp_k(count(j)) = k
             count(j) = count(j) + 1
-        end do
-        ! Sort rows inside each column (insertion sort: columns are short).
-        do j = 1, ncol
-            do p = start(j) + 1, start(j + 1) - 1
-                q = p
-                do while (q > start(j))
-                    if (tmp_row(q - 1) <= tmp_row(q)) exit
-                    call swap(tmp_row(q - 1), tmp_row(q))
-                    call swap(tmp_k(q - 1), tmp_k(q))
-                    q = q - 1
-                end do
-            end do
         end do
         ! Merge duplicates.
         if (allocated(self%colptr)) deallocate (self%colptr)
@@ -134,11 +140,6 @@ contains
             if (allocated(self%triplet_map)) deallocate (self%triplet_map)
             self%nnz = 0
         end subroutine forget
-        pure subroutine swap(a, b)
-            integer(i8), intent(inout) :: a, b
-            integer(i8) :: t
-            t = a; a = b; b = t
-        end subroutine swap
     end subroutine csc_build
 
     !> Refill the values from triplet values (same order as at build time),

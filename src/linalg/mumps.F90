@@ -18,6 +18,13 @@
 !>   percentage by which MUMPS enlarges its estimated workspace, multiplied
 !>   by `memory_growth`, at most `max_memory_retries` times; the larger value
 !>   stays for later factorisations.
+!> - The real/complex workspace is ours (WK_USER, LWK_USER), sized by the
+!>   analysis' estimate INFO(8) and kept across factorisations: MUMPS would
+!>   otherwise allocate its array S afresh at each one, and the kernel's
+!>   zeroing of new pages cost 12 % of a refined coupler's run (RADAU5,
+!>   condensed, 8x32x8; 684 k page faults against 216 k). Error -9 grows it
+!>   to the largest of the estimate, `memory_growth` times its size and its
+!>   size plus the entries MUMPS reports missing (INFO(2)).
 !> - Null pivots: ICNTL(24) = 1 makes MUMPS detect null pivots instead of
 !>   dividing by them; their count INFOG(28) > 0 is reported as a singular
 !>   matrix, like INFO(1) = -10. The threshold is absolute and tiny
@@ -108,6 +115,10 @@ module flexmbs_linalg_mumps
         integer :: infog(80) = 0
         real(wp) :: rinfog(40) = 0.0_wp
         integer :: memory_retries = 0      !! workspace retries so far
+        integer(i8) :: workspace = 0       !! entries of WK_USER allocated
+        integer(i8) :: workspace_start = 0 !! first WK_USER size asked (0: INFO(8))
+        integer(i8) :: workspace_estimate = 0 !! the analysis' estimate INFO(8)
+        integer(i8) :: workspace_needed = 0 !! entries the next factorisation asks for
         integer :: last_nrhs = 0           !! right-hand sides of the latest solve
     contains
         procedure :: configure => mumps_configure
@@ -117,6 +128,7 @@ module flexmbs_linalg_mumps
         procedure :: null_pivots => mumps_null_pivots
         procedure :: accuracy => mumps_accuracy
         procedure :: memory_percent => mumps_memory_percent
+        procedure :: workspace_entries => mumps_workspace_entries
         procedure :: order => mumps_order
         procedure :: is_analysed => mumps_is_analysed
         procedure :: is_factored => mumps_is_factored
@@ -124,6 +136,7 @@ module flexmbs_linalg_mumps
         procedure(run_i), deferred, private :: run
         procedure(attach_i), deferred, private :: attach
         procedure(release_i), deferred, private :: release
+        procedure(reserve_i), deferred, private :: reserve
     end type mumps_factor_t
 
     abstract interface
@@ -141,11 +154,18 @@ module flexmbs_linalg_mumps
             integer(i8), intent(in) :: colptr(:), rowind(:)
             type(status_t), intent(inout) :: status
         end subroutine attach_i
-        !> Deallocate the arrays `attach` allocated.
+        !> Deallocate the arrays `attach` and `reserve` allocated.
         subroutine release_i(self)
             import :: mumps_factor_t
             class(mumps_factor_t), intent(inout) :: self
         end subroutine release_i
+        !> Make WK_USER hold at least `entries` entries and tell MUMPS its size.
+        subroutine reserve_i(self, entries, status)
+            import :: mumps_factor_t, i8, status_t
+            class(mumps_factor_t), intent(inout) :: self
+            integer(i8), intent(in) :: entries
+            type(status_t), intent(inout) :: status
+        end subroutine reserve_i
     end interface
 
     !> MUMPS LU of real unsymmetric matrices (DMUMPS).
@@ -207,13 +227,17 @@ contains
     !> Settings for the next analysis (each optional; unset ones keep their
     !> value). `comm` takes effect when the MUMPS instance is created, at the
     !> first analysis or the first after `destroy`.
-    subroutine mumps_configure(self, status, ordering, verbose, error_analysis, comm)
+    subroutine mumps_configure(self, status, ordering, verbose, error_analysis, comm, &
+                               workspace)
         class(mumps_factor_t), intent(inout) :: self
         type(status_t), intent(out) :: status
         integer, intent(in), optional :: ordering     !! mumps_ordering_*
         logical, intent(in), optional :: verbose      !! MUMPS prints to standard output
         logical, intent(in), optional :: error_analysis !! ICNTL(11) = 1 at each solve
         integer, intent(in), optional :: comm         !! MPI communicator
+        !> entries of the first workspace WK_USER (0, the default: MUMPS's
+        !> estimate INFO(8)); a smaller one grows on demand
+        integer(i8), intent(in), optional :: workspace
         character(len=160) :: msg
         if (present(ordering)) then
             if (mumps_ordering_name(ordering) == 'none' .or. ordering == 1) then
@@ -227,6 +251,7 @@ contains
         if (present(verbose)) self%verbose = verbose
         if (present(error_analysis)) self%error_analysis = error_analysis
         if (present(comm)) self%comm = comm
+        if (present(workspace)) self%workspace_start = max(workspace, 0_i8)
     end subroutine mumps_configure
 
     !> Analyse the pattern of n x n matrices in CSC form (0-based, no
@@ -280,6 +305,10 @@ contains
         self%nnz = colptr(n + 1)
         call execute(self, job_analyse, 'mumps analyse', status)
         if (.not. status%ok()) return
+        ! INFO(8): MUMPS's estimate of the in-core workspace, ICNTL(14) included
+        self%workspace_estimate = counted(self%info(8))
+        self%workspace_needed = self%workspace_estimate
+        if (self%workspace_start > 0) self%workspace_needed = self%workspace_start
         self%stage = stage_analysed
     end subroutine mumps_analyse
 
@@ -310,12 +339,22 @@ contains
         character(len=*), intent(in) :: where
         type(status_t), intent(inout) :: status
         do
+            if (job == job_factor) then
+                call self%reserve(self%workspace_needed, status)
+                if (.not. status%ok()) return
+            end if
             call self%run(job)
             if (self%info(1) >= 0) return
             if (.not. (job == job_factor .and. is_workspace_error(self%info(1)) &
                        .and. self%memory_retries < mumps_max_memory_retries)) exit
             self%memory_retries = self%memory_retries + 1
             self%icntl(14) = memory_growth * max(self%icntl(14), 1)
+            ! -9: WK_USER, the real/complex workspace, lacked INFO(2) entries
+            ! at the moment of the error (more may follow): at least the
+            ! analysis' estimate, twice the old size, or what was missing
+            if (self%info(1) == -9) self%workspace_needed = max(self%workspace_estimate, &
+                memory_growth * self%workspace_needed, &
+                self%workspace_needed + counted(self%info(2)))
         end do
         call set_error(self, status, where)
     end subroutine execute
@@ -399,6 +438,19 @@ contains
         end if
     end function mumps_factor_nonzeros
 
+    !> LWK_USER for a workspace of `entries` entries: the count, or minus
+    !> the millions beyond the default integer's range (`reserve` allocates
+    !> whole millions there).
+    pure integer function workspace_code(entries) result(code)
+        integer(i8), intent(in) :: entries
+        integer(i8), parameter :: million = 1000000_i8
+        if (entries <= huge(code)) then
+            code = int(entries)
+        else
+            code = -int(entries / million)
+        end if
+    end function workspace_code
+
     pure integer(i8) function counted(value)
         integer, intent(in) :: value
         integer(i8), parameter :: million = 1000000_i8
@@ -436,6 +488,14 @@ contains
         class(mumps_factor_t), intent(in) :: self
         mumps_memory_percent = self%icntl(14)
     end function mumps_memory_percent
+
+    !> Entries of the workspace WK_USER given to MUMPS (0 before the first
+    !> factorisation).
+    integer(i8) function mumps_workspace_entries(self)
+        class(mumps_factor_t), intent(in) :: self
+        mumps_workspace_entries = 0
+        if (owns(self)) mumps_workspace_entries = self%workspace
+    end function mumps_workspace_entries
 
     !> Matrix order (0 before analysis).
     pure integer function mumps_order(self)
