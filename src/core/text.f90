@@ -1,9 +1,14 @@
 !> Numbers as text for status messages, and small string helpers.
 module flexmbs_core_text
-    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_kinds, only: wp, i8
     implicit none
     private
     public :: real_text, exact_text, int_text, lower, excerpt, nearest
+
+    !> An integer (default or 64-bit) without blanks.
+    interface int_text
+        module procedure int_text_default, int_text_i8
+    end interface int_text
 
 contains
 
@@ -57,13 +62,22 @@ contains
     end function exact_text
 
     !> i without blanks.
-    pure function int_text(i) result(text)
+    pure function int_text_default(i) result(text)
         integer, intent(in) :: i
         character(len=:), allocatable :: text
         character(len=16) :: buf
         write (buf, '(i0)') i
         text = trim(buf)
-    end function int_text
+    end function int_text_default
+
+    !> i without blanks (64-bit: counts of entries, bytes, offsets).
+    pure function int_text_i8(i) result(text)
+        integer(i8), intent(in) :: i
+        character(len=:), allocatable :: text
+        character(len=24) :: buf
+        write (buf, '(i0)') i
+        text = trim(buf)
+    end function int_text_i8
 
     !> s in lower case (ASCII).
     pure function lower(s) result(t)

@@ -281,20 +281,11 @@ contains
         if (components > 1) tag = tag // ' NumberOfComponents="' // int_text(components) // '"'
         if (present(tuples)) tag = tag // ' NumberOfTuples="' // int_text(tuples) // '"'
         if (present(offset)) then
-            tag = tag // ' format="appended" offset="' // big_text(offset) // '"/>'
+            tag = tag // ' format="appended" offset="' // int_text(offset) // '"/>'
         else
             tag = tag // ' format="ascii">'
         end if
     end function array_tag
-
-    !> A count of characters as text.
-    pure function big_text(i) result(text)
-        integer(i8), intent(in) :: i
-        character(len=:), allocatable :: text
-        character(len=24) :: buf
-        write (buf, '(i0)') i
-        text = trim(buf)
-    end function big_text
 
     !> Integers on one line of text.
     subroutine text_integers(self, values)
@@ -321,7 +312,7 @@ contains
             allocate (character(len=max(need, 2 * len(self%encoded, kind=i8))) :: grown, &
                       stat=stat)
             if (stat /= 0) then
-                self%failure = 'out of memory for ' // big_text(need) // ' characters of arrays'
+                self%failure = 'out of memory for ' // int_text(need) // ' characters of arrays'
                 return
             end if
             grown(1:self%used) = self%encoded(1:self%used)
