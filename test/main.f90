@@ -19,6 +19,7 @@ program flexmbs_tests
     use test_mexax, only: collect_mexax
     use test_mexax_sparse, only: collect_mexax_sparse
     use test_mexax_accuracy, only: collect_mexax_accuracy
+    use test_mexax_deuflhard, only: collect_mexax_deuflhard
     use test_fe, only: collect_fe
     use test_fe_element, only: collect_fe_element
     use test_fe_body, only: collect_fe_body
@@ -80,6 +81,7 @@ program flexmbs_tests
     call run_suite('mexax', collect_mexax(), filter, npassed, nfailed)
     call run_suite('mexax_sparse', collect_mexax_sparse(), filter, npassed, nfailed)
     call run_suite('mexax_accuracy', collect_mexax_accuracy(), filter, npassed, nfailed)
+    call run_suite('mexax_deuflhard', collect_mexax_deuflhard(), filter, npassed, nfailed)
     call run_suite('fe', collect_fe(), filter, npassed, nfailed)
     call run_suite('fe_element', collect_fe_element(), filter, npassed, nfailed)
     call run_suite('fe_body', collect_fe_body(), filter, npassed, nfailed)

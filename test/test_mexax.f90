@@ -23,7 +23,7 @@ module test_mexax
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
     private
-    public :: collect_mexax
+    public :: collect_mexax, anchor_run
 
     real(wp), parameter :: phi0 = 1.0_wp        ! pendulum start angle [rad]
     real(wp), parameter :: omega = sqrt(9.81_wp) ! sqrt(g/L) of the default pendulum
@@ -478,16 +478,18 @@ contains
     !> One run of the §8 chain anchor: 8 bars, base (E), t in [0, 1], TOL
     !> for rtol and atol, initial step h0; a and λ extrapolated as the
     !> original's (no extra LU per step), the classic elimination order.
-    subroutine anchor_run(solver, tol, h0, status)
+    subroutine anchor_run(solver, tol, h0, status, control)
         type(mexax_t), intent(inout) :: solver
         real(wp), intent(in) :: tol, h0
         type(status_t), intent(out) :: status
+        integer, intent(in), optional :: control !! mexax_control_*; the solver's default
         type(pendulum_chain_t) :: chain
         type(dae_options_t) :: options
         type(dae_stats_t) :: stats
         real(wp) :: q(24), v(24), lam(16), t
         chain = new_pendulum_chain(8)
         solver%base = mexax_base_euler
+        if (present(control)) solver%control = control
         solver%consistent_accelerations = .false.
         call pendulum_chain_initial(chain, q, v, lam)
         options%rtol = tol
@@ -585,14 +587,15 @@ contains
         call check(error, status%code == status_bad_input, 'dae problem: ' // status%text())
     end subroutine test_failures
 
-    !> `&solver name = 'mexax', max_extrapolation, mexax_base` through
-    !> run_scene on the pendulum; bad values are refused by name.
+    !> `&solver name = 'mexax', max_extrapolation, mexax_base, mexax_control`
+    !> through run_scene on the pendulum; bad values are refused by name.
     subroutine test_scene(error)
         type(error_t), allocatable, intent(out) :: error
         type(scene_input_t) :: scene
         type(status_t) :: status
         type(run_result_t) :: result
         real(wp) :: phi, dphi
+        integer :: nst_hairer
         character(len=*), parameter :: sim = '&simulation problem = ''pendulum'', ' // &
             't_end = 1, pendulum_angle = 1.0, pendulum_formulation = ''ggl'' /' // &
             new_line('a') // '&output file = ''none'', progress = .false. /' // new_line('a')
@@ -612,6 +615,24 @@ contains
             1.0e-8_wp) <= 1.0e-7_wp, 'pendulum position at t = 1')
         call check_close(error, result%y(5), dphi**2 + 9.81_wp * cos(phi), 1.0e-5_wp, &
             'lambda at t = 1', rel=.true.)
+        ! the two controls reach the solver: both accurate, with other steps
+        nst_hairer = result%stats%nst
+        call parse_scene(sim // '&solver name = ''MEXAX'', max_extrapolation = 6, ' // &
+            'mexax_base = ''Euler'', mexax_control = ''Deuflhard'', rtol = 1e-8, atol = 1e-8 /', &
+            'pend.nml', scene, status)
+        call check(error, status%ok() .and. scene%mexax_control == 'deuflhard', &
+            'parse mexax_control: ' // status%text())
+        if (allocated(error)) return
+        call run_scene(scene, .true., result, status)
+        call check(error, status%ok(), 'run (deuflhard): ' // status%text())
+        if (allocated(error)) return
+        call check(error, paper_error(result%y(1:2), [sin(phi), -cos(phi)], 1.0e-8_wp, &
+            1.0e-8_wp) <= 1.0e-7_wp, 'pendulum position at t = 1 (deuflhard)')
+        call check(error, result%stats%nst /= nst_hairer, 'the same steps under both controls')
+        call parse_scene(sim // '&solver name = ''mexax'', mexax_control = ''odex'' /', &
+            'pend.nml', scene, status)
+        call check(error, index(status%text(), 'mexax_control') > 0, &
+            'mexax_control = odex accepted: ' // status%text())
         call parse_scene(sim // '&solver name = ''mexax'', max_extrapolation = 13 /', &
             'pend.nml', scene, status)
         call check(error, index(status%text(), 'max_extrapolation') > 0, &

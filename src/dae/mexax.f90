@@ -37,7 +37,7 @@ module flexmbs_dae_mexax
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_sink, only: sink_t
     use flexmbs_dae_mexax_control, only: mexax_base_midpoint, mexax_base_euler, &
-        mexax_max_columns
+        mexax_max_columns, mexax_control_hairer, mexax_control_deuflhard
     use flexmbs_dae_mexax_workspace, only: workspace_t, workspace_linear_solver, mexax_native_t, mexax_auto_klu_order, &
         setup_workspace, ev_ok
     use flexmbs_dae_mexax_tableau, only: start_point, base_column, extrapolate_column
@@ -49,7 +49,7 @@ module flexmbs_dae_mexax
     private
 
     public :: mexax_base_midpoint, mexax_base_euler, mexax_max_columns, mexax_native_t, &
-        mexax_auto_klu_order
+        mexax_auto_klu_order, mexax_control_hairer, mexax_control_deuflhard
     ! Defined with the state; part of this module's interface.
     public :: mexax_dense_t, mexax_failed_none, mexax_failed_step, mexax_failed_projection
 

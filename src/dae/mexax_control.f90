@@ -8,16 +8,27 @@
 !> the Euler base (E), an h-extrapolation like the linearly implicit Euler
 !> method of SEULEX [HW96 IV.9], takes SEULEX's, which transfer ODEX's
 !> control to h-expansions. Each constant below names its source.
+!>
+!> `mexax_control_deuflhard` selects instead the control of Deuflhard's
+!> school (flexmbs_dae_mexax_deuflhard): the same tableau, sequences and
+!> work, other rules for the order, the step size and the rejections.
 module flexmbs_dae_mexax_control
     use flexmbs_core_kinds, only: wp
+    use flexmbs_dae_mexax_deuflhard, only: alpha_table, window_top, window_test, &
+        order_after_accept_window, deuflhard_safety, deuflhard_growth, window_continue, &
+        window_accept, window_reject
     implicit none
     private
+    public :: window_continue, window_accept, window_reject
 
     !> Base methods (§3.2).
     integer, parameter, public :: mexax_base_midpoint = 1 !! (M), h²-extrapolation (default)
     integer, parameter, public :: mexax_base_euler = 2    !! (E), h-extrapolation (MEXX21)
     !> At most this many extrapolation columns (KDMAX).
     integer, parameter, public :: mexax_max_columns = 12
+    !> Order and step-size controls (docs/theory.md §7.3).
+    integer, parameter, public :: mexax_control_hairer = 1    !! ODEX / SEULEX [HNW93; HW96]
+    integer, parameter, public :: mexax_control_deuflhard = 2 !! Deuflhard's [Deu83]
 
     ! Step-number sequence of (E) (LNPE95: MEXX21); (M) uses n_j = 2j, the
     ! default sequence of ODEX [HNW93 II.9].
@@ -41,11 +52,14 @@ module flexmbs_dae_mexax_control
     ! rtol + atol (SEULEX, (E)); (E) within [3, KDMAX − 2] (SEULEX).
     real(wp), parameter :: start_slope = -0.6_wp, start_offset = 1.5_wp
     integer, parameter :: euler_start_min = 3
+    ! Deuflhard's model accuracy ε = min rtol within these bounds (own)
+    real(wp), parameter :: model_eps_min = 1.0e-14_wp, model_eps_max = 0.1_wp
 
     !> The control state of one integration: sequence, work, and per column
     !> the error estimate, the step size it proposes and the work per unit step.
     type, public :: control_t
         integer :: base = mexax_base_midpoint
+        integer :: scheme = mexax_control_hairer !! mexax_control_hairer | _deuflhard
         integer :: km = 0                   !! KDMAX
         real(wp) :: varpi = 2.0_wp          !! the expansion is in h^varpi
         real(wp) :: order_down = midpoint_fac3, order_up = midpoint_fac4 !! FAC3, FAC4
@@ -54,6 +68,11 @@ module flexmbs_dae_mexax_control
         real(wp), allocatable :: err(:)     !! err_j
         real(wp), allocatable :: hh(:)      !! H_j
         real(wp), allocatable :: work(:)    !! W_j = A_j / H_j
+        ! Deuflhard's control only
+        real(wp), allocatable :: fac(:)     !! step factor H/H_j of column j
+        real(wp), allocatable :: alpha(:, :) !! α(j, q) at the run's tolerance
+        integer :: qmax = 0                 !! the highest column worth computing
+        real(wp) :: h_retry = 0.0_wp        !! |H| after the monitor's rejection
     contains
         procedure :: init => control_init
         procedure :: start_column
@@ -61,21 +80,27 @@ module flexmbs_dae_mexax_control
         procedure :: diverged
         procedure :: monitor_rejects
         procedure :: hope_rejects
+        procedure :: window
         procedure :: order_after_accept
         procedure :: order_after_reject
     end type control_t
 
 contains
 
-    !> Sequence, work and constants of `base` for `km` columns.
-    subroutine control_init(self, base, km)
+    !> Sequence, work and constants of `base` and `scheme` for `km` columns.
+    subroutine control_init(self, base, km, scheme)
         class(control_t), intent(inout) :: self
         integer, intent(in) :: base, km
+        integer, intent(in), optional :: scheme
         integer :: j
         self%base = base
         self%km = km
-        if (allocated(self%nj)) deallocate (self%nj, self%awork, self%err, self%hh, self%work)
-        allocate (self%nj(km), self%awork(km), self%err(km), self%hh(km), self%work(km))
+        self%scheme = mexax_control_hairer
+        if (present(scheme)) self%scheme = scheme
+        if (allocated(self%nj)) deallocate (self%nj, self%awork, self%err, self%hh, self%work, &
+                                            self%fac, self%alpha)
+        allocate (self%nj(km), self%awork(km), self%err(km), self%hh(km), self%work(km), &
+                  self%fac(km), self%alpha(km, km))
         if (base == mexax_base_euler) then
             self%nj = euler_sequence(1:km)
             self%varpi = 1.0_wp
@@ -94,13 +119,26 @@ contains
         self%err = 0.0_wp
         self%hh = 0.0_wp
         self%work = 0.0_wp
+        self%fac = 0.0_wp
+        self%alpha = 1.0_wp
     end subroutine control_init
 
     !> The first column k: ODEX from min rtol (M), SEULEX from min(rtol +
     !> atol) within [3, KDMAX − 2] (E); always within [2, KDMAX − 1].
+    !> Deuflhard's control: the model's α at ε = min rtol, and its highest
+    !> column worth computing, where the first step's window lies [Deu83 §3].
     integer function start_column(self, rtol, atol) result(k)
-        class(control_t), intent(in) :: self
+        class(control_t), intent(inout) :: self
         real(wp), intent(in) :: rtol(:), atol(:)
+        integer :: j
+        if (self%scheme == mexax_control_deuflhard) then
+            ! ε = TOL [Deu83], kept below 1 and above round-off (α ≥ 1 needs ε < 1)
+            self%alpha = alpha_table(self%awork, [(1.0_wp / error_exponent(self, j), &
+                j = 1, self%km)], min(max(minval(rtol), model_eps_min), model_eps_max))
+            self%qmax = window_top(self%awork, self%alpha, self%km)
+            k = self%qmax
+            return
+        end if
         if (self%base == mexax_base_euler) then
             k = int(start_slope * log10(minval(rtol + atol)) + start_offset)
             k = max(euler_start_min, min(self%km - 2, k))
@@ -118,16 +156,42 @@ contains
         integer, intent(in) :: j
         real(wp), intent(in) :: big_h, hmax
         real(wp) :: expo, fmin, fac
-        if (self%base == mexax_base_euler) then
-            expo = 1.0_wp / j
-        else
-            expo = 1.0_wp / (2 * j - 1)
+        expo = error_exponent(self, j)
+        if (self%scheme == mexax_control_deuflhard) then
+            ! [Deu83 §3]: H_j aims at ρ TOL; the growth bounded
+            self%fac(j) = (self%err(j) / deuflhard_safety)**expo
+            self%hh(j) = min(abs(big_h) / max(self%fac(j), 1.0_wp / deuflhard_growth), hmax)
+            self%work(j) = self%awork(j) / self%hh(j)
+            return
         end if
         fmin = fac1**expo
         fac = min(fac2 / fmin, max(fmin, (self%err(j) / safe1)**expo / safe2))
         self%hh(j) = min(abs(big_h) / fac, hmax)
         self%work(j) = self%awork(j) / self%hh(j)
     end subroutine column_step
+
+    !> 1/γ_j, with err_j = O(H^γ_j): γ_j = j for (E), 2j − 1 for (M).
+    pure real(wp) function error_exponent(self, j)
+        class(control_t), intent(in) :: self
+        integer, intent(in) :: j
+        if (self%base == mexax_base_euler) then
+            error_exponent = 1.0_wp / j
+        else
+            error_exponent = 1.0_wp / (2 * j - 1)
+        end if
+    end function error_exponent
+
+    !> Deuflhard's convergence monitor on column j of a step planned for
+    !> column q (flexmbs_dae_mexax_deuflhard's window_test): window_continue,
+    !> window_accept or window_reject (then h_retry holds the next |H|).
+    integer function window(self, j, q, first, h) result(decision)
+        class(control_t), intent(inout) :: self
+        integer, intent(in) :: j, q
+        logical, intent(in) :: first
+        real(wp), intent(in) :: h
+        call window_test(self%err(j), self%fac(j), self%alpha, j, q, self%qmax, first, &
+                         abs(h), decision, self%h_retry)
+    end function window
 
     !> The tableau diverges in column j > 2 (ODEX, SEULEX): restart with H/2.
     logical function diverged(self, j)
@@ -167,13 +231,19 @@ contains
 
     !> After acceptance with column kc, planned column k: the next column and
     !> step size (ODEX = SEULEX). After a rejected step neither grows.
-    subroutine order_after_accept(self, kc, k, after_reject, h)
+    subroutine order_after_accept(self, kc, k, after_reject, h, hmax)
         class(control_t), intent(in) :: self
         integer, intent(in) :: kc
         integer, intent(inout) :: k         !! planned column in, next column out
         logical, intent(in) :: after_reject !! the previous attempt was rejected
         real(wp), intent(inout) :: h        !! |H| of the step in, next |H| out
+        real(wp), intent(in) :: hmax
         integer :: kopt
+        if (self%scheme == mexax_control_deuflhard) then
+            call order_after_accept_window(self%awork, self%hh, self%work, self%alpha, kc, &
+                                           self%qmax, after_reject, abs(h), hmax, k, h)
+            return
+        end if
         associate (w => self%work, km => self%km)
             if (kc == 2) then
                 kopt = min(3, km - 1)
@@ -208,11 +278,16 @@ contains
 
     !> After a rejection in column kc: the column k to retry with (lowered
     !> when the lower order is cheaper) and its step size |H| = H_k.
+    !> Deuflhard's control keeps the column and takes the monitor's step.
     subroutine order_after_reject(self, kc, k, h)
         class(control_t), intent(in) :: self
         integer, intent(in) :: kc
         integer, intent(inout) :: k
         real(wp), intent(out) :: h
+        if (self%scheme == mexax_control_deuflhard) then
+            h = self%h_retry
+            return
+        end if
         k = max(min(k, kc, self%km - 1), 2)
         if (k > 2) then
             if (self%work(k - 1) < self%order_down * self%work(k)) k = k - 1

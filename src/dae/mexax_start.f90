@@ -11,7 +11,8 @@ module flexmbs_dae_mexax_start
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_sink, only: sink_t
-    use flexmbs_dae_mexax_control, only: mexax_base_midpoint, mexax_base_euler, &
+    use flexmbs_dae_mexax_control, only: mexax_control_hairer, mexax_control_deuflhard, &
+        mexax_base_midpoint, mexax_base_euler, &
         mexax_max_columns
     use flexmbs_dae_mexax_workspace, only: setup_workspace
     use flexmbs_dae_mexax_tableau, only: start_point
@@ -51,6 +52,9 @@ contains
             call bad(status, 'max_extrapolation = ' // int_text(r%km) // ': must lie in 2..12')
         else if (self%base /= mexax_base_midpoint .and. self%base /= mexax_base_euler) then
             call bad(status, 'base must be mexax_base_midpoint or mexax_base_euler')
+        else if (self%control /= mexax_control_hairer .and. &
+                 self%control /= mexax_control_deuflhard) then
+            call bad(status, 'control must be mexax_control_hairer or mexax_control_deuflhard')
         else
             call options%validate(problem%nq + problem%nv, status)
             if (.not. status%ok()) then
@@ -94,6 +98,7 @@ contains
         call setup_workspace(r%w, problem, self%base, r%km, options%linear_solver, status, &
             options%sparse_ordering, options%classic_lu, options%newton_system == 'condensed')
         if (.not. status%ok()) return
+        r%w%ctl%scheme = self%control
         call options%tolerances(r%w%rtol, r%w%atol)
         self%dense = mexax_dense_t()  ! drops the last run's arrays
         associate (m => r%w%nq + r%w%nv + r%w%nc)

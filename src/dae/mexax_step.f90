@@ -27,6 +27,7 @@ module flexmbs_dae_mexax_step
         small_step_factor, projection_reject_min, projection_reject_safe, undecided, &
         do_accept, do_reject, do_restart, do_stop
     use flexmbs_dae_mexax_start, only: interrupted
+    use flexmbs_dae_mexax_control, only: mexax_control_deuflhard, window_accept, window_reject
     implicit none
     private
     public :: macro_step
@@ -73,8 +74,12 @@ contains
             return
         end if
 
-        ! ---- one attempt: the ODEX column sequence (§3.4) ----
-        call attempt(self, r, problem, status)
+        ! ---- one attempt: ODEX's column sequence (§3.4) or Deuflhard's window ----
+        if (r%w%ctl%scheme == mexax_control_deuflhard) then
+            call attempt_window(self, r, problem, status)
+        else
+            call attempt(self, r, problem, status)
+        end if
 
         select case (r%decision)
         case (do_stop)
@@ -177,6 +182,30 @@ contains
             end if
         end if
     end subroutine attempt
+
+    !> One attempt under Deuflhard's control (docs/theory.md §7.3): the
+    !> columns 1, 2, … with the convergence monitor on each, until it
+    !> accepts or rejects; the planned column k is the window's centre.
+    subroutine attempt_window(self, r, problem, status)
+        class(mexax_engine_t), intent(inout) :: self
+        type(mexax_run_t), intent(inout) :: r
+        class(mechanical_problem_t), intent(inout) :: problem
+        type(status_t), intent(inout) :: status
+        integer :: j
+        r%decision = undecided
+        do j = 1, r%w%ctl%qmax
+            if (.not. column(self, r, problem, j, status)) return
+            r%kc = j
+            select case (r%w%ctl%window(j, r%k, r%first, r%h))
+            case (window_accept)
+                r%decision = do_accept
+                return
+            case (window_reject)
+                r%decision = do_reject
+                return
+            end select
+        end do
+    end subroutine attempt_window
 
     !> Column j of the tableau; false (with r%decision set) on a restart
     !> or a stop.
@@ -330,7 +359,7 @@ contains
 
         ! ---- order and step size after acceptance (§3.4) ----
         r%h = abs(r%h)
-        call r%w%ctl%order_after_accept(r%kc, r%k, r%reject, r%h)
+        call r%w%ctl%order_after_accept(r%kc, r%k, r%reject, r%h, r%hmax)
         r%reject = .false.
         r%h = r%posneg * min(abs(r%h), r%hmax)
         self%h_next = r%h

@@ -9,7 +9,7 @@ module flexmbs_dae_mexax_tableau
         reason_user_function, reason_det_f, reason_singular_matrix
     use flexmbs_core_text, only: real_text
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
-    use flexmbs_dae_mexax_control, only: mexax_base_euler
+    use flexmbs_dae_mexax_control, only: mexax_base_euler, mexax_control_deuflhard
     use flexmbs_dae_mexax_workspace, only: workspace_t, mexax_native_t, ev_ok, ev_restart, &
         ev_stop, ev_refused, eval_block, block_mass, block_jacobian, copy_block, assemble, &
         factor, solve, factor_solve, user_failed, block_times, rms
@@ -273,7 +273,15 @@ contains
         real(wp) :: err
         ev = ev_ok
         call step_weights(w, j)
-        err = rms(w%tab(1:w%ne, j) - w%tab(1:w%ne, j - 1), w%wt)
+        associate (d => w%tab(1:w%ne, j) - w%tab(1:w%ne, j - 1))
+            if (w%ctl%scheme == mexax_control_deuflhard) then
+                ! the largest scaled component (docs/theory.md §7.3: the RMS
+                ! norm let the longer chains' errors reach 90 TOL)
+                err = maxval(abs(d) / w%wt)
+            else
+                err = rms(d, w%wt)
+            end if
+        end associate
         w%ctl%err(j) = err
         if (.not. ieee_is_finite(err) .or. err * epsilon(1.0_wp) >= 1.0_wp) then
             ev = ev_restart

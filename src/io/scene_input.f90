@@ -188,6 +188,8 @@ module flexmbs_io_scene_input
         logical :: netlib !! DDASSL: later netlib revision
         integer :: max_extrapolation !! MEXAX: extrapolation columns (KDMAX), 2..12
         character(len=len_name) :: mexax_base !! MEXAX's base method: 'midpoint' | 'euler'
+        !> MEXAX's order and step-size control: 'hairer' | 'deuflhard'
+        character(len=len_name) :: mexax_control
         ! &output
         !> HDF5 file; '' = none. Derived from the input name when not given.
         character(len=:), allocatable :: output_file

@@ -89,10 +89,10 @@ contains
         type(scene_input_t), intent(inout) :: scene
         character(len=*), parameter :: g = 'solver'
         !> the solvers' own settings, which have no default here (scene_input)
-        character(len=24), parameter :: own_settings(15) = [character(len=24) :: 'nit', &
+        character(len=24), parameter :: own_settings(16) = [character(len=24) :: 'nit', &
             'thet', 'fnewt', 'quot1', 'quot2', 'safe', 'fac_min', 'fac_max', 'controller', &
             'zero_start', 'initial_derivative', 'exclude_index23', 'netlib', &
-            'max_extrapolation', 'mexax_base']
+            'max_extrapolation', 'mexax_base', 'mexax_control']
         integer :: k
         call get(e, g, 'name', scene%solver_name)
         scene%solver_name = lower(scene%solver_name)
@@ -127,6 +127,8 @@ contains
         call get(e, g, 'max_extrapolation', scene%max_extrapolation)
         call get(e, g, 'mexax_base', scene%mexax_base)
         scene%mexax_base = lower(scene%mexax_base)
+        call get(e, g, 'mexax_control', scene%mexax_control)
+        scene%mexax_control = lower(scene%mexax_control)
         scene%solver_settings = pack(own_settings, [(has_entry(e, g, trim(own_settings(k))), &
             k=1, size(own_settings))])
     end subroutine read_solver

@@ -121,6 +121,8 @@ module flexmbs_io_scene_schema
             doc='MEXAX: extrapolation columns'), &
         var_spec_t('solver', 'mexax_base', kind_string, &
             choices='midpoint|euler', doc='MEXAX: basic step'), &
+        var_spec_t('solver', 'mexax_control', kind_string, &
+            choices='hairer|deuflhard', doc='MEXAX: order and step-size control'), &
         var_spec_t('output', 'file', kind_string, &
             doc='HDF5 result (default: the scene''s name with .h5; ''none'': no file)'), &
         var_spec_t('output', 'n_output', kind_integer, default='101', rule='[2,inf)', &

@@ -10,7 +10,8 @@ module flexmbs_run_solver_factory
         radau5_controller_classical
     use flexmbs_dae_ida, only: ida_t
     use flexmbs_dae_ddassl, only: ddassl_t
-    use flexmbs_dae_mexax, only: mexax_t, mexax_base_midpoint, mexax_base_euler
+    use flexmbs_dae_mexax, only: mexax_t, mexax_base_midpoint, mexax_base_euler, &
+        mexax_control_hairer, mexax_control_deuflhard
     use flexmbs_io_scene_input, only: scene_input_t, setting_given
     use flexmbs_run_catalogue, only: solver_id, solver_radau5, solver_ddassl, solver_ida, &
         solver_mexax, solver_choices
@@ -95,5 +96,7 @@ contains
             mexax%max_extrapolation = scene%max_extrapolation
         if (setting_given(scene, 'mexax_base')) mexax%base = merge(mexax_base_euler, &
             mexax_base_midpoint, scene%mexax_base == 'euler')
+        if (setting_given(scene, 'mexax_control')) mexax%control = merge(mexax_control_hairer, &
+            mexax_control_deuflhard, scene%mexax_control == 'hairer')
     end subroutine set_mexax
 end module flexmbs_run_solver_factory

@@ -1,0 +1,196 @@
+!> `flexmbs-bench-mexax-control`: MEXAX's two order and step-size controls
+!> (ODEX/SEULEX's 'hairer' and 'deuflhard', docs/theory.md §7.3) side by
+!> side on the planar bar chain of docs/solvers.md, from horizontal at rest
+!> to t = 1, rtol = atol = TOL, H0 = 1e-3.
+!>
+!> Part 1, the work-precision table: for chains of 3, 5, 8, 12 and 16 bars
+!> and TOL 1e-3 … 1e-9, per base and control, NSTEP, NACCPT, NREJCT, NFCN
+!> and the largest relative error of the bars' angles at t = 1 over TOL,
+!> against Radau IIA at 1e-12 (index-2 formulation; a reference from another
+!> integrator). Lines 'wp BASE CONTROL NB TOL ...' are what
+!> bench/mexax_control.py plots.
+!> Part 2, the 8-bar anchor of docs/theory.md §7.7 (base (E), a and λ
+!> extrapolated, the classic elimination order) per control: the counters
+!> of one run at H0 = 1e-3 and the means over H0 = 1e-3 (1 + 1e-4 m), m =
+!> 0 … 9, beside the original's.
+!> Arguments: optional chain lengths (default 3 5 8 12 16). Never asserts.
+program flexmbs_bench_mexax_control
+    use flexmbs_core_kinds, only: wp
+    use flexmbs_core_status, only: status_t
+    use flexmbs_dae_options, only: dae_options_t
+    use flexmbs_dae_stats, only: dae_stats_t
+    use flexmbs_dae_mexax, only: mexax_t, mexax_base_euler, mexax_base_midpoint, &
+        mexax_control_hairer, mexax_control_deuflhard
+    use flexmbs_dae_solver, only: dae_solver_t
+    use flexmbs_run_catalogue, only: solvers, solver_radau5
+    use flexmbs_run_solver_factory, only: new_solver
+    use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index2
+    use flexmbs_problems_pendulum_chain, only: pendulum_chain_t, new_pendulum_chain, &
+        pendulum_chain_initial
+    implicit none
+    integer, parameter :: default_chains(5) = [3, 5, 8, 12, 16]
+    integer, parameter :: bases(2) = [mexax_base_euler, mexax_base_midpoint]
+    integer, parameter :: controls(2) = [mexax_control_hairer, mexax_control_deuflhard]
+    character(len=*), parameter :: base_names(2) = ['euler   ', 'midpoint']
+    character(len=*), parameter :: control_names(2) = ['hairer   ', 'deuflhard']
+    ! the original's anchor: NSTEP, NACCPT, NREJCT at TOL 1e-3, 1e-5, 1e-7, 1e-9
+    integer, parameter :: anchor(3, 4) = reshape([49, 38, 11, 58, 45, 13, 54, 45, 9, &
+                                                  68, 60, 8], [3, 4])
+    integer, allocatable :: chains(:)
+    integer :: n, i
+    character(len=32) :: arg
+    n = command_argument_count()
+    if (n == 0) then
+        chains = default_chains
+    else
+        allocate (chains(n))
+        do i = 1, n
+            call get_command_argument(i, arg)
+            read (arg, *) chains(i)
+        end do
+    end if
+    call work_precision(chains)
+    call anchor_ensembles()
+
+contains
+
+    subroutine work_precision(chains)
+        integer, intent(in) :: chains(:)
+        real(wp), allocatable :: ref(:), q(:)
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        integer :: b, ib, ic, e, counts(9)
+        real(wp) :: tol, err
+        print '(a)', 'wp base control NB TOL NSTEP NACCPT NREJCT NFCN max|dphi/phi|/TOL ' // &
+            '(against ' // trim(solvers(solver_radau5)%name) // ' at 1e-12)'
+        do b = 1, size(chains)
+            call radau5_reference(chains(b), ref, status)
+            if (.not. status%ok()) then
+                print '(a)', 'reference failed: ' // status%text()
+                cycle
+            end if
+            print '(a,i3,a,es9.2)', 'NB', chains(b), ': smallest |phi| at t = 1', &
+                minval(abs(ref(3::3)))
+            do ib = 1, size(bases)
+                do ic = 1, size(controls)
+                    do e = 3, 9
+                        tol = 10.0_wp**(-e)
+                        call chain_run(chains(b), bases(ib), controls(ic), tol, 1.0e-3_wp, .false., &
+                                       q, stats, status, counts)
+                        if (.not. status%ok()) then
+                            print '(a)', 'failed: ' // status%text()
+                            cycle
+                        end if
+                        err = maxval(abs(q(3::3) - ref(3::3)) / abs(ref(3::3)))
+                        print '(a,1x,a,1x,a,i4,es9.1,4i7,es11.3)', 'wp', trim(base_names(ib)), &
+                            trim(control_names(ic)), chains(b), tol, counts(1:3), counts(5), &
+                            err / tol
+                    end do
+                end do
+            end do
+        end do
+    end subroutine work_precision
+
+    subroutine anchor_ensembles()
+        integer, parameter :: members = 10
+        ! the original's cost counters at TOL 1e-3: NFPROB NFCN NGCN NMULT NDEC NSOL
+        integer, parameter :: anchor_cost(6) = [2080, 871, 44, 1126, 1160, 1165]
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        real(wp), allocatable :: q(:)
+        real(wp) :: tol, mean(9)
+        integer :: ic, e, m, counts(9)
+        print '(a)', 'anchor control TOL: one run NSTEP NACCPT NREJCT NFPROB NFCN NGCN NMULT ' // &
+            'NDEC NSOL; ensemble means; original'
+        do ic = 1, size(controls)
+            do e = 1, 4
+                tol = 10.0_wp**(-(2 * e + 1))
+                mean = 0.0_wp
+                do m = 0, members - 1
+                    call chain_run(8, mexax_base_euler, controls(ic), tol, &
+                                   1.0e-3_wp * (1.0_wp + 1.0e-4_wp * m), .true., q, stats, status, &
+                                   counts)
+                    if (m == 0) print '(a,1x,a,es8.0,a,9i6)', 'anchor', trim(control_names(ic)), &
+                        tol, ': one run', counts
+                    mean = mean + real(counts, wp) / members
+                end do
+                if (e == 1) then
+                    print '(a,1x,a,es8.0,a,9f8.1,a,9i6)', 'anchor', trim(control_names(ic)), tol, &
+                        ': means', mean, '; original', anchor(:, e), anchor_cost
+                else
+                    print '(a,1x,a,es8.0,a,9f8.1,a,3i6)', 'anchor', trim(control_names(ic)), tol, &
+                        ': means', mean, '; original', anchor(:, e)
+                end if
+            end do
+        end do
+    end subroutine anchor_ensembles
+
+    !> MEXAX on the chain from its start to t = 1; `classic`: the anchor's
+    !> settings (a and λ extrapolated, the classic elimination order).
+    subroutine chain_run(bodies, base, control, tol, h0, classic, q, stats, status, counts)
+        integer, intent(in) :: bodies, base, control
+        real(wp), intent(in) :: tol, h0
+        logical, intent(in) :: classic
+        real(wp), allocatable, intent(out) :: q(:)
+        type(dae_stats_t), intent(out) :: stats
+        type(status_t), intent(out) :: status
+        !> NSTEP NACCPT NREJCT NFPROB NFCN NGCN NMULT NDEC NSOL
+        integer, intent(out) :: counts(9)
+        type(pendulum_chain_t) :: chain
+        type(mexax_t) :: solver
+        type(dae_options_t) :: options
+        real(wp), allocatable :: v(:), lam(:)
+        real(wp) :: t
+        chain = new_pendulum_chain(bodies)
+        allocate (q(chain%nq), v(chain%nv), lam(chain%nc))
+        call pendulum_chain_initial(chain, q, v, lam)
+        solver%base = base
+        solver%control = control
+        options%rtol = tol
+        options%atol = tol
+        options%h0 = h0
+        if (classic) then
+            solver%consistent_accelerations = .false.
+            options%classic_lu = .true.
+        end if
+        t = 0.0_wp
+        call solver%integrate_mechanical(chain, t, q, v, 1.0_wp, options, stats, status, &
+                                         lambda=lam)
+        associate (n => solver%native)
+            counts = [n%nstep, n%naccpt, n%nrejct, n%nfprob, n%nfcn, n%ngcn, n%nmult, n%ndec, &
+                      n%nsol]
+        end associate
+    end subroutine chain_run
+
+    !> The catalogue's Radau IIA solver at rtol = atol = 1e-12 on the index-2
+    !> formulation: q at t = 1.
+    subroutine radau5_reference(bodies, q, status)
+        integer, intent(in) :: bodies
+        real(wp), allocatable, intent(out) :: q(:)
+        type(status_t), intent(out) :: status
+        type(pendulum_chain_t), target :: chain
+        type(formulation_t) :: gen
+        class(dae_solver_t), allocatable :: solver
+        type(dae_options_t) :: options
+        type(dae_stats_t) :: stats
+        real(wp), allocatable :: v(:), lam(:), y(:), yp(:)
+        real(wp) :: t
+        chain = new_pendulum_chain(bodies)
+        allocate (q(chain%nq), v(chain%nv), lam(chain%nc))
+        call pendulum_chain_initial(chain, q, v, lam)
+        gen = new_formulation(chain, formulation_index2, q, constant_mass=.true., status=status)
+        if (.not. status%ok()) return
+        allocate (y(gen%n), yp(gen%n), source=0.0_wp)
+        y(gen%oq + 1:gen%oq + gen%nq) = q
+        y(gen%ov + 1:gen%ov + gen%nv) = v
+        call gen%consistent_initial(0.0_wp, y, yp, status)
+        if (.not. status%ok()) return
+        options%rtol = 1.0e-12_wp
+        options%atol = 1.0e-12_wp
+        call new_solver(solvers(solver_radau5)%name, solver, status)
+        if (.not. status%ok()) return
+        t = 0.0_wp
+        call solver%integrate_system(chain, gen, t, y, 1.0_wp, options, stats, status)
+        q = y(gen%oq + 1:gen%oq + gen%nq)
+    end subroutine radau5_reference
+end program flexmbs_bench_mexax_control
