@@ -20,7 +20,8 @@ module test_rejections
     use flexmbs_dae_radau5, only: radau5_t
     use flexmbs_dae_ddassl, only: ddassl_t
     use flexmbs_dae_ida, only: ida_t
-    use flexmbs_dae_mexax, only: mexax_t, mexax_base_euler
+    use flexmbs_dae_mexax, only: mexax_t, mexax_base_euler, mexax_control_hairer, &
+        mexax_control_deuflhard
     use flexmbs_problems_van_der_pol, only: van_der_pol_t, new_van_der_pol
     use flexmbs_problems_robertson, only: robertson_t, new_robertson
     use flexmbs_problems_pendulum, only: pendulum_mechanical_t, new_pendulum_mechanical, &
@@ -532,12 +533,12 @@ contains
     end subroutine test_ida_causes
 
     !> A regression check only, the 8-bar chain (Euler base, TOL 1e-3, the
-    !> classic face's settings) with NSTEP/NACCPT/NREJCT = 45/36/9 and all
-    !> 9 rejections by the error estimates. These are our MEXAX's own
-    !> counts, not a reference: the original MEXX gives 49/38/11 there, and
-    !> the published step-size rules do not reproduce its rejections
-    !> (docs/solvers.md, MEXAX). The pin catches unintended changes of the
-    !> step-size control and of the cause counting.
+    !> classic face's settings) with NSTEP/NACCPT/NREJCT = 45/36/9 under
+    !> ODEX/SEULEX's control and 54/43/11 under Deuflhard's, all rejections
+    !> by the error estimates. These are our MEXAX's own counts, not a
+    !> reference: the original MEXX gives 49/38/11 there (docs/solvers.md,
+    !> MEXAX). The pin catches unintended changes of the step-size controls
+    !> and of the cause counting.
     subroutine test_mexax_regression(error)
         type(error_t), allocatable, intent(out) :: error
         type(pendulum_chain_t) :: chain
@@ -548,6 +549,7 @@ contains
         real(wp) :: q(24), v(24), lam(16), t
         chain = new_pendulum_chain(8)
         solver%base = mexax_base_euler
+        solver%control = mexax_control_hairer
         solver%consistent_accelerations = .false.
         call pendulum_chain_initial(chain, q, v, lam)
         options%rtol = 1.0e-3_wp
@@ -561,6 +563,17 @@ contains
             solver%native%nrejct == 9, 'regression pin: counters moved from 45/36/9')
         call check_sum(error, stats, 'mexax chain')
         call check_counts(error, stats, [9, 0, 0, 0, 0, 0, 0], 'mexax chain (regression pin)')
+        ! the same under Deuflhard's control (the default)
+        solver%control = mexax_control_deuflhard
+        call pendulum_chain_initial(chain, q, v, lam)
+        t = 0.0_wp
+        call solver%integrate_mechanical(chain, t, q, v, 1.0_wp, options, stats, status)
+        call check(error, status%ok(), status%text())
+        call check(error, solver%native%nstep == 54 .and. solver%native%naccpt == 43 .and. &
+            solver%native%nrejct == 11, 'regression pin: counters moved from 54/43/11')
+        call check_sum(error, stats, 'mexax chain, deuflhard')
+        call check_counts(error, stats, [11, 0, 0, 0, 0, 0, 0], &
+                          'mexax chain, deuflhard (regression pin)')
     end subroutine test_mexax_regression
 
     !> Each cause MEXAX can have besides those of the chain, provoked alone.

@@ -11,7 +11,7 @@ module flexmbs_dae_mexax_state
     use flexmbs_dae_sink, only: dense_output_t
     use flexmbs_dae_solver, only: dae_solver_t
     use flexmbs_dae_mexax_control, only: mexax_base_midpoint, mexax_max_columns, &
-        mexax_control_hairer
+        mexax_control_deuflhard
     use flexmbs_dae_mexax_workspace, only: workspace_t, mexax_native_t
     implicit none
     private
@@ -57,8 +57,8 @@ module flexmbs_dae_mexax_state
     type, extends(dae_solver_t), abstract, public :: mexax_engine_t
         integer :: max_extrapolation = mexax_max_columns !! KDMAX, 2..12
         integer :: base = mexax_base_midpoint            !! mexax_base_midpoint | _euler
-        !> order and step-size control: mexax_control_hairer | _deuflhard
-        integer :: control = mexax_control_hairer
+        !> order and step-size control: mexax_control_deuflhard | _hairer
+        integer :: control = mexax_control_deuflhard
         !> a and λ at every accepted point from the index-1 system
         !> [M Gᵀ; G 0][a; λ] = [f; −γ] (one more LU a step; needs
         !> constraint_curvature). False, or without γ: the extrapolated values

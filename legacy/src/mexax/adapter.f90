@@ -4,7 +4,8 @@
 !> lengths (docs/solvers.md, MEXAX, IERR −2 … −135), wraps FPROB in a
 !> `mechanical_problem_t` (one FPROB call, one flag, per item the core
 !> needs), runs the core from T to TFIN with the half-explicit Euler base
-!> unless MXJOB(29) = 1, and returns the state, the proposed step, the
+!> unless MXJOB(29) = 1 and under the default control (Deuflhard's; ODEX's
+!> with MXJOB(28) = 1), and returns the state, the proposed step, the
 !> statistics MXJOB(41..74) and IERR. Only T, P, V, A, RLAM, H, the output
 !> slots of MXJOB and IERR are written; U, IWK and RWK are left as they are.
 !>
@@ -22,7 +23,7 @@ module flexmbs_legacy_mexax_adapter
         reason_projection, reason_user_function
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_mexax, only: mexax_t, mexax_base_euler, mexax_base_midpoint, &
-        mexax_dense_t, mexax_failed_projection, mexax_max_columns
+        mexax_dense_t, mexax_failed_projection, mexax_max_columns, mexax_control_hairer
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_sink, only: sink_t, dense_output_t
@@ -44,7 +45,8 @@ module flexmbs_legacy_mexax_adapter
     integer, parameter :: liwk_extra = 60, lrwk_extra = 50
     ! §3.9 MXJOB slots.
     integer, parameter :: slot_mdisc = 1, slot_job = 2, slot_mmode = 3, slot_mgpfl = 6, &
-        slot_kdmax = 9, slot_ialam = 22, slot_base = 29, slot_mout = 30, slot_mdout = 31, &
+        slot_kdmax = 9, slot_ialam = 22, slot_control = 28, slot_base = 29, slot_mout = 30, &
+        slot_mdout = 31, &
         slot_mswit = 35, slot_liwk_need = 41, slot_lrwk_need = 42, slot_liwk_used = 43, &
         slot_lrwk_used = 44, slot_nstep = 51, slot_ierr = 73, slot_failing_dec = 74
     ! JOB values the face solves with its one dense LU (§3.9).
@@ -149,6 +151,8 @@ contains
         options%classic_lu = .true.
         solver%max_extrapolation = kdmax
         solver%base = merge(mexax_base_midpoint, mexax_base_euler, mxjob(slot_base) == 1)
+        ! our extension: MXJOB(28) = 1 selects ODEX/SEULEX's control
+        if (mxjob(slot_control) == 1) solver%control = mexax_control_hairer
         ! the original's a and λ: extrapolated, no extra decomposition a step
         solver%consistent_accelerations = .false.
 
@@ -237,6 +241,8 @@ contains
                 k = slot_ialam
             else if (mxjob(slot_base) < 0 .or. mxjob(slot_base) > 1) then
                 k = slot_base
+            else if (mxjob(slot_control) < 0 .or. mxjob(slot_control) > 1) then
+                k = slot_control
             else if (mxjob(slot_mout) < 0 .or. mxjob(slot_mout) > 1) then
                 k = slot_mout
             else if (mxjob(slot_mdout) /= 0) then
