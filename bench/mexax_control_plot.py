@@ -20,7 +20,7 @@ def read(path):
     with open(path) as table:
         for line in table:
             words = line.split()
-            if len(words) != 10 or words[0] != "wp" or words[1] == "base":
+            if len(words) != 11 or words[0] != "wp" or words[1] == "base":
                 continue
             base, control, bars = words[1], words[2], int(words[3])
             tol, nfcn, ratio = float(words[4]), int(words[8]), float(words[9])

@@ -5,7 +5,8 @@
 !>
 !> Part 1, the work-precision table: for chains of 3, 5, 8, 12 and 16 bars
 !> and TOL 1e-3 … 1e-9, per base and control, NSTEP, NACCPT, NREJCT, NFCN
-!> and the largest relative error of the bars' angles at t = 1 over TOL,
+!> and the largest relative error of the bars' angles at t = 1 over TOL
+!> and as correct digits (−log10 of it),
 !> against Radau IIA at 1e-12 (index-2 formulation; a reference from another
 !> integrator). Lines 'wp BASE CONTROL NB TOL ...' are what
 !> bench/mexax_control.py plots.
@@ -62,7 +63,7 @@ contains
         integer :: b, ib, ic, e, counts(9)
         real(wp) :: tol, err
         print '(a)', 'wp base control NB TOL NSTEP NACCPT NREJCT NFCN max|dphi/phi|/TOL ' // &
-            '(against ' // trim(solvers(solver_radau5)%name) // ' at 1e-12)'
+            'digits (against ' // trim(solvers(solver_radau5)%name) // ' at 1e-12)'
         do b = 1, size(chains)
             call radau5_reference(chains(b), ref, status)
             if (.not. status%ok()) then
@@ -82,9 +83,9 @@ contains
                             cycle
                         end if
                         err = maxval(abs(q(3::3) - ref(3::3)) / abs(ref(3::3)))
-                        print '(a,1x,a,1x,a,i4,es9.1,4i7,es11.3)', 'wp', trim(base_names(ib)), &
-                            trim(control_names(ic)), chains(b), tol, counts(1:3), counts(5), &
-                            err / tol
+                        print '(a,1x,a,1x,a,i4,es9.1,4i7,es11.3,f6.2)', 'wp', &
+                            trim(base_names(ib)), trim(control_names(ic)), chains(b), tol, &
+                            counts(1:3), counts(5), err / tol, -log10(err)
                     end do
                 end do
             end do
