@@ -182,7 +182,7 @@ contains
                 call full%solve_real(xf)
                 xc = b
                 call condensed%solve_real(xc)
-                call judge(real_difference(xc, xf), real_backward(cs(ic), xc, b), &
+                call judge(real_difference(xc, xf), real_backward(mass, jac, cs(ic), xc, b), &
                     'real c = ' // real_text(cs(ic)))
                 if (allocated(error)) return
             end do
@@ -194,7 +194,7 @@ contains
             call full%solve_complex(zf)
             zx = zb
             call condensed%solve_complex(zx)
-            call judge(maxval(abs(zx - zf)) / maxval(abs(zf)), complex_backward(zx, zb), &
+            call judge(maxval(abs(zx - zf)) / maxval(abs(zf)), complex_backward(mass, jac, zc, zx, zb), &
                 'complex c')
             if (allocated(error)) return
             deallocate (condensed)
@@ -216,58 +216,63 @@ contains
             real_difference = maxval(abs(x - ref)) / maxval(abs(ref))
         end function real_difference
 
-        !> ‖A x − b‖∞ / (‖A‖∞ ‖x‖∞ + ‖b‖∞), A = c M − J.
-        real(wp) function real_backward(c, x, rhs)
-            real(wp), intent(in) :: c, x(:), rhs(:)
-            real(wp), allocatable :: r(:), t(:), rowsum(:)
-            allocate (r(n), t(n))
-            call mass%csc%matvec(x, r)
-            call jac%csc%matvec(x, t)
-            r = c * r - t - rhs
-            rowsum = norm_rows(c)
-            real_backward = maxval(abs(r)) / (maxval(rowsum) * maxval(abs(x)) + maxval(abs(rhs)))
-        end function real_backward
-
-        real(wp) function complex_backward(x, rhs)
-            complex(wp), intent(in) :: x(:), rhs(:)
-            real(wp), allocatable :: rr(:), ri(:), t(:), rowsum(:)
-            allocate (rr(n), ri(n), t(n))
-            ! (c M − J)(xr + i xi) with c = zc
-            call mass%csc%matvec(real(x, wp), rr)
-            call mass%csc%matvec(aimag(x), ri)
-            associate (mr => rr, mi => ri)
-                t = real(zc) * mr - aimag(zc) * mi
-                ri = aimag(zc) * mr + real(zc) * mi
-                rr = t
-            end associate
-            call jac%csc%matvec(real(x, wp), t)
-            rr = rr - t - real(rhs, wp)
-            call jac%csc%matvec(aimag(x), t)
-            ri = ri - t - aimag(rhs)
-            rowsum = norm_rows(abs(zc))
-            complex_backward = maxval(sqrt(rr**2 + ri**2)) / (maxval(rowsum) * &
-                maxval(abs(x)) + maxval(abs(rhs)))
-        end function complex_backward
-
-        !> Row sums of |c| |M| + |J|: ‖A‖∞ bounded by the largest.
-        function norm_rows(c) result(rowsum)
-            real(wp), intent(in) :: c
-            real(wp), allocatable :: rowsum(:)
-            integer :: j
-            integer(kind(jac%csc%colptr)) :: p
-            allocate (rowsum(n), source=0.0_wp)
-            do j = 1, n
-                do p = jac%csc%colptr(j) + 1, jac%csc%colptr(j + 1)
-                    rowsum(jac%csc%rowind(p) + 1) = rowsum(jac%csc%rowind(p) + 1) &
-                        + abs(jac%csc%values(p))
-                end do
-                do p = mass%csc%colptr(j) + 1, mass%csc%colptr(j + 1)
-                    rowsum(mass%csc%rowind(p) + 1) = rowsum(mass%csc%rowind(p) + 1) &
-                        + c * abs(mass%csc%values(p))
-                end do
-            end do
-        end function norm_rows
     end subroutine compare
+
+    !> ‖A x − b‖∞ / (‖A‖∞ ‖x‖∞ + ‖b‖∞), A = c M − J.
+    real(wp) function real_backward(mass, jac, c, x, rhs)
+        type(matrix_t), intent(in) :: mass, jac
+        real(wp), intent(in) :: c, x(:), rhs(:)
+        real(wp), allocatable :: r(:), t(:), rowsum(:)
+        allocate (r(size(x)), t(size(x)))
+        call mass%csc%matvec(x, r)
+        call jac%csc%matvec(x, t)
+        r = c * r - t - rhs
+        rowsum = norm_rows(mass, jac, c)
+        real_backward = maxval(abs(r)) / (maxval(rowsum) * maxval(abs(x)) + maxval(abs(rhs)))
+    end function real_backward
+
+    !> The same for A = zc M − J and complex x, b.
+    real(wp) function complex_backward(mass, jac, zc, x, rhs)
+        type(matrix_t), intent(in) :: mass, jac
+        complex(wp), intent(in) :: zc, x(:), rhs(:)
+        real(wp), allocatable :: rr(:), ri(:), t(:), rowsum(:)
+        allocate (rr(size(x)), ri(size(x)), t(size(x)))
+        ! (c M − J)(xr + i xi) with c = zc
+        call mass%csc%matvec(real(x, wp), rr)
+        call mass%csc%matvec(aimag(x), ri)
+        associate (mr => rr, mi => ri)
+            t = real(zc) * mr - aimag(zc) * mi
+            ri = aimag(zc) * mr + real(zc) * mi
+            rr = t
+        end associate
+        call jac%csc%matvec(real(x, wp), t)
+        rr = rr - t - real(rhs, wp)
+        call jac%csc%matvec(aimag(x), t)
+        ri = ri - t - aimag(rhs)
+        rowsum = norm_rows(mass, jac, abs(zc))
+        complex_backward = maxval(sqrt(rr**2 + ri**2)) / (maxval(rowsum) * &
+            maxval(abs(x)) + maxval(abs(rhs)))
+    end function complex_backward
+
+    !> Row sums of |c| |M| + |J|: ‖A‖∞ bounded by the largest.
+    function norm_rows(mass, jac, c) result(rowsum)
+        type(matrix_t), intent(in) :: mass, jac
+        real(wp), intent(in) :: c
+        real(wp), allocatable :: rowsum(:)
+        integer :: j
+        integer(kind(jac%csc%colptr)) :: p
+        allocate (rowsum(jac%n), source=0.0_wp)
+        do j = 1, jac%n
+            do p = jac%csc%colptr(j) + 1, jac%csc%colptr(j + 1)
+                rowsum(jac%csc%rowind(p) + 1) = rowsum(jac%csc%rowind(p) + 1) &
+                    + abs(jac%csc%values(p))
+            end do
+            do p = mass%csc%colptr(j) + 1, mass%csc%colptr(j + 1)
+                rowsum(mass%csc%rowind(p) + 1) = rowsum(mass%csc%rowind(p) + 1) &
+                    + c * abs(mass%csc%values(p))
+            end do
+        end do
+    end function norm_rows
 
     !> Every mechanical scene of inputs/ over a short time, RADAU5, DDASSL
     !> and IDA at TOL 1e-6 with newton_system = 'condensed' against 'full'

@@ -229,7 +229,7 @@ contains
             call status%set(status_bad_input, 'mexax: columns must lie in 1..12')
             return
         end if
-        call setup_workspace(w, problem, self%base, columns, 'auto', status)
+        call setup_workspace(w, problem, self%base, self%control, columns, 'auto', status)
         if (.not. status%ok()) return
         w%rtol = 1.0_wp
         w%atol = 1.0_wp

@@ -91,12 +91,11 @@ contains
     subroutine control_init(self, base, km, scheme)
         class(control_t), intent(inout) :: self
         integer, intent(in) :: base, km
-        integer, intent(in), optional :: scheme
+        integer, intent(in) :: scheme !! mexax_control_hairer | _deuflhard
         integer :: j
         self%base = base
         self%km = km
-        self%scheme = mexax_control_hairer
-        if (present(scheme)) self%scheme = scheme
+        self%scheme = scheme
         if (allocated(self%nj)) deallocate (self%nj, self%awork, self%err, self%hh, self%work, &
                                             self%fac, self%alpha)
         allocate (self%nj(km), self%awork(km), self%err(km), self%hh(km), self%work(km), &
@@ -126,7 +125,7 @@ contains
     !> The first column k: ODEX from min rtol (M), SEULEX from min(rtol +
     !> atol) within [3, KDMAX − 2] (E); always within [2, KDMAX − 1].
     !> Deuflhard's control: the model's α at ε = min rtol, and its highest
-    !> column worth computing, where the first step's window lies [Deu83 §3].
+    !> column worth computing, where the first step's window lies [Deu83].
     integer function start_column(self, rtol, atol) result(k)
         class(control_t), intent(inout) :: self
         real(wp), intent(in) :: rtol(:), atol(:)
@@ -158,7 +157,7 @@ contains
         real(wp) :: expo, fmin, fac
         expo = error_exponent(self, j)
         if (self%scheme == mexax_control_deuflhard) then
-            ! [Deu83 §3]: H_j aims at ρ TOL; the growth bounded
+            ! [Deu83]: H_j aims at ρ TOL; the growth bounded
             self%fac(j) = (self%err(j) / deuflhard_safety)**expo
             self%hh(j) = min(abs(big_h) / max(self%fac(j), 1.0_wp / deuflhard_growth), hmax)
             self%work(j) = self%awork(j) / self%hh(j)

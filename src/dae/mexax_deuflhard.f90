@@ -4,7 +4,7 @@
 !> DB02], to which MEXX belongs. The pieces work on the column data of
 !> flexmbs_dae_mexax_control's control_t, passed as arrays.
 !>
-!> The model [Deu83 §3]: for the step H_q with which column q just meets
+!> The model [Deu83]: for the step H_q with which column q just meets
 !> the accuracy ε, the error estimates of the lower columns gain the same
 !> number of digits per unit of work, ε_j = ε^((A_j − A_1 + 1)/(A_q − A_1 +
 !> 1)). With err_j = O(H^γ_j) this gives the ratio of the columns' step
@@ -31,9 +31,9 @@ module flexmbs_dae_mexax_deuflhard
     !> A step grows by at most this factor after an acceptance (the
     !> original's FAC2 of the column step sizes, docs/theory.md §7.3).
     real(wp), parameter, public :: deuflhard_growth = 4.0_wp
-    !> A rejected step shrinks by at least this factor, and by at most its
-    !> inverse's tenfold (own bounds; the monitor's reduction lies inside
-    !> them except when an estimate is far off).
+    !> A rejected step shrinks to between these fractions of itself (own
+    !> bounds; the monitor's reduction lies inside them unless an estimate
+    !> is far off).
     real(wp), parameter :: reduction_max = 0.9_wp, reduction_min = 0.01_wp
 
 contains
@@ -53,7 +53,7 @@ contains
         end do
     end function alpha_table
 
-    !> The highest column worth computing [Deu83 §3]: the first q ≥ 2 whose
+    !> The highest column worth computing [Deu83]: the first q ≥ 2 whose
     !> next column costs more per unit step under the model, A_{q+1} >
     !> A_q α(q, q + 1); at most km.
     pure integer function window_top(awork, alpha, km) result(qmax)
@@ -66,7 +66,7 @@ contains
     end function window_top
 
     !> The convergence monitor on column j ≥ 2 of a step planned for column
-    !> q (window {q − 1, q, q + 1}, below qmax) [Deu83 §4; DB02 §6.4]:
+    !> q (window {q − 1, q, q + 1}, below qmax) [Deu83; DB02]:
     !> accept when err_j ≤ 1; reject at the window's top; below it, reject
     !> when the step factor fac_j = H/H_j exceeds α(j, top) — not even the
     !> top column is expected to converge — and retry with the step for
@@ -100,7 +100,7 @@ contains
         h_retry = h * min(reduction_max, max(reduction_min, reduction))
     end subroutine window_test
 
-    !> After acceptance in column kc [Deu83 §4]: the next column is the one
+    !> After acceptance in column kc [Deu83]: the next column is the one
     !> of least work per unit step among 2..kc, and its step size; when
     !> that is kc itself, below qmax and no rejection preceded in this step,
     !> the order rises by one with the model's step H_kc α(kc, kc + 1).

@@ -95,10 +95,10 @@ contains
             call out_of_memory(status, 'mexax workspace', 1_i8, storage_size(r%w) / 8)
             return
         end if
-        call setup_workspace(r%w, problem, self%base, r%km, options%linear_solver, status, &
-            options%sparse_ordering, options%classic_lu, options%newton_system == 'condensed')
+        call setup_workspace(r%w, problem, self%base, self%control, r%km, &
+            options%linear_solver, status, options%sparse_ordering, options%classic_lu, &
+            options%newton_system == 'condensed')
         if (.not. status%ok()) return
-        r%w%ctl%scheme = self%control
         call options%tolerances(r%w%rtol, r%w%atol)
         self%dense = mexax_dense_t()  ! drops the last run's arrays
         associate (m => r%w%nq + r%w%nv + r%w%nc)

@@ -90,152 +90,174 @@ contains
         nv = w%nv
         w%wst = w%rtol(nq + 1:) * abs(w%v0) + w%atol(nq + 1:)
         if (w%base == mexax_base_euler) then
-            call euler_substeps()
+            call euler_substeps(native, problem, w, t, big_h, n, check_stability, ev, status)
         else
-            call midpoint_substeps()
+            call midpoint_substeps(native, problem, w, t, big_h, n, check_stability, ev, status)
         end if
         if (ev /= ev_ok) return
         w%x(1:nq) = w%p
         w%x(nq + 1:nq + nv) = w%v
         w%x(nq + nv + 1:nq + 2 * nv) = w%acc
         w%x(nq + 2 * nv + 1:) = w%lam
+    end subroutine base_column
 
-    contains
-
-        !> (E), §3.2: p_{i+1} = p_i + h T v_i, then one augmented solve for
-        !> (v_{i+1}, h λ_{i+1}) with the matrices at p_{i+1}.
-        subroutine euler_substeps()
-            integer :: i
-            real(wp) :: h, ti, tn
-            h = big_h / n
-            w%p = w%p0
-            w%v = w%v0
-            w%f = w%f0
-            ev = ev_ok
-            do i = 0, n - 1
-                ti = t + big_h * real(i, wp) / n
-                tn = t + big_h * real(i + 1, wp) / n
-                if (i > 0) then
-                    ! one FPROB call (flags 4, 5): f and T v at (t_i, p_i, v_i)
-                    call problem%forces(ti, w%p, w%v, w%f, status)
-                    native%nfcn = native%nfcn + 1
-                    native%nfprob = native%nfprob + 1
-                    if (user_failed(status, 'forces', w%f)) exit
-                    call problem%kinematics(ti, w%p, w%v, w%pdot, status)
-                    if (user_failed(status, 'kinematics')) exit
-                else
-                    w%pdot = w%pdot0   ! shared start point (§3.2)
-                end if
-                w%pn = w%p + h * w%pdot
-                call eval_block(problem, w, block_mass, tn, w%pn, w%mm, status)
-                if (user_failed(status, 'mass')) exit
-                call eval_block(problem, w, block_jacobian, tn, w%pn, w%gm, status)
-                if (user_failed(status, 'constraint_jacobian')) exit
-                call problem%constraint_time_derivative(tn, w%pn, w%gt, status)
-                if (user_failed(status, 'constraint_time_derivative')) exit
-                native%nfprob = native%nfprob + 1
-                call block_times(w, w%mm, w%mpat, w%v, w%rhs(1:nv))
-                w%rhs(1:nv) = w%rhs(1:nv) + h * w%f
-                native%nmult = native%nmult + 1
-                w%rhs(nv + 1:) = -w%gt
-                call assemble(w, w%mm, w%gm, w%gm)
-                call factor_solve(native, w, 'in a step', ev, status)
-                if (ev /= ev_ok) return
-                w%vp = w%v
-                w%v = w%rhs(1:nv)
-                w%lam = w%rhs(nv + 1:) / h
-                w%acc = (w%v - w%vp) / h
-                w%p = w%pn
-                if (unstable(i)) return
-            end do
-            if (.not. status%ok()) ev = merge(ev_refused, ev_stop, status%reason == reason_det_f &
-                                              .or. status%reason == reason_non_finite)
-        end subroutine euler_substeps
-
-        !> (M), §3.2: an explicit start step, then q_{i+1} = q_{i−1} + 2h T v_i,
-        !> v_{i+1} = v_{i−1} + 2h a_i with [M(q_i) G(q_i)ᵀ; G(q_{i+1}) 0].
-        subroutine midpoint_substeps()
-            integer :: i
-            real(wp) :: h, ti, tn
-            h = big_h / n
-            ev = ev_ok
-            tn = t + big_h / n
-            w%pp = w%p0
-            w%vp = w%v0
-            w%p = w%p0 + h * w%pdot0
-            call eval_block(problem, w, block_jacobian, tn, w%p, w%gn, status)
-            if (user_failed(status, 'constraint_jacobian')) then
-                ev = ev_stop
-                return
-            end if
-            call problem%constraint_time_derivative(tn, w%p, w%gt, status)
-            if (user_failed(status, 'constraint_time_derivative')) then
-                ev = ev_stop
-                return
-            end if
-            native%nfprob = native%nfprob + 1
-            w%rhs(1:nv) = w%f0
-            call block_times(w, w%gn, w%gpat, w%v0, w%rhs(nv + 1:))
-            w%rhs(nv + 1:) = -(w%rhs(nv + 1:) + w%gt) / h
-            call assemble(w, w%m0, w%g0, w%gn)
-            call factor_solve(native, w, 'in a step', ev, status)
-            if (ev /= ev_ok) return
-            w%acc = w%rhs(1:nv)
-            w%lam = w%rhs(nv + 1:)
-            w%v = w%v0 + h * w%acc
-            call copy_block(w%gm, w%gn)
-            do i = 1, n - 1
-                ti = t + big_h * real(i, wp) / n
-                tn = t + big_h * real(i + 1, wp) / n
-                ! one FPROB call (flags 1, 4, 5) at (t_i, q_i, v_i), one (2, 8) at q_{i+1}
+    !> (E), §3.2: p_{i+1} = p_i + h T v_i, then one augmented solve for
+    !> (v_{i+1}, h λ_{i+1}) with the matrices at p_{i+1}.
+    subroutine euler_substeps(native, problem, w, t, big_h, n, check_stability, ev, status)
+        type(mexax_native_t), intent(inout) :: native
+        class(mechanical_problem_t), intent(inout) :: problem
+        type(workspace_t), intent(inout) :: w
+        real(wp), intent(in) :: t, big_h
+        integer, intent(in) :: n
+        logical, intent(in) :: check_stability
+        integer, intent(out) :: ev
+        type(status_t), intent(inout) :: status
+        integer :: nv
+        integer :: i
+        real(wp) :: h, ti, tn
+        nv = w%nv
+        h = big_h / n
+        w%p = w%p0
+        w%v = w%v0
+        w%f = w%f0
+        ev = ev_ok
+        do i = 0, n - 1
+            ti = t + big_h * real(i, wp) / n
+            tn = t + big_h * real(i + 1, wp) / n
+            if (i > 0) then
+                ! one FPROB call (flags 4, 5): f and T v at (t_i, p_i, v_i)
                 call problem%forces(ti, w%p, w%v, w%f, status)
                 native%nfcn = native%nfcn + 1
                 native%nfprob = native%nfprob + 1
                 if (user_failed(status, 'forces', w%f)) exit
-                call eval_block(problem, w, block_mass, ti, w%p, w%mm, status)
-                if (user_failed(status, 'mass')) exit
                 call problem%kinematics(ti, w%p, w%v, w%pdot, status)
                 if (user_failed(status, 'kinematics')) exit
-                w%pn = w%pp + 2.0_wp * h * w%pdot
-                call eval_block(problem, w, block_jacobian, tn, w%pn, w%gn, status)
-                if (user_failed(status, 'constraint_jacobian')) exit
-                call problem%constraint_time_derivative(tn, w%pn, w%gt, status)
-                if (user_failed(status, 'constraint_time_derivative')) exit
-                native%nfprob = native%nfprob + 1
-                w%rhs(1:nv) = w%f
-                call block_times(w, w%gn, w%gpat, w%vp, w%rhs(nv + 1:))
-                w%rhs(nv + 1:) = -(w%rhs(nv + 1:) + w%gt) / (2.0_wp * h)
-                call assemble(w, w%mm, w%gm, w%gn)
-                call factor_solve(native, w, 'in a step', ev, status)
-                if (ev /= ev_ok) return
-                w%acc = w%rhs(1:nv)
-                w%lam = w%rhs(nv + 1:)
-                w%pp = w%p
-                w%p = w%pn
-                ! v_{i+1} = v_{i−1} + 2h a_i; vp becomes v_i
-                w%f = w%vp + 2.0_wp * h * w%acc
-                w%vp = w%v
-                w%v = w%f
-                call copy_block(w%gm, w%gn)
-                if (unstable(i)) return
-            end do
-            if (.not. status%ok()) ev = merge(ev_refused, ev_stop, status%reason == reason_det_f &
-                                              .or. status%reason == reason_non_finite)
-        end subroutine midpoint_substeps
-
-        !> Non-finite values, or the §3.5 check after the second substep
-        !> (i = 1): ‖v2 − v1‖ > 2 ‖v2‖ in the weights of the step start.
-        logical function unstable(i)
-            integer, intent(in) :: i
-            unstable = .not. (all(ieee_is_finite(w%v)) .and. all(ieee_is_finite(w%p)))
-            if (unstable) then
-                call status%set(status_solver_failure, 'non-finite values', reason_non_finite)
-            else if (check_stability .and. i == 1) then
-                unstable = rms(w%v - w%vp, w%wst) > stability_ratio * rms(w%v, w%wst)
+            else
+                w%pdot = w%pdot0   ! shared start point (§3.2)
             end if
-            if (unstable) ev = ev_restart
-        end function unstable
-    end subroutine base_column
+            w%pn = w%p + h * w%pdot
+            call eval_block(problem, w, block_mass, tn, w%pn, w%mm, status)
+            if (user_failed(status, 'mass')) exit
+            call eval_block(problem, w, block_jacobian, tn, w%pn, w%gm, status)
+            if (user_failed(status, 'constraint_jacobian')) exit
+            call problem%constraint_time_derivative(tn, w%pn, w%gt, status)
+            if (user_failed(status, 'constraint_time_derivative')) exit
+            native%nfprob = native%nfprob + 1
+            call block_times(w, w%mm, w%mpat, w%v, w%rhs(1:nv))
+            w%rhs(1:nv) = w%rhs(1:nv) + h * w%f
+            native%nmult = native%nmult + 1
+            w%rhs(nv + 1:) = -w%gt
+            call assemble(w, w%mm, w%gm, w%gm)
+            call factor_solve(native, w, 'in a step', ev, status)
+            if (ev /= ev_ok) return
+            w%vp = w%v
+            w%v = w%rhs(1:nv)
+            w%lam = w%rhs(nv + 1:) / h
+            w%acc = (w%v - w%vp) / h
+            w%p = w%pn
+            if (unstable(w, i, check_stability, ev, status)) return
+        end do
+        if (.not. status%ok()) ev = merge(ev_refused, ev_stop, status%reason == reason_det_f &
+                                          .or. status%reason == reason_non_finite)
+    end subroutine euler_substeps
+
+    !> (M), §3.2: an explicit start step, then q_{i+1} = q_{i−1} + 2h T v_i,
+    !> v_{i+1} = v_{i−1} + 2h a_i with [M(q_i) G(q_i)ᵀ; G(q_{i+1}) 0].
+    subroutine midpoint_substeps(native, problem, w, t, big_h, n, check_stability, ev, status)
+        type(mexax_native_t), intent(inout) :: native
+        class(mechanical_problem_t), intent(inout) :: problem
+        type(workspace_t), intent(inout) :: w
+        real(wp), intent(in) :: t, big_h
+        integer, intent(in) :: n
+        logical, intent(in) :: check_stability
+        integer, intent(out) :: ev
+        type(status_t), intent(inout) :: status
+        integer :: nv
+        integer :: i
+        real(wp) :: h, ti, tn
+        nv = w%nv
+        h = big_h / n
+        ev = ev_ok
+        tn = t + big_h / n
+        w%pp = w%p0
+        w%vp = w%v0
+        w%p = w%p0 + h * w%pdot0
+        call eval_block(problem, w, block_jacobian, tn, w%p, w%gn, status)
+        if (user_failed(status, 'constraint_jacobian')) then
+            ev = ev_stop
+            return
+        end if
+        call problem%constraint_time_derivative(tn, w%p, w%gt, status)
+        if (user_failed(status, 'constraint_time_derivative')) then
+            ev = ev_stop
+            return
+        end if
+        native%nfprob = native%nfprob + 1
+        w%rhs(1:nv) = w%f0
+        call block_times(w, w%gn, w%gpat, w%v0, w%rhs(nv + 1:))
+        w%rhs(nv + 1:) = -(w%rhs(nv + 1:) + w%gt) / h
+        call assemble(w, w%m0, w%g0, w%gn)
+        call factor_solve(native, w, 'in a step', ev, status)
+        if (ev /= ev_ok) return
+        w%acc = w%rhs(1:nv)
+        w%lam = w%rhs(nv + 1:)
+        w%v = w%v0 + h * w%acc
+        call copy_block(w%gm, w%gn)
+        do i = 1, n - 1
+            ti = t + big_h * real(i, wp) / n
+            tn = t + big_h * real(i + 1, wp) / n
+            ! one FPROB call (flags 1, 4, 5) at (t_i, q_i, v_i), one (2, 8) at q_{i+1}
+            call problem%forces(ti, w%p, w%v, w%f, status)
+            native%nfcn = native%nfcn + 1
+            native%nfprob = native%nfprob + 1
+            if (user_failed(status, 'forces', w%f)) exit
+            call eval_block(problem, w, block_mass, ti, w%p, w%mm, status)
+            if (user_failed(status, 'mass')) exit
+            call problem%kinematics(ti, w%p, w%v, w%pdot, status)
+            if (user_failed(status, 'kinematics')) exit
+            w%pn = w%pp + 2.0_wp * h * w%pdot
+            call eval_block(problem, w, block_jacobian, tn, w%pn, w%gn, status)
+            if (user_failed(status, 'constraint_jacobian')) exit
+            call problem%constraint_time_derivative(tn, w%pn, w%gt, status)
+            if (user_failed(status, 'constraint_time_derivative')) exit
+            native%nfprob = native%nfprob + 1
+            w%rhs(1:nv) = w%f
+            call block_times(w, w%gn, w%gpat, w%vp, w%rhs(nv + 1:))
+            w%rhs(nv + 1:) = -(w%rhs(nv + 1:) + w%gt) / (2.0_wp * h)
+            call assemble(w, w%mm, w%gm, w%gn)
+            call factor_solve(native, w, 'in a step', ev, status)
+            if (ev /= ev_ok) return
+            w%acc = w%rhs(1:nv)
+            w%lam = w%rhs(nv + 1:)
+            w%pp = w%p
+            w%p = w%pn
+            ! v_{i+1} = v_{i−1} + 2h a_i; vp becomes v_i
+            w%f = w%vp + 2.0_wp * h * w%acc
+            w%vp = w%v
+            w%v = w%f
+            call copy_block(w%gm, w%gn)
+            if (unstable(w, i, check_stability, ev, status)) return
+        end do
+        if (.not. status%ok()) ev = merge(ev_refused, ev_stop, status%reason == reason_det_f &
+                                          .or. status%reason == reason_non_finite)
+    end subroutine midpoint_substeps
+
+    !> Non-finite values, or the §3.5 check after the second substep
+    !> (i = 1): ‖v2 − v1‖ > 2 ‖v2‖ in the weights of the step start.
+    logical function unstable(w, i, check_stability, ev, status)
+        type(workspace_t), intent(in) :: w
+        integer, intent(in) :: i
+        logical, intent(in) :: check_stability
+        integer, intent(inout) :: ev
+        type(status_t), intent(inout) :: status
+        unstable = .not. (all(ieee_is_finite(w%v)) .and. all(ieee_is_finite(w%p)))
+        if (unstable) then
+            call status%set(status_solver_failure, 'non-finite values', reason_non_finite)
+        else if (check_stability .and. i == 1) then
+            unstable = rms(w%v - w%vp, w%wst) > stability_ratio * rms(w%v, w%wst)
+        end if
+        if (unstable) ev = ev_restart
+    end function unstable
 
     !> Aitken–Neville: w%tab(:, l) holds T_{j−1,l}; afterwards T_{j,l}.
     subroutine extrapolate_column(w, j)

@@ -89,13 +89,15 @@ contains
         end if
     end function workspace_linear_solver
 
-    !> Allocate the workspace for `km` columns and set up the linear solver
-    !> of the augmented system ('auto' | 'dense' | 'klu').
-    subroutine setup_workspace(w, problem, base, km, linear_solver, status, ordering, &
+    !> Allocate the workspace for `km` columns under the order and step-size
+    !> control `control` and set up the linear solver of the augmented
+    !> system ('auto' | 'dense' | 'klu').
+    subroutine setup_workspace(w, problem, base, control, km, linear_solver, status, ordering, &
                                classic_lu, structured)
         type(workspace_t), intent(out) :: w
         class(mechanical_problem_t), intent(inout) :: problem
         integer, intent(in) :: base, km
+        integer, intent(in) :: control !! mexax_control_hairer | _deuflhard
         character(len=*), intent(in) :: linear_solver
         type(status_t), intent(out) :: status
         character(len=*), intent(in), optional :: ordering !! 'auto' | 'amd' | 'nd'
@@ -119,7 +121,7 @@ contains
         w%ny = nq + 2 * nv + nc
         w%km = km
         w%base = base
-        call w%ctl%init(base, km)
+        call w%ctl%init(base, km, control)
         allocate (w%rtol(w%ne), w%atol(w%ne), w%wt(w%ne), w%wst(nv), w%p0(nq), w%v0(nv), &
             w%a0(nv), w%lam0(nc), w%f0(nv), w%pdot0(nq), w%rhs(w%na), w%p(nq), w%pp(nq), &
             w%pn(nq), w%v(nv), w%vp(nv), w%f(nv), w%pdot(nq), w%gt(nc), w%acc(nv), w%lam(nc), &
