@@ -22,18 +22,21 @@ module flexmbs_dae_mexax_deuflhard
     !> Decisions of the convergence monitor on one column.
     integer, parameter, public :: window_continue = 0, window_accept = 1, window_reject = 2
 
-    !> Safety factor ρ: a column's step size aims at the error ρ TOL.
+    !> Safety factor ρ: a column's step size aims at the error ρ TOL (the
+    !> value of SAFE1 in Numerical Recipes' Deuflhard control, [PTVF96]).
     real(wp), parameter, public :: deuflhard_safety = 0.25_wp
     !> A retry aimed at the window's top column, the last one there is,
     !> takes this further factor (docs/theory.md §7.3: without it, 1e-9 on
-    !> the 8-bar chain rejects the retries again).
+    !> the 8-bar chain rejects the retries again; the value of [PTVF96]'s
+    !> SAFE2).
     real(wp), parameter :: top_safety = 0.7_wp
     !> A step grows by at most this factor after an acceptance (the
     !> original's FAC2 of the column step sizes, docs/theory.md §7.3).
     real(wp), parameter, public :: deuflhard_growth = 4.0_wp
     !> A rejected step shrinks to between these fractions of itself (own
     !> bounds; the monitor's reduction lies inside them unless an estimate
-    !> is far off).
+    !> is far off). [PTVF96]'s [1e-5, 0.7] put a 12-bar chain's angle
+    !> error above 20 TOL in one run of the test (docs/theory.md §7.3).
     real(wp), parameter :: reduction_max = 0.9_wp, reduction_min = 0.01_wp
 
 contains

@@ -112,9 +112,8 @@ contains
         real(wp) :: tt
         integer :: liwk_need, lrwk_need, kdmax, ntol, i
 
-        liwk_need = 0
-        lrwk_need = 0
-        ierr = check_input()
+        ierr = check_input(np, nv, nl, ng, nu, t, tfin, mxjob, liwk, lrwk, kdmax, liwk_need, &
+                           lrwk_need)
         call workspace_slots()
         if (ierr /= ierr_ok) then
             call finish_slots()
@@ -122,21 +121,7 @@ contains
         end if
 
         ! ---- the problem, the options, the solver ----
-        problem%fprob => fprob
-        problem%nq = np
-        problem%nv = nv
-        problem%nc = nl
-        problem%nl = nl
-        problem%ng = ng
-        problem%nu = nu
-        allocate (problem%u(max(1, nu)), problem%rlam(max(1, nl)))
-        problem%u = 0.0_wp
-        if (nu > 0) problem%u(1:nu) = u(1:nu)
-        problem%rlam = 0.0_wp
-        if (nl > 0) problem%rlam(1:nl) = rlam(1:nl)
-        allocate (problem%am(nv, nv), problem%gp(max(1, nl), nv), problem%fl(nv, max(1, nl)))
-        allocate (problem%f(nv), problem%pdot(np), problem%udot(max(1, nu)), &
-            problem%g(max(1, ng)), problem%gi(max(1, nl)))
+        call setup_problem(problem, fprob, np, nv, nl, ng, nu, u, rlam)
 
         ntol = np + nv + nu
         if (itol == 0) then
@@ -192,87 +177,6 @@ contains
 
     contains
 
-        !> §3.9 bad input, in the order of the list; 0 when all is well.
-        integer function check_input() result(code)
-            integer :: k
-            code = ierr_ok
-            if (np <= 0) then
-                code = ierr_np
-                call message('NP = ' // int_text(np) // ': must be positive')
-            else if (nv <= 0) then
-                code = ierr_np
-                call message('NV = ' // int_text(nv) // ': must be positive')
-            else if (ng < 0) then
-                code = ierr_ng
-                call message('NG = ' // int_text(ng) // ': must not be negative')
-            else if (nu < 0) then
-                code = ierr_nu
-                call message('NU = ' // int_text(nu) // ': must not be negative')
-            else if (nu > 0) then
-                code = ierr_nu
-                call message('NU = ' // int_text(nu) // ': extra states u are not integrated &
-                    &by this face; use NU = 0')
-            else if (ng > nl) then
-                code = ierr_ng_nl
-                call message('NG = ' // int_text(ng) // ' > NL = ' // int_text(nl))
-            else if (ng < nl) then
-                code = ierr_ng_nl
-                call message('NG = ' // int_text(ng) // ' < NL = ' // int_text(nl) // &
-                    ': this face needs NG = NL (every velocity constraint a derivative of a &
-                    &position constraint)')
-            else if (tfin <= t) then
-                code = ierr_tfin
-                call message('TFIN must be greater than T')
-            end if
-            if (code /= ierr_ok) return
-            k = 0
-            if (mxjob(slot_mdisc) /= 0) then
-                k = slot_mdisc
-            else if (mxjob(slot_job) < 0 .or. mxjob(slot_job) > job_max_dense) then
-                k = slot_job
-            else if (mxjob(slot_mmode) /= 0) then
-                k = slot_mmode
-            else if (mxjob(slot_mgpfl) /= 0) then
-                k = slot_mgpfl
-            else if (mxjob(slot_kdmax) /= 0 .and. (mxjob(slot_kdmax) < 2 .or. &
-                mxjob(slot_kdmax) > mexax_max_columns)) then
-                k = slot_kdmax
-            else if (mxjob(slot_ialam) < 0 .or. mxjob(slot_ialam) > 1) then
-                k = slot_ialam
-            else if (mxjob(slot_base) < 0 .or. mxjob(slot_base) > 1) then
-                k = slot_base
-            else if (mxjob(slot_control) < 0 .or. mxjob(slot_control) > 1) then
-                k = slot_control
-            else if (mxjob(slot_mout) < 0 .or. mxjob(slot_mout) > 1) then
-                k = slot_mout
-            else if (mxjob(slot_mdout) /= 0) then
-                k = slot_mdout
-            else if (mxjob(slot_mswit) /= 0) then
-                k = slot_mswit
-            end if
-            if (k /= 0) then
-                code = ierr_mxjob - k
-                call message('MXJOB(' // int_text(k) // ') = ' // int_text(mxjob(k)) // &
-                    ': not a value this face accepts (docs/solvers.md, MEXAX)')
-                return
-            end if
-            kdmax = mxjob(slot_kdmax)
-            if (kdmax == 0) kdmax = mexax_max_columns
-            ! workspace (§3.9), empty dimensions counted as 1
-            liwk_need = np + 4 * nv + max(1, nl) + max(1, nu) + liwk_extra
-            lrwk_need = (nv + max(1, nl))**2 + np * (max(1, ng, nl) + 18) + nv * (nv + 45) &
-                + 28 * max(1, nl) + max(1, ng) + 18 * max(1, nu) + lrwk_extra
-            if (liwk < liwk_need) then
-                code = ierr_liwk
-                call message('LIWK = ' // int_text(liwk) // ': at least ' // &
-                    int_text(liwk_need) // ' needed')
-            else if (lrwk < lrwk_need) then
-                code = ierr_lrwk
-                call message('LRWK = ' // int_text(lrwk) // ': at least ' // &
-                    int_text(lrwk_need) // ' needed')
-            end if
-        end function check_input
-
         subroutine workspace_slots()
             mxjob(slot_liwk_need) = liwk_need
             mxjob(slot_lrwk_need) = lrwk_need
@@ -313,6 +217,130 @@ contains
             end if
         end function status_ierr
     end subroutine mexax_classic
+
+    !> §3.9 bad input, in the order of the list: the IERR (0 when all is
+    !> well, with a message otherwise), the columns KDMAX and the workspace the
+    !> run needs.
+    integer function check_input(np, nv, nl, ng, nu, t, tfin, mxjob, liwk, lrwk, kdmax, &
+                                 liwk_need, lrwk_need) result(code)
+        integer, intent(in) :: np, nv, nl, ng, nu
+        real(wp), intent(in) :: t, tfin
+        integer, intent(in) :: mxjob(*)
+        integer, intent(in) :: liwk, lrwk
+        integer, intent(out) :: kdmax, liwk_need, lrwk_need
+        integer :: k
+        code = ierr_ok
+        kdmax = mexax_max_columns
+        liwk_need = 0
+        lrwk_need = 0
+        if (np <= 0) then
+            code = ierr_np
+            call message('NP = ' // int_text(np) // ': must be positive')
+        else if (nv <= 0) then
+            code = ierr_np
+            call message('NV = ' // int_text(nv) // ': must be positive')
+        else if (ng < 0) then
+            code = ierr_ng
+            call message('NG = ' // int_text(ng) // ': must not be negative')
+        else if (nu < 0) then
+            code = ierr_nu
+            call message('NU = ' // int_text(nu) // ': must not be negative')
+        else if (nu > 0) then
+            code = ierr_nu
+            call message('NU = ' // int_text(nu) // ': extra states u are not integrated &
+                &by this face; use NU = 0')
+        else if (ng > nl) then
+            code = ierr_ng_nl
+            call message('NG = ' // int_text(ng) // ' > NL = ' // int_text(nl))
+        else if (ng < nl) then
+            code = ierr_ng_nl
+            call message('NG = ' // int_text(ng) // ' < NL = ' // int_text(nl) // &
+                ': this face needs NG = NL (every velocity constraint a derivative of a &
+                &position constraint)')
+        else if (tfin <= t) then
+            code = ierr_tfin
+            call message('TFIN must be greater than T')
+        end if
+        if (code /= ierr_ok) return
+        k = rejected_slot(mxjob)
+        if (k /= 0) then
+            code = ierr_mxjob - k
+            call message('MXJOB(' // int_text(k) // ') = ' // int_text(mxjob(k)) // &
+                ': not a value this face accepts (docs/solvers.md, MEXAX)')
+            return
+        end if
+        kdmax = mxjob(slot_kdmax)
+        if (kdmax == 0) kdmax = mexax_max_columns
+        ! workspace (§3.9), empty dimensions counted as 1
+        liwk_need = np + 4 * nv + max(1, nl) + max(1, nu) + liwk_extra
+        lrwk_need = (nv + max(1, nl))**2 + np * (max(1, ng, nl) + 18) + nv * (nv + 45) &
+            + 28 * max(1, nl) + max(1, ng) + 18 * max(1, nu) + lrwk_extra
+        if (liwk < liwk_need) then
+            code = ierr_liwk
+            call message('LIWK = ' // int_text(liwk) // ': at least ' // &
+                int_text(liwk_need) // ' needed')
+        else if (lrwk < lrwk_need) then
+            code = ierr_lrwk
+            call message('LRWK = ' // int_text(lrwk) // ': at least ' // &
+                int_text(lrwk_need) // ' needed')
+        end if
+    end function check_input
+
+    !> The first MXJOB option slot whose value the face does not accept; 0
+    !> when there is none.
+    integer function rejected_slot(mxjob) result(k)
+        integer, intent(in) :: mxjob(*)
+        k = 0
+        if (mxjob(slot_mdisc) /= 0) then
+            k = slot_mdisc
+        else if (mxjob(slot_job) < 0 .or. mxjob(slot_job) > job_max_dense) then
+            k = slot_job
+        else if (mxjob(slot_mmode) /= 0) then
+            k = slot_mmode
+        else if (mxjob(slot_mgpfl) /= 0) then
+            k = slot_mgpfl
+        else if (mxjob(slot_kdmax) /= 0 .and. (mxjob(slot_kdmax) < 2 .or. &
+            mxjob(slot_kdmax) > mexax_max_columns)) then
+            k = slot_kdmax
+        else if (mxjob(slot_ialam) < 0 .or. mxjob(slot_ialam) > 1) then
+            k = slot_ialam
+        else if (mxjob(slot_base) < 0 .or. mxjob(slot_base) > 1) then
+            k = slot_base
+        else if (mxjob(slot_control) < 0 .or. mxjob(slot_control) > 1) then
+            k = slot_control
+        else if (mxjob(slot_mout) < 0 .or. mxjob(slot_mout) > 1) then
+            k = slot_mout
+        else if (mxjob(slot_mdout) /= 0) then
+            k = slot_mdout
+        else if (mxjob(slot_mswit) /= 0) then
+            k = slot_mswit
+        end if
+    end function rejected_slot
+
+    !> The classic FPROB as the core's mechanical problem, with U and RLAM as
+    !> its fixed arguments and its output arrays allocated once.
+    subroutine setup_problem(problem, fprob, np, nv, nl, ng, nu, u, rlam)
+        type(classic_mechanical_t), intent(out) :: problem
+        procedure(mexax_fprob_i) :: fprob
+        integer, intent(in) :: np, nv, nl, ng, nu
+        real(wp), intent(in) :: u(*), rlam(*)
+        problem%fprob => fprob
+        problem%nq = np
+        problem%nv = nv
+        problem%nc = nl
+        problem%nl = nl
+        problem%ng = ng
+        problem%nu = nu
+        allocate (problem%u(max(1, nu)), problem%rlam(max(1, nl)))
+        problem%u = 0.0_wp
+        if (nu > 0) problem%u(1:nu) = u(1:nu)
+        problem%rlam = 0.0_wp
+        if (nl > 0) problem%rlam(1:nl) = rlam(1:nl)
+        allocate (problem%am(nv, nv), problem%gp(max(1, nl), nv), problem%fl(nv, max(1, nl)))
+        allocate (problem%f(nv), problem%pdot(np), problem%udot(max(1, nu)), &
+            problem%g(max(1, ng)), problem%gi(max(1, nl)))
+
+    end subroutine setup_problem
 
     !> One line on the standard error unit (docs/theory.md §4).
     subroutine message(text)
