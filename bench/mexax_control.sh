@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `make bench`, part: MEXAX's two order and step-size controls ('hairer',
 # 'deuflhard') side by side on the bar chains of 3 to 16 bars, TOL 1e-3 to
-# 1e-9, both base methods, and on the 8-bar anchor (flexmbs-bench-mexax-control;
+# 1e-9, both base methods, on the 8-bar anchor, and the accuracy's spread
+# over the anchor's ten H0 on 8, 12 and 16 bars (flexmbs-bench-mexax-control;
 # docs/solvers.md). Writes build/bench/mexax_control.txt and, with
 # matplotlib, the work-precision plot build/bench/mexax_control.png (copy it
 # to docs/ when the figures in docs/solvers.md are updated). Never asserts.

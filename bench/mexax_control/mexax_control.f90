@@ -15,6 +15,12 @@
 !> of one run at H0 = 1e-3 and the means over H0 = 1e-3 (1 + 1e-4 m), m =
 !> 0 … 9, beside the original's; a member that fails is named and left out
 !> of the means.
+!> Part 3, the spread of part 1's accuracy: the same runs on the chains of
+!> 8, 12 and 16 bars (the longer ones within the given lengths) from the
+!> anchor's ten H0 (1e-3 (1 + 1e-4 m)) — a single run's largest angle error
+!> moves by an order of magnitude under such a change (docs/theory.md §7.3)
+!> — per base and control: runs, how many above 20 TOL, median and worst
+!> over TOL.
 !> Arguments: optional chain lengths (default 3 5 8 12 16). Never asserts.
 program flexmbs_bench_mexax_control
     use flexmbs_core_kinds, only: wp
@@ -53,6 +59,7 @@ program flexmbs_bench_mexax_control
     end if
     call work_precision(chains)
     call anchor_ensembles()
+    call accuracy_ensembles(pack(chains, chains >= 8))
 
 contains
 
@@ -66,11 +73,7 @@ contains
         print '(a)', 'wp base control NB TOL NSTEP NACCPT NREJCT NFCN max|dphi/phi|/TOL ' // &
             'digits (against ' // trim(solvers(solver_radau5)%name) // ' at 1e-12)'
         do b = 1, size(chains)
-            call radau5_reference(chains(b), ref, status)
-            if (.not. status%ok()) then
-                print '(a)', 'reference failed: ' // status%text()
-                cycle
-            end if
+            if (.not. reference(chains(b), ref)) cycle
             print '(a,i3,a,es9.2)', 'NB', chains(b), ': smallest |phi| at t = 1', &
                 minval(abs(ref(3::3)))
             do ib = 1, size(bases)
@@ -140,6 +143,66 @@ contains
         end do
     end subroutine anchor_ensembles
 
+    subroutine accuracy_ensembles(chains)
+        integer, intent(in) :: chains(:)
+        integer, parameter :: members = 10, tols = 7
+        real(wp), allocatable :: ref(:), q(:)
+        type(dae_stats_t) :: stats
+        type(status_t) :: status
+        real(wp) :: ratio(members * tols), tol
+        integer :: b, ib, ic, e, m, n, failed, counts(9)
+        print '(a)', 'ensemble base control NB: runs, above 20 TOL, median and worst ' // &
+            'max|dphi/phi|/TOL over H0 = 1e-3 (1 + 1e-4 m), m = 0..9, and TOL 1e-3..1e-9'
+        do b = 1, size(chains)
+            if (.not. reference(chains(b), ref)) cycle
+            do ib = 1, size(bases)
+                do ic = 1, size(controls)
+                    n = 0
+                    failed = 0
+                    do m = 0, members - 1
+                        do e = 3, 2 + tols
+                            tol = 10.0_wp**(-e)
+                            call chain_run(chains(b), bases(ib), controls(ic), tol, &
+                                           1.0e-3_wp * (1.0_wp + 1.0e-4_wp * m), .false., q, &
+                                           stats, status, counts)
+                            if (.not. status%ok()) then
+                                failed = failed + 1
+                                cycle
+                            end if
+                            n = n + 1
+                            ratio(n) = maxval(abs(q(3::3) - ref(3::3)) / abs(ref(3::3))) / tol
+                        end do
+                    end do
+                    if (n == 0) cycle
+                    print '(a,1x,a,1x,a,i4,a,i4,a,i3,a,2f8.2,a,i0)', 'ensemble', &
+                        trim(base_names(ib)), trim(control_names(ic)), chains(b), ':', n, &
+                        ' runs,', count(ratio(1:n) > 20.0_wp), ' above 20 TOL, median, worst', &
+                        median(ratio(1:n)), maxval(ratio(1:n)), '; failed ', failed
+                end do
+            end do
+        end do
+    end subroutine accuracy_ensembles
+
+    !> The median of x (sorted by insertion: the ensembles are small).
+    pure real(wp) function median(x)
+        real(wp), intent(in) :: x(:)
+        real(wp) :: s(size(x)), v
+        integer :: i, j
+        s = x
+        do i = 2, size(s)
+            v = s(i)
+            j = i - 1
+            do while (j >= 1)
+                if (s(j) <= v) exit
+                s(j + 1) = s(j)
+                j = j - 1
+            end do
+            s(j + 1) = v
+        end do
+        i = size(s)
+        median = 0.5_wp * (s((i + 1) / 2) + s(i / 2 + 1))
+    end function median
+
     !> MEXAX on the chain from its start to t = 1; `classic`: the anchor's
     !> settings (a and λ extrapolated, the classic elimination order).
     subroutine chain_run(bodies, base, control, tol, h0, classic, q, stats, status, counts)
@@ -176,6 +239,16 @@ contains
                       n%nsol]
         end associate
     end subroutine chain_run
+
+    !> radau5_reference, its failure printed.
+    logical function reference(bodies, q) result(ok)
+        integer, intent(in) :: bodies
+        real(wp), allocatable, intent(out) :: q(:)
+        type(status_t) :: status
+        call radau5_reference(bodies, q, status)
+        ok = status%ok()
+        if (.not. ok) print '(a)', 'reference failed: ' // status%text()
+    end function reference
 
     !> The catalogue's Radau IIA solver at rtol = atol = 1e-12 on the index-2
     !> formulation: q at t = 1.
