@@ -98,6 +98,10 @@ contains
         call dense%factor_real(shift, mass, jac, status)
         call zdense%factor_complex(zshift, mass, jac, status)
         if (allocated(error)) return
+        ! allocated first: gfortran's reallocation on assignment tests the
+        ! bounds of a never-allocated array's descriptor (valgrind: a jump on
+        ! uninitialised values)
+        allocate (xm(n), xk(n), xd(n), zm(n), zk(n), zd(n))
         xm = rhs(n, 1)
         xk = xm
         xd = xm
@@ -213,6 +217,7 @@ contains
         if (allocated(error)) return
         call mumps%init(mass, jac, status)
         call mumps%factor_real(shift, mass, jac, status)
+        allocate (x1(jac%n), x2(jac%n), xd(jac%n)) ! see check_agreement
         x1 = rhs(jac%n, 1)
         call mumps%solve_real(x1)
         call mumps%factor_real(shift, mass, jac2, status)
@@ -350,6 +355,7 @@ contains
         call check(error, status%ok(), 'complex solve of 3: ' // status%text())
         call dense%init(mass, jac, status)
         call dense%factor_real(0.0_wp, mass, jac, status)
+        allocate (x(n)) ! see check_agreement
         do k = 1, 3
             x = rhs(n, k)
             call dense%solve_real(x)
@@ -373,6 +379,7 @@ contains
         call lu%configure(status, error_analysis=.true.)
         call lu%analyse(jac%n, jac%csc%colptr, jac%csc%rowind, status)
         call lu%factor(-jac%csc%values, status)
+        allocate (x(jac%n)) ! see check_agreement
         x = rhs(jac%n, 1)
         call lu%solve(x, status)
         call check(error, status%ok(), 'solve: ' // status%text())
@@ -412,6 +419,7 @@ contains
         if (status%ok()) call dense%factor_real(0.0_wp, mass, jac, status)
         call check(error, status%ok(), 'node graph, dense LU of -J: ' // status%text())
         if (allocated(error)) return
+        allocate (x(jac%n), xd(jac%n)) ! see check_agreement
         xd = rhs(jac%n, 2)
         call dense%solve_real(xd)
 
