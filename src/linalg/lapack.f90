@@ -1,4 +1,4 @@
-!> Explicit interfaces to the LAPACK routines flexmbs calls.
+!> Explicit interfaces to the LAPACK (and BLAS) routines flexmbs calls.
 module flexmbs_linalg_lapack
     use, intrinsic :: ieee_exceptions, only: ieee_status_type, ieee_get_status, ieee_set_status
     use flexmbs_core_kinds, only: wp
@@ -6,9 +6,26 @@ module flexmbs_linalg_lapack
     private
     public :: dgetrf, dgetrs, zgetrf, zgetrs, dgbtrf, dgbtrs, zgbtrf, zgbtrs, dgesvd, dsyev
     public :: dggev3
+    public :: dgemm, zgemm
     public :: dgesvd_quiet, dsyev_quiet, dggev3_quiet
 
     interface
+        subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
+            import :: wp
+            character(len=1), intent(in) :: transa, transb
+            integer, intent(in) :: m, n, k, lda, ldb, ldc
+            real(wp), intent(in) :: alpha, beta
+            real(wp), intent(in) :: a(lda, *), b(ldb, *)
+            real(wp), intent(inout) :: c(ldc, *)
+        end subroutine dgemm
+        subroutine zgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
+            import :: wp
+            character(len=1), intent(in) :: transa, transb
+            integer, intent(in) :: m, n, k, lda, ldb, ldc
+            complex(wp), intent(in) :: alpha, beta
+            complex(wp), intent(in) :: a(lda, *), b(ldb, *)
+            complex(wp), intent(inout) :: c(ldc, *)
+        end subroutine zgemm
         subroutine dgetrf(m, n, a, lda, ipiv, info)
             import :: wp
             integer, intent(in) :: m, n, lda

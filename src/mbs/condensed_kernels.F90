@@ -6,7 +6,7 @@ module flexmbs_mbs_condensed_kernels
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_text, only: int_text
     use flexmbs_core_status, only: status_t, status_solver_failure, reason_singular_matrix
-    use flexmbs_linalg_lapack, only: dgetrf, dgetrs, zgetrf, zgetrs
+    use flexmbs_linalg_lapack, only: dgetrf, dgetrs, zgetrf, zgetrs, dgemm, zgemm
     use flexmbs_linalg_sparse_lu, only: sparse_lu_t
     use flexmbs_mbs_condensed_structure, only: condensed_structure_t
     implicit none
@@ -32,6 +32,7 @@ contains
 #define SCALAR real(wp)
 #define GETRF dgetrf
 #define GETRS dgetrs
+#define GEMM dgemm
 #define FACTOR_BLOCKS_P factor_blocks_real
 #define W_VALUES_P w_values_real
 #define S_VALUES_P s_values_real
@@ -41,6 +42,7 @@ contains
 #undef SCALAR
 #undef GETRF
 #undef GETRS
+#undef GEMM
 #undef FACTOR_BLOCKS_P
 #undef W_VALUES_P
 #undef S_VALUES_P
@@ -49,6 +51,7 @@ contains
 #define SCALAR complex(wp)
 #define GETRF zgetrf
 #define GETRS zgetrs
+#define GEMM zgemm
 #define FACTOR_BLOCKS_P factor_blocks_complex
 #define W_VALUES_P w_values_complex
 #define S_VALUES_P s_values_complex

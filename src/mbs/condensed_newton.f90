@@ -60,9 +60,9 @@ module flexmbs_mbs_condensed_newton
         integer(i8), allocatable :: va_slot(:) !! J's slot of (v_i, a_i): v' = a
         real(wp) :: c_real = 0.0_wp
         complex(wp) :: c_complex = (0.0_wp, 0.0_wp)
-        real(wp), allocatable :: lu_r(:), w_r(:), s_r(:), rhs_r(:)
+        real(wp), allocatable :: lu_r(:), w_r(:), s_r(:), rhs_r(:), g_r(:), prod_r(:)
         real(wp), allocatable :: xe_r(:), xk_r(:), rv_r(:), buf_r(:), res_r(:)
-        complex(wp), allocatable :: lu_z(:), w_z(:), s_z(:), rhs_z(:)
+        complex(wp), allocatable :: lu_z(:), w_z(:), s_z(:), rhs_z(:), g_z(:), prod_z(:)
         complex(wp), allocatable :: xe_z(:), xk_z(:), rv_z(:), buf_z(:), res_z(:)
         !> KLU on S: its refactorisations keep the old pivot order, which may
         !> cost a few digits; one step of iterative refinement wins them back
@@ -160,6 +160,8 @@ contains
             allocate (self%lu_r(st%lu_size()), self%lu_z(st%lu_size()), self%piv_r(nr), &
                 self%piv_z(nr), self%w_r(st%w%nnz), self%w_z(st%w%nnz), self%s_r(st%s%nnz), &
                 self%s_z(st%s%nnz), self%rhs_r(st%rhs_size()), self%rhs_z(st%rhs_size()), &
+                self%g_r(st%gather_size()), self%g_z(st%gather_size()), &
+                self%prod_r(st%product_size()), self%prod_z(st%product_size()), &
                 self%xe_r(st%ne), self%xe_z(st%ne), self%xk_r(st%nk), self%xk_z(st%nk), &
                 self%res_r(st%nk), self%res_z(st%nk), &
                 self%rv_r(st%nv), self%rv_z(st%nv), self%buf_r(max(st%max_block, 1)), &
@@ -167,7 +169,8 @@ contains
                 self%va_slot(merge(st%nv, 0, st%accelerations)), stat=stat)
             if (stat /= 0) then
                 call out_of_memory(status, who // ' values', 4 * (st%w%nnz + st%s%nnz) + &
-                    4 * st%lu_size() + 4 * st%rhs_size(), 8)
+                    4 * st%lu_size() + 4 * st%rhs_size() + 3 * st%gather_size() + &
+                    3 * st%product_size(), 8)
                 return
             end if
             if (st%accelerations) then
@@ -216,7 +219,8 @@ contains
         call factor_blocks(self%st, c, self%lu_r, self%piv_r, status)
         if (.not. status%ok()) return
         call w_values(self%st, c, self%lu_r, self%piv_r, self%rhs_r, self%w_r)
-        call s_values(self%st, c, self%w_r, self%s_r, self%pos)
+        call s_values(self%st, c, self%w_r, self%rhs_r, self%g_r, self%prod_r, self%s_r, &
+            self%pos)
         call self%lu%factor(self%s_r, status)
     end subroutine condensed_factor_real
 
@@ -231,7 +235,8 @@ contains
         call factor_blocks(self%st, c, self%lu_z, self%piv_z, status)
         if (.not. status%ok()) return
         call w_values(self%st, c, self%lu_z, self%piv_z, self%rhs_z, self%w_z)
-        call s_values(self%st, c, self%w_z, self%s_z, self%pos)
+        call s_values(self%st, c, self%w_z, self%rhs_z, self%g_z, self%prod_z, self%s_z, &
+            self%pos)
         call self%lu%factor(self%s_z, status)
     end subroutine condensed_factor_complex
 

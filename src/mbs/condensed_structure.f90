@@ -48,6 +48,10 @@ module flexmbs_mbs_condensed_structure
     !> BLAS thread).
     integer, parameter, public :: max_eliminated_block_klu = 512
     integer, parameter, public :: max_eliminated_block_mumps = 16
+    !> Components of at least this order add their share of J_KE W to S as
+    !> one dense product (product_plan); the smaller ones (quaternions) in
+    !> s_values' sparse loop.
+    integer, parameter, public :: dense_product_min = 8
 
     !> Offsets of the formulation's blocks in y (flexmbs_mbs_formulation).
     type, public :: condensed_layout_t
@@ -79,12 +83,22 @@ module flexmbs_mbs_condensed_structure
         integer, allocatable :: rhs_ncol(:)    !! columns of a component's right-hand sides
         integer(i8), allocatable :: rhs_ptr(:) !! offset of its m x ncol block
         integer(i8), allocatable :: rhs_to_w(:) !! rhs index -> W slot
+        integer, allocatable :: rhs_col_ptr(:), rhs_cols(:) !! S column of each rhs column
+        !> J_KE W of the large components as dense products (product_plan)
+        logical, allocatable :: in_product(:)  !! eliminated e in such a component
+        integer, allocatable :: g_rows(:)      !! kept rows its J_KE columns touch (0: none)
+        integer(i8), allocatable :: g_ptr(:)   !! offset of its g_rows x m block of J_KE
+        integer(i8), allocatable :: p_ptr(:)   !! offset of its g_rows x ncol product
+        integer(i8), allocatable :: jke_to_g(:) !! J_KE slot -> index in the gathered blocks
+        integer(i8), allocatable :: prod_to_s(:) !! product index -> S slot
         type(csc_matrix_t) :: s                !! pattern of S (nk x nk)
         integer(i8), allocatable :: jkk_to_s(:), jka_to_s(:), mkk_to_s(:)
     contains
         procedure :: build => structure_build
         procedure :: lu_size => structure_lu_size
         procedure :: rhs_size => structure_rhs_size
+        procedure :: gather_size => structure_gather_size
+        procedure :: product_size => structure_product_size
     end type condensed_structure_t
 
     character(len=*), parameter :: who = 'condensed Newton system'
@@ -138,6 +152,7 @@ contains
         call eliminated_components(self, comp, lay, status)
         if (status%ok()) call w_pattern(self, status)
         if (status%ok()) call s_pattern(self, status)
+        if (status%ok()) call product_plan(self, status)
     end subroutine structure_build
 
     !> Acceleration layout: the v rows must read v' = a (J: only (v_i, a_i);
@@ -472,6 +487,8 @@ contains
             end do
             call self%w%build(self%ne, self%nk, rows, cols, status)
             if (.not. status%ok()) return
+            call move_alloc(cols_ptr, self%rhs_col_ptr)
+            call move_alloc(comp_cols, self%rhs_cols)
             allocate (self%rhs_to_w(self%rhs_ptr(nc + 1)))
             self%jek_to_w = 0
             self%jek_to_rhs = 0
@@ -494,12 +511,122 @@ contains
                     do l = 1, m
                         idx = self%rhs_ptr(k) + int(c - 1, i8) * m + l
                         self%rhs_to_w(idx) = self%w%find(self%comp_rows(self%comp_ptr(k) + l &
-                            - 1), comp_cols(cols_ptr(k) + c - 1))
+                            - 1), self%rhs_cols(self%rhs_col_ptr(k) + c - 1))
                     end do
                 end do
             end do
         end associate
     end subroutine w_pattern
+
+    !> The dense products of J_KE W for the components of at least
+    !> dense_product_min positions: a component's J_KE columns gathered into
+    !> a block over the kept rows R they touch (column l: the component's
+    !> l-th position), times its right-hand-side block (W's rows there,
+    !> dense), subtracted from S through prod_to_s. Every (r, column) pair
+    !> of R and the block's columns is in S's pattern, which holds J_KE W.
+    subroutine product_plan(self, status)
+        type(condensed_structure_t), intent(inout) :: self
+        type(status_t), intent(inout) :: status
+        integer, allocatable :: rowpos(:), rlist(:)
+        integer :: k, m, l, e, r, nr, c, i, stat
+        integer(i8) :: q, idx
+        associate (a => self%jke%a, nc => self%ncomp)
+            allocate (self%in_product(max(self%ne, 1)), self%g_rows(max(nc, 1)), &
+                self%g_ptr(nc + 1), self%p_ptr(nc + 1), self%jke_to_g(a%nnz), &
+                rowpos(self%nk), rlist(self%nk), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, who // ' product maps', a%nnz + 2_i8 * self%nk, 8)
+                return
+            end if
+            self%in_product = .false.
+            self%g_rows = 0
+            self%jke_to_g = 0
+            self%g_ptr(1) = 0
+            self%p_ptr(1) = 0
+            rowpos = 0
+            ! pass 1: rows, positions in the gathered blocks
+            do k = 1, nc
+                m = self%comp_ptr(k + 1) - self%comp_ptr(k)
+                nr = 0
+                if (m >= dense_product_min .and. self%rhs_ncol(k) > 0) then
+                    call component_rows(k, nr)
+                    do i = 1, nr
+                        rowpos(rlist(i)) = 0
+                    end do
+                end if
+                self%g_rows(k) = nr
+                self%g_ptr(k + 1) = self%g_ptr(k) + int(nr, i8) * m
+                self%p_ptr(k + 1) = self%p_ptr(k) + int(nr, i8) * self%rhs_ncol(k)
+            end do
+            allocate (self%prod_to_s(self%p_ptr(nc + 1)), stat=stat)
+            if (stat /= 0) then
+                call out_of_memory(status, who // ' product map', self%p_ptr(nc + 1), 8)
+                return
+            end if
+            ! pass 2: the maps
+            do k = 1, nc
+                if (self%g_rows(k) == 0) cycle
+                call component_rows(k, nr)
+                do l = self%comp_ptr(k), self%comp_ptr(k + 1) - 1
+                    e = self%comp_rows(l)
+                    self%in_product(e) = .true.
+                    do q = a%colptr(e) + 1, a%colptr(e + 1)
+                        r = int(a%rowind(q)) + 1
+                        self%jke_to_g(q) = self%g_ptr(k) + int(self%local_of(e) - 1, i8) * nr &
+                            + rowpos(r)
+                    end do
+                end do
+                do c = 1, self%rhs_ncol(k)
+                    do i = 1, nr
+                        idx = self%p_ptr(k) + int(c - 1, i8) * nr + i
+                        self%prod_to_s(idx) = self%s%find(rlist(i), &
+                            self%rhs_cols(self%rhs_col_ptr(k) + c - 1))
+                        if (self%prod_to_s(idx) <= 0) then
+                            call status%set(status_bad_input, who // ': S''s pattern misses ' // &
+                                'an entry of J_KE W (component ' // int_text(k) // ')')
+                            return
+                        end if
+                    end do
+                end do
+                do i = 1, nr
+                    rowpos(rlist(i)) = 0
+                end do
+            end do
+        end associate
+    contains
+        !> Kept rows touched by component k's J_KE columns: rlist(1:nr), and
+        !> their places rowpos(r).
+        subroutine component_rows(k, nr)
+            integer, intent(in) :: k
+            integer, intent(out) :: nr
+            integer :: ll, ee, rr
+            integer(i8) :: qq
+            nr = 0
+            do ll = self%comp_ptr(k), self%comp_ptr(k + 1) - 1
+                ee = self%comp_rows(ll)
+                do qq = self%jke%a%colptr(ee) + 1, self%jke%a%colptr(ee + 1)
+                    rr = int(self%jke%a%rowind(qq)) + 1
+                    if (rowpos(rr) /= 0) cycle
+                    nr = nr + 1
+                    rlist(nr) = rr
+                    rowpos(rr) = nr
+                end do
+            end do
+        end subroutine component_rows
+    end subroutine product_plan
+
+    !> Size of the gathered J_KE blocks and of the products (product_plan).
+    pure integer(i8) function structure_gather_size(self)
+        class(condensed_structure_t), intent(in) :: self
+        structure_gather_size = 0
+        if (allocated(self%g_ptr)) structure_gather_size = self%g_ptr(self%ncomp + 1)
+    end function structure_gather_size
+
+    pure integer(i8) function structure_product_size(self)
+        class(condensed_structure_t), intent(in) :: self
+        structure_product_size = 0
+        if (allocated(self%p_ptr)) structure_product_size = self%p_ptr(self%ncomp + 1)
+    end function structure_product_size
 
     !> S's pattern: J_KK, M_KK, J_KA moved to the v columns, and J_KE W;
     !> the slot maps of the first three.
