@@ -94,6 +94,9 @@ contains
         else
             call midpoint_substeps(native, problem, w, t, big_h, n, check_stability, ev, status)
         end if
+        ! a substep loop left by a failed user function: refused or stop
+        if (ev == ev_ok .and. .not. status%ok()) ev = merge(ev_refused, ev_stop, &
+            status%reason == reason_det_f .or. status%reason == reason_non_finite)
         if (ev /= ev_ok) return
         w%x(1:nq) = w%p
         w%x(nq + 1:nq + nv) = w%v
@@ -157,8 +160,6 @@ contains
             w%p = w%pn
             if (unstable(w, i, check_stability, ev, status)) return
         end do
-        if (.not. status%ok()) ev = merge(ev_refused, ev_stop, status%reason == reason_det_f &
-                                          .or. status%reason == reason_non_finite)
     end subroutine euler_substeps
 
     !> (M), §3.2: an explicit start step, then q_{i+1} = q_{i−1} + 2h T v_i,
@@ -238,8 +239,6 @@ contains
             call copy_block(w%gm, w%gn)
             if (unstable(w, i, check_stability, ev, status)) return
         end do
-        if (.not. status%ok()) ev = merge(ev_refused, ev_stop, status%reason == reason_det_f &
-                                          .or. status%reason == reason_non_finite)
     end subroutine midpoint_substeps
 
     !> Non-finite values, or the §3.5 check after the second substep

@@ -173,6 +173,9 @@ contains
                     3 * st%product_size(), 8)
                 return
             end if
+            ! the gathered J_KE blocks: their slots outside J_KE's pattern stay zero
+            self%g_r = 0.0_wp
+            self%g_z = 0.0_wp
             if (st%accelerations) then
                 do i = 1, st%nv
                     self%va_slot(i) = jac%csc%find(st%ov + i, st%oa + i)
