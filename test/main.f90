@@ -55,6 +55,8 @@ program flexmbs_tests
     use test_structured_saddle, only: collect_structured_saddle
     use test_out_of_memory, only: collect_out_of_memory
     use test_modes, only: collect_modes
+    use test_modal_basis, only: collect_modal_basis
+    use test_modal_body, only: collect_modal_body
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -117,6 +119,8 @@ program flexmbs_tests
     call run_suite('structured_saddle', collect_structured_saddle(), filter, npassed, nfailed)
     call run_suite('out_of_memory', collect_out_of_memory(), filter, npassed, nfailed)
     call run_suite('modes', collect_modes(), filter, npassed, nfailed)
+    call run_suite('modal_basis', collect_modal_basis(), filter, npassed, nfailed)
+    call run_suite('modal_body', collect_modal_body(), filter, npassed, nfailed)
     call run_suite('node_frame', collect_node_frame(), filter, npassed, nfailed)
     call run_suite('study', collect_study(), filter, npassed, nfailed)
     call run_suite('run', collect_run(), filter, npassed, nfailed)

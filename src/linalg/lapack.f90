@@ -7,7 +7,7 @@ module flexmbs_linalg_lapack
     public :: dgetrf, dgetrs, zgetrf, zgetrs, dgbtrf, dgbtrs, zgbtrf, zgbtrs, dgesvd, dsyev
     public :: dggev3
     public :: dgemm, zgemm
-    public :: dgesvd_quiet, dsyev_quiet, dggev3_quiet
+    public :: dgesvd_quiet, dsyev_quiet, dggev3_quiet, dsygv_quiet
 
     interface
         subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
@@ -98,6 +98,14 @@ module flexmbs_linalg_lapack
             real(wp), intent(out) :: w(*), work(*)
             integer, intent(out) :: info
         end subroutine dsyev
+        subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
+            import :: wp
+            integer, intent(in) :: itype, n, lda, ldb, lwork
+            character, intent(in) :: jobz, uplo
+            real(wp), intent(inout) :: a(lda, *), b(ldb, *)
+            real(wp), intent(out) :: w(*), work(*)
+            integer, intent(out) :: info
+        end subroutine dsygv
         subroutine dggev3(jobvl, jobvr, n, a, lda, b, ldb, alphar, alphai, beta, vl, ldvl, &
                          vr, ldvr, work, lwork, info)
             import :: wp
@@ -141,6 +149,19 @@ contains
         call dsyev(jobz, uplo, n, a, lda, w, work, lwork, info)
         call ieee_set_status(saved)
     end subroutine dsyev_quiet
+
+    !> dsygv, leaving the IEEE flags as they were (see dgesvd_quiet).
+    subroutine dsygv_quiet(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
+        integer, intent(in) :: itype, n, lda, ldb, lwork
+        character, intent(in) :: jobz, uplo
+        real(wp), intent(inout) :: a(lda, *), b(ldb, *)
+        real(wp), intent(out) :: w(*), work(*)
+        integer, intent(out) :: info
+        type(ieee_status_type) :: saved
+        call ieee_get_status(saved)
+        call dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
+        call ieee_set_status(saved)
+    end subroutine dsygv_quiet
 
     !> dggev3, leaving the IEEE flags as they were (see dgesvd_quiet).
     subroutine dggev3_quiet(jobvl, jobvr, n, a, lda, b, ldb, alphar, alphai, beta, vl, ldvl, &
