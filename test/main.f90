@@ -57,6 +57,8 @@ program flexmbs_tests
     use test_modes, only: collect_modes
     use test_modal_basis, only: collect_modal_basis
     use test_modal_body, only: collect_modal_body
+    use test_modal_frame, only: collect_modal_frame
+    use test_modal_system, only: collect_modal_system
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -121,6 +123,8 @@ program flexmbs_tests
     call run_suite('modes', collect_modes(), filter, npassed, nfailed)
     call run_suite('modal_basis', collect_modal_basis(), filter, npassed, nfailed)
     call run_suite('modal_body', collect_modal_body(), filter, npassed, nfailed)
+    call run_suite('modal_frame', collect_modal_frame(), filter, npassed, nfailed)
+    call run_suite('modal_system', collect_modal_system(), filter, npassed, nfailed)
     call run_suite('node_frame', collect_node_frame(), filter, npassed, nfailed)
     call run_suite('study', collect_study(), filter, npassed, nfailed)
     call run_suite('run', collect_run(), filter, npassed, nfailed)

@@ -29,7 +29,7 @@ module test_modal_body
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
     private
-    public :: collect_modal_body, new_test_modal_body
+    public :: collect_modal_body, new_test_modal_body, allocate_solver
 
     real(wp), parameter :: bar(3) = [0.6_wp, 0.08_wp, 0.05_wp]
 
@@ -75,6 +75,22 @@ contains
         call new_modal_body(body, basis, modal_invariants(fe%mass_matrix, fe%mesh%x, &
                             basis%shapes), status, gravity)
     end subroutine new_test_modal_body
+
+    !> Solver s of RADAU5, DDASSL, IDA, MEXAX.
+    subroutine allocate_solver(s, solver)
+        integer, intent(in) :: s
+        class(dae_solver_t), allocatable, intent(out) :: solver
+        select case (s)
+        case (1)
+            allocate (radau5_t :: solver)
+        case (2)
+            allocate (ddassl_t :: solver)
+        case (3)
+            allocate (ida_t :: solver)
+        case default
+            allocate (mexax_t :: solver)
+        end select
+    end subroutine allocate_solver
 
     !> A state with every term awake: off-unit quaternion excluded, η of
     !> the size of a visible deflection.
@@ -271,16 +287,7 @@ contains
         options%rtol = rtol
         options%atol = rtol
         do s = 1, 4
-            select case (s)
-            case (1)
-                allocate (radau5_t :: solver)
-            case (2)
-                allocate (ddassl_t :: solver)
-            case (3)
-                allocate (ida_t :: solver)
-            case (4)
-                allocate (mexax_t :: solver)
-            end select
+            call allocate_solver(s, solver)
             t = 0.0_wp
             if (s < 4) then
                 gen = new_formulation(body, formulation_index2, q, status=status)

@@ -27,6 +27,10 @@
 !>
 !> Local columns of a frame: position space (r, p, x_1, …, x_n), 7 + 3n;
 !> velocity space (ṙ, ω′, ẋ_1, …, ẋ_n), 6 + 3n.
+!>
+!> A frame on an interface of a modal body (`modal` > 0) has the rows and
+!> local columns of flexmbs_mbs_modal_frame instead, which every procedure
+!> here hands it to, so that the system treats both kinds alike.
 module flexmbs_mbs_node_frame
     use flexmbs_core_kinds, only: wp
     use flexmbs_mbs_rotation, only: rotation_matrix, rotated_vector_jacobian, skew, cross, &
@@ -35,6 +39,10 @@ module flexmbs_mbs_node_frame
         assignment(=), matmul
     use flexmbs_mbs_rotation_dual, only: rotation_matrix_d => rotation_matrix, &
         cross_d => cross
+    use flexmbs_mbs_modal_frame, only: modal_interface_t, modal_frame_columns, &
+        modal_frame_value, modal_frame_jacobian, modal_frame_curvature, &
+        modal_frame_jacobian_ad, modal_frame_curvature_ad, modal_frame_rate_q, &
+        modal_frame_gtl_q, modal_frame_curvature_qv
     implicit none
     private
 
@@ -53,6 +61,14 @@ module flexmbs_mbs_node_frame
         integer :: iq = 0, iv = 0          !! the frame body's offsets in q, v
         integer, allocatable :: nq(:), nv(:) !! node a's x offset in q, v
         integer :: row0 = 0                !! rows row0 + 1 .. row0 + 6
+        !> an interface frame of a modal body (flexmbs_mbs_modal_frame) instead:
+        !> the body's number and interface; placed by the system: the
+        !> interface's data and the body's offsets in q and v. Its local
+        !> columns are the frame body's, then the modal body's.
+        integer :: modal = 0
+        integer :: modal_interface = 0
+        type(modal_interface_t) :: rigid_interface
+        integer :: mq = 0, mv = 0
     end type node_frame_t
 
     interface transpose_times
@@ -69,8 +85,30 @@ contains
     pure integer function frame_columns(f, position_space) result(n)
         type(node_frame_t), intent(in) :: f
         logical, intent(in) :: position_space
+        if (f%modal > 0) then
+            n = modal_frame_columns(f%rigid_interface, position_space)
+            return
+        end if
         n = merge(body_nq, body_nv, position_space) + 3 * size(f%nodes)
     end function frame_columns
+
+    !> A modal frame's local positions (the frame body's, the modal body's).
+    pure function modal_positions(f, q) result(z)
+        type(node_frame_t), intent(in) :: f
+        real(wp), intent(in) :: q(:)
+        real(wp) :: z(frame_columns(f, .true.))
+        z(1:body_nq) = q(f%iq + 1:f%iq + body_nq)
+        z(body_nq + 1:) = q(f%mq + 1:f%mq + size(z) - body_nq)
+    end function modal_positions
+
+    !> A modal frame's local velocities.
+    pure function modal_velocities(f, v) result(w)
+        type(node_frame_t), intent(in) :: f
+        real(wp), intent(in) :: v(:)
+        real(wp) :: w(frame_columns(f, .false.))
+        w(1:body_nv) = v(f%iv + 1:f%iv + body_nv)
+        w(body_nv + 1:) = v(f%mv + 1:f%mv + size(w) - body_nv)
+    end function modal_velocities
 
     ! ------------------------------------------------ hand-coded (real)
 
@@ -105,6 +143,10 @@ contains
         real(wp), intent(out) :: c(node_frame_rows)
         real(wp) :: r(3), p(4), x(3, size(f%nodes)), rm(3, 3)
         integer :: a
+        if (f%modal > 0) then
+            call modal_frame_value(f%rigid_interface, modal_positions(f, q), c)
+            return
+        end if
         call gather(f, q, r, p, x)
         rm = rotation_matrix(p)
         c(1:3) = -r
@@ -123,6 +165,11 @@ contains
         real(wp), intent(out) :: block(:, :)
         real(wp) :: r(3), p(4), x(3, size(f%nodes)), rm(3, 3), am(3, 3), e(3)
         integer :: a, j, l, off
+        if (f%modal > 0) then
+            call modal_frame_jacobian(f%rigid_interface, modal_positions(f, q), position_space, &
+                                      block)
+            return
+        end if
         call gather(f, q, r, p, x)
         rm = rotation_matrix(p)
         am = amat(f, x)
@@ -157,6 +204,11 @@ contains
         real(wp) :: r(3), p(4), x(3, size(f%nodes)), rd(3), wb(3), xd(3, size(f%nodes)), &
             rm(3, 3), w(3), wy(3)
         integer :: a
+        if (f%modal > 0) then
+            call modal_frame_curvature(f%rigid_interface, modal_positions(f, q), &
+                                       modal_velocities(f, v), gamma)
+            return
+        end if
         call gather(f, q, r, p, x)
         call gather_rates(f, v, rd, wb, xd)
         rm = rotation_matrix(p)
@@ -437,6 +489,11 @@ contains
         real(wp), intent(out) :: block(:, :)
         type(dual_t) :: r(3), p(4), x(3, size(f%nodes))
         integer :: k, cols(dual_size), nd
+        if (f%modal > 0) then
+            call modal_frame_jacobian_ad(f%rigid_interface, modal_positions(f, q), &
+                                         position_space, block)
+            return
+        end if
         block = 0.0_wp
         do k = 1, passes(f)
             call seed_positions(f, q, k, position_space, r, p, x, cols, nd)
@@ -453,6 +510,11 @@ contains
             c(node_frame_rows)
         real(wp) :: rr(3), pr(4), xr(3, size(f%nodes)), rdr(3), wr(3), xdr(3, size(f%nodes))
         integer :: a, i
+        if (f%modal > 0) then
+            call modal_frame_curvature_ad(f%rigid_interface, modal_positions(f, q), &
+                                          modal_velocities(f, v), gamma)
+            return
+        end if
         call gather(f, q, rr, pr, xr)
         call gather_rates(f, v, rdr, wr, xdr)
         p = pr
@@ -478,6 +540,11 @@ contains
         type(dual_t) :: r(3), p(4), x(3, size(f%nodes)), rd(3), wb(3), xd(3, size(f%nodes))
         real(wp) :: rdr(3), wr(3), xdr(3, size(f%nodes))
         integer :: k, a, cols(dual_size), nd
+        if (f%modal > 0) then
+            call modal_frame_rate_q(f%rigid_interface, modal_positions(f, q), &
+                                    modal_velocities(f, w), block)
+            return
+        end if
         call gather_rates(f, w, rdr, wr, xdr)
         rd = rdr
         wb = wr
@@ -499,6 +566,10 @@ contains
         real(wp), intent(out) :: block(:, :)
         type(dual_t) :: r(3), p(4), x(3, size(f%nodes))
         integer :: k, cols(dual_size), nd
+        if (f%modal > 0) then
+            call modal_frame_gtl_q(f%rigid_interface, modal_positions(f, q), lam, block)
+            return
+        end if
         block = 0.0_wp
         do k = 1, passes(f)
             call seed_positions(f, q, k, .true., r, p, x, cols, nd)
@@ -514,6 +585,11 @@ contains
         type(dual_t) :: r(3), p(4), x(3, size(f%nodes)), rd(3), wb(3), xd(3, size(f%nodes))
         real(wp) :: rr(3), pr(4), xr(3, size(f%nodes)), rdr(3), wr(3), xdr(3, size(f%nodes))
         integer :: k, a, cols(dual_size), nd
+        if (f%modal > 0) then
+            call modal_frame_curvature_qv(f%rigid_interface, modal_positions(f, q), &
+                                          modal_velocities(f, v), gq, gv)
+            return
+        end if
         call gather(f, q, rr, pr, xr)
         call gather_rates(f, v, rdr, wr, xdr)
         gq = 0.0_wp

@@ -71,6 +71,7 @@ module flexmbs_mbs_system
         chain_marker_state_d => chain_marker_state, &
         chain_marker_jacobian_d => chain_marker_jacobian
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, chain_joint_spherical
+    use flexmbs_mbs_modal_body, only: modal_body_t
     use flexmbs_mbs_driver, only: driver_t, driver_values
     use flexmbs_mbs_force_element, only: force_element_t, element_frame_t
     use flexmbs_mbs_jet, only: jet_t
@@ -201,6 +202,14 @@ module flexmbs_mbs_system
         real(wp), allocatable :: chain_vq(:, :), chain_vv(:, :), chain_qq(:, :), &
             chain_unit(:), chain_rate(:)
         type(chain_geometry_t), allocatable :: chain_geom(:)
+        !> modal bodies (floating frame, flexmbs_mbs_modal_body) after the
+        !> flexible bodies: body f's (r, p, η) at q(modal_q(f)+1 ...), its
+        !> velocities at v(modal_v(f)+1 ...); joints reach them through
+        !> interface frames (node_frame_t with `modal` set)
+        type(modal_body_t), allocatable :: modal(:)
+        integer, allocatable :: modal_q(:), modal_v(:)
+        !> scratch blocks of the largest modal body (nv x nq, nv x nv)
+        real(wp), allocatable :: modal_vq(:, :), modal_vv(:, :)
         !> the markers' workspace (marker i, marker j), allocated when built;
         !> the evaluations that fill it take the system intent(inout)
         type(marker_work_t), allocatable :: work(:)
@@ -727,7 +736,8 @@ module flexmbs_mbs_system
         !> `constraint_derivatives` is 'analytic' (default) or 'ad'. On bad input
         !> `status` says which item is wrong and why.
         module function new_mbs_system(bodies, markers, joints, gravity, constraint_derivatives, &
-                                           status, flexible, chains, frames, elements) result(self)
+                                           status, flexible, chains, frames, elements, modal) &
+                                           result(self)
             type(rigid_body_t), intent(in) :: bodies(:)
             type(marker_t), intent(in) :: markers(:)
             type(mbs_joint_t), intent(in) :: joints(:)
@@ -743,6 +753,8 @@ module flexmbs_mbs_system
             type(node_frame_t), intent(in), optional :: frames(:)
             !> force elements between the markers and applied loads on them
             type(force_element_t), intent(in), optional :: elements(:)
+            !> modal bodies (their own gravity), after the flexible bodies
+            type(modal_body_t), intent(in), optional :: modal(:)
             type(mbs_system_t) :: self
         end function new_mbs_system
     end interface

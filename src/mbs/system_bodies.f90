@@ -21,6 +21,13 @@ contains
             qdot(self%flex_q(f) + 1:self%flex_q(f) + self%flex(f)%nq) = &
                 w(self%flex_v(f) + 1:self%flex_v(f) + self%flex(f)%nv)
         end do
+        do f = 1, size(self%modal)
+            associate (iq => self%modal_q(f), iv => self%modal_v(f), nq => self%modal(f)%nq, &
+                       nv => self%modal(f)%nv)
+                call self%modal(f)%kinematics(t, q(iq + 1:iq + nq), w(iv + 1:iv + nv), &
+                                              qdot(iq + 1:iq + nq), status)
+            end associate
+        end do
     end procedure system_kinematics
 
     module procedure system_kinematics_derivative
@@ -32,6 +39,13 @@ contains
             associate (iq => self%chain_q(f), iv => self%chain_v(f), nq => self%chains(f)%nq, &
                        nv => self%chains(f)%nv)
                 call self%chains(f)%kinematics_derivative(t, q(iq + 1:iq + nq), &
+                    w(iv + 1:iv + nv), dq(iq + 1:iq + nq, iq + 1:iq + nq), status)
+            end associate
+        end do
+        do f = 1, size(self%modal)
+            associate (iq => self%modal_q(f), iv => self%modal_v(f), nq => self%modal(f)%nq, &
+                       nv => self%modal(f)%nv)
+                call self%modal(f)%kinematics_derivative(t, q(iq + 1:iq + nq), &
                     w(iv + 1:iv + nv), dq(iq + 1:iq + nq, iq + 1:iq + nq), status)
             end associate
         end do
@@ -53,6 +67,13 @@ contains
                 call self%flex(f)%mass_matrix%to_dense(m(i0 + 1:i0 + n, i0 + 1:i0 + n))
             end associate
         end do
+        do f = 1, size(self%modal)
+            associate (iq => self%modal_q(f), iv => self%modal_v(f), n => self%modal(f)%nv, &
+                       nq => self%modal(f)%nq)
+                call self%modal(f)%mass(t, q(iq + 1:iq + nq), m(iv + 1:iv + n, iv + 1:iv + n), &
+                                        status)
+            end associate
+        end do
     end procedure system_mass
 
     module procedure system_mass_derivative
@@ -62,7 +83,8 @@ contains
     end procedure system_mass_derivative
 
     !> ∂(M w)/∂q added into dq: zero for rigid and flexible bodies (constant
-    !> M), the chains' analytic blocks (differentiated RNEA).
+    !> M), the chains' analytic blocks (differentiated RNEA), the modal
+    !> bodies' (through η).
     module procedure mass_derivative_into
         integer :: f
         do f = 1, size(self%chains)
@@ -71,6 +93,15 @@ contains
                 call self%chains(f)%mass_derivative(t, q(iq + 1:iq + nq), w(iv + 1:iv + n), &
                                                     self%chain_vq(1:n, 1:nq), status)
                 call dq%add_range(iv, iq, self%chain_vq(1:n, 1:nq))
+            end associate
+        end do
+        do f = 1, size(self%modal)
+            associate (iq => self%modal_q(f), iv => self%modal_v(f), n => self%modal(f)%nv, &
+                       nq => self%modal(f)%nq)
+                call self%modal(f)%mass_derivative(t, q(iq + 1:iq + nq), w(iv + 1:iv + n), &
+                                                   self%modal_vq(1:n, 1:nq), status)
+                ! M depends on η alone: its columns (the pattern's)
+                if (nq > 7) call dq%add_range(iv, iq + 7, self%modal_vq(1:n, 8:nq))
             end associate
         end do
     end procedure mass_derivative_into
@@ -91,6 +122,13 @@ contains
             associate (iq => self%flex_q(b), iv => self%flex_v(b), n => self%flex(b)%nv)
                 call self%flex(b)%forces(t, q(iq + 1:iq + n), v(iv + 1:iv + n), &
                                          f(iv + 1:iv + n), status)
+            end associate
+        end do
+        do b = 1, size(self%modal)
+            associate (iq => self%modal_q(b), iv => self%modal_v(b), n => self%modal(b)%nv, &
+                       nq => self%modal(b)%nq)
+                call self%modal(b)%forces(t, q(iq + 1:iq + nq), v(iv + 1:iv + n), &
+                                          f(iv + 1:iv + n), status)
             end associate
         end do
         if (status%ok()) call add_element_forces(self, t, q, v, f, status)
@@ -116,6 +154,13 @@ contains
             associate (iq => self%flex_q(b), iv => self%flex_v(b), n => self%flex(b)%nv)
                 call self%flex(b)%force_derivatives(t, q(iq + 1:iq + n), v(iv + 1:iv + n), &
                     fq(iv + 1:iv + n, iq + 1:iq + n), fv(iv + 1:iv + n, iv + 1:iv + n), status)
+            end associate
+        end do
+        do b = 1, size(self%modal)
+            associate (iq => self%modal_q(b), iv => self%modal_v(b), n => self%modal(b)%nv, &
+                       nq => self%modal(b)%nq)
+                call self%modal(b)%force_derivatives(t, q(iq + 1:iq + nq), v(iv + 1:iv + n), &
+                    fq(iv + 1:iv + n, iq + 1:iq + nq), fv(iv + 1:iv + n, iv + 1:iv + n), status)
             end associate
         end do
         if (size(self%elements) == 0 .or. .not. status%ok()) return
@@ -150,6 +195,10 @@ contains
             call self%chains(f)%normalize(q(self%chain_q(f) + 1:self%chain_q(f) + &
                                             self%chains(f)%nq))
         end do
+        do f = 1, size(self%modal)
+            call self%modal(f)%normalize(q(self%modal_q(f) + 1:self%modal_q(f) + &
+                                           self%modal(f)%nq))
+        end do
     end procedure system_normalize
 
     !> Kinetic plus potential energy; flexible bodies add kinetic and strain
@@ -175,6 +224,13 @@ contains
                                   q(iq + 1:iq + n) - self%flex(b)%free_positions())
             end associate
         end do
+        do b = 1, size(self%modal)
+            associate (iq => self%modal_q(b), iv => self%modal_v(b), n => self%modal(b)%nv, &
+                       nq => self%modal(b)%nq)
+                call self%modal(b)%energy(q(iq + 1:iq + nq), v(iv + 1:iv + n), ek, ep)
+            end associate
+            e = e + ek + ep
+        end do
         e = e + elements_energy(self, q, v)
     end procedure system_energy
 
@@ -193,6 +249,14 @@ contains
         do b = 1, size(self%flex)
             associate (iq => self%flex_q(b), iv => self%flex_v(b), n => self%flex(b)%nv)
                 call self%flex(b)%momenta(q(iq + 1:iq + n), v(iv + 1:iv + n), lf, af)
+            end associate
+            linear = linear + lf
+            angular = angular + af
+        end do
+        do b = 1, size(self%modal)
+            associate (iq => self%modal_q(b), iv => self%modal_v(b), n => self%modal(b)%nv, &
+                       nq => self%modal(b)%nq)
+                call self%modal(b)%momenta(q(iq + 1:iq + nq), v(iv + 1:iv + n), lf, af)
             end associate
             linear = linear + lf
             angular = angular + af

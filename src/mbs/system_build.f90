@@ -35,6 +35,7 @@ contains
         end if
         call place_chains(self, chains, status)
         if (.not. status%ok()) return
+        call place_modal(self, modal)
         call check_markers(self, bodies, markers, status)
         if (.not. status%ok()) return
         call place_joints(self, markers, joints, row0, status)
@@ -269,8 +270,27 @@ contains
         point_or_ground = m%flexible > 0 .or. (m%body == 0 .and. m%chain == 0)
     end function point_or_ground
 
+    !> The modal bodies and the scratch blocks of the largest.
+    subroutine place_modal(self, modal)
+        type(mbs_system_t), intent(inout) :: self
+        type(modal_body_t), intent(in), optional :: modal(:)
+        integer :: f, nq, nv
+        if (present(modal)) then
+            self%modal = modal
+        else
+            allocate (self%modal(0))
+        end if
+        nq = 0
+        nv = 0
+        do f = 1, size(self%modal)
+            nq = max(nq, self%modal(f)%nq)
+            nv = max(nv, self%modal(f)%nv)
+        end do
+        allocate (self%modal_vq(nv, nq), self%modal_vv(nv, nv))
+    end subroutine place_modal
+
     !> Offsets in q and v: the rigid bodies, then the chains, then the
-    !> flexible bodies.
+    !> flexible bodies, then the modal bodies.
     subroutine place_coordinates(self)
         type(mbs_system_t), intent(inout) :: self
         integer :: f
@@ -291,6 +311,13 @@ contains
             self%flex_v(f) = self%nv
             self%nq = self%nq + self%flex(f)%nq
             self%nv = self%nv + self%flex(f)%nv
+        end do
+        allocate (self%modal_q(size(self%modal)), self%modal_v(size(self%modal)))
+        do f = 1, size(self%modal)
+            self%modal_q(f) = self%nq
+            self%modal_v(f) = self%nv
+            self%nq = self%nq + self%modal(f)%nq
+            self%nv = self%nv + self%modal(f)%nv
         end do
     end subroutine place_coordinates
 
@@ -316,11 +343,6 @@ contains
             associate (fr => self%frames(i))
                 f = fr%flexible
                 b = fr%body
-                if (f < 1 .or. f > size(self%flex)) then
-                    call status%set(status_bad_input, where // ': flexible = ' // int_text(f) &
-                        // ': must name a flexible body 1 .. ' // int_text(size(self%flex)))
-                    return
-                end if
                 if (b < 1 .or. b > size(bodies)) then
                     call status%set(status_bad_input, where // ': body = ' // int_text(b) // &
                         ': must name a rigid body 1 .. ' // int_text(size(bodies)))
@@ -329,6 +351,18 @@ contains
                 if (.not. bodies(b)%frame) then
                     call status%set(status_bad_input, where // ': rigid body ' // int_text(b) &
                         // ' is not a frame (massless) body')
+                    return
+                end if
+                if (fr%modal > 0) then
+                    call place_modal_frame(self, fr, where, status)
+                    if (.not. status%ok()) return
+                    fr%row0 = row0
+                    row0 = row0 + node_frame_rows
+                    cycle
+                end if
+                if (f < 1 .or. f > size(self%flex)) then
+                    call status%set(status_bad_input, where // ': flexible = ' // int_text(f) &
+                        // ': must name a flexible body 1 .. ' // int_text(size(self%flex)))
                     return
                 end if
                 associate (fb => self%flex(f))
@@ -367,4 +401,40 @@ contains
             end associate
         end do
     end subroutine place_frames
+
+    !> An interface frame of a modal body (its frame body checked): body and
+    !> interface checked, the interface's offset, translation and rotation
+    !> per unit η copied, the offsets of the frame body and the modal body
+    !> in q and v.
+    subroutine place_modal_frame(self, fr, where, status)
+        type(mbs_system_t), intent(in) :: self
+        type(node_frame_t), intent(inout) :: fr
+        character(len=*), intent(in) :: where
+        type(status_t), intent(inout) :: status
+        integer :: m, j, b
+        m = fr%modal
+        j = fr%modal_interface
+        b = fr%body
+        if (m > size(self%modal)) then
+            call status%set(status_bad_input, where // ': modal = ' // int_text(m) // &
+                ': must name a modal body 1 .. ' // int_text(size(self%modal)))
+            return
+        end if
+        if (j < 1 .or. j > size(self%modal(m)%interface_offset, 2)) then
+            call status%set(status_bad_input, where // ': interface ' // int_text(j) // &
+                ' of modal body ' // int_text(m) // ': it has ' // &
+                int_text(size(self%modal(m)%interface_offset, 2)))
+            return
+        end if
+        fr%flexible = 0
+        allocate (fr%nodes(0), fr%nq(0), fr%nv(0), fr%s(3, 0))
+        fr%weight = 0.0_wp
+        fr%rigid_interface%offset = self%modal(m)%interface_offset(:, j)
+        fr%rigid_interface%translation = self%modal(m)%interface_motion(1:3, :, j)
+        fr%rigid_interface%rotation = self%modal(m)%interface_motion(4:6, :, j)
+        fr%iq = rigid_body_nq * (b - 1)
+        fr%iv = rigid_body_nv * (b - 1)
+        fr%mq = self%modal_q(m)
+        fr%mv = self%modal_v(m)
+    end subroutine place_modal_frame
 end submodule flexmbs_mbs_system_build

@@ -11,6 +11,8 @@ contains
         nb = merge(rigid_body_nq, rigid_body_nv, position_space)
         if (l <= nb) then
             c = merge(fr%iq, fr%iv, position_space) + l
+        else if (fr%modal > 0) then
+            c = merge(fr%mq, fr%mv, position_space) + l - nb
         else
             a = (l - nb - 1) / 3 + 1
             c = merge(fr%nq(a), fr%nv(a), position_space) + l - nb - 3 * (a - 1)

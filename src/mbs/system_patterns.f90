@@ -24,6 +24,9 @@ contains
         do f = 1, size(self%chains)
             n = n + self%chains(f)%nv**2
         end do
+        do f = 1, size(self%modal)
+            n = n + self%modal(f)%nv**2
+        end do
         allocate (rows(n), cols(n))
         n = 0
         do b = 1, size(self%rigid%bodies)
@@ -63,6 +66,16 @@ contains
                 end do
             end associate
         end do
+        ! modal bodies: dense blocks M(η), column by column
+        do f = 1, size(self%modal)
+            do j = 1, self%modal(f)%nv
+                do i = 1, self%modal(f)%nv
+                    n = n + 1
+                    rows(n) = self%modal_v(f) + i
+                    cols(n) = self%modal_v(f) + j
+                end do
+            end do
+        end do
         call pattern%build(self%nv, self%nv, rows, cols, status)
         if (status%ok()) self%mass_csc = pattern
     end procedure system_mass_pattern
@@ -100,6 +113,17 @@ contains
                 do p = 1, mm%nnz
                     n = n + 1
                     values(self%mass_csc%triplet_map(n)) = mm%values(p)
+                end do
+            end associate
+        end do
+        do f = 1, size(self%modal)
+            associate (iq => self%modal_q(f), nc => self%modal(f)%nv, nq => self%modal(f)%nq)
+                call self%modal(f)%mass(t, q(iq + 1:iq + nq), self%modal_vv(1:nc, 1:nc), status)
+                do j = 1, nc
+                    do i = 1, nc
+                        n = n + 1
+                        values(self%mass_csc%triplet_map(n)) = self%modal_vv(i, j)
+                    end do
                 end do
             end associate
         end do
@@ -242,6 +266,24 @@ contains
             call fq%add_pattern(self%flex_v(f), self%flex_q(f), self%flex(f)%stiffness)
             call fv%add_pattern(self%flex_v(f), self%flex_v(f), self%flex(f)%damping)
         end do
+        do f = 1, size(self%modal)
+            ! T: I₃, L(p)ᵀ/2, I; ∂(T w)/∂q: the quaternion's 4 x 4; f and M w
+            ! depend on η alone, f on all of v
+            nq = self%modal(f)%nq
+            nv = self%modal(f)%nv
+            iq = self%modal_q(f)
+            iv = self%modal_v(f)
+            do i = 1, 3
+                call tk%add(iq + i, iv + i)
+            end do
+            call tk%add_range(iq + 3, iv + 3, 4, 3)
+            do i = 1, self%modal(f)%modes
+                call tk%add(iq + 7 + i, iv + 6 + i)
+            end do
+            call tq%add_range(iq + 3, iq + 3, 4, 4)
+            if (self%modal(f)%modes > 0) call fq%add_range(iv, iq + 7, nv, self%modal(f)%modes)
+            call fv%add_range(iv, iv, nv, nv)
+        end do
         do k = 1, size(self%joints)
             associate (jt => self%joints(k))
                 do side = 1, 2
@@ -360,6 +402,18 @@ contains
                     call acc%add(self%flex_q(f) + i, self%flex_v(f) + i, 1.0_wp)
                 end do
             end do
+            do f = 1, size(self%modal)
+                iq = self%modal_q(f)
+                iv = self%modal_v(f)
+                do i = 1, 3
+                    call acc%add(iq + i, iv + i, 1.0_wp)
+                end do
+                l = quat_l(q(iq + 4:iq + 7))
+                call acc%add_range(iq + 3, iv + 3, 0.5_wp * transpose(l))
+                do i = 1, self%modal(f)%modes
+                    call acc%add(iq + 7 + i, iv + 6 + i, 1.0_wp)
+                end do
+            end do
             call acc%get_values(values, 'mbs system: T', status)
         end associate
     end procedure system_kinematics_sparse
@@ -381,6 +435,11 @@ contains
                         w(cv + 1:cv + nv), self%chain_qq(1:nq, 1:nq), status)
                     call acc%add_range(cq, cq, self%chain_qq(1:nq, 1:nq))
                 end associate
+            end do
+            do f = 1, size(self%modal)
+                iq = self%modal_q(f)
+                iv = self%modal_v(f)
+                call acc%add_range(iq + 3, iq + 3, quaternion_rate_derivative(w(iv + 4:iv + 6)))
             end do
             call acc%get_values(values, 'mbs system: d(T w)/dq', status)
         end associate
@@ -415,6 +474,18 @@ contains
                         self%chain_vv(1:nv, 1:nv), status)
                     call aq%add_range(cv, cq, self%chain_vq(1:nv, 1:nq))
                     call av%add_range(cv, cv, self%chain_vv(1:nv, 1:nv))
+                end associate
+            end do
+            do b = 1, size(self%modal)
+                associate (mq => self%modal_q(b), mv => self%modal_v(b), &
+                           nq => self%modal(b)%nq, nv => self%modal(b)%nv, &
+                           nm => self%modal(b)%modes)
+                    call self%modal(b)%force_derivatives(t, q(mq + 1:mq + nq), &
+                        v(mv + 1:mv + nv), self%modal_vq(1:nv, 1:nq), &
+                        self%modal_vv(1:nv, 1:nv), status)
+                    ! ∂f/∂q lies in the η columns (the pattern's)
+                    if (nm > 0) call aq%add_range(mv, mq + 7, self%modal_vq(1:nv, 8:nq))
+                    call av%add_range(mv, mv, self%modal_vv(1:nv, 1:nv))
                 end associate
             end do
             do b = 1, size(self%flex)
