@@ -59,6 +59,7 @@ program flexmbs_tests
     use test_modal_body, only: collect_modal_body
     use test_modal_frame, only: collect_modal_frame
     use test_modal_system, only: collect_modal_system
+    use test_modal_scene, only: collect_modal_scene
     implicit none
     integer :: npassed, nfailed, nargs
     character(len=256) :: filter
@@ -125,6 +126,7 @@ program flexmbs_tests
     call run_suite('modal_body', collect_modal_body(), filter, npassed, nfailed)
     call run_suite('modal_frame', collect_modal_frame(), filter, npassed, nfailed)
     call run_suite('modal_system', collect_modal_system(), filter, npassed, nfailed)
+    call run_suite('modal_scene', collect_modal_scene(), filter, npassed, nfailed)
     call run_suite('node_frame', collect_node_frame(), filter, npassed, nfailed)
     call run_suite('study', collect_study(), filter, npassed, nfailed)
     call run_suite('run', collect_run(), filter, npassed, nfailed)

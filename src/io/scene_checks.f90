@@ -115,6 +115,8 @@ contains
         do b = 1, size(scene%bodies)
             if (len_trim(scene%bodies(b)%mesh_file) > 0) scene%bodies(b)%mesh_file = &
                 relative_to(dir, trim(scene%bodies(b)%mesh_file))
+            if (len_trim(scene%bodies(b)%modes_cache) > 0) scene%bodies(b)%modes_cache = &
+                relative_to(dir, trim(scene%bodies(b)%modes_cache))
         end do
         if (len_trim(scene%table) > 0) scene%table = relative_to(dir, trim(scene%table))
         if (len_trim(scene%vtk) > 0) scene%vtk = relative_to(dir, trim(scene%vtk))

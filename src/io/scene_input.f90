@@ -3,7 +3,8 @@
 !> defaults (flexmbs_io_scene_schema) for the rest.
 module flexmbs_io_scene_input
     use flexmbs_core_kinds, only: wp
-    use flexmbs_io_scene_schema, only: len_title, len_name, len_path, max_fixed_sets
+    use flexmbs_io_scene_schema, only: len_title, len_name, len_path, max_fixed_sets, &
+        max_interfaces
     implicit none
     private
 
@@ -37,6 +38,11 @@ module flexmbs_io_scene_input
         real(wp) :: initial_velocity(3) !! [m/s], rigid field
         real(wp) :: initial_angular_velocity(3) !! [rad/s] about the centroid
         character(len=len_name) :: formulation
+        character(len=len_name) :: model = 'nonlinear' !! 'nonlinear' | 'modal'
+        integer :: modes = 8 !! modal: fixed-interface modes
+        character(len=len_name) :: interfaces(max_interfaces) = '' !! modal: interface sets
+        character(len=len_name) :: modes_method = 'auto' !! modal: 'auto' | 'dense' | 'arpack'
+        character(len=len_path) :: modes_cache = '' !! modal: HDF5 cache of the basis
         integer :: line = 0                               !! where the group starts
     end type body_input_t
 
@@ -220,7 +226,8 @@ module flexmbs_io_scene_input
         procedure :: has_body => scene_has_body
     end type scene_input_t
 
-    public :: setting_given, marker_index, flexible_index, material_of
+    public :: setting_given, marker_index, flexible_index, material_of, nonlinear_body, &
+        modal_body
 
 contains
 
@@ -260,6 +267,37 @@ contains
         end do
         flexible_index = 0
     end function flexible_index
+
+    !> The scene index of the i-th &flexible_body with model = 'nonlinear'
+    !> (the system's flexible body i), 0 if there are fewer.
+    pure integer function nonlinear_body(scene, i) result(ib)
+        type(scene_input_t), intent(in) :: scene
+        integer, intent(in) :: i
+        ib = nth_body(scene, i, .false.)
+    end function nonlinear_body
+
+    !> The scene index of the j-th &flexible_body with model = 'modal' (the
+    !> system's modal body j), 0 if there are fewer.
+    pure integer function modal_body(scene, j) result(ib)
+        type(scene_input_t), intent(in) :: scene
+        integer, intent(in) :: j
+        ib = nth_body(scene, j, .true.)
+    end function modal_body
+
+    pure integer function nth_body(scene, n, modal) result(ib)
+        type(scene_input_t), intent(in) :: scene
+        integer, intent(in) :: n
+        logical, intent(in) :: modal
+        integer :: k
+        k = 0
+        if (allocated(scene%bodies)) then
+            do ib = 1, size(scene%bodies)
+                if ((scene%bodies(ib)%model == 'modal') .eqv. modal) k = k + 1
+                if (k == n) return
+            end do
+        end if
+        ib = 0
+    end function nth_body
 
     !> Whether &material `m` belongs to the &flexible_body numbered `body`
     !> (a material naming no body belongs to the only one).

@@ -177,6 +177,13 @@ contains
                 call get(ei, g, 'initial_angular_velocity', b%initial_angular_velocity, i)
                 call get(ei, g, 'formulation', b%formulation, i)
                 b%formulation = lower(b%formulation)
+                call get(ei, g, 'model', b%model, i)
+                b%model = lower(b%model)
+                call get(ei, g, 'modes', b%modes, i)
+                call get(ei, g, 'interfaces', b%interfaces, i)
+                call get(ei, g, 'modes_method', b%modes_method, i)
+                b%modes_method = lower(b%modes_method)
+                call get(ei, g, 'modes_cache', b%modes_cache, i)
             end associate
         end do
         call instance_ranges(e, 'material', size(scene%materials), ranges)

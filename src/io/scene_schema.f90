@@ -17,6 +17,8 @@ module flexmbs_io_scene_schema
     integer, parameter, public :: max_study_solvers = 4, max_study_tolerances = 16
     !> At most this many node-set names in `&flexible_body fixed`.
     integer, parameter, public :: max_fixed_sets = 6
+    !> At most this many node-set names in `&flexible_body interfaces`.
+    integer, parameter, public :: max_interfaces = 8
     !> Smallest tolerance a scene or study may ask for: below it rounding
     !> errors of double precision dominate every solver's error estimate.
     real(wp), parameter, public :: min_tolerance = 1.0e-14_wp
@@ -164,6 +166,21 @@ module flexmbs_io_scene_schema
             default='0, 0, 0', unit='rad/s', doc='initial angular velocity about the centroid'), &
         var_spec_t('flexible_body', 'formulation', kind_string, default='index2', &
             choices='index3|index2|index1|ggl', doc='DAE formulation (problem = flexible_body)'), &
+        var_spec_t('flexible_body', 'model', kind_string, default='nonlinear', &
+            choices='nonlinear|modal', doc='nonlinear finite elements, or modal: a floating &
+            &frame with Craig-Bampton modes of the same mesh (problem = multibody)'), &
+        var_spec_t('flexible_body', 'modes', kind_integer, default='8', rule='[0,inf)', &
+            doc='modal: fixed-interface normal modes k (6 static modes per interface come &
+            &with them)'), &
+        var_spec_t('flexible_body', 'interfaces', kind_string, max_interfaces, &
+            doc='modal: the node sets joints and markers use, each moving rigidly (default: &
+            &the node sets of its markers)'), &
+        var_spec_t('flexible_body', 'modes_method', kind_string, default='auto', &
+            choices='auto|dense|arpack', doc='modal: eigen-solver of the fixed-interface &
+            &modes (auto: dense up to 1200 interior coordinates)'), &
+        var_spec_t('flexible_body', 'modes_cache', kind_string, &
+            doc='modal: HDF5 file keeping the basis, reused when mesh, materials, interfaces &
+            &and modes match (default: none)'), &
         var_spec_t('material', 'name', kind_string, doc='for messages (default: material N)'), &
         var_spec_t('material', 'youngs_modulus', kind_real, rule='positive', unit='Pa', &
             doc='Young''s modulus E, required'), &

@@ -41,6 +41,7 @@ module flexmbs_io_vtk_sink
     use flexmbs_io_vtu_file, only: vtu_file_t, open_vtu, comment_opening, comment_closing
     use flexmbs_dae_sink, only: sink_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
+    use flexmbs_mbs_modal_body, only: modal_body_t
     use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     use flexmbs_mbs_system, only: mbs_system_t
@@ -51,11 +52,14 @@ module flexmbs_io_vtk_sink
     implicit none
     private
 
-    !> A flexible body to draw: its free q and v after y(oq) and y(ov).
+    !> A flexible body to draw: its free q and v after y(oq) and y(ov); or
+    !> a modal body (`modal`; body => its FE body), its (r, p, η) after
+    !> y(oq) and (ṙ, ω′, η̇) after y(ov), its nodes reconstructed.
     type, public :: vtk_flexible_t
         type(flexible_body_t), pointer :: body => null()
         integer :: oq = 0, ov = 0
         character(len=32) :: name = ''
+        type(modal_body_t), pointer :: modal => null()
     end type vtk_flexible_t
 
     type, extends(sink_t), public :: vtk_sink_t
@@ -247,15 +251,21 @@ contains
                 nn = size(mesh%connectivity, 1)
                 x(:, n + 1:n + m) = mesh%x
                 v(:, n + 1:n + m) = 0.0_wp
-                do i = 1, m
-                    do j = 1, 3
-                        if (body%dof(j, i) == 0) cycle
-                        x(j, n + i) = y(oq + body%dof(j, i))
-                        v(j, n + i) = y(ov + body%dof(j, i))
+                if (associated(flexible%modal)) then
+                    call modal_fields(flexible%modal, y(oq + 1:oq + flexible%modal%nq), &
+                        y(ov + 1:ov + flexible%modal%nv), x(:, n + 1:n + m), v(:, n + 1:n + m), &
+                        stress_status)
+                else
+                    do i = 1, m
+                        do j = 1, 3
+                            if (body%dof(j, i) == 0) cycle
+                            x(j, n + i) = y(oq + body%dof(j, i))
+                            v(j, n + i) = y(ov + body%dof(j, i))
+                        end do
                     end do
-                end do
-                call body%element_stress(y(oq + 1:oq + body%nq), y(ov + 1:ov + body%nv), &
-                    sigma(:, ne + 1:ne + me), mises(ne + 1:ne + me), stress_status)
+                    call body%element_stress(y(oq + 1:oq + body%nq), y(ov + 1:ov + body%nv), &
+                        sigma(:, ne + 1:ne + me), mises(ne + 1:ne + me), stress_status)
+                end if
                 if (.not. stress_status%ok()) then
                     sigma(:, ne + 1:ne + me) = 0.0_wp
                     mises(ne + 1:ne + me) = 0.0_wp
@@ -274,6 +284,24 @@ contains
                 ne = ne + me
             end associate
         end subroutine body_fields
+
+        !> A modal body's nodes and element stresses (into sigma, mises at
+        !> ne + 1 ...) from its coordinates.
+        subroutine modal_fields(modal, qm, vm, xb, vb, stress_status)
+            type(modal_body_t), intent(inout) :: modal
+            real(wp), intent(in) :: qm(:), vm(:)
+            real(wp), intent(out) :: xb(:, :), vb(:, :)
+            type(status_t), intent(out) :: stress_status
+            real(wp) :: xf(size(xb)), vf(size(vb))
+            integer :: me
+            me = modal%fe%mesh%element_count()
+            call modal%node_positions(qm, xf)
+            call modal%node_velocities(qm, vm, vf)
+            xb = reshape(xf, shape(xb))
+            vb = reshape(vf, shape(vb))
+            call modal%fe%element_stress(xf, vf, sigma(:, ne + 1:ne + me), &
+                                         mises(ne + 1:ne + me), stress_status)
+        end subroutine modal_fields
 
         !> The bodies' reference positions, as x.
         function reference() result(x0)

@@ -38,6 +38,7 @@ module flexmbs_mbs_modal_body
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_fe_modal_basis, only: modal_basis_t
     use flexmbs_fe_modal_invariants, only: modal_invariants_t
+    use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_mbs_rotation, only: skew, cross, quat_l, rotation_matrix, quat_normalize
     use flexmbs_mbs_rigid_body, only: quaternion_rate_derivative, gyroscopic_derivative
     implicit none
@@ -63,6 +64,12 @@ module flexmbs_mbs_modal_body
         !> translation (1:3) and rotation (4:6) per unit η (6, n, j)
         real(wp), allocatable :: interface_offset(:, :)
         real(wp), allocatable :: interface_motion(:, :, :)
+        !> for output: the mesh's reference positions from the centre of mass
+        !> (3, nodes), the shapes (3 nodes, n), and the FE body of the same
+        !> mesh and materials (element stresses of the reconstructed field)
+        real(wp), allocatable :: reference(:, :), shapes(:, :)
+        real(wp) :: centre(3) = 0.0_wp
+        type(flexible_body_t), allocatable :: fe
         ! workspace: A_l (3, 3, n), filled by moments()
         real(wp), allocatable :: a(:, :, :)
     contains
@@ -80,17 +87,22 @@ module flexmbs_mbs_modal_body
         procedure :: total_energy => modal_total_energy
         procedure :: momenta => modal_momenta
         procedure :: interface_pose => modal_interface_pose
+        procedure :: node_positions => modal_node_positions
+        procedure :: node_velocities => modal_node_velocities
     end type modal_body_t
 
 contains
 
-    !> The body of `basis` and its invariants `inv` (of the same shapes).
-    subroutine new_modal_body(self, basis, inv, status, gravity)
+    !> The body of `basis` and its invariants `inv` (of the same shapes);
+    !> with `fe`, the FE body they were computed from, the body can also
+    !> give its nodes' positions and velocities and its elements' stresses.
+    subroutine new_modal_body(self, basis, inv, status, gravity, fe)
         type(modal_body_t), intent(out) :: self
         type(modal_basis_t), intent(in) :: basis
         type(modal_invariants_t), intent(in) :: inv
         type(status_t), intent(out) :: status
         real(wp), intent(in), optional :: gravity(3)
+        type(flexible_body_t), intent(in), optional :: fe
         integer :: n, k, l
         n = basis%count
         if (size(inv%coupling, 3) /= n .or. .not. inv%mass > 0.0_wp) then
@@ -119,7 +131,48 @@ contains
         self%interface_offset = basis%interface_centre - spread(inv%centre, 2, &
             size(basis%interface_centre, 2))
         self%interface_motion = basis%interface_motion
+        self%centre = inv%centre
+        if (present(fe)) then
+            self%fe = fe
+            self%reference = fe%mesh%x - spread(inv%centre, 2, fe%mesh%node_count())
+            self%shapes = basis%shapes
+        end if
     end subroutine new_modal_body
+
+    !> Every node's world position r + A (X − c + Φ η), node by node x y z.
+    pure subroutine modal_node_positions(self, q, x)
+        class(modal_body_t), intent(in) :: self
+        real(wp), intent(in) :: q(:)
+        real(wp), intent(out) :: x(:)
+        real(wp) :: a(3, 3), s(size(x))
+        integer :: i
+        a = rotation_matrix(q(4:7))
+        s = reshape(self%reference, [size(x)])
+        if (self%modes > 0) s = s + matmul(self%shapes, q(8:))
+        do i = 1, size(x) / 3
+            x(3 * i - 2:3 * i) = q(1:3) + matmul(a, s(3 * i - 2:3 * i))
+        end do
+    end subroutine modal_node_positions
+
+    !> Every node's world velocity ṙ + A (ω′ × s + Φ η̇), s = X − c + Φ η.
+    pure subroutine modal_node_velocities(self, q, v, xd)
+        class(modal_body_t), intent(in) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(out) :: xd(:)
+        real(wp) :: a(3, 3), s(size(xd)), sd(size(xd))
+        integer :: i
+        a = rotation_matrix(q(4:7))
+        s = reshape(self%reference, [size(xd)])
+        sd = 0.0_wp
+        if (self%modes > 0) then
+            s = s + matmul(self%shapes, q(8:))
+            sd = matmul(self%shapes, v(7:))
+        end if
+        do i = 1, size(xd) / 3
+            xd(3 * i - 2:3 * i) = v(1:3) + matmul(a, cross(v(4:6), s(3 * i - 2:3 * i)) + &
+                                                  sd(3 * i - 2:3 * i))
+        end do
+    end subroutine modal_node_velocities
 
     !> (a₂₃ − a₃₂, a₃₁ − a₁₃, a₁₂ − a₂₁): ∫ρ a × b for a = ∫ρ a bᵀ.
     pure function axial(a) result(w)

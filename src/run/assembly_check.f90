@@ -11,7 +11,7 @@ module flexmbs_run_assembly_check
     use flexmbs_core_text, only: real_text
     use flexmbs_mbs_system, only: mbs_system_t
     use flexmbs_mbs_rigid_body, only: rigid_body_nq
-    use flexmbs_io_scene_input, only: scene_input_t
+    use flexmbs_io_scene_input, only: scene_input_t, nonlinear_body
     use flexmbs_run_chain_builder, only: link_names
     implicit none
     private
@@ -61,7 +61,8 @@ contains
         do i = 1, size(sys%flex)
             associate (f => sys%flex_q(i), n => sys%flex(i)%nq)
                 move = maxval([0.0_wp, abs(q(f + 1:f + n) - q0(f + 1:f + n))])
-                call note('flexible body ''' // trim(scene%bodies(i)%name) // '''', &
+                call note('flexible body ''' // trim(scene%bodies(nonlinear_body(scene, i))%name) &
+                          // '''', &
                           real_text(move) // ' m (largest node move)', move, 0)
             end associate
         end do

@@ -3,11 +3,18 @@
 !> element type, node and element sets) and per record every node's
 !> displacement and velocity, every element's mean Cauchy and von Mises
 !> stress and the body's strain and kinetic energy (docs/output.md).
+!>
+!> A modal body writes the same datasets, reconstructed from its frame and
+!> modal coordinates (x = r + A (X − c + Φ η); the stresses are its FE
+!> body's element stresses of that field), and adds `modal_coordinates`
+!> per record and its `frequencies`, so that a reduced and a nonlinear run
+!> of one scene are read and drawn alike.
 module flexmbs_run_flexible_output
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_fe_flexible_body, only: flexible_body_t
+    use flexmbs_mbs_modal_body, only: modal_body_t
     use flexmbs_io_record_values, only: record_values_t
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_hdf5_text, only: path_name
@@ -21,6 +28,9 @@ module flexmbs_run_flexible_output
         type(flexible_body_t), pointer :: body => null()
         integer :: oq = 0, ov = 0
         logical :: velocity = .false.
+        !> a modal body's (body => its FE body): nodes reconstructed into x
+        type(modal_body_t), pointer :: modal => null()
+        real(wp), allocatable :: x(:)
     contains
         procedure :: evaluate => node_evaluate
     end type node_values_t
@@ -34,6 +44,8 @@ module flexmbs_run_flexible_output
         integer :: oq = 0, ov = 0
         logical :: von_mises = .false.
         real(wp), allocatable :: sigma(:, :), mises(:)
+        type(modal_body_t), pointer :: modal => null()
+        real(wp), allocatable :: x(:), xd(:)
     contains
         procedure :: evaluate => stress_evaluate
     end type stress_values_t
@@ -43,11 +55,19 @@ module flexmbs_run_flexible_output
     type, extends(record_values_t) :: energy_values_t
         type(flexible_body_t), pointer :: body => null()
         integer :: oq = 0, ov = 0
+        type(modal_body_t), pointer :: modal => null()
     contains
         procedure :: evaluate => energy_evaluate
     end type energy_values_t
 
-    public :: add_flexible, xdmf_body
+    !> A modal body's η per record.
+    type, extends(record_values_t) :: modal_values_t
+        integer :: oq = 0, n = 0
+    contains
+        procedure :: evaluate => modal_evaluate
+    end type modal_values_t
+
+    public :: add_flexible, add_modal, xdmf_body
 
 contains
 
@@ -65,9 +85,63 @@ contains
         type(stress_values_t) :: stress
         type(energy_values_t) :: energy
         character(len=:), allocatable :: base
-        integer :: k, nn, ne, stat
         base = 'flexible/' // path_name(name) // '/'
-        nn = body%mesh%node_count()
+        call write_mesh(h5, body, base, status)
+        if (.not. status%ok()) return
+        nodes%body => body
+        stress%body => body
+        energy%body => body
+        call add_body_series(h5, base, oq, ov, nodes, stress, energy, status)
+    end subroutine add_flexible
+
+    !> /flexible/<name>/ of a modal body: its FE body's mesh, the
+    !> reconstructed series of add_flexible, `modal_coordinates` (η per
+    !> record) and `frequencies` (its ω, rad/s). Its (r, p, η) start after
+    !> y(oq), (ṙ, ω′, η̇) after y(ov).
+    subroutine add_modal(h5, body, name, oq, ov, status)
+        type(hdf5_sink_t), intent(inout) :: h5
+        type(modal_body_t), intent(in), target :: body
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: oq, ov
+        type(status_t), intent(out) :: status
+        type(node_values_t) :: nodes
+        type(stress_values_t) :: stress
+        type(energy_values_t) :: energy
+        type(modal_values_t) :: eta
+        character(len=:), allocatable :: base
+        integer :: n3
+        base = 'flexible/' // path_name(name) // '/'
+        call write_mesh(h5, body%fe, base, status)
+        if (status%ok()) call h5%write_vector(base // 'frequencies', sqrt(body%stiffness), &
+                                              status)
+        if (status%ok()) call h5%annotate(base // 'frequencies', 'unit', 'rad/s', status)
+        if (status%ok()) call h5%annotate(base // 'frequencies', 'description', 'the modal &
+            &body''s own frequencies (its reduced K and M), one per modal coordinate', status)
+        if (.not. status%ok()) return
+        n3 = 3 * body%fe%mesh%node_count()
+        nodes%body => body%fe
+        nodes%modal => body
+        allocate (nodes%x(n3), stress%x(n3), stress%xd(n3))
+        stress%body => body%fe
+        stress%modal => body
+        energy%body => body%fe
+        energy%modal => body
+        call add_body_series(h5, base, oq, ov, nodes, stress, energy, status)
+        if (.not. status%ok() .or. body%modes == 0) return
+        eta%oq = oq
+        eta%n = body%modes
+        call h5%add_series(base // 'modal_coordinates', body%modes, '1', eta, status, &
+            'eta of every mode (shapes M-orthonormal: eta in sqrt(kg) m)')
+    end subroutine add_modal
+
+    !> The mesh of `body` under `base`: reference nodes, connectivity and
+    !> element type, node and element sets.
+    subroutine write_mesh(h5, body, base, status)
+        type(hdf5_sink_t), intent(inout) :: h5
+        type(flexible_body_t), intent(in) :: body
+        character(len=*), intent(in) :: base
+        type(status_t), intent(out) :: status
+        integer :: k
         call h5%write_matrix(base // 'reference_nodes', body%mesh%x, status)
         if (status%ok()) call h5%annotate(base // 'reference_nodes', 'unit', 'm', status)
         if (status%ok()) call h5%write_integers(base // 'connectivity', &
@@ -94,8 +168,19 @@ contains
                 end associate
             end do
         end if
-        if (.not. status%ok()) return
-        nodes%body => body
+    end subroutine write_mesh
+
+    !> The per-record series of a body (its evaluators' bodies set).
+    subroutine add_body_series(h5, base, oq, ov, nodes, stress, energy, status)
+        type(hdf5_sink_t), intent(inout) :: h5
+        character(len=*), intent(in) :: base
+        integer, intent(in) :: oq, ov
+        type(node_values_t), intent(inout) :: nodes
+        type(stress_values_t), intent(inout) :: stress
+        type(energy_values_t), intent(inout) :: energy
+        type(status_t), intent(out) :: status
+        integer :: nn, ne, stat
+        nn = nodes%body%mesh%node_count()
         nodes%oq = oq
         nodes%ov = ov
         nodes%velocity = .false.
@@ -106,14 +191,13 @@ contains
         call h5%add_series(base // 'velocity', 3, 'm/s', nodes, status, 'of every node', &
             columns=nn)
         if (.not. status%ok()) return
-        ne = body%mesh%element_count()
+        ne = nodes%body%mesh%element_count()
         allocate (stress%sigma(6, ne), stress%mises(ne), stat=stat)
         if (stat /= 0) then
             call out_of_memory(status, 'the elements'' stress for the HDF5 file', &
                 7_i8 * ne, 8)
             return
         end if
-        stress%body => body
         stress%oq = oq
         stress%ov = ov
         call h5%add_series(base // 'stress', 6, 'Pa', stress, status, 'Cauchy stress of &
@@ -124,12 +208,11 @@ contains
         call h5%add_series(base // 'von_mises', ne, 'Pa', stress, status, 'von Mises &
             &stress of every element, from its mean Cauchy stress')
         if (.not. status%ok()) return
-        energy%body => body
         energy%oq = oq
         energy%ov = ov
         call h5%add_series(base // 'energy', 2, 'J', energy, status, 'strain and kinetic &
             &energy of the body')
-    end subroutine add_flexible
+    end subroutine add_body_series
 
     subroutine stress_evaluate(self, t, y, values, status)
         class(stress_values_t), intent(inout) :: self
@@ -137,11 +220,20 @@ contains
         real(wp), intent(out) :: values(:)
         type(status_t), intent(inout) :: status
         integer :: el
-        associate (body => self%body)
-            call body%element_stress(y(self%oq + 1:self%oq + body%nq), &
-                                     y(self%ov + 1:self%ov + body%nv), self%sigma, &
-                                     self%mises, status)
-        end associate
+        if (associated(self%modal)) then
+            associate (m => self%modal)
+                call m%node_positions(y(self%oq + 1:self%oq + m%nq), self%x)
+                call m%node_velocities(y(self%oq + 1:self%oq + m%nq), &
+                                       y(self%ov + 1:self%ov + m%nv), self%xd)
+                call self%body%element_stress(self%x, self%xd, self%sigma, self%mises, status)
+            end associate
+        else
+            associate (body => self%body)
+                call body%element_stress(y(self%oq + 1:self%oq + body%nq), &
+                                         y(self%ov + 1:self%ov + body%nv), self%sigma, &
+                                         self%mises, status)
+            end associate
+        end if
         if (self%von_mises) then
             values = self%mises
         else
@@ -157,6 +249,18 @@ contains
         real(wp), intent(out) :: values(:)
         type(status_t), intent(inout) :: status
         integer :: i, j, d
+        if (associated(self%modal)) then
+            associate (m => self%modal)
+                if (self%velocity) then
+                    call m%node_velocities(y(self%oq + 1:self%oq + m%nq), &
+                                           y(self%ov + 1:self%ov + m%nv), values)
+                else
+                    call m%node_positions(y(self%oq + 1:self%oq + m%nq), self%x)
+                    values = self%x - reshape(self%body%mesh%x, [size(values)])
+                end if
+            end associate
+            return
+        end if
         associate (dof => self%body%dof)
             do i = 1, size(dof, 2)
                 do j = 1, 3
@@ -178,11 +282,30 @@ contains
         real(wp), intent(in) :: t, y(:)
         real(wp), intent(out) :: values(:)
         type(status_t), intent(inout) :: status
+        real(wp) :: kinetic, potential
+        if (associated(self%modal)) then
+            associate (m => self%modal)
+                ! the energy of the reduced model: ½ Σ ω² η² and ½ vᵀ M v
+                call m%energy(y(self%oq + 1:self%oq + m%nq), y(self%ov + 1:self%ov + m%nv), &
+                              kinetic, potential)
+                values(1) = 0.5_wp * dot_product(m%stiffness, y(self%oq + 8:self%oq + m%nq)**2)
+                values(2) = kinetic
+            end associate
+            return
+        end if
         associate (body => self%body)
             values(1) = body%strain_energy(y(self%oq + 1:self%oq + body%nq), status)
             values(2) = body%kinetic_energy(y(self%ov + 1:self%ov + body%nv))
         end associate
     end subroutine energy_evaluate
+
+    subroutine modal_evaluate(self, t, y, values, status)
+        class(modal_values_t), intent(inout) :: self
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: values(:)
+        type(status_t), intent(inout) :: status
+        values = y(self%oq + 8:self%oq + 7 + self%n)
+    end subroutine modal_evaluate
 
     !> The body as add_flexible stores it, for the XDMF file beside the
     !> HDF5 result (io/xdmf_file).

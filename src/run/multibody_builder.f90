@@ -31,6 +31,8 @@ module flexmbs_run_multibody_builder
     use flexmbs_io_namelist, only: scene_input_t
     use flexmbs_io_scene_input, only: marker_index, flexible_index
     use flexmbs_run_body_builder, only: build_flexible_body
+    use flexmbs_run_modal_builder, only: build_modal_body, modal_interfaces, interface_number
+    use flexmbs_mbs_modal_body, only: modal_body_t
     use flexmbs_run_chain_builder, only: build_rigid_chains, chain_link
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
@@ -61,8 +63,10 @@ contains
         type(flexible_body_t), allocatable :: flex(:)
         type(rigid_chain_t), allocatable :: chains(:)
         type(node_frame_t), allocatable :: frames(:)
+        type(modal_body_t), allocatable :: modal(:)
         real(wp), allocatable :: qf(:), vf(:), qc(:), vc(:)
-        integer, allocatable :: nodes(:), frame_of(:), flex_v0(:)
+        integer, allocatable :: nodes(:), frame_of(:), flex_v0(:), flex_of(:), modal_of(:), &
+            modal_q0(:)
         logical :: centroid(size(scene%markers))
         character(len=:), allocatable :: labels(:), frame_labels(:), defect, names(:)
         real(wp) :: p(4), r(3, 3), anchor(3), origin(3)
@@ -111,12 +115,25 @@ contains
         if (.not. status%ok()) return
         q0 = [q0, qc]
         v0 = [v0, vc]
-        ! the flexible bodies, after them (body fb's velocities after v0(flex_v0(fb)))
-        allocate (flex(size(scene%bodies)), flex_v0(size(scene%bodies)))
-        do fb = 1, size(flex)
-            call build_flexible_body(scene, fb, flex(fb), qf, vf, status)
+        ! the flexible bodies, after them (body fb's velocities after
+        ! v0(flex_v0(fb))), then the modal bodies (their q after q0(modal_q0))
+        call number_bodies(scene, flex_of, modal_of)
+        allocate (flex(count(flex_of > 0)), flex_v0(size(scene%bodies)), &
+                  modal(count(modal_of > 0)), modal_q0(size(scene%bodies)))
+        do fb = 1, size(scene%bodies)
+            if (flex_of(fb) == 0) cycle
+            call build_flexible_body(scene, fb, flex(flex_of(fb)), qf, vf, status)
             if (.not. status%ok()) return
             flex_v0(fb) = size(v0)
+            q0 = [q0, qf]
+            v0 = [v0, vf]
+        end do
+        do fb = 1, size(scene%bodies)
+            if (modal_of(fb) == 0) cycle
+            call build_modal_body(scene, fb, modal_interfaces(scene, fb), &
+                                  modal(modal_of(fb)), qf, vf, status)
+            if (.not. status%ok()) return
+            modal_q0(fb) = size(q0)
             q0 = [q0, qf]
             v0 = [v0, vf]
         end do
@@ -129,17 +146,22 @@ contains
             k = frame_of(i)
             if (k == 0) cycle
             fb = flexible_index(scene, scene%markers(i)%body)
-            call flex(fb)%mesh%node_set(trim(scene%markers(i)%node_set), nodes, status)
+            b = size(scene%rigid_bodies) + k
+            if (modal_of(fb) > 0) then
+                call modal_frame(i, k, b)
+                if (.not. status%ok()) return
+                cycle
+            end if
+            call flex(flex_of(fb))%mesh%node_set(trim(scene%markers(i)%node_set), nodes, status)
             if (.not. status%ok()) then
                 call status%set(status_bad_input, scene%path // ': &marker ''' // &
                     trim(scene%markers(i)%name) // ''': ' // status%text())
                 return
             end if
-            b = size(scene%rigid_bodies) + k
             bodies(b)%frame = .true.
-            frames(k) = node_frame_t(flexible=fb, body=b, nodes=nodes)
+            frames(k) = node_frame_t(flexible=flex_of(fb), body=b, nodes=nodes)
             frame_labels(k) = '&marker ''' // trim(scene%markers(i)%name) // ''' (node frame)'
-            anchor = sum(flex(fb)%mesh%x(:, nodes), dim=2) / size(nodes)
+            anchor = sum(flex(flex_of(fb))%mesh%x(:, nodes), dim=2) / size(nodes)
             q0(7 * b - 6:7 * b) = [anchor, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
             v0(6 * b - 5:6 * b) = [mean_velocity(fb, nodes), &
                                    scene%bodies(fb)%initial_angular_velocity]
@@ -165,7 +187,7 @@ contains
                     cycle
                 end if
                 if (centroid(i)) then
-                    fb = flexible_index(scene, m%body)
+                    fb = flex_of(flexible_index(scene, m%body))
                     call flex(fb)%mesh%node_set(trim(m%node_set), nodes, status)
                     if (.not. status%ok()) then
                         call status%set(status_bad_input, scene%path // ': &marker ''' // &
@@ -202,7 +224,14 @@ contains
                 ! link's) frame
                 mi = marker_index(scene, jt%marker_i)
                 associate (mj => scene%markers(marker_index(scene, jt%marker_j)))
-                    fb = flexible_index(scene, mj%body)
+                    fb = flex_of(flexible_index(scene, mj%body))
+                    if (fb == 0) then
+                        call status%set(status_bad_input, scene%path // ': &joint ''' // &
+                            trim(jt%name) // ''': type = ''attach'' ties nodes of a nonlinear &
+                            &body; on the modal body ''' // trim(mj%body) // ''' use a &
+                            &''fixed'' joint on its interface')
+                        return
+                    end if
                     call flex(fb)%mesh%node_set(trim(mj%node_set), nodes, status)
                 end associate
                 if (.not. status%ok()) then
@@ -245,7 +274,8 @@ contains
         end do
         sys = new_mbs_system(bodies, markers, joints, gravity=scene%multibody%gravity, &
             constraint_derivatives=trim(scene%multibody%constraint_derivatives), status=status, &
-            flexible=flex, chains=chains, frames=frames, elements=scene_forces(scene))
+            flexible=flex, chains=chains, frames=frames, elements=scene_forces(scene), &
+            modal=modal)
         if (.not. status%ok()) then
             call status%set(status_bad_input, scene%path // ': ' // status%text())
             return
@@ -280,6 +310,39 @@ contains
             frame_of(k) = maxval(frame_of) + 1
         end subroutine use_frame
 
+        !> The interface frame of node-set marker i on a modal body: frame k,
+        !> rigid body b, at the interface's centroid with the mesh's axes,
+        !> moving with the body's initial rigid field.
+        subroutine modal_frame(i, k, b)
+            integer, intent(in) :: i, k, b
+            integer :: j, mb, fm
+            real(wp) :: d(3), c(3)
+            fm = flexible_index(scene, scene%markers(i)%body)
+            mb = modal_of(fm)
+            j = interface_number(scene, fm, scene%markers(i)%node_set)
+            if (j == 0) then
+                call status%set(status_bad_input, scene%path // ': &marker ''' // &
+                    trim(scene%markers(i)%name) // ''': node_set = ''' // &
+                    trim(scene%markers(i)%node_set) // ''': not an interface of the modal &
+                    &body ''' // trim(scene%bodies(fm)%name) // ''' (line ' // &
+                    int_text(scene%markers(i)%line) // ')')
+                return
+            end if
+            bodies(b)%frame = .true.
+            frames(k) = node_frame_t(body=b, modal=mb, modal_interface=j)
+            frame_labels(k) = '&marker ''' // trim(scene%markers(i)%name) // &
+                ''' (interface frame)'
+            d = modal(mb)%interface_offset(:, j)
+            c = q0(modal_q0(fm) + 1:modal_q0(fm) + 3)
+            q0(7 * b - 6:7 * b) = [c + d, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+            associate (bd => scene%bodies(fm))
+                ! the rigid field v₀ + ω × (X − X̄) at the interface's centroid
+                v0(6 * b - 5:6 * b) = [bd%initial_velocity + cross(bd%initial_angular_velocity, &
+                    c + d - sum(modal(mb)%fe%mesh%x, dim=2) / modal(mb)%fe%mesh%node_count()), &
+                    bd%initial_angular_velocity]
+            end associate
+        end subroutine modal_frame
+
         !> Mean initial velocity of nodes of flexible body fb (fixed nodes at rest).
         function mean_velocity(fb, set) result(u)
             integer, intent(in) :: fb, set(:)
@@ -288,7 +351,7 @@ contains
             u = 0.0_wp
             do a = 1, size(set)
                 do l = 1, 3
-                    associate (d => flex(fb)%dof(l, set(a)))
+                    associate (d => flex(flex_of(fb))%dof(l, set(a)))
                         if (d > 0) u(l) = u(l) + v0(flex_v0(fb) + d)
                     end associate
                 end do
@@ -296,6 +359,22 @@ contains
             u = u / size(set)
         end function mean_velocity
     end subroutine build_multibody
+
+    !> Each &flexible_body's number among the nonlinear ones (flex_of) or
+    !> the modal ones (modal_of), 0 in the other.
+    pure subroutine number_bodies(scene, flex_of, modal_of)
+        type(scene_input_t), intent(in) :: scene
+        integer, allocatable, intent(out) :: flex_of(:), modal_of(:)
+        integer :: fb
+        allocate (flex_of(size(scene%bodies)), modal_of(size(scene%bodies)), source=0)
+        do fb = 1, size(scene%bodies)
+            if (scene%bodies(fb)%model == 'modal') then
+                modal_of(fb) = maxval([0, modal_of]) + 1
+            else
+                flex_of(fb) = maxval([0, flex_of]) + 1
+            end if
+        end do
+    end subroutine number_bodies
 
     !> The node-set markers that need no node frame: without a `position`
     !> (at the set's centroid) and used by spherical joints only (besides
@@ -312,6 +391,11 @@ contains
         do k = 1, size(scene%markers)
             centroid(k) = len_trim(scene%markers(k)%node_set) > 0 .and. &
                 .not. scene%markers(k)%position_given
+            ! a modal body's interfaces are reached through interface frames
+            i = flexible_index(scene, scene%markers(k)%body)
+            if (i > 0) then
+                if (scene%bodies(i)%model == 'modal') centroid(k) = .false.
+            end if
         end do
         used = .false.
         do i = 1, size(scene%drivers)

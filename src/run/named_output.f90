@@ -53,7 +53,8 @@ module flexmbs_run_named_output
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_run_plan, only: run_plan_t
     use flexmbs_run_force_output, only: add_force_output
-    use flexmbs_run_flexible_output, only: add_flexible
+    use flexmbs_run_flexible_output, only: add_flexible, add_modal
+    use flexmbs_io_scene_input, only: nonlinear_body, modal_body
     use flexmbs_io_hdf5_text, only: path_name
     use flexmbs_run_chain_builder, only: link_names
     implicit none
@@ -163,8 +164,13 @@ contains
                     if (.not. status%ok()) return
                 end do
                 do i = 1, size(sys%flex)
-                    call add_flexible(h5, sys%flex(i), scene%bodies(i)%name, f%oq + sys%flex_q(i), &
-                                      f%ov + sys%flex_v(i), status)
+                    call add_flexible(h5, sys%flex(i), scene%bodies(nonlinear_body(scene, i))%name, &
+                                      f%oq + sys%flex_q(i), f%ov + sys%flex_v(i), status)
+                    if (.not. status%ok()) return
+                end do
+                do i = 1, size(sys%modal)
+                    call add_modal(h5, sys%modal(i), scene%bodies(modal_body(scene, i))%name, &
+                                   f%oq + sys%modal_q(i), f%ov + sys%modal_v(i), status)
                     if (.not. status%ok()) return
                 end do
                 allocate (character(len=80) :: groups(size(scene%forces)))
@@ -316,8 +322,14 @@ contains
                     merge(f%oa + sys%chain_v(i), -1, f%accelerations))
             end do
             do i = 1, size(sys%flex)
-                call flexible_labels(sys%flex(i), trim(scene%bodies(i)%name), f%oq + sys%flex_q(i), &
-                    f%ov + sys%flex_v(i), merge(f%oa + sys%flex_v(i), -1, f%accelerations))
+                call flexible_labels(sys%flex(i), trim(scene%bodies(nonlinear_body(scene, i))%name), &
+                    f%oq + sys%flex_q(i), f%ov + sys%flex_v(i), &
+                    merge(f%oa + sys%flex_v(i), -1, f%accelerations))
+            end do
+            do i = 1, size(sys%modal)
+                call modal_labels(sys%modal(i)%modes, trim(scene%bodies(modal_body(scene, i))%name), &
+                    f%oq + sys%modal_q(i), f%ov + sys%modal_v(i), &
+                    merge(f%oa + sys%modal_v(i), -1, f%accelerations))
             end do
             ! multipliers: a row's unit is the force its constraint exerts
             do i = 1, size(sys%joints)
@@ -396,6 +408,35 @@ contains
                 end do
             end do
         end subroutine flexible_labels
+
+        !> (r, p, η), (ṙ, ω′, η̇) and their rates of a modal body.
+        subroutine modal_labels(modes, name, oq, ov, oa)
+            integer, intent(in) :: modes
+            character(len=*), intent(in) :: name
+            integer, intent(in) :: oq, ov, oa   !! oa < 0: no accelerations in y
+            integer :: j
+            call put3(oq, name // '/frame/position', 'm')
+            do j = 1, 4
+                labels(oq + 3 + j) = name // '/frame/orientation/p' // int_text(j - 1)
+                units(oq + 3 + j) = '1'
+            end do
+            call put3(ov, name // '/frame/velocity', 'm/s')
+            call put3(ov + 3, name // '/frame/angular_velocity (body)', 'rad/s')
+            if (oa >= 0) then
+                call put3(oa, name // '/frame/acceleration', 'm/s^2')
+                call put3(oa + 3, name // '/frame/angular_acceleration (body)', 'rad/s^2')
+            end if
+            do j = 1, modes
+                labels(oq + 7 + j) = name // '/eta ' // int_text(j)
+                units(oq + 7 + j) = 'sqrt(kg) m'
+                labels(ov + 6 + j) = name // '/eta ' // int_text(j) // '/rate'
+                units(ov + 6 + j) = 'sqrt(kg) m/s'
+                if (oa >= 0) then
+                    labels(oa + 6 + j) = name // '/eta ' // int_text(j) // '/acceleration'
+                    units(oa + 6 + j) = 'sqrt(kg) m/s^2'
+                end if
+            end do
+        end subroutine modal_labels
 
         subroutine put3(offset, base, unit)
             integer, intent(in) :: offset

@@ -16,6 +16,7 @@ module flexmbs_run_runner
     use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_mbs_system, only: mbs_system_t
     use flexmbs_io_namelist, only: scene_input_t
+    use flexmbs_io_scene_input, only: nonlinear_body, modal_body
     use flexmbs_io_scene_schema, only: len_name
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_io_progress, only: progress_t, new_progress, announce
@@ -365,10 +366,10 @@ contains
                 vtk%chains => m%chains
                 vtk%chain_q = m%chain_q
             end if
-            allocate (vtk%flexible(size(m%flex)))
+            allocate (vtk%flexible(size(m%flex) + size(m%modal)))
             do k = 1, size(m%flex)
                 vtk%flexible(k)%body => m%flex(k)
-                vtk%flexible(k)%name = scene%bodies(k)%name
+                vtk%flexible(k)%name = scene%bodies(nonlinear_body(scene, k))%name
                 vtk%flexible(k)%oq = m%flex_q(k)
                 vtk%flexible(k)%ov = m%nq + m%flex_v(k)
                 select type (p => plan%problem)
@@ -376,6 +377,20 @@ contains
                     vtk%flexible(k)%oq = p%oq + m%flex_q(k)
                     vtk%flexible(k)%ov = p%ov + m%flex_v(k)
                 end select
+            end do
+            do k = 1, size(m%modal)
+                associate (vf => vtk%flexible(size(m%flex) + k))
+                    vf%body => m%modal(k)%fe
+                    vf%modal => m%modal(k)
+                    vf%name = scene%bodies(modal_body(scene, k))%name
+                    vf%oq = m%modal_q(k)
+                    vf%ov = m%nq + m%modal_v(k)
+                    select type (p => plan%problem)
+                    type is (formulation_t)
+                        vf%oq = p%oq + m%modal_q(k)
+                        vf%ov = p%ov + m%modal_v(k)
+                    end select
+                end associate
             end do
             if (size(m%joints) > 0) then
                 vtk%system => m
@@ -411,9 +426,13 @@ contains
             allocate (bodies(1))
             bodies(1) = xdmf_body(m, scene%bodies(1)%name)
         type is (mbs_system_t)
-            allocate (bodies(size(m%flex)))
+            allocate (bodies(size(m%flex) + size(m%modal)))
             do k = 1, size(m%flex)
-                bodies(k) = xdmf_body(m%flex(k), scene%bodies(k)%name)
+                bodies(k) = xdmf_body(m%flex(k), scene%bodies(nonlinear_body(scene, k))%name)
+            end do
+            do k = 1, size(m%modal)
+                bodies(size(m%flex) + k) = xdmf_body(m%modal(k)%fe, &
+                    scene%bodies(modal_body(scene, k))%name)
             end do
         class default
             return

@@ -16,6 +16,8 @@ module flexmbs_run_summary
     use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_io_namelist, only: scene_input_t
+    use flexmbs_io_scene_input, only: nonlinear_body, modal_body
+    use flexmbs_mbs_modal_body, only: modal_body_t
     use flexmbs_run_plan, only: run_plan_t
     use flexmbs_run_named_output, only: joint_angle
     use flexmbs_run_chain_builder, only: link_names
@@ -57,9 +59,16 @@ contains
                     end do
                 end if
                 do i = 1, size(m%flex)
-                    text = text // flexible_line(m%flex(i), trim(scene%bodies(i)%name), &
+                    text = text // flexible_line(m%flex(i), &
+                        trim(scene%bodies(nonlinear_body(scene, i))%name), &
                         y(f%oq + m%flex_q(i) + 1:f%oq + m%flex_q(i) + m%flex(i)%nq), &
                         y(f%ov + m%flex_v(i) + 1:f%ov + m%flex_v(i) + m%flex(i)%nv))
+                end do
+                do i = 1, size(m%modal)
+                    text = text // modal_line(m%modal(i), &
+                        trim(scene%bodies(modal_body(scene, i))%name), &
+                        y(f%oq + m%modal_q(i) + 1:f%oq + m%modal_q(i) + m%modal(i)%nq), &
+                        y(f%ov + m%modal_v(i) + 1:f%ov + m%modal_v(i) + m%modal(i)%nv))
                 end do
             type is (rigid_chain_t)
                 text = chain_lines(m, y(f%oq + 1:f%oq + m%nq), link_names(scene, 0))
@@ -138,6 +147,18 @@ contains
     end function joint_line
 
     !> 'coupler: largest displacement D m (node N), largest von Mises stress S Pa'
+    !> flexible_line of a modal body's reconstructed nodes.
+    function modal_line(body, name, q, v) result(line)
+        type(modal_body_t), intent(inout) :: body
+        character(len=*), intent(in) :: name
+        real(wp), intent(in) :: q(:), v(:)
+        character(len=:), allocatable :: line
+        real(wp) :: x(3 * body%fe%mesh%node_count()), xd(3 * body%fe%mesh%node_count())
+        call body%node_positions(q, x)
+        call body%node_velocities(q, v, xd)
+        line = flexible_line(body%fe, name // ' (modal)', x, xd)
+    end function modal_line
+
     function flexible_line(body, name, q, v) result(line)
         type(flexible_body_t), intent(inout) :: body
         character(len=*), intent(in) :: name
