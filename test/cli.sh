@@ -145,6 +145,11 @@ bad chain-inertia-not-definite \
 sed -e "0,/inertia = [0-9., ]*/s//inertia = 0.001, 0.001, 0.01, /" "$root/inputs/four_bar.nml" \
     > triangle.nml
 bad rigid-inertia-triangle "violate the triangle inequality J1 + J2 >= J3" triangle.nml
+# a moment zero to working precision beside the others (the fuzzer's case:
+# 1e-310 overflowed the body's rotational acceleration)
+sed -e "0,/inertia = [0-9., ]*/s//inertia = 0.01, 0.01, 1e-310, /" "$root/inputs/four_bar.nml" \
+    > singular_inertia.nml
+bad rigid-inertia-singular "singular to working precision" singular_inertia.nml
 
 # sizes that cannot fit: counted in 64 bits and against the machine's
 # memory before anything is allocated (2000^3 used to overflow and crash)

@@ -11,7 +11,9 @@ that of the quaternion and orthogonal (up to |p|^2); the world angular velocity 
 R ω'; every joint's and driver's reaction force and torque on the body of
 marker i are among the per-joint columns of /reactions; each flexible
 body's reference nodes plus displacements, over the nodes that move, are
-one slice of /q, its node velocities one of /v. With FLEXMBS, `flexmbs
+one slice of /q, its node velocities one of /v (a modal body's
+modal_coordinates are one slice of /q instead, its frequencies positive and
+ascending). With FLEXMBS, `flexmbs
 columns` by name (BODY/position/z, JOINT/reaction_force/x, BODY/node N/x
 and .../velocity/y) prints the same numbers as the datasets. Chain links:
 coordinate and rate are slices of /q and /v, the rotation orthonormal, and
@@ -127,6 +129,20 @@ for body in flexible:
     conn = g['connectivity'][:]
     if conn.min() < 1 or conn.max() > x0.shape[0]:
         problems.append('%s: connectivity outside nodes 1..%d' % (body, x0.shape[0]))
+    if 'frequencies' in g:
+        # a modal body: its nodes are reconstructed from the frame and η;
+        # η is one slice of /q, the frequencies positive and ascending
+        omega = g['frequencies'][:]
+        if np.any(omega <= 0) or np.any(np.diff(omega) < 0):
+            problems.append('%s: frequencies not positive and ascending' % body)
+        if 'modal_coordinates' in g:
+            eta = g['modal_coordinates'][:].reshape(records, -1)
+            m = eta.shape[1]
+            if not any(np.array_equal(q[:, k:k + m], eta) for k in range(q.shape[1] - m + 1)):
+                problems.append('%s: modal_coordinates are not one slice of /q' % body)
+        if not (np.all(np.isfinite(u)) and np.all(np.isfinite(g['velocity'][:]))):
+            problems.append('%s: reconstructed nodes not finite' % body)
+        continue
     # the free coordinates, node by node, are one slice of /q (fixed nodes
     # do not move: displacement 0)
     moving = np.any(u != 0, axis=0).reshape(-1)

@@ -46,6 +46,7 @@ contains
     function collect_mechanisms() result(tests)
         type(test_case_t), allocatable :: tests(:)
         tests = [new_test('driver_values_exact', test_driver_values), &
+                 new_test('ramp_then_hold', test_ramp), &
                  new_test('driver_rows_ad_vs_analytic', test_driver_rows), &
                  new_test('slider_crank_closed_form', test_slider_crank), &
                  new_test('four_bar_closed_form', test_four_bar), &
@@ -74,6 +75,39 @@ contains
         call check(error, abs(s(1) - (0.3_wp - 1.2_wp * t + 0.7_wp * t**2 + 0.25_wp * t**3 + &
                    0.4_wp * sin(3.0_wp * t + 0.2_wp))) < 1.0e-15_wp, 's')
     end subroutine test_driver_values
+
+    !> The ramp-then-hold term: s' and s'' against central differences
+    !> inside the ramp and after it, s, s', s'' continuous at T (the C²
+    !> joint: s'' and its slope vanish there), s' = Ω/2 at T/2 by symmetry
+    !> (∫ of the rising rate), s = Ω (t − T/2) after, 0 before 0.
+    subroutine test_ramp(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(driver_t) :: d
+        real(wp) :: s(3), sp(3), sm(3), t
+        real(wp), parameter :: h = 1.0e-6_wp, rate = 4.0_wp, ramp = 1.5_wp, &
+            times(3) = [0.4_wp, 1.1_wp, 2.3_wp]
+        integer :: k
+        d%ramp_rate = rate
+        d%ramp_time = ramp
+        do k = 1, 3
+            t = times(k)
+            s = driver_values(d, t)
+            sp = driver_values(d, t + h)
+            sm = driver_values(d, t - h)
+            call check(error, abs((sp(1) - sm(1)) / (2 * h) - s(2)) < 1.0e-8_wp, "ramp s'")
+            call check(error, abs((sp(2) - sm(2)) / (2 * h) - s(3)) < 1.0e-8_wp, "ramp s''")
+        end do
+        sm = driver_values(d, ramp * (1.0_wp - 1.0e-9_wp))
+        sp = driver_values(d, ramp * (1.0_wp + 1.0e-9_wp))
+        call check(error, maxval(abs(sp - sm)) < 1.0e-7_wp, 'continuous at T')
+        s = driver_values(d, ramp / 2)
+        call check(error, abs(s(2) - rate / 2) < 1.0e-14_wp, "s'(T/2) = rate/2")
+        s = driver_values(d, 3.0_wp)
+        call check(error, maxval(abs(s - [rate * (3.0_wp - ramp / 2), rate, 0.0_wp])) < &
+                   1.0e-13_wp, 'held')
+        s = driver_values(d, -0.5_wp)
+        call check(error, all(s == 0.0_wp), 'zero before t = 0')
+    end subroutine test_ramp
 
     !> Two free bodies with an angle, a translation and a distance driver on
     !> random markers: c, G, c_q, c_t and γ of 'ad' equal 'analytic'

@@ -22,7 +22,8 @@ module test_modal_body
     use flexmbs_fe_flexible_body, only: flexible_body_t, new_flexible_body
     use flexmbs_fe_modal_basis, only: modal_basis_t, craig_bampton
     use flexmbs_fe_modal_invariants, only: modal_invariants
-    use flexmbs_mbs_rotation, only: quat_from_axis_angle
+    use flexmbs_mbs_rotation, only: quat_from_axis_angle, skew
+    use flexmbs_linalg_lapack, only: dgetrf, dgetrs
     use flexmbs_mbs_rigid_body, only: rigid_body_t, rigid_bodies_t, new_rigid_bodies
     use flexmbs_mbs_modal_body, only: modal_body_t, new_modal_body
     use test_formulation, only: difference_jacobian
@@ -41,7 +42,8 @@ contains
                  new_test('power_balance', test_power), &
                  new_test('formulation_jacobian_vs_differences', test_jacobian), &
                  new_test('no_modes_one_interface_is_rigid', test_rigid), &
-                 new_test('free_body_conserves_every_solver', test_conservation)]
+                 new_test('free_body_conserves_every_solver', test_conservation), &
+                 new_test('clamped_static_deflection_converges', test_static)]
     end function collect_modal_body
 
     !> A modal bar (hex8, divisions d) with k fixed-interface modes on the
@@ -73,7 +75,7 @@ contains
         call craig_bampton(fe, sets, k, basis, status)
         if (.not. status%ok()) return
         call new_modal_body(body, basis, modal_invariants(fe%mass_matrix, fe%mesh%x, &
-                            basis%shapes), status, gravity)
+                            basis%shapes), status, gravity, fe=fe)
     end subroutine new_test_modal_body
 
     !> Solver s of RADAU5, DDASSL, IDA, MEXAX.
@@ -323,4 +325,79 @@ contains
             deallocate (solver, y, yp)
         end do
     end subroutine test_conservation
+
+    !> A cantilever clamped at its xmin interface under gravity: the modal
+    !> body's linear static deflection converges to the linear FE one of the
+    !> same mesh clamped there as k grows, and equals it with every mode.
+    !> Statics of the modal body: the interface held, δθ = −Θη and
+    !> δt = −Uη − δθ × d; gravity works on r alone, so η minimises
+    !> ½ ηᵀ diag(ω²) η + m gᵀ (U η + d̃ Θ η): diag(ω²) η = −m (Uᵀ g − Θᵀ d̃ g);
+    !> a node moves by δt + δθ × (X − c) + Φ η.
+    subroutine test_static(error)
+        type(error_t), allocatable, intent(out) :: error
+        integer, parameter :: ks(5) = [1, 2, 4, 8, 72]
+        real(wp), parameter :: g(3) = [0.0_wp, -9.81_wp, 0.0_wp]
+        type(modal_body_t) :: body
+        type(status_t) :: status
+        type(mesh_t) :: mesh
+        type(neo_hooke_t) :: material
+        type(flexible_body_t) :: clamped
+        integer, allocatable :: xmin(:), xmax(:), ipiv(:)
+        real(wp), allocatable :: k(:, :), u_fe(:), eta(:), u(:)
+        real(wp) :: tip_fe, tip(size(ks)), dt(3), dth(3), d(3), rhs(1)
+        integer :: info, l, node, nf, j
+        call box_mesh(mesh, hex8, [6, 1, 1], bar, status)
+        if (status%ok()) call new_neo_hooke(material, 7.0e5_wp, 0.3_wp, 920.0_wp, 0.0_wp, status)
+        if (status%ok()) call mesh%node_set('xmin', xmin, status)
+        if (status%ok()) call mesh%node_set('xmax', xmax, status)
+        if (status%ok()) call new_flexible_body(clamped, mesh, [material], xmin, status, &
+                                                gravity=g)
+        if (status%ok()) call clamped%assemble_tangents(clamped%free_positions(), &
+            spread(0.0_wp, 1, clamped%nv), status)
+        call check(error, status%ok(), 'FE: ' // status%text())
+        if (allocated(error)) return
+        nf = clamped%nv
+        allocate (k(nf, nf), ipiv(nf))
+        call clamped%stiffness%to_dense(k)
+        u_fe = clamped%applied_force
+        call dgetrf(nf, nf, k, nf, ipiv, info)
+        if (info == 0) call dgetrs('N', nf, 1, k, nf, ipiv, u_fe, nf, info)
+        call check(error, info == 0, 'FE solve')
+        if (allocated(error)) return
+        ! the tip: the mean y displacement of the xmax face
+        tip_fe = 0.0_wp
+        do j = 1, size(xmax)
+            tip_fe = tip_fe + u_fe(clamped%dof(2, xmax(j))) / size(xmax)
+        end do
+        do l = 1, size(ks)
+            call new_test_modal_body([6, 1, 1], [character(len=4) :: 'xmin'], ks(l), 0.0_wp, &
+                                     body, status, gravity=g)
+            call check(error, status%ok(), 'modal: ' // status%text())
+            if (allocated(error)) return
+            associate (uu => body%interface_motion(1:3, :, 1), th => body%interface_motion(4:6, :, 1))
+                d = body%interface_offset(:, 1)
+                eta = -body%total_mass * (matmul(transpose(uu), g) - &
+                                          matmul(transpose(th), matmul(skew(d), g))) / body%stiffness
+                dth = -matmul(th, eta)
+                dt = -matmul(uu, eta) + matmul(skew(d), dth)
+            end associate
+            u = matmul(body%shapes, eta)
+            tip(l) = 0.0_wp
+            do j = 1, size(xmax)
+                node = xmax(j)
+                rhs = dt(2) + dth(3) * body%reference(1, node) - dth(1) * body%reference(3, node) &
+                    + u(3 * node - 1)
+                tip(l) = tip(l) + rhs(1) / size(xmax)
+            end do
+        end do
+        print '(4x,a,es11.4,a,5es10.2)', 'clamped static tip deflection: FE ', tip_fe, &
+            ', modal error (k = 1, 2, 4, 8, all) ', abs(tip - tip_fe) / abs(tip_fe)
+        call check(error, all(abs(tip(2:) - tip_fe) <= abs(tip(:size(ks) - 1) - tip_fe) * &
+                   (1.0_wp + 1.0e-9_wp)), 'the error does not fall with k')
+        call check(error, abs(tip(size(ks)) - tip_fe) <= 1.0e-9_wp * abs(tip_fe), &
+                   'every mode: not the FE deflection')
+        ! mode 1 bends the bar about y (its thinner side), mode 2 along g
+        call check(error, abs(tip(2) - tip_fe) <= 0.05_wp * abs(tip_fe), &
+                   'two modes: more than 5 % off')
+    end subroutine test_static
 end module test_modal_body

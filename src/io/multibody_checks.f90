@@ -145,6 +145,9 @@ contains
                 else
                     call check_markers('driver', i, d%marker_i, d%marker_j, d%name, d%line)
                 end if
+                if (d%ramp_rate /= 0.0_wp .and. .not. d%ramp_time > 0.0_wp) call value_error( &
+                    errors, entries, 'driver', 'ramp_time', 'must be positive with ramp_rate &
+                    &(the ramp''s duration in s)', i, d%name, d%line)
             end associate
         end do
 

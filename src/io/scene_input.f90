@@ -103,6 +103,8 @@ module flexmbs_io_scene_input
         real(wp) :: amplitude !! + a sin(ω t + φ)
         real(wp) :: frequency !! ω [rad/s]
         real(wp) :: phase !! φ [rad]
+        real(wp) :: ramp_rate = 0.0_wp !! + a ramp to this rate, then held
+        real(wp) :: ramp_time = 0.0_wp !! the ramp's duration [s]
         integer :: line = 0
     end type driver_input_t
 

@@ -269,6 +269,8 @@ contains
                 call get(ei, 'driver', 'amplitude', d%amplitude, i)
                 call get(ei, 'driver', 'frequency', d%frequency, i)
                 call get(ei, 'driver', 'phase', d%phase, i)
+                call get(ei, 'driver', 'ramp_rate', d%ramp_rate, i)
+                call get(ei, 'driver', 'ramp_time', d%ramp_time, i)
             end associate
         end do
         call instance_ranges(e, 'rigid_chain', size(scene%chain), ranges)

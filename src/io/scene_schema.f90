@@ -252,6 +252,11 @@ module flexmbs_io_scene_schema
         var_spec_t('driver', 'amplitude', kind_real, default='0', doc='... + a sin(w t + phi)'), &
         var_spec_t('driver', 'frequency', kind_real, default='0', unit='rad/s', doc='w'), &
         var_spec_t('driver', 'phase', kind_real, default='0', unit='rad', doc='phi'), &
+        var_spec_t('driver', 'ramp_rate', kind_real, default='0', doc='... + a ramp then &
+            &hold: the rate rises smoothly from 0 to ramp_rate over ramp_time, then holds &
+            &(rad/s for angle drivers, m/s else)'), &
+        var_spec_t('driver', 'ramp_time', kind_real, default='0', rule='[0,inf)', unit='s', &
+            doc='the ramp''s duration, positive with ramp_rate'), &
         var_spec_t('force', 'name', kind_string, doc='unique name (default: force N)'), &
         var_spec_t('force', 'type', kind_string, &
             choices='spring_damper|rotational|bushing|applied', doc='the element, required'), &

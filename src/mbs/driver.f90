@@ -1,6 +1,14 @@
-!> Prescribed functions of time, s(t) = Σ_k c_k t^k (k ≤ 3) + a sin(ω t + φ),
-!> with s' and s'' exact: what the drivers of flexmbs_mbs_system follow and
-!> what scales the applied loads of flexmbs_mbs_force_element.
+!> Prescribed functions of time, s(t) = Σ_k c_k t^k (k ≤ 3) + a sin(ω t + φ)
+!> + a ramp-then-hold term, with s' and s'' exact: what the drivers of
+!> flexmbs_mbs_system follow and what scales the applied loads of
+!> flexmbs_mbs_force_element.
+!>
+!> Ramp then hold (the spin-up manoeuvre of Kane, Ryan and Banerjee 1987):
+!> the rate s' rises from 0 to Ω over T as Ω/T (t − T/(2π) sin(2πt/T)) and
+!> then holds, so s'' = Ω/T (1 − cos(2πt/T)) starts and ends at zero and
+!> the motion has no jerk at either end:
+!>   s = Ω/T (t²/2 + (T/2π)² (cos(2πt/T) − 1))   for 0 ≤ t < T,
+!>   s = Ω (t − T/2)                              for t ≥ T   (s = 0 before 0).
 module flexmbs_mbs_driver
     use flexmbs_core_kinds, only: wp
     implicit none
@@ -13,6 +21,8 @@ module flexmbs_mbs_driver
         real(wp) :: amplitude = 0.0_wp
         real(wp) :: frequency = 0.0_wp !! ω [rad/s]
         real(wp) :: phase = 0.0_wp     !! φ [rad]
+        real(wp) :: ramp_rate = 0.0_wp !! Ω: the rate held after the ramp
+        real(wp) :: ramp_time = 0.0_wp !! T [s] (> 0 when Ω /= 0)
     end type driver_t
 
     public :: driver_values
@@ -32,5 +42,24 @@ contains
         arg = driver%frequency * t + driver%phase
         drv = drv + driver%amplitude * [sin(arg), driver%frequency * cos(arg), &
                                         -driver%frequency**2 * sin(arg)]
+        if (driver%ramp_rate /= 0.0_wp) drv = drv + ramp_values(driver%ramp_rate, &
+                                                                driver%ramp_time, t)
     end function driver_values
+
+    !> (s, s', s'') of the ramp-then-hold term (module header).
+    pure function ramp_values(rate, time, t) result(drv)
+        real(wp), intent(in) :: rate, time, t
+        real(wp) :: drv(3), w, c
+        real(wp), parameter :: two_pi = 2.0_wp * acos(-1.0_wp)
+        if (t <= 0.0_wp) then
+            drv = 0.0_wp
+        else if (t < time) then
+            w = two_pi / time
+            c = rate / time
+            drv = c * [t**2 / 2 + (cos(w * t) - 1.0_wp) / w**2, t - sin(w * t) / w, &
+                       1.0_wp - cos(w * t)]
+        else
+            drv = [rate * (t - time / 2), rate, 0.0_wp]
+        end if
+    end function ramp_values
 end module flexmbs_mbs_driver

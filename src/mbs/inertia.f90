@@ -5,7 +5,8 @@
 !> definite, and its principal moments J1, J2, J3 satisfy the triangle
 !> inequalities J1 + J2 >= J3 (and permutations), since J1 + J2 - J3 =
 !> 2 ∫ ρ x3² dV >= 0 in principal axes. The principal moments come from
-!> LAPACK's symmetric eigensolver.
+!> LAPACK's symmetric eigensolver. The smallest must exceed ε times the
+!> largest: below it the tensor is singular to working precision.
 module flexmbs_mbs_inertia
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_text, only: real_text
@@ -45,6 +46,14 @@ contains
         if (w(1) <= 0.0_wp) then
             why = 'the inertia tensor is not positive definite (principal moments ' // &
                 moments_text(w) // ')'
+            return
+        end if
+        ! a moment below ε times the largest is zero to working precision:
+        ! the body's mass matrix would be singular in all but name (1e-310
+        ! beside 0.01 overflowed its rotational accelerations)
+        if (w(1) <= epsilon(1.0_wp) * w(3)) then
+            why = 'the inertia tensor is singular to working precision (principal moments ' &
+                // moments_text(w) // '): the smallest must exceed 2.2e-16 times the largest'
             return
         end if
         ! w ascends: the largest must not exceed the sum of the other two

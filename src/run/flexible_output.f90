@@ -10,6 +10,7 @@
 !> per record and its `frequencies`, so that a reduced and a nonlinear run
 !> of one scene are read and drawn alike.
 module flexmbs_run_flexible_output
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t
     use flexmbs_core_resources, only: out_of_memory
@@ -219,13 +220,20 @@ contains
         real(wp), intent(in) :: t, y(:)
         real(wp), intent(out) :: values(:)
         type(status_t), intent(inout) :: status
+        type(status_t) :: local
         integer :: el
         if (associated(self%modal)) then
             associate (m => self%modal)
                 call m%node_positions(y(self%oq + 1:self%oq + m%nq), self%x)
                 call m%node_velocities(y(self%oq + 1:self%oq + m%nq), &
                                        y(self%ov + 1:self%ov + m%nv), self%xd)
-                call self%body%element_stress(self%x, self%xd, self%sigma, self%mises, status)
+                call self%body%element_stress(self%x, self%xd, self%sigma, self%mises, local)
+                ! the reduced model has no det F > 0 to keep: a field that
+                ! inverts an element (a diverging spin-up) has no stress there
+                if (.not. local%ok()) then
+                    self%sigma = ieee_value(1.0_wp, ieee_quiet_nan)
+                    self%mises = ieee_value(1.0_wp, ieee_quiet_nan)
+                end if
             end associate
         else
             associate (body => self%body)

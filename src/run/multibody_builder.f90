@@ -267,7 +267,8 @@ contains
                 joints = [joints, mbs_joint_t(joint_primitive, marker_index(scene, d%marker_i), &
                     marker_index(scene, d%marker_j), &
                     driver_kind(d%type), d%axis_i, d%axis_j, &
-                    driver_t(d%coefficients, d%amplitude, d%frequency, d%phase))]
+                    driver_t(d%coefficients, d%amplitude, d%frequency, d%phase, d%ramp_rate, &
+                             d%ramp_time))]
                 labels = [character(len=80) :: labels, '&driver ''' // trim(d%name) // '''']
                 names = [character(len=80) :: names, 'drivers/' // trim(d%name)]
             end associate
