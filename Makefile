@@ -315,6 +315,7 @@ bench: deps
 	bash bench/assemblies.sh
 	bash bench/output.sh
 	bash bench/mexax_control.sh
+	bash bench/modal.sh
 
 # The Python environment of test/vtk_files.py: $(PY_PACKAGES) from PyPI
 # (installed once) over the system's Python with its h5py and numpy.
