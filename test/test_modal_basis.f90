@@ -88,6 +88,7 @@ contains
         ! then one per interior dof.
         nw = 12 + interior
         allocate (t0(3 * n, nw), source=0.0_wp)
+        allocate (g(3 * n, 6))
         do j = 1, 2
             g = rigid_motions(body%mesh%x, sum(body%mesh%x(:, faces(j)%nodes), dim=2) / &
                               size(faces(j)%nodes))
@@ -172,6 +173,7 @@ contains
         ! interfaces rigid: u_i = t + θ × (X_i − X_c)
         worst = 0.0_wp
         nb = size(faces)
+        allocate (g(size(basis%shapes, 1), 6))
         do l = 1, nb
             g = rigid_motions(body%mesh%x, basis%interface_centre(:, l))
             do i = 1, size(faces(l)%nodes)

@@ -23,6 +23,8 @@ contains
         type(test_case_t), allocatable :: tests(:)
         tests = [new_test('five_body_modal_vs_nonlinear', test_five_body), &
                  new_test('every_solver', test_solvers), &
+                 new_test('every_formulation', test_formulations), &
+                 new_test('spring_on_an_interface', test_spring), &
                  new_test('basis_cache', test_cache), &
                  new_test('bad_input_named', test_bad)]
     end function collect_modal_scene
@@ -93,6 +95,82 @@ contains
             call check(error, dev <= 1.0e-5_wp, trim(solvers(k)) // ': positions differ')
         end do
     end subroutine test_solvers
+
+    !> The modal five-body in each formulation (RADAU5, 0.05 s): the same
+    !> state as GGL's to the tolerance, the position constraints held.
+    subroutine test_formulations(error)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=6), parameter :: forms(4) = ['ggl   ', 'index1', 'index2', 'index3']
+        type(scene_input_t) :: scene
+        type(run_result_t) :: result
+        type(status_t) :: status
+        real(wp), allocatable :: y_ref(:)
+        real(wp) :: dev
+        integer :: k
+        do k = 1, size(forms)
+            call read_scene('inputs/five_body_modal.nml', scene, status)
+            call check(error, status%ok(), 'read: ' // status%text())
+            if (allocated(error)) return
+            scene%output_file = ''
+            scene%progress = .false.
+            scene%t_end = 0.05_wp
+            scene%multibody%formulation = forms(k)
+            call run_scene(scene, .true., result, status)
+            call check(error, status%ok(), trim(forms(k)) // ': ' // status%text())
+            if (allocated(error)) return
+            call check(error, result%has_drift .and. result%drift_end(1) <= 1.0e-5_wp, &
+                       trim(forms(k)) // ': position drift ' // real_text(result%drift_end(1)))
+            if (k == 1) then
+                y_ref = result%y(result%q_first:result%q_last)
+                cycle
+            end if
+            dev = maxval(abs(result%y(result%q_first:result%q_last) - y_ref))
+            print '(4x,a,es9.2)', trim(forms(k)) // ': positions off GGL by ', dev
+            call check(error, dev <= 1.0e-4_wp, trim(forms(k)) // ': positions differ')
+        end do
+    end subroutine test_formulations
+
+    !> A force element on a modal body's interface: the modal bar hung by a
+    !> spring at each end face (no joint) from ground points above them
+    !> settles where the springs carry its weight, m g / 2k below their
+    !> free length (3 s, the springs' damping).
+    subroutine test_spring(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(run_result_t) :: result
+        type(status_t) :: status
+        real(wp), parameter :: stiffness = 200.0_wp, length = 0.5_wp, g = 9.81_wp
+        real(wp) :: mass, stretch
+        character(len=:), allocatable :: text
+        mass = 920.0_wp * 0.6_wp * 0.08_wp * 0.05_wp
+        text = '&simulation problem = ''multibody'', t_end = 3 /' // nl // &
+            '&flexible_body name = ''bar'', divisions = 4, 1, 1, lengths = 0.6, 0.08, 0.05, &
+            &origin = -0.3, -0.04, -0.025, model = ''modal'', modes = 2, gravity = 0, 0, -9.81 /' &
+            // nl // &
+            '&material youngs_modulus = 7e5, density = 920, viscosity = 500 /' // nl // &
+            '&multibody gravity = 0, 0, -9.81 /' // nl // &
+            '&marker name = ''hook'', body = ''ground'', position = -0.3, 0, 0.5 /' // nl // &
+            '&marker name = ''end'', body = ''bar'', node_set = ''xmin'' /' // nl // &
+            '&marker name = ''far'', body = ''bar'', node_set = ''xmax'' /' // nl // &
+            '&marker name = ''hook 2'', body = ''ground'', position = 0.3, 0, 0.5 /' // nl // &
+            '&force name = ''s1'', type = ''spring_damper'', marker_i = ''hook'', &
+            &marker_j = ''end'', stiffness = 200, damping = 20, free_length = 0.5 /' // nl // &
+            '&force name = ''s2'', type = ''spring_damper'', marker_i = ''hook 2'', &
+            &marker_j = ''far'', stiffness = 200, damping = 20, free_length = 0.5 /' // nl // &
+            '&output file = ''none'' /'
+        call run_text(text, result, status)
+        call check(error, status%ok(), 'run: ' // status%text())
+        if (allocated(error)) return
+        ! two springs share the weight: each face's centroid (where its
+        ! interface frame, the first rigid body, sits) hangs (m g / 2) / k
+        ! below z = 0
+        stretch = mass * g / 2 / stiffness
+        associate (z => result%y(result%q_first + 2))
+            print '(4x,a,es12.4,a,es12.4)', 'modal bar on two springs: xmin face z ', z, &
+                ', expected ', -stretch
+            call check(error, abs(z + stretch) <= 2.0e-3_wp * stretch, 'centre at ' // &
+                       real_text(z) // ', expected ' // real_text(-stretch))
+        end associate
+    end subroutine test_spring
 
     !> A modal pendulum: a bar hung at its xmin face. With modes_cache the
     !> first run writes the basis, the second reads it and gives the same

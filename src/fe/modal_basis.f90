@@ -306,6 +306,7 @@ contains
                 return
             end if
         end if
+        allocate (g(size(v, 1), 6))   ! before the assignment (see remove_rigid)
         do j = 1, size(centre, 2)
             g = rigid_motions(body%mesh%x, centre(:, j))
             do l = 1, 6
@@ -336,7 +337,9 @@ contains
         real(wp), allocatable :: g(:, :), mg(:, :), coef(:, :)
         real(wp) :: gmg(6, 6), c(3), total, d(3)
         integer :: l, j, info, ipiv(6)
-        allocate (mg(size(v, 1), 6))
+        ! allocated before the assignments: gfortran's reallocation reads the
+        ! bounds of an unallocated array (valgrind's uninitialised jumps)
+        allocate (mg(size(v, 1), 6), g(size(v, 1), 6))
         g = rigid_motions(body%mesh%x, [0.0_wp, 0.0_wp, 0.0_wp])
         call body%mass_matrix%matvec(g(:, 1), mg(:, 1))
         ! M e_x holds ∫ρ N_i dV in every node's x slot: mass and centre.

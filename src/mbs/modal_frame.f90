@@ -19,11 +19,14 @@
 !> space (ṙ_f, ω_f′, ṙ, ω′, η̇), 12 + n. c, G, c_q and γ are hand-coded
 !> (modal_frame.inc); with constraint_derivatives = 'ad' c_q, G and γ are
 !> AD of c and of the hand-coded G v; the second derivatives ∂(G w)/∂q,
-!> ∂(Gᵀλ)/∂q, ∂γ/∂q and ∂γ/∂v are always AD of the hand-coded forms, in
-!> passes of at most dual_size directions.
+!> ∂(Gᵀλ)/∂q, ∂γ/∂q and ∂γ/∂v are AD of the hand-coded forms along the
+!> frame's and the body's poses (one pass of 14 or 12 directions), and
+!> hand-coded along η and η̇, where the forms are affine (each η_k, η̇_k
+!> enters through u_k = U e_k and d_i = Θ e_k × e_i only): a body of many
+!> modes costs no AD pass per 16 of them.
 module flexmbs_mbs_modal_frame
     use flexmbs_core_kinds, only: wp
-    use flexmbs_mbs_rotation, only: quat_rate_matrix
+    use flexmbs_mbs_rotation, only: quat_rate_matrix, rotation_matrix, cross
     use flexmbs_mbs_dual, only: dual_t, dual_size, assignment(=), matmul
     use flexmbs_mbs_modal_frame_forms, only: modal_interface_t, modal_frame_rows, &
         modal_frame_velocity_jacobian, modal_frame_position_jacobian, &
@@ -180,12 +183,13 @@ contains
         type(dual_t) :: zd(size(z))
         integer :: lo, hi
         block = 0.0_wp
-        do lo = 1, size(block, 2), dual_size
-            hi = min(size(block, 2), lo + dual_size - 1)
+        do lo = 1, frame_nq, dual_size
+            hi = min(frame_nq, lo + dual_size - 1)
             call seed_positions(z, lo, hi, .true., zd)
             call scatter(matmul(velocity_jacobian_d(m, zd(4:7), zd(11:14), zd(15:)), w), lo, &
                          hi, block)
         end do
+        call eta_columns(m, z, w, rate=block(:, frame_nq + 1:))
     end subroutine modal_frame_rate_q
 
     !> ∂(Gᵀλ)/∂q, (12 + n, 14 + n), λ the frame's six multipliers.
@@ -196,12 +200,13 @@ contains
         type(dual_t) :: zd(size(z))
         integer :: lo, hi
         block = 0.0_wp
-        do lo = 1, size(block, 2), dual_size
-            hi = min(size(block, 2), lo + dual_size - 1)
+        do lo = 1, frame_nq, dual_size
+            hi = min(frame_nq, lo + dual_size - 1)
             call seed_positions(z, lo, hi, .true., zd)
             call scatter(matmul(transpose(velocity_jacobian_d(m, zd(4:7), zd(11:14), &
                                                               zd(15:))), lam), lo, hi, block)
         end do
+        call eta_columns(m, z, lam=lam, gtl=block(:, frame_nq + 1:))
     end subroutine modal_frame_gtl_q
 
     !> ∂γ/∂q (6, 14 + n) and ∂γ/∂v (6, 12 + n).
@@ -214,15 +219,16 @@ contains
         gq = 0.0_wp
         gv = 0.0_wp
         wd = w
-        do lo = 1, size(gq, 2), dual_size
-            hi = min(size(gq, 2), lo + dual_size - 1)
+        do lo = 1, frame_nq, dual_size
+            hi = min(frame_nq, lo + dual_size - 1)
             call seed_positions(z, lo, hi, .true., zd)
             call scatter(curvature_d(m, zd(4:7), zd(11:14), zd(15:), wd(1:6), wd(7:)), lo, hi, &
                          gq)
         end do
+        call eta_columns(m, z, w, gamma_q=gq(:, frame_nq + 1:), gamma_v=gv(:, frame_nv + 1:))
         zd = z
-        do lo = 1, size(gv, 2), dual_size
-            hi = min(size(gv, 2), lo + dual_size - 1)
+        do lo = 1, frame_nv, dual_size
+            hi = min(frame_nv, lo + dual_size - 1)
             wd = w
             do c = lo, hi
                 wd(c)%der(c - lo + 1) = 1.0_wp
@@ -231,4 +237,82 @@ contains
                          gv)
         end do
     end subroutine modal_frame_curvature_qv
+
+    !> The η (and η̇) columns of ∂(G w)/∂q (rate), ∂(Gᵀλ)/∂q (gtl), ∂γ/∂q
+    !> (gamma_q) and ∂γ/∂v (gamma_v), hand-coded (the forms of
+    !> modal_frame.inc): η_k moves u by u_k = U e_k and s_i = (I + θ̃) e_i by
+    !> d_i = θ_k × e_i, θ_k = Θ e_k; G's ω_f′ column l has Σ_i R (e_l × e_i)
+    !> × A s_i, its ω′ column l (A (e_l × u), Σ_i y_i × A (e_l × s_i)); its
+    !> η̇ columns do not depend on η; γ of modal_frame_curvature_rows.
+    pure subroutine eta_columns(m, z, w, lam, rate, gtl, gamma_q, gamma_v)
+        type(modal_interface_t), intent(in) :: m
+        real(wp), intent(in) :: z(:)
+        real(wp), intent(in), optional :: w(:), lam(6)
+        real(wp), intent(out), optional :: rate(:, :), gtl(:, :), gamma_q(:, :), gamma_v(:, :)
+        real(wp) :: rm(3, 3), am(3, 3), th(3), thd(3), wf(3), wm(3), e(3, 3), d(3), s(3), &
+            uk(3), tk(3), yd(3), ydd(3), a(3), b(3)
+        integer :: k, i, l
+        rm = rotation_matrix(z(4:7))
+        am = rotation_matrix(z(11:14))
+        th = matmul(m%rotation, z(15:))
+        e = 0.0_wp
+        do i = 1, 3
+            e(i, i) = 1.0_wp
+        end do
+        if (present(w)) then
+            wf = w(4:6)
+            wm = w(10:12)
+            thd = matmul(m%rotation, w(13:))
+        end if
+        if (present(gtl)) gtl = 0.0_wp
+        do k = 1, size(m%translation, 2)
+            uk = m%translation(:, k)
+            tk = m%rotation(:, k)
+            if (present(rate)) then
+                rate(1:3, k) = matmul(am, cross(wm, uk))
+                rate(4:6, k) = 0.0_wp
+            end if
+            if (present(gamma_q)) then
+                gamma_q(1:3, k) = matmul(am, cross(wm, cross(wm, uk)))
+                gamma_q(4:6, k) = 0.0_wp
+            end if
+            if (present(gamma_v)) then
+                gamma_v(1:3, k) = 2.0_wp * matmul(am, cross(wm, uk))
+                gamma_v(4:6, k) = 0.0_wp
+            end if
+            if (present(gtl)) then
+                ! ω′ columns of ∂G/∂η_k: position rows A (e_l × u_k)
+                do l = 1, 3
+                    gtl(9 + l, k) = dot_product(lam(1:3), matmul(am, cross(e(:, l), uk)))
+                end do
+            end if
+            do i = 1, 3
+                d = cross(tk, e(:, i))
+                if (present(rate)) rate(4:6, k) = rate(4:6, k) &
+                    + cross(matmul(rm, cross(wf, e(:, i))), matmul(am, d)) &
+                    + cross(rm(:, i), matmul(am, cross(wm, d)))
+                if (present(gtl)) then
+                    do l = 1, 3
+                        gtl(3 + l, k) = gtl(3 + l, k) + dot_product(lam(4:6), &
+                            cross(matmul(rm, cross(e(:, l), e(:, i))), matmul(am, d)))
+                        gtl(9 + l, k) = gtl(9 + l, k) + dot_product(lam(4:6), &
+                            cross(rm(:, i), matmul(am, cross(e(:, l), d))))
+                    end do
+                end if
+                if (present(gamma_q) .or. present(gamma_v)) then
+                    s = e(:, i) + cross(th, e(:, i))
+                    yd = matmul(rm, cross(wf, e(:, i)))
+                    ydd = matmul(rm, cross(wf, cross(wf, e(:, i))))
+                end if
+                if (present(gamma_q)) gamma_q(4:6, k) = gamma_q(4:6, k) &
+                    + cross(ydd, matmul(am, d)) + 2.0_wp * cross(yd, matmul(am, cross(wm, d))) &
+                    + cross(rm(:, i), matmul(am, cross(wm, cross(wm, d))))
+                if (present(gamma_v)) then
+                    a = matmul(am, d)
+                    b = matmul(am, 2.0_wp * cross(wm, d))
+                    gamma_v(4:6, k) = gamma_v(4:6, k) + 2.0_wp * cross(yd, a) + cross(rm(:, i), b)
+                end if
+            end do
+        end do
+    end subroutine eta_columns
 end module flexmbs_mbs_modal_frame
