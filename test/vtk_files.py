@@ -7,7 +7,8 @@ Needs meshio and VTK (pip packages `meshio`, `vtk`) beside h5py and numpy:
 `make test` makes build/py-venv for it. Runs example scenes of inputs/,
 shortened, with `&output vtk` on (binary, the default, and one as text):
 the five-body mechanism (a flexible coupler, rigid bodies, chain links,
-joints), the two soft links (two flexible bodies), a hex27 cantilever
+joints) and its modal variant (the coupler reconstructed from its frame
+and modes), the two soft links (two flexible bodies), a hex27 cantilever
 whose name needs XML's escapes, a rigid four-bar chain (no mesh, no XDMF)
 and a cantilever whose solver gives up (its XDMF file has the records there
 are). Every .vtu is read by VTK's vtkXMLUnstructuredGridReader (points,
@@ -368,6 +369,16 @@ def main():
     check('five-body-binary-by-default',
           '' if b'format="appended"' in head and b'header_type="UInt64"' in head
           else head.decode(errors='replace'))
+
+    # a modal coupler: the mesh reconstructed from the frame and the modes,
+    # drawn and stored alike
+    variant('five_body_modal.nml', 'modal.nml', short, "vtk = 'modal', file = 'modal.h5'")
+    problem = run(exe, 'modal.nml')
+    check('modal-run', problem)
+    if not problem:
+        parts = check_vtu_files(exe, 'modal', 'modal.pvd', 'modal.h5')
+        check('modal-all-parts', '' if parts == {0, 1, 2} else 'parts %s' % parts)
+        check_xdmf('modal', 'modal.h5')
 
     # two flexible bodies: two pieces, two grids per time step
     variant('two_soft_links.nml', 'links.nml',
