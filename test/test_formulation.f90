@@ -5,7 +5,8 @@
 !> exact solution, and the drift behaviour of the formulations.
 module test_formulation
     use flexmbs_core_kinds, only: wp
-    use flexmbs_core_status, only: status_t
+    use flexmbs_core_status, only: status_t, status_solver_failure, reason_user_function
+    use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_sink, only: sink_t, dense_output_t
@@ -34,6 +35,20 @@ module test_formulation
         procedure :: step => drift_step
     end type drift_sink_t
 
+    !> The mechanical pendulum with only the bindings a problem must give:
+    !> every derivative is the default forward difference; its forces fail
+    !> for x above `fail_above`.
+    type, extends(mechanical_problem_t) :: plain_pendulum_t
+        type(pendulum_mechanical_t) :: p
+        real(wp) :: fail_above = huge(1.0_wp)
+    contains
+        procedure :: kinematics => plain_kinematics
+        procedure :: mass => plain_mass
+        procedure :: forces => plain_forces
+        procedure :: constraint => plain_constraint
+        procedure :: constraint_jacobian => plain_constraint_jacobian
+    end type plain_pendulum_t
+
     real(wp), parameter :: phi0 = 1.0_wp
     ! a state off the constraint manifold (residual and Jacobian checks)
     real(wp), parameter :: y_test(6) = [0.6_wp, -0.7_wp, 0.3_wp, 0.4_wp, 2.5_wp, 0.1_wp]
@@ -50,7 +65,8 @@ contains
                  new_test('radau5_acceleration_layout', test_radau5_accelerations), &
                  new_test('ddassl_runs', test_ddassl), &
                  new_test('consistent_initial', test_consistent_initial), &
-                 new_test('drift_growth', test_drift)]
+                 new_test('drift_growth', test_drift), &
+                 new_test('default_differences', test_default_differences)]
     end function collect_formulation
 
     !> Residuals, Jacobians, mass matrices and index classes of the constant-
@@ -399,4 +415,87 @@ contains
         self%position(bin) = max(self%position(bin), dpos)
         self%velocity(bin) = max(self%velocity(bin), dvel)
     end subroutine drift_step
+
+    !> The default derivatives (forward differences, one routine) against
+    !> the pendulum's analytic ones; a failing evaluation ends them with its
+    !> status.
+    subroutine test_default_differences(error)
+        type(error_t), allocatable, intent(out) :: error
+        type(plain_pendulum_t) :: plain
+        type(status_t) :: status
+        real(wp) :: q(2), v(2), w(2), lam(1), fq(2, 2), fv(2, 2), aq(2, 2), av(2, 2), &
+            gwq(1, 2), gtlq(2, 2), bwq(1, 2), btlq(2, 2), kq(2, 2), bq(2, 2), cq(1, 2), dcq(1, 2)
+        plain%p = new_pendulum_mechanical(status=status)
+        plain%nq = plain%p%nq
+        plain%nv = plain%p%nv
+        plain%nc = plain%p%nc
+        q = [0.6_wp, -0.8_wp]
+        v = [0.3_wp, 0.2_wp]
+        w = [1.5_wp, -0.5_wp]
+        lam = [2.0_wp]
+        call plain%force_derivatives(0.0_wp, q, v, fq, fv, status)
+        call plain%p%force_derivatives(0.0_wp, q, v, aq, av, status)
+        call check(error, status%ok() .and. maxval(abs(fq - aq)) <= 1.0e-7_wp .and. &
+                   maxval(abs(fv - av)) <= 1.0e-7_wp, 'df/dq, df/dv')
+        call plain%constraint_jacobian_derivatives(0.0_wp, q, w, lam, gwq, gtlq, status)
+        call plain%p%constraint_jacobian_derivatives(0.0_wp, q, w, lam, bwq, btlq, status)
+        call check(error, status%ok() .and. maxval(abs(gwq - bwq)) <= 1.0e-7_wp .and. &
+                   maxval(abs(gtlq - btlq)) <= 1.0e-7_wp, 'd(G w)/dq, d(G^T lambda)/dq')
+        call plain%kinematics_derivative(0.0_wp, q, w, kq, status)
+        call check(error, status%ok() .and. maxval(abs(kq)) == 0.0_wp, 'd(T w)/dq = 0')
+        call plain%constraint_position_jacobian(0.0_wp, q, cq, status)
+        call plain%p%constraint_position_jacobian(0.0_wp, q, dcq, status)
+        call check(error, status%ok() .and. maxval(abs(cq - dcq)) <= 1.0e-7_wp, 'g_q')
+        ! forces fail beyond x = 0.6 + 1e-9: the first column's step goes there
+        plain%fail_above = 0.6_wp + 1.0e-9_wp
+        call plain%force_derivatives(0.0_wp, q, v, fq, fv, status)
+        call check(error, status%code == status_solver_failure .and. &
+                   index(status%text(), 'x above') > 0, 'a failed evaluation: ' // status%text())
+        call status%clear()
+        call plain%mass_derivative(0.0_wp, q, w, bq, status)
+        call check(error, status%ok() .and. maxval(abs(bq)) == 0.0_wp, 'd(M w)/dq = 0')
+    end subroutine test_default_differences
+
+    subroutine plain_kinematics(self, t, q, w, qdot, status)
+        class(plain_pendulum_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), w(:)
+        real(wp), intent(out) :: qdot(:)
+        type(status_t), intent(inout) :: status
+        call self%p%kinematics(t, q, w, qdot, status)
+    end subroutine plain_kinematics
+
+    subroutine plain_mass(self, t, q, m, status)
+        class(plain_pendulum_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: m(:, :)
+        type(status_t), intent(inout) :: status
+        call self%p%mass(t, q, m, status)
+    end subroutine plain_mass
+
+    subroutine plain_forces(self, t, q, v, f, status)
+        class(plain_pendulum_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:), v(:)
+        real(wp), intent(out) :: f(:)
+        type(status_t), intent(inout) :: status
+        call self%p%forces(t, q, v, f, status)
+        if (q(1) > self%fail_above) call status%set(status_solver_failure, &
+            'plain pendulum: forces refused for x above the test''s bound', &
+            reason_user_function)
+    end subroutine plain_forces
+
+    subroutine plain_constraint(self, t, q, g, status)
+        class(plain_pendulum_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: g(:)
+        type(status_t), intent(inout) :: status
+        call self%p%constraint(t, q, g, status)
+    end subroutine plain_constraint
+
+    subroutine plain_constraint_jacobian(self, t, q, gmat, status)
+        class(plain_pendulum_t), intent(inout) :: self
+        real(wp), intent(in) :: t, q(:)
+        real(wp), intent(out) :: gmat(:, :)
+        type(status_t), intent(inout) :: status
+        call self%p%constraint_jacobian(t, q, gmat, status)
+    end subroutine plain_constraint_jacobian
 end module test_formulation

@@ -15,7 +15,8 @@
 !> The formulations (src/mbs/formulation.f90) need the derivatives of these
 !> terms with respect to q and v for their Jacobians. A problem may override
 !> the `*_derivative(s)` bindings with analytic ones; the defaults difference
-!> the base bindings by forward differences (step sqrt(eps) max(1, |x_j|)),
+!> the base bindings by forward differences (step sqrt(eps) max(1, |x_j|),
+!> one routine for all, which stops at the first evaluation that fails),
 !> one evaluation per column, so they are accurate to about sqrt(eps).
 !>
 !> Large models (flexible bodies) also provide those derivatives sparse
@@ -132,6 +133,17 @@ module flexmbs_dae_mechanical_problem
 
     public :: difference_step
 
+    !> y = F(x) for forward_differences (an internal procedure of the
+    !> default derivative binding, which knows t and the other arguments).
+    abstract interface
+        subroutine vector_function_i(x, y, status)
+            import :: wp, status_t
+            real(wp), intent(in) :: x(:)
+            real(wp), intent(out) :: y(:)
+            type(status_t), intent(inout) :: status
+        end subroutine vector_function_i
+    end interface
+
 contains
 
     !> Forward-difference step for a variable of value x.
@@ -168,23 +180,45 @@ contains
         call status%clear()
     end subroutine default_admissible
 
+    !> Forward differences of y = F(x) at x into the columns of jac, F given
+    !> by `evaluate` and `base` = F(x): step difference_step(x_j) per column,
+    !> one evaluation each. An evaluation that fails ends the differences
+    !> with its status (nothing of a failed state enters jac).
+    subroutine forward_differences(x, base, evaluate, jac, status)
+        real(wp), intent(in) :: x(:), base(:)
+        procedure(vector_function_i) :: evaluate
+        real(wp), intent(out) :: jac(:, :)
+        type(status_t), intent(inout) :: status
+        real(wp) :: xp(size(x)), pert(size(base)), delta
+        integer :: j
+        if (.not. status%ok()) return
+        xp = x
+        do j = 1, size(x)
+            delta = difference_step(x(j))
+            xp(j) = x(j) + delta
+            call evaluate(xp, pert, status)
+            if (.not. status%ok()) return
+            jac(:, j) = (pert - base) / delta
+            xp(j) = x(j)
+        end do
+    end subroutine forward_differences
+
     !> ∂(T(t,q) w)/∂q, nq x nq (default: forward differences).
     subroutine default_kinematics_derivative(self, t, q, w, dq, status)
         class(mechanical_problem_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:), w(:)
         real(wp), intent(out) :: dq(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: qp(size(q)), base(self%nq), pert(self%nq), delta
-        integer :: j
+        real(wp) :: base(self%nq)
         call self%kinematics(t, q, w, base, status)
-        qp = q
-        do j = 1, self%nq
-            delta = difference_step(q(j))
-            qp(j) = q(j) + delta
-            call self%kinematics(t, qp, w, pert, status)
-            dq(:, j) = (pert - base) / delta
-            qp(j) = q(j)
-        end do
+        call forward_differences(q, base, at, dq, status)
+    contains
+        subroutine at(x, y, st)
+            real(wp), intent(in) :: x(:)
+            real(wp), intent(out) :: y(:)
+            type(status_t), intent(inout) :: st
+            call self%kinematics(t, x, w, y, st)
+        end subroutine at
     end subroutine default_kinematics_derivative
 
     !> ∂(M(t,q) w)/∂q, nv x nq (default: forward differences).
@@ -193,18 +227,17 @@ contains
         real(wp), intent(in) :: t, q(:), w(:) !! the vector M acts on (an acceleration)
         real(wp), intent(out) :: dq(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: qp(size(q)), m(self%nv, self%nv), base(self%nv), delta
-        integer :: j
-        call self%mass(t, q, m, status)
-        base = matmul(m, w)
-        qp = q
-        do j = 1, self%nq
-            delta = difference_step(q(j))
-            qp(j) = q(j) + delta
-            call self%mass(t, qp, m, status)
-            dq(:, j) = (matmul(m, w) - base) / delta
-            qp(j) = q(j)
-        end do
+        real(wp) :: m(self%nv, self%nv), base(self%nv)
+        call at(q, base, status)
+        call forward_differences(q, base, at, dq, status)
+    contains
+        subroutine at(x, y, st)
+            real(wp), intent(in) :: x(:)
+            real(wp), intent(out) :: y(:)
+            type(status_t), intent(inout) :: st
+            call self%mass(t, x, m, st)
+            y = matmul(m, w)
+        end subroutine at
     end subroutine default_mass_derivative
 
     !> ∂f/∂q (nv x nq) and ∂f/∂v (nv x nv) (default: forward differences).
@@ -213,25 +246,23 @@ contains
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: fq(:, :), fv(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: qp(size(q)), vp(size(v)), base(self%nv), pert(self%nv), delta
-        integer :: j
+        real(wp) :: base(self%nv)
         call self%forces(t, q, v, base, status)
-        qp = q
-        do j = 1, self%nq
-            delta = difference_step(q(j))
-            qp(j) = q(j) + delta
-            call self%forces(t, qp, v, pert, status)
-            fq(:, j) = (pert - base) / delta
-            qp(j) = q(j)
-        end do
-        vp = v
-        do j = 1, self%nv
-            delta = difference_step(v(j))
-            vp(j) = v(j) + delta
-            call self%forces(t, q, vp, pert, status)
-            fv(:, j) = (pert - base) / delta
-            vp(j) = v(j)
-        end do
+        call forward_differences(q, base, at_q, fq, status)
+        call forward_differences(v, base, at_v, fv, status)
+    contains
+        subroutine at_q(x, y, st)
+            real(wp), intent(in) :: x(:)
+            real(wp), intent(out) :: y(:)
+            type(status_t), intent(inout) :: st
+            call self%forces(t, x, v, y, st)
+        end subroutine at_q
+        subroutine at_v(x, y, st)
+            real(wp), intent(in) :: x(:)
+            real(wp), intent(out) :: y(:)
+            type(status_t), intent(inout) :: st
+            call self%forces(t, q, x, y, st)
+        end subroutine at_v
     end subroutine default_force_derivatives
 
     !> g_q, nc x nq (default: forward differences of g).
@@ -240,40 +271,43 @@ contains
         real(wp), intent(in) :: t, q(:)
         real(wp), intent(out) :: gq(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: qp(size(q)), base(self%nc), pert(self%nc), delta
-        integer :: j
+        real(wp) :: base(self%nc)
         call self%constraint(t, q, base, status)
-        qp = q
-        do j = 1, self%nq
-            delta = difference_step(q(j))
-            qp(j) = q(j) + delta
-            call self%constraint(t, qp, pert, status)
-            gq(:, j) = (pert - base) / delta
-            qp(j) = q(j)
-        end do
+        call forward_differences(q, base, at, gq, status)
+    contains
+        subroutine at(x, y, st)
+            real(wp), intent(in) :: x(:)
+            real(wp), intent(out) :: y(:)
+            type(status_t), intent(inout) :: st
+            call self%constraint(t, x, y, st)
+        end subroutine at
     end subroutine default_constraint_position_jacobian
 
     !> ∂(G(t,q) w)/∂q (nc x nq) and ∂(G(t,q)ᵀ λ)/∂q (nv x nq) (default:
-    !> forward differences of G).
+    !> forward differences of G; both from one evaluation of G per column).
     subroutine default_constraint_jacobian_derivatives(self, t, q, w, lambda, gwq, gtlq, status)
         class(mechanical_problem_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:), w(:), lambda(:)
         real(wp), intent(out) :: gwq(:, :), gtlq(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: qp(size(q)), gmat(self%nc, self%nv), gw(self%nc), gtl(self%nv), delta
-        integer :: j
-        call self%constraint_jacobian(t, q, gmat, status)
-        gw = matmul(gmat, w)
-        gtl = matmul(lambda, gmat)
-        qp = q
-        do j = 1, self%nq
-            delta = difference_step(q(j))
-            qp(j) = q(j) + delta
-            call self%constraint_jacobian(t, qp, gmat, status)
-            gwq(:, j) = (matmul(gmat, w) - gw) / delta
-            gtlq(:, j) = (matmul(lambda, gmat) - gtl) / delta
-            qp(j) = q(j)
-        end do
+        real(wp) :: gmat(self%nc, self%nv), base(self%nc + self%nv)
+        real(wp), allocatable :: both(:, :)   ! on the heap: (nc + nv) x nq
+        allocate (both(self%nc + self%nv, self%nq))
+        call at(q, base, status)
+        call forward_differences(q, base, at, both, status)
+        if (.not. status%ok()) return
+        gwq = both(1:self%nc, :)
+        gtlq = both(self%nc + 1:, :)
+    contains
+        !> (G w, Gᵀ λ) at positions x.
+        subroutine at(x, y, st)
+            real(wp), intent(in) :: x(:)
+            real(wp), intent(out) :: y(:)
+            type(status_t), intent(inout) :: st
+            call self%constraint_jacobian(t, x, gmat, st)
+            y(1:self%nc) = matmul(gmat, w)
+            y(self%nc + 1:) = matmul(lambda, gmat)
+        end subroutine at
     end subroutine default_constraint_jacobian_derivatives
 
     !> ∂g_I/∂q, nc x nq (default: forward differences of g_I).
@@ -282,17 +316,16 @@ contains
         real(wp), intent(in) :: t, q(:)
         real(wp), intent(out) :: dq(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: qp(size(q)), base(self%nc), pert(self%nc), delta
-        integer :: j
+        real(wp) :: base(self%nc)
         call self%constraint_time_derivative(t, q, base, status)
-        qp = q
-        do j = 1, self%nq
-            delta = difference_step(q(j))
-            qp(j) = q(j) + delta
-            call self%constraint_time_derivative(t, qp, pert, status)
-            dq(:, j) = (pert - base) / delta
-            qp(j) = q(j)
-        end do
+        call forward_differences(q, base, at, dq, status)
+    contains
+        subroutine at(x, y, st)
+            real(wp), intent(in) :: x(:)
+            real(wp), intent(out) :: y(:)
+            type(status_t), intent(inout) :: st
+            call self%constraint_time_derivative(t, x, y, st)
+        end subroutine at
     end subroutine default_constraint_time_derivative_jacobian
 
     !> ∂γ/∂q (nc x nq) and ∂γ/∂v (nc x nv) (default: forward differences).
@@ -301,25 +334,23 @@ contains
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: gq(:, :), gv(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: qp(size(q)), vp(size(v)), base(self%nc), pert(self%nc), delta
-        integer :: j
+        real(wp) :: base(self%nc)
         call self%constraint_curvature(t, q, v, base, status)
-        qp = q
-        do j = 1, self%nq
-            delta = difference_step(q(j))
-            qp(j) = q(j) + delta
-            call self%constraint_curvature(t, qp, v, pert, status)
-            gq(:, j) = (pert - base) / delta
-            qp(j) = q(j)
-        end do
-        vp = v
-        do j = 1, self%nv
-            delta = difference_step(v(j))
-            vp(j) = v(j) + delta
-            call self%constraint_curvature(t, q, vp, pert, status)
-            gv(:, j) = (pert - base) / delta
-            vp(j) = v(j)
-        end do
+        call forward_differences(q, base, at_q, gq, status)
+        call forward_differences(v, base, at_v, gv, status)
+    contains
+        subroutine at_q(x, y, st)
+            real(wp), intent(in) :: x(:)
+            real(wp), intent(out) :: y(:)
+            type(status_t), intent(inout) :: st
+            call self%constraint_curvature(t, x, v, y, st)
+        end subroutine at_q
+        subroutine at_v(x, y, st)
+            real(wp), intent(in) :: x(:)
+            real(wp), intent(out) :: y(:)
+            type(status_t), intent(inout) :: st
+            call self%constraint_curvature(t, q, x, y, st)
+        end subroutine at_v
     end subroutine default_constraint_curvature_derivatives
 
     !> g_I = ∂g/∂t; zero for scleronomic constraints.

@@ -9,6 +9,7 @@
 module flexmbs_io_table
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use flexmbs_core_kinds, only: wp
+    use flexmbs_core_text, only: int_text
     use flexmbs_core_status, only: status_t, status_bad_input, status_io_error
     use flexmbs_core_version, only: written_by, is_written_by
     use flexmbs_core_files, only: read_first_lines
@@ -146,7 +147,7 @@ contains
             cells(i + 1, 5)%s = run(9)%s
             counts = rows(i)%stats%rejections%counts_by_cause()
             do k = 6, nrow
-                cells(i + 1, k)%s = itoa(counts(k - 5))
+                cells(i + 1, k)%s = int_text(counts(k - 5))
             end do
         end do
         flags = .true.
@@ -346,10 +347,10 @@ contains
         else
             cells(4)%s = sci(row%err, format)
         end if
-        cells(5)%s = itoa(row%stats%nst)
-        cells(6)%s = itoa(row%stats%nac)
-        cells(7)%s = itoa(row%stats%nfe)
-        cells(8)%s = itoa(row%stats%nje)
+        cells(5)%s = int_text(row%stats%nst)
+        cells(6)%s = int_text(row%stats%nac)
+        cells(7)%s = int_text(row%stats%nfe)
+        cells(8)%s = int_text(row%stats%nje)
         if (row%cpu_unit > 0.0_wp) then
             write (buf, '(f0.2)') row%stats%cpu / row%cpu_unit
         else
@@ -357,9 +358,9 @@ contains
         end if
         if (buf(1:1) == '.') buf = '0' // trim(buf)
         cells(9)%s = trim(buf)
-        cells(10)%s = itoa(row%stats%nrj)
-        cells(11)%s = itoa(row%stats%ndec)
-        cells(12)%s = itoa(row%stats%nsol)
+        cells(10)%s = int_text(row%stats%nrj)
+        cells(11)%s = int_text(row%stats%ndec)
+        cells(12)%s = int_text(row%stats%nsol)
     end subroutine fill_cells
 
     !> NRJ by cause, in the order of the cause_* constants.
@@ -369,7 +370,7 @@ contains
         integer :: counts(cause_count), c
         counts = row%stats%rejections%counts_by_cause()
         do c = 1, size(cells)
-            cells(c)%s = itoa(counts(c))
+            cells(c)%s = int_text(counts(c))
         end do
     end subroutine fill_causes
 
@@ -445,12 +446,4 @@ contains
         end do
         t = t // '"'
     end function csv_field
-
-    pure function itoa(i) result(s)
-        integer, intent(in) :: i
-        character(len=:), allocatable :: s
-        character(len=24) :: buf
-        write (buf, '(i0)') i
-        s = trim(buf)
-    end function itoa
 end module flexmbs_io_table

@@ -15,6 +15,7 @@ module flexmbs_legacy_radau5_adapter
     use, intrinsic :: iso_fortran_env, only: error_unit
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_text, only: int_text
     use flexmbs_core_status, only: status_t, status_ok, status_bad_input, status_interrupted, &
         reason_max_steps, reason_step_too_small, reason_singular_matrix
     use flexmbs_linalg_matrix, only: storage_none, storage_identity, storage_dense, storage_sparse
@@ -139,16 +140,16 @@ contains
         idid = -1
         ! Sizes first: the option slots are read only from large enough arrays.
         if (n <= 0) then
-            call reject('N = ' // itoa(n) // ': must be positive')
+            call reject('N = ' // int_text(n) // ': must be positive')
             return
         end if
         if (liwork < 3 * n + 20) then
-            call reject('LIWORK = ' // itoa(liwork) // ': must be at least 3N+20 = ' &
-                // itoa(3 * n + 20))
+            call reject('LIWORK = ' // int_text(liwork) // ': must be at least 3N+20 = ' &
+                // int_text(3 * n + 20))
             return
         end if
         if (lwork < min_slots) then
-            call reject('LWORK = ' // itoa(lwork) // ': too small')
+            call reject('LWORK = ' // int_text(lwork) // ': too small')
             return
         end if
 
@@ -167,8 +168,8 @@ contains
         else
             do i = 1, n
                 if (atol(i) <= 0.0_wp .or. rtol(i) <= 10.0_wp * uround) then
-                    call reject('tolerances RTOL(' // itoa(i) // ') = ' // rtoa(rtol(i)) // &
-                        ', ATOL(' // itoa(i) // ') = ' // rtoa(atol(i)) // &
+                    call reject('tolerances RTOL(' // int_text(i) // ') = ' // rtoa(rtol(i)) // &
+                        ', ATOL(' // int_text(i) // ') = ' // rtoa(atol(i)) // &
                         ': need ATOL > 0 and RTOL > 10*uround')
                     return
                 end if
@@ -176,26 +177,26 @@ contains
         end if
         nmax = merge(nmax_default, iwork(2), iwork(2) == 0)
         if (nmax <= 0) then
-            call reject('IWORK(2) = NMAX = ' // itoa(nmax) // ': must be positive')
+            call reject('IWORK(2) = NMAX = ' // int_text(nmax) // ': must be positive')
             return
         end if
         nit = merge(defaults%nit, iwork(3), iwork(3) == 0)
         if (nit <= 0) then
-            call reject('IWORK(3) = NIT = ' // itoa(nit) // ': must be positive')
+            call reject('IWORK(3) = NIT = ' // int_text(nit) // ': must be positive')
             return
         end if
         nind1 = merge(n, iwork(5), iwork(5) == 0)
         nind2 = iwork(6)
         nind3 = iwork(7)
         if (nind1 < 0 .or. nind2 < 0 .or. nind3 < 0 .or. nind1 + nind2 + nind3 /= n) then
-            call reject('IWORK(5..7) = NIND1..3 = ' // itoa(nind1) // ', ' // itoa(nind2) // &
-                ', ' // itoa(nind3) // ': must be non-negative and add up to N')
+            call reject('IWORK(5..7) = NIND1..3 = ' // int_text(nind1) // ', ' // int_text(nind2) // &
+                ', ' // int_text(nind3) // ': must be non-negative and add up to N')
             return
         end if
         m1 = iwork(9)
         m2 = merge(m1, iwork(10), iwork(10) == 0)
         if (m1 < 0 .or. m2 < 0 .or. m1 + m2 > n) then
-            call reject('IWORK(9..10) = M1, M2 = ' // itoa(m1) // ', ' // itoa(m2) // &
+            call reject('IWORK(9..10) = M1, M2 = ' // int_text(m1) // ', ' // int_text(m2) // &
                 ': need M1 >= 0, M2 >= 0 and M1 + M2 <= N')
             return
         end if
@@ -236,7 +237,7 @@ contains
         ! ---- matrix structure ----
         problem%banded = mljac < nm1
         if (problem%banded .and. (mljac < 0 .or. mujac < 0)) then
-            call reject('MLJAC, MUJAC = ' // itoa(mljac) // ', ' // itoa(mujac) // &
+            call reject('MLJAC, MUJAC = ' // int_text(mljac) // ', ' // int_text(mujac) // &
                 ': bandwidths must not be negative')
             return
         end if
@@ -245,7 +246,7 @@ contains
         if (problem%banded .and. m1 > 0) then
             if (m1 + m2 /= n .or. mod(m1, max(m2, 1)) /= 0) then
                 call reject('banded Jacobian with M1 > 0 needs M1 + M2 = N and M1 a ' // &
-                    'multiple of M2; got M1, M2 = ' // itoa(m1) // ', ' // itoa(m2))
+                    'multiple of M2; got M1, M2 = ' // int_text(m1) // ', ' // int_text(m2))
                 return
             end if
         end if
@@ -253,15 +254,15 @@ contains
         if (problem%has_mass) then
             problem%mass_banded = mlmas < nm1
             if (problem%mass_banded .and. (mlmas < 0 .or. mumas < 0)) then
-                call reject('MLMAS, MUMAS = ' // itoa(mlmas) // ', ' // itoa(mumas) // &
+                call reject('MLMAS, MUMAS = ' // int_text(mlmas) // ', ' // int_text(mumas) // &
                     ': bandwidths must not be negative')
                 return
             end if
             if (problem%banded) then
                 if (.not. problem%mass_banded .or. mlmas > mljac .or. mumas > mujac) then
-                    call reject('mass bandwidths MLMAS, MUMAS = ' // itoa(mlmas) // ', ' // &
-                        itoa(mumas) // ' exceed the Jacobian''s ' // itoa(mljac) // ', ' // &
-                        itoa(mujac))
+                    call reject('mass bandwidths MLMAS, MUMAS = ' // int_text(mlmas) // ', ' // &
+                        int_text(mumas) // ' exceed the Jacobian''s ' // int_text(mljac) // ', ' // &
+                        int_text(mujac))
                     return
                 end if
             end if
@@ -283,7 +284,7 @@ contains
         if (problem%has_mass) lmas = merge(mlmas + mumas + 1, nm1, problem%mass_banded)
         need = int(n, i8) * (int(ljac, i8) + lmas + 3_i8 * le + 12) + 20
         if (lwork < need) then
-            call reject('LWORK = ' // itoa(lwork) // ': must be at least ' // i8toa(need))
+            call reject('LWORK = ' // int_text(lwork) // ': must be at least ' // int_text(need))
             return
         end if
 
@@ -769,21 +770,7 @@ contains
 
     ! ---------------------------------------------------------------- helpers
 
-    pure function itoa(i) result(text)
-        integer, intent(in) :: i
-        character(len=:), allocatable :: text
-        character(len=16) :: buf
-        write (buf, '(i0)') i
-        text = trim(buf)
-    end function itoa
 
-    pure function i8toa(i) result(text)
-        integer(i8), intent(in) :: i
-        character(len=:), allocatable :: text
-        character(len=24) :: buf
-        write (buf, '(i0)') i
-        text = trim(buf)
-    end function i8toa
 
     pure function rtoa(x) result(text)
         real(wp), intent(in) :: x
