@@ -193,90 +193,17 @@ contains
         end if
     end subroutine check_layout
 
-    !> Add s*A into the band of ab (real s); status_bad_input when A has an
-    !> entry outside the band (values changed since init, or a new pattern).
-    subroutine add_real(self, s, a, ab, status)
-        class(band_solver_t), intent(in) :: self
-        real(wp), intent(in) :: s
-        type(matrix_t), intent(in) :: a
-        real(wp), intent(inout) :: ab(:, :)
-        type(status_t), intent(inout) :: status
-        integer :: i, j, d
-        integer(i8) :: p
-        d = self%ml + self%mu + 1
-        select case (a%storage)
-        case (storage_identity)
-            do j = 1, self%n
-                ab(d, j) = ab(d, j) + s
-            end do
-        case (storage_sparse)
-            do j = 1, self%n
-                do p = a%csc%colptr(j) + 1, a%csc%colptr(j + 1)
-                    i = int(a%csc%rowind(p)) + 1
-                    if (i - j > self%ml .or. j - i > self%mu) then
-                        call outside(self, i, j, status)
-                        return
-                    end if
-                    ab(d + i - j, j) = ab(d + i - j, j) + s * a%csc%values(p)
-                end do
-            end do
-        case (storage_dense)
-            do j = 1, self%n
-                do i = 1, self%n
-                    if (i - j > self%ml .or. j - i > self%mu) then
-                        if (a%dense(i, j) /= 0.0_wp) then
-                            call outside(self, i, j, status)
-                            return
-                        end if
-                    else
-                        ab(d + i - j, j) = ab(d + i - j, j) + s * a%dense(i, j)
-                    end if
-                end do
-            end do
-        end select
-    end subroutine add_real
-
-    !> add_real with a complex factor s.
-    subroutine add_complex(self, s, a, zab, status)
-        class(band_solver_t), intent(in) :: self
-        complex(wp), intent(in) :: s
-        type(matrix_t), intent(in) :: a
-        complex(wp), intent(inout) :: zab(:, :)
-        type(status_t), intent(inout) :: status
-        integer :: i, j, d
-        integer(i8) :: p
-        d = self%ml + self%mu + 1
-        select case (a%storage)
-        case (storage_identity)
-            do j = 1, self%n
-                zab(d, j) = zab(d, j) + s
-            end do
-        case (storage_sparse)
-            do j = 1, self%n
-                do p = a%csc%colptr(j) + 1, a%csc%colptr(j + 1)
-                    i = int(a%csc%rowind(p)) + 1
-                    if (i - j > self%ml .or. j - i > self%mu) then
-                        call outside(self, i, j, status)
-                        return
-                    end if
-                    zab(d + i - j, j) = zab(d + i - j, j) + s * a%csc%values(p)
-                end do
-            end do
-        case (storage_dense)
-            do j = 1, self%n
-                do i = 1, self%n
-                    if (i - j > self%ml .or. j - i > self%mu) then
-                        if (a%dense(i, j) /= 0.0_wp) then
-                            call outside(self, i, j, status)
-                            return
-                        end if
-                    else
-                        zab(d + i - j, j) = zab(d + i - j, j) + s * a%dense(i, j)
-                    end if
-                end do
-            end do
-        end select
-    end subroutine add_complex
+    ! add_real and add_complex: one body (band_add.inc) for both types.
+#define SCALAR real(wp)
+#define ADD_NAME add_real
+#include "band_add.inc"
+#undef SCALAR
+#undef ADD_NAME
+#define SCALAR complex(wp)
+#define ADD_NAME add_complex
+#include "band_add.inc"
+#undef SCALAR
+#undef ADD_NAME
 
     subroutine outside(self, i, j, status)
         class(band_solver_t), intent(in) :: self
