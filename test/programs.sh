@@ -101,5 +101,11 @@ if out=$(gfortran -J "$work" -o "$work/rigid_flexible_shared" examples/rigid_fle
 else
     fail shared-library "$out"
 fi
+# no executable stack (a trampoline of an internal procedure passed as an
+# argument would need one, and glibc refuses to dlopen such a library)
+stacks=$(for f in "$prefix"/lib/libflexmbs*.so; do
+    readelf -lW "$f" | grep GNU_STACK | grep -q 'RWE' && echo "$f"; done)
+if [ -z "$stacks" ]; then pass no-executable-stack; else
+    fail no-executable-stack "needs an executable stack: $stacks"; fi
 echo "${passed} passed, ${failed} failed"
 [ "$failed" -eq 0 ]

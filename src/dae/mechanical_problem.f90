@@ -133,16 +133,9 @@ module flexmbs_dae_mechanical_problem
 
     public :: difference_step
 
-    !> y = F(x) for forward_differences (an internal procedure of the
-    !> default derivative binding, which knows t and the other arguments).
-    abstract interface
-        subroutine vector_function_i(x, y, status)
-            import :: wp, status_t
-            real(wp), intent(in) :: x(:)
-            real(wp), intent(out) :: y(:)
-            type(status_t), intent(inout) :: status
-        end subroutine vector_function_i
-    end interface
+    ! The quantities forward_differences differences (evaluate).
+    integer, parameter :: of_kinematics = 1, of_mass = 2, of_forces = 3, of_constraint = 4, &
+        of_jacobian = 5, of_time = 6, of_curvature = 7
 
 contains
 
@@ -180,28 +173,76 @@ contains
         call status%clear()
     end subroutine default_admissible
 
-    !> Forward differences of y = F(x) at x into the columns of jac, F given
-    !> by `evaluate` and `base` = F(x): step difference_step(x_j) per column,
-    !> one evaluation each. An evaluation that fails ends the differences
-    !> with its status (nothing of a failed state enters jac).
-    subroutine forward_differences(x, base, evaluate, jac, status)
-        real(wp), intent(in) :: x(:), base(:)
-        procedure(vector_function_i) :: evaluate
+    !> Forward differences of y = F(q, v) along q (or, with `along_v`,
+    !> along v) into the columns of jac, F the quantity `what` (of_*) and
+    !> `base` = F at (q, v): step difference_step per column, one evaluation
+    !> each. An evaluation that fails ends the differences with its status
+    !> (nothing of a failed state enters jac). A selector rather than a
+    !> procedure argument: an internal procedure passed on would need an
+    !> executable stack for its trampoline.
+    subroutine forward_differences(self, what, t, q, v, w, lambda, along_v, base, jac, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        integer, intent(in) :: what
+        real(wp), intent(in) :: t, q(:), v(:), w(:), lambda(:)
+        logical, intent(in) :: along_v
+        real(wp), intent(in) :: base(:)
         real(wp), intent(out) :: jac(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: xp(size(x)), pert(size(base)), delta
+        real(wp) :: qp(size(q)), vp(size(v)), pert(size(base)), delta
         integer :: j
         if (.not. status%ok()) return
-        xp = x
-        do j = 1, size(x)
-            delta = difference_step(x(j))
-            xp(j) = x(j) + delta
-            call evaluate(xp, pert, status)
+        qp = q
+        vp = v
+        do j = 1, size(jac, 2)
+            if (along_v) then
+                delta = difference_step(v(j))
+                vp(j) = v(j) + delta
+            else
+                delta = difference_step(q(j))
+                qp(j) = q(j) + delta
+            end if
+            call evaluate(self, what, t, qp, vp, w, lambda, pert, status)
             if (.not. status%ok()) return
             jac(:, j) = (pert - base) / delta
-            xp(j) = x(j)
+            if (along_v) then
+                vp(j) = v(j)
+            else
+                qp(j) = q(j)
+            end if
         end do
     end subroutine forward_differences
+
+    !> The quantity `what` (of_*) at (t, q, v): T w, M w, f, g, (G w, Gᵀ λ),
+    !> g_I or γ.
+    subroutine evaluate(self, what, t, q, v, w, lambda, y, status)
+        class(mechanical_problem_t), intent(inout) :: self
+        integer, intent(in) :: what
+        real(wp), intent(in) :: t, q(:), v(:), w(:), lambda(:)
+        real(wp), intent(out) :: y(:)
+        type(status_t), intent(inout) :: status
+        real(wp), allocatable :: m(:, :)
+        select case (what)
+        case (of_kinematics)
+            call self%kinematics(t, q, w, y, status)
+        case (of_mass)
+            allocate (m(self%nv, self%nv))
+            call self%mass(t, q, m, status)
+            y = matmul(m, w)
+        case (of_forces)
+            call self%forces(t, q, v, y, status)
+        case (of_constraint)
+            call self%constraint(t, q, y, status)
+        case (of_jacobian)
+            allocate (m(self%nc, self%nv))
+            call self%constraint_jacobian(t, q, m, status)
+            y(1:self%nc) = matmul(m, w)
+            y(self%nc + 1:) = matmul(lambda, m)
+        case (of_time)
+            call self%constraint_time_derivative(t, q, y, status)
+        case (of_curvature)
+            call self%constraint_curvature(t, q, v, y, status)
+        end select
+    end subroutine evaluate
 
     !> ∂(T(t,q) w)/∂q, nq x nq (default: forward differences).
     subroutine default_kinematics_derivative(self, t, q, w, dq, status)
@@ -209,16 +250,10 @@ contains
         real(wp), intent(in) :: t, q(:), w(:)
         real(wp), intent(out) :: dq(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: base(self%nq)
+        real(wp) :: base(self%nq), none(0)
         call self%kinematics(t, q, w, base, status)
-        call forward_differences(q, base, at, dq, status)
-    contains
-        subroutine at(x, y, st)
-            real(wp), intent(in) :: x(:)
-            real(wp), intent(out) :: y(:)
-            type(status_t), intent(inout) :: st
-            call self%kinematics(t, x, w, y, st)
-        end subroutine at
+        call forward_differences(self, of_kinematics, t, q, none, w, none, .false., base, dq, &
+                                 status)
     end subroutine default_kinematics_derivative
 
     !> ∂(M(t,q) w)/∂q, nv x nq (default: forward differences).
@@ -227,17 +262,9 @@ contains
         real(wp), intent(in) :: t, q(:), w(:) !! the vector M acts on (an acceleration)
         real(wp), intent(out) :: dq(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: m(self%nv, self%nv), base(self%nv)
-        call at(q, base, status)
-        call forward_differences(q, base, at, dq, status)
-    contains
-        subroutine at(x, y, st)
-            real(wp), intent(in) :: x(:)
-            real(wp), intent(out) :: y(:)
-            type(status_t), intent(inout) :: st
-            call self%mass(t, x, m, st)
-            y = matmul(m, w)
-        end subroutine at
+        real(wp) :: base(self%nv), none(0)
+        call evaluate(self, of_mass, t, q, none, w, none, base, status)
+        call forward_differences(self, of_mass, t, q, none, w, none, .false., base, dq, status)
     end subroutine default_mass_derivative
 
     !> ∂f/∂q (nv x nq) and ∂f/∂v (nv x nv) (default: forward differences).
@@ -246,23 +273,10 @@ contains
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: fq(:, :), fv(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: base(self%nv)
+        real(wp) :: base(self%nv), none(0)
         call self%forces(t, q, v, base, status)
-        call forward_differences(q, base, at_q, fq, status)
-        call forward_differences(v, base, at_v, fv, status)
-    contains
-        subroutine at_q(x, y, st)
-            real(wp), intent(in) :: x(:)
-            real(wp), intent(out) :: y(:)
-            type(status_t), intent(inout) :: st
-            call self%forces(t, x, v, y, st)
-        end subroutine at_q
-        subroutine at_v(x, y, st)
-            real(wp), intent(in) :: x(:)
-            real(wp), intent(out) :: y(:)
-            type(status_t), intent(inout) :: st
-            call self%forces(t, q, x, y, st)
-        end subroutine at_v
+        call forward_differences(self, of_forces, t, q, v, none, none, .false., base, fq, status)
+        call forward_differences(self, of_forces, t, q, v, none, none, .true., base, fv, status)
     end subroutine default_force_derivatives
 
     !> g_q, nc x nq (default: forward differences of g).
@@ -271,16 +285,10 @@ contains
         real(wp), intent(in) :: t, q(:)
         real(wp), intent(out) :: gq(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: base(self%nc)
+        real(wp) :: base(self%nc), none(0)
         call self%constraint(t, q, base, status)
-        call forward_differences(q, base, at, gq, status)
-    contains
-        subroutine at(x, y, st)
-            real(wp), intent(in) :: x(:)
-            real(wp), intent(out) :: y(:)
-            type(status_t), intent(inout) :: st
-            call self%constraint(t, x, y, st)
-        end subroutine at
+        call forward_differences(self, of_constraint, t, q, none, none, none, .false., base, gq, &
+                                 status)
     end subroutine default_constraint_position_jacobian
 
     !> ∂(G(t,q) w)/∂q (nc x nq) and ∂(G(t,q)ᵀ λ)/∂q (nv x nq) (default:
@@ -290,24 +298,15 @@ contains
         real(wp), intent(in) :: t, q(:), w(:), lambda(:)
         real(wp), intent(out) :: gwq(:, :), gtlq(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: gmat(self%nc, self%nv), base(self%nc + self%nv)
+        real(wp) :: base(self%nc + self%nv), none(0)
         real(wp), allocatable :: both(:, :)   ! on the heap: (nc + nv) x nq
         allocate (both(self%nc + self%nv, self%nq))
-        call at(q, base, status)
-        call forward_differences(q, base, at, both, status)
+        call evaluate(self, of_jacobian, t, q, none, w, lambda, base, status)
+        call forward_differences(self, of_jacobian, t, q, none, w, lambda, .false., base, both, &
+                                 status)
         if (.not. status%ok()) return
         gwq = both(1:self%nc, :)
         gtlq = both(self%nc + 1:, :)
-    contains
-        !> (G w, Gᵀ λ) at positions x.
-        subroutine at(x, y, st)
-            real(wp), intent(in) :: x(:)
-            real(wp), intent(out) :: y(:)
-            type(status_t), intent(inout) :: st
-            call self%constraint_jacobian(t, x, gmat, st)
-            y(1:self%nc) = matmul(gmat, w)
-            y(self%nc + 1:) = matmul(lambda, gmat)
-        end subroutine at
     end subroutine default_constraint_jacobian_derivatives
 
     !> ∂g_I/∂q, nc x nq (default: forward differences of g_I).
@@ -316,16 +315,9 @@ contains
         real(wp), intent(in) :: t, q(:)
         real(wp), intent(out) :: dq(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: base(self%nc)
+        real(wp) :: base(self%nc), none(0)
         call self%constraint_time_derivative(t, q, base, status)
-        call forward_differences(q, base, at, dq, status)
-    contains
-        subroutine at(x, y, st)
-            real(wp), intent(in) :: x(:)
-            real(wp), intent(out) :: y(:)
-            type(status_t), intent(inout) :: st
-            call self%constraint_time_derivative(t, x, y, st)
-        end subroutine at
+        call forward_differences(self, of_time, t, q, none, none, none, .false., base, dq, status)
     end subroutine default_constraint_time_derivative_jacobian
 
     !> ∂γ/∂q (nc x nq) and ∂γ/∂v (nc x nv) (default: forward differences).
@@ -334,23 +326,12 @@ contains
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: gq(:, :), gv(:, :)
         type(status_t), intent(inout) :: status
-        real(wp) :: base(self%nc)
+        real(wp) :: base(self%nc), none(0)
         call self%constraint_curvature(t, q, v, base, status)
-        call forward_differences(q, base, at_q, gq, status)
-        call forward_differences(v, base, at_v, gv, status)
-    contains
-        subroutine at_q(x, y, st)
-            real(wp), intent(in) :: x(:)
-            real(wp), intent(out) :: y(:)
-            type(status_t), intent(inout) :: st
-            call self%constraint_curvature(t, x, v, y, st)
-        end subroutine at_q
-        subroutine at_v(x, y, st)
-            real(wp), intent(in) :: x(:)
-            real(wp), intent(out) :: y(:)
-            type(status_t), intent(inout) :: st
-            call self%constraint_curvature(t, q, x, y, st)
-        end subroutine at_v
+        call forward_differences(self, of_curvature, t, q, v, none, none, .false., base, gq, &
+                                 status)
+        call forward_differences(self, of_curvature, t, q, v, none, none, .true., base, gv, &
+                                 status)
     end subroutine default_constraint_curvature_derivatives
 
     !> g_I = ∂g/∂t; zero for scleronomic constraints.
