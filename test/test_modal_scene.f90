@@ -29,12 +29,14 @@ contains
                  new_test('bad_input_named', test_bad)]
     end function collect_modal_scene
 
-    !> Run the scene file with `solver` to t_end, no output file.
-    subroutine run_file(path, solver, t_end, result, status)
+    !> Run the scene file with `solver` to t_end (in `formulation` when
+    !> given), no output file.
+    subroutine run_file(path, solver, t_end, result, status, formulation)
         character(len=*), intent(in) :: path, solver
         real(wp), intent(in) :: t_end
         type(run_result_t), intent(out) :: result
         type(status_t), intent(out) :: status
+        character(len=*), intent(in), optional :: formulation
         type(scene_input_t) :: scene
         call read_scene(path, scene, status)
         if (.not. status%ok()) return
@@ -42,6 +44,7 @@ contains
         scene%progress = .false.
         scene%solver_name = solver
         scene%t_end = t_end
+        if (present(formulation)) scene%multibody%formulation = formulation
         call run_scene(scene, .true., result, status)
     end subroutine run_file
 
@@ -101,21 +104,14 @@ contains
     subroutine test_formulations(error)
         type(error_t), allocatable, intent(out) :: error
         character(len=6), parameter :: forms(4) = ['ggl   ', 'index1', 'index2', 'index3']
-        type(scene_input_t) :: scene
         type(run_result_t) :: result
         type(status_t) :: status
         real(wp), allocatable :: y_ref(:)
         real(wp) :: dev
         integer :: k
         do k = 1, size(forms)
-            call read_scene('inputs/five_body_modal.nml', scene, status)
-            call check(error, status%ok(), 'read: ' // status%text())
-            if (allocated(error)) return
-            scene%output_file = ''
-            scene%progress = .false.
-            scene%t_end = 0.05_wp
-            scene%multibody%formulation = forms(k)
-            call run_scene(scene, .true., result, status)
+            call run_file('inputs/five_body_modal.nml', 'radau5', 0.05_wp, result, status, &
+                          formulation=forms(k))
             call check(error, status%ok(), trim(forms(k)) // ': ' // status%text())
             if (allocated(error)) return
             call check(error, result%has_drift .and. result%drift_end(1) <= 1.0e-5_wp, &

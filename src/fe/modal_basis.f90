@@ -37,7 +37,7 @@ module flexmbs_fe_modal_basis
     use flexmbs_linalg_linear_solver, only: linear_solver_t
     use flexmbs_linalg_factory, only: new_linear_solver
     use flexmbs_linalg_lapack, only: dsyev_quiet, dgetrf, dgetrs
-    use flexmbs_linalg_symmetric_modes, only: lowest_modes, symmetric_dense_limit
+    use flexmbs_linalg_symmetric_modes, only: lowest_modes
     use flexmbs_fe_mesh, only: node_set_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
     implicit none
@@ -128,15 +128,13 @@ contains
         if (.not. status%ok()) return
         call k_ii%gather(body%stiffness%values)
         call m_ii%gather(body%mass_matrix%values)
-        call lowest_modes(k_ii%a, m_ii%a, modes, eigen, lambda, phi, status)
+        call lowest_modes(k_ii%a, m_ii%a, modes, eigen, lambda, phi, status, &
+                          used=basis%eigen_method)
         if (.not. status%ok()) then
             status%message = 'modal basis, fixed-interface modes: ' // status%message
             return
         end if
         basis%fixed_frequencies = sqrt(max(lambda, 0.0_wp))
-        basis%eigen_method = merge('dense ', 'arpack', eigen == 'dense' .or. &
-            (eigen == 'auto' .and. (ni <= symmetric_dense_limit .or. modes >= ni - 1)))
-        basis%eigen_method = trim(basis%eigen_method)
 
         ! Columns: the constraint modes, then the fixed-interface modes; b
         ! keeps each column's interface coordinates alongside.

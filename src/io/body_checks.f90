@@ -106,7 +106,7 @@ contains
                         size(entries(k)%items))) == '')) call value_error(errors, entries, fb, &
                         'fixed', 'node-set names must not be empty', i)
                 end if
-                call check_model(i)
+                call check_model(scene, entries, errors, i)
                 if (has_entry(entries, fb, 'load', i) .and. len_trim(b%load_set) == 0) &
                     call value_error(errors, entries, fb, 'load', 'needs load_set (the node &
                     &set that carries it)', i)
@@ -132,41 +132,6 @@ contains
                     &&rigid_body or &rigid_chain body (markers name bodies)', i, b%name, b%line)
             end associate
         end subroutine check_one_body
-
-        !> model = 'modal' in a multibody scene, without supports or nodal
-        !> loads (joints hold it, force elements load it); the modal
-        !> settings only with it.
-        subroutine check_model(i)
-            integer, intent(in) :: i
-            character(len=*), parameter :: modal_vars(4) = [character(len=12) :: 'modes', &
-                'interfaces', 'modes_method', 'modes_cache']
-            integer :: k
-            associate (b => scene%bodies(i))
-                if (b%model /= 'modal') then
-                    do k = 1, size(modal_vars)
-                        if (has_entry(entries, fb, trim(modal_vars(k)), i)) call value_error( &
-                            errors, entries, fb, trim(modal_vars(k)), 'only with model = &
-                            &''modal''', i)
-                    end do
-                    return
-                end if
-                if (scene%problem /= 'multibody') call value_error(errors, entries, fb, &
-                    'model', 'a modal body needs problem = ''multibody'' (joints hold it on &
-                    &its interfaces)', i)
-                if (has_entry(entries, fb, 'fixed', i)) call value_error(errors, entries, fb, &
-                    'fixed', 'not with model = ''modal'': hold a modal body by a joint on an &
-                    &interface', i)
-                if (has_entry(entries, fb, 'load_set', i)) call value_error(errors, entries, &
-                    fb, 'load_set', 'not with model = ''modal'': load it by a &force on a &
-                    &marker', i)
-                k = entry_index(entries, fb, 'interfaces', i)
-                if (k > 0) then
-                    if (.not. entries(k)%bad .and. any(b%interfaces(1:min(size(b%interfaces), &
-                        size(entries(k)%items))) == '')) call value_error(errors, entries, fb, &
-                        'interfaces', 'node-set names must not be empty', i)
-                end if
-            end associate
-        end subroutine check_model
 
         !> '&flexible_body', or with several '&flexible_body ''NAME'''.
         function label(i) result(text)
@@ -203,6 +168,45 @@ contains
             end associate
         end subroutine check_unique
     end subroutine check_body
+
+    !> model = 'modal' in a multibody scene, without supports or nodal
+    !> loads (joints hold it, force elements load it); the modal
+    !> settings only with it.
+    subroutine check_model(scene, entries, errors, i)
+        type(scene_input_t), intent(in) :: scene
+        type(entry_t), intent(in) :: entries(:)
+        type(input_errors_t), intent(inout) :: errors
+        integer, intent(in) :: i !! the &flexible_body
+        character(len=*), parameter :: fb = 'flexible_body'
+        character(len=*), parameter :: modal_vars(4) = [character(len=12) :: 'modes', &
+            'interfaces', 'modes_method', 'modes_cache']
+        integer :: k
+        associate (b => scene%bodies(i))
+            if (b%model /= 'modal') then
+                do k = 1, size(modal_vars)
+                    if (has_entry(entries, fb, trim(modal_vars(k)), i)) call value_error( &
+                        errors, entries, fb, trim(modal_vars(k)), 'only with model = &
+                        &''modal''', i)
+                end do
+                return
+            end if
+            if (scene%problem /= 'multibody') call value_error(errors, entries, fb, &
+                'model', 'a modal body needs problem = ''multibody'' (joints hold it on &
+                &its interfaces)', i)
+            if (has_entry(entries, fb, 'fixed', i)) call value_error(errors, entries, fb, &
+                'fixed', 'not with model = ''modal'': hold a modal body by a joint on an &
+                &interface', i)
+            if (has_entry(entries, fb, 'load_set', i)) call value_error(errors, entries, &
+                fb, 'load_set', 'not with model = ''modal'': load it by a &force on a &
+                &marker', i)
+            k = entry_index(entries, fb, 'interfaces', i)
+            if (k > 0) then
+                if (.not. entries(k)%bad .and. any(b%interfaces(1:min(size(b%interfaces), &
+                    size(entries(k)%items))) == '')) call value_error(errors, entries, fb, &
+                    'interfaces', 'node-set names must not be empty', i)
+            end if
+        end associate
+    end subroutine check_model
 
 
     !> Why a box mesh of `divisions` elements of type `element` cannot be

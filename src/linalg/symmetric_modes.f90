@@ -77,7 +77,7 @@ contains
     !> λ wanted; `linear_solver` names the factory's LU for K − σM
     !> (default 'auto').
     subroutine lowest_modes(stiffness, mass, count, method, values, vectors, status, shift, &
-                            linear_solver)
+                            linear_solver, used)
         type(csc_matrix_t), intent(in) :: stiffness   !! K (n x n)
         type(csc_matrix_t), intent(in) :: mass        !! M (n x n)
         integer, intent(in) :: count
@@ -87,6 +87,9 @@ contains
         type(status_t), intent(out) :: status
         real(wp), intent(in), optional :: shift
         character(len=*), intent(in), optional :: linear_solver
+        !> the method that ran: 'dense' or 'arpack' ('' for none asked)
+        character(len=:), allocatable, intent(out), optional :: used
+        character(len=:), allocatable :: chosen
         integer :: n
         real(wp) :: sigma
         character(len=:), allocatable :: lu
@@ -105,27 +108,27 @@ contains
             return
         end if
         allocate (values(count), vectors(n, count))
+        if (present(used)) used = ''
         if (count == 0) return
         sigma = 0.0_wp
         if (present(shift)) sigma = shift
         lu = 'auto'
         if (present(linear_solver)) lu = linear_solver
-        select case (method)
+        chosen = method
+        ! 'auto': ARPACK needs count < n; the dense method takes any count
+        if (method == 'auto') chosen = merge('dense ', 'arpack', n <= symmetric_dense_limit &
+                                             .or. count >= n - 1)
+        select case (trim(chosen))
         case ('dense')
             call dense_modes(stiffness, mass, count, values, vectors, status)
         case ('arpack')
             call arpack_modes(stiffness, mass, count, sigma, lu, values, vectors, status)
-        case ('auto')
-            ! ARPACK needs count < n; the dense method any count.
-            if (n <= symmetric_dense_limit .or. count >= n - 1) then
-                call dense_modes(stiffness, mass, count, values, vectors, status)
-            else
-                call arpack_modes(stiffness, mass, count, sigma, lu, values, vectors, status)
-            end if
         case default
             call status%set(status_bad_input, "symmetric modes: method '" // method // &
                 "': use 'auto', 'dense' or 'arpack'")
+            return
         end select
+        if (present(used)) used = trim(chosen)
     end subroutine lowest_modes
 
     !> Every pair by dsygv (itype 1: K φ = λ M φ), the lowest `count` kept.
