@@ -21,6 +21,7 @@ module test_condensed_newton
         formulation_index2, formulation_index3, formulation_ggl
     use flexmbs_mbs_condensed_newton, only: condensed_solver_t
     use flexmbs_io_namelist, only: scene_input_t, read_scene
+    use flexmbs_dae_solver_setting, only: solver_setting_t
     use flexmbs_run_runner, only: run_result_t, run_scene
     use flexmbs_dae_error_measure, only: paper_error
     use flexmbs_run_problem_factory, only: build_problem, block_spec_t
@@ -406,13 +407,8 @@ contains
             scene%t_end = t_end
             scene%newton_system = system
             if (present(mexax_control) .and. solver == 'mexax') then
-                scene%mexax_control = mexax_control
-                if (allocated(scene%solver_settings)) then
-                    scene%solver_settings = [character(len=24) :: scene%solver_settings, &
-                                             'mexax_control']
-                else
-                    scene%solver_settings = [character(len=24) :: 'mexax_control']
-                end if
+                scene%solver_settings = [scene%solver_settings, &
+                    solver_setting_t(name='mexax_control', string_value=mexax_control)]
             end if
             call run_scene(scene, .true., result, status)
             call check(error, status%ok(), path // ' ' // solver // ' ' // system // ': ' // &

@@ -19,8 +19,12 @@ module test_io
     use flexmbs_io_progress, only: progress_t, new_progress
     use flexmbs_dae_radau5, only: radau5_t, radau5_controller_classical
     use flexmbs_dae_solver, only: dae_solver_t
-    use flexmbs_io_scene_input, only: setting_given
-    use flexmbs_run_solver_factory, only: build_solver
+    use flexmbs_io_scene_input, only: setting_given, given_setting
+    use flexmbs_dae_solver_setting, only: solver_setting_t
+    use flexmbs_run_solver_factory, only: build_solver, new_solver
+    use flexmbs_run_catalogue, only: solvers
+    use flexmbs_io_scene_schema, only: schema
+    use flexmbs_core_text, only: int_text
     use flexmbs_dae_ida, only: ida_t
     use flexmbs_run_runner, only: run_result_t, run_scene
     use flexmbs_io_xdmf_file, only: xdmf_beside
@@ -54,6 +58,7 @@ contains
                  new_test('unknown_variable', test_unknown_variable), &
                  new_test('wrong_type', test_wrong_type), &
                  new_test('negative_tolerance', test_negative_tolerance), &
+                 new_test('own_settings_reach_one_solver', test_own_settings), &
                  new_test('missing_file', test_missing_file), &
                  new_test('unknown_group', test_unknown_group), &
                  new_test('other_bad_text', test_other_bad_text), &
@@ -85,6 +90,7 @@ contains
         type(scene_input_t) :: scene
         type(status_t) :: status
         class(dae_solver_t), allocatable :: solver
+        type(solver_setting_t) :: setting
         character(len=:), allocatable :: path
         path = scratch('valid.nml')
         ! its output folder, beside it
@@ -117,9 +123,12 @@ contains
         call check_close(error, scene%rtol, 1.0e-8_wp, 0.0_wp, 'rtol')
         call check_close(error, scene%atol, 1.0e-9_wp, 0.0_wp, 'atol')
         call check(error, scene%max_steps == 5000, 'max_steps')
-        call check(error, scene%controller == 'classical', 'controller lower-cased')
-        call check_close(error, scene%thet, -1.0_wp, 0.0_wp, 'thet')
-        call check(error, scene%zero_start, 'zero_start')
+        setting = given_setting(scene, 'controller')
+        call check(error, setting%string_value == 'classical', 'controller lower-cased')
+        setting = given_setting(scene, 'thet')
+        call check_close(error, setting%real_value, -1.0_wp, 0.0_wp, 'thet')
+        setting = given_setting(scene, 'zero_start')
+        call check(error, setting%logical_value, 'zero_start')
         ! relative to the scene's folder
         call check(error, scene%output_file == path(1:index(path, '/', back=.true.)) // &
                    'out/run.h5', 'file: ' // scene%output_file)
@@ -235,7 +244,39 @@ contains
             'linear_solver = ''lu'': must be ''auto'', ''dense'', ''klu'', ''band'' or ''mumps''')
         status = parse_status(vdp_sim() // '&output table = ''x.txt'' /')
         call expect(error, status, 'table = ''x.txt'': must end in .md, .csv or .tex')
+        ! the range RADAU5 checks itself (core/rules' safety_factor_rule)
+        status = parse_status(vdp_sim() // '&solver safe = 1 /')
+        call expect(error, status, 'in.nml: &solver: safe = 1: must lie in (0.001, 1)')
     end subroutine test_negative_tolerance
+
+    !> Every solver's own setting in the schema (a &solver variable without
+    !> a default) is taken by a solver of the catalogue, and by one only
+    !> unless it is a shared name; no solver takes a name the schema lacks.
+    subroutine test_own_settings(error)
+        type(error_t), allocatable, intent(out) :: error
+        class(dae_solver_t), allocatable :: solver
+        type(status_t) :: status
+        logical :: applied
+        integer :: v, k, takers
+        do v = 1, size(schema)
+            if (schema(v)%group /= 'solver' .or. len_trim(schema(v)%default) > 0) cycle
+            takers = 0
+            do k = 1, size(solvers)
+                call new_solver(trim(solvers(k)%name), solver, status)
+                call check(error, status%ok(), status%text())
+                if (allocated(error)) return
+                call solver%apply_setting(solver_setting_t(name=schema(v)%name), applied)
+                if (applied) takers = takers + 1
+            end do
+            call check(error, takers == 1, trim(schema(v)%name) // ': taken by ' // &
+                       int_text(takers) // ' solvers')
+        end do
+        do k = 1, size(solvers)
+            call new_solver(trim(solvers(k)%name), solver, status)
+            call solver%apply_setting(solver_setting_t(name='rtol'), applied)
+            call check(error, .not. applied, trim(solvers(k)%name) // ' takes rtol')
+        end do
+    end subroutine test_own_settings
 
     subroutine test_missing_file(error)
         type(error_t), allocatable, intent(out) :: error

@@ -20,6 +20,8 @@ module test_mexax
     use flexmbs_problems_pendulum_chain, only: pendulum_chain_t, new_pendulum_chain, &
         pendulum_chain_initial, chain_anchor_t1
     use flexmbs_io_namelist, only: scene_input_t, parse_scene
+    use flexmbs_io_scene_input, only: given_setting
+    use flexmbs_dae_solver_setting, only: solver_setting_t
     use flexmbs_run_runner, only: run_result_t, run_scene
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
@@ -605,13 +607,16 @@ contains
         type(run_result_t) :: result
         real(wp) :: phi, dphi
         integer :: nst_default
+        type(solver_setting_t) :: columns, base, control
         character(len=*), parameter :: sim = '&simulation problem = ''pendulum'', ' // &
             't_end = 1, pendulum_angle = 1.0, pendulum_formulation = ''ggl'' /' // &
             new_line('a') // '&output file = ''none'', progress = .false. /' // new_line('a')
         call parse_scene(sim // '&solver name = ''MEXAX'', max_extrapolation = 6, ' // &
             'mexax_base = ''Euler'', rtol = 1e-8, atol = 1e-8 /', 'pend.nml', scene, status)
         call check(error, status%ok(), 'parse: ' // status%text())
-        call check(error, scene%max_extrapolation == 6 .and. scene%mexax_base == 'euler', &
+        columns = given_setting(scene, 'max_extrapolation')
+        base = given_setting(scene, 'mexax_base')
+        call check(error, columns%integer_value == 6 .and. base%string_value == 'euler', &
             'MEXAX settings')
         if (allocated(error)) return
         call run_scene(scene, .true., result, status)
@@ -629,7 +634,8 @@ contains
         call parse_scene(sim // '&solver name = ''MEXAX'', max_extrapolation = 6, ' // &
             'mexax_base = ''Euler'', mexax_control = ''Hairer'', rtol = 1e-8, atol = 1e-8 /', &
             'pend.nml', scene, status)
-        call check(error, status%ok() .and. scene%mexax_control == 'hairer', &
+        control = given_setting(scene, 'mexax_control')
+        call check(error, status%ok() .and. control%string_value == 'hairer', &
             'parse mexax_control: ' // status%text())
         if (allocated(error)) return
         call run_scene(scene, .true., result, status)

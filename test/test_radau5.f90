@@ -349,6 +349,20 @@ contains
         solver%thet = 2.0_wp
         call solver%integrate(problem, t, y, 2.0_wp, options, stats, status)
         call check(error, status%code == status_bad_input, 'thet >= 1 accepted')
+        ! SAFE's range is the scene schema's rule (core/rules): both ends open
+        solver%thet = 0.001_wp
+        solver%safe = 1.0_wp
+        call solver%integrate(problem, t, y, 2.0_wp, options, stats, status)
+        call check(error, status%code == status_bad_input .and. &
+            index(status%text(), 'safe must lie in (0.001, 1)') > 0, 'safe = 1: ' // status%text())
+        solver%safe = 0.001_wp
+        call solver%integrate(problem, t, y, 2.0_wp, options, stats, status)
+        call check(error, status%code == status_bad_input, 'safe = 0.001 accepted')
+        solver%safe = 0.0011_wp
+        call solver%integrate(problem, t, y, 2.0_wp, options, stats, status)
+        ! (inside the range, though no use on van der Pol: the steps stall)
+        call check(error, status%code /= status_bad_input, 'safe = 0.0011 refused: ' // &
+            status%text())
     end subroutine test_bad_input
 
     subroutine test_interrupt(error)

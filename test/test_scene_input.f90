@@ -12,7 +12,7 @@ module test_scene_input
     use flexmbs_core_text, only: nearest, int_text
     use flexmbs_io_scene_schema, only: schema, kind_real, kind_integer, kind_string, &
         kind_logical, find_var
-    use flexmbs_io_scene_values, only: rule_reason
+    use flexmbs_core_rules, only: rule_reason
     use flexmbs_io_input_errors, only: max_errors
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none

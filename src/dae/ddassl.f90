@@ -26,6 +26,7 @@ module flexmbs_dae_ddassl
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t, projection_refusal
     use flexmbs_dae_sink, only: sink_t, dense_output_t
+    use flexmbs_dae_solver_setting, only: solver_setting_t
     use flexmbs_dae_ddassl_state, only: ddassl_engine_t, ddassl_work_t, ddassl_native_t, &
         ddassl_max_order, mx, hmin_factor, tstop_tol, ddassl_fail_none, &
         ddassl_fail_tolerances, ddassl_fail_weights, ddassl_fail_error_test, &
@@ -77,6 +78,7 @@ module flexmbs_dae_ddassl
         procedure :: interpolate => ddassl_interpolate
         procedure :: name => ddassl_name
         procedure :: step_counts => ddassl_step_counts
+        procedure :: apply_setting => ddassl_apply_setting
     end type ddassl_t
 
 contains
@@ -94,6 +96,25 @@ contains
         attempted = self%native%nst
         accepted = self%native%nst
     end subroutine ddassl_step_counts
+
+    !> A scene's DDASSL setting (scene schema, group &solver); p_max reaches
+    !> DDASSL through dae_options_t (MAXORD).
+    subroutine ddassl_apply_setting(self, setting, applied)
+        class(ddassl_t), intent(inout) :: self
+        type(solver_setting_t), intent(in) :: setting
+        logical, intent(out) :: applied
+        applied = .true.
+        select case (setting%name)
+        case ('initial_derivative')
+            self%initial_derivative = setting%logical_value
+        case ('exclude_index23')
+            self%exclude_index23 = setting%logical_value
+        case ('netlib')
+            self%netlib = setting%logical_value
+        case default
+            applied = .false.
+        end select
+    end subroutine ddassl_apply_setting
 
     subroutine dense_evaluate(self, s, y)
         class(ddassl_dense_t), intent(in) :: self

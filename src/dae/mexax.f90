@@ -36,6 +36,7 @@ module flexmbs_dae_mexax
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_sink, only: sink_t
+    use flexmbs_dae_solver_setting, only: solver_setting_t
     use flexmbs_dae_mexax_control, only: mexax_base_midpoint, mexax_base_euler, &
         mexax_max_columns, mexax_control_hairer, mexax_control_deuflhard
     use flexmbs_dae_mexax_workspace, only: workspace_t, workspace_linear_solver, mexax_native_t, mexax_auto_klu_order, &
@@ -63,6 +64,7 @@ module flexmbs_dae_mexax
         procedure :: extrapolate => mexax_extrapolate
         procedure :: name => mexax_name
         procedure :: step_counts => mexax_step_counts
+        procedure :: apply_setting => mexax_apply_setting
     end type mexax_t
 
 contains
@@ -80,6 +82,26 @@ contains
         attempted = self%native%nstep
         accepted = self%native%naccpt
     end subroutine mexax_step_counts
+
+    !> A scene's MEXAX setting (scene schema, group &solver).
+    subroutine mexax_apply_setting(self, setting, applied)
+        class(mexax_t), intent(inout) :: self
+        type(solver_setting_t), intent(in) :: setting
+        logical, intent(out) :: applied
+        applied = .true.
+        select case (setting%name)
+        case ('max_extrapolation')
+            self%max_extrapolation = setting%integer_value
+        case ('mexax_base')
+            self%base = merge(mexax_base_euler, mexax_base_midpoint, &
+                              setting%string_value == 'euler')
+        case ('mexax_control')
+            self%control = merge(mexax_control_hairer, mexax_control_deuflhard, &
+                                 setting%string_value == 'hairer')
+        case default
+            applied = .false.
+        end select
+    end subroutine mexax_apply_setting
 
     !> MEXAX takes mechanical problems only (docs/theory.md §3).
     subroutine mexax_integrate(self, problem, t, y, t_end, options, stats, status, sink, yp)

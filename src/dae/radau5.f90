@@ -23,6 +23,7 @@ module flexmbs_dae_radau5
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_rejections, only: cause_singular_matrix
     use flexmbs_dae_sink, only: sink_t
+    use flexmbs_dae_solver_setting, only: solver_setting_t
     use flexmbs_dae_radau5_state, only: radau5_engine_t, radau5_work_t, radau5_dense_t, &
         radau5_native_t, radau5_controller_predictive, radau5_controller_classical, &
         blk_jacobian, blk_factor, blk_attempt
@@ -43,6 +44,7 @@ module flexmbs_dae_radau5
         procedure :: integrate_dae => radau5_integrate
         procedure :: name => radau5_name
         procedure :: step_counts => radau5_step_counts
+        procedure :: apply_setting => radau5_apply_setting
     end type radau5_t
 
 contains
@@ -60,6 +62,39 @@ contains
         attempted = self%native%nstep
         accepted = self%native%naccpt
     end subroutine radau5_step_counts
+
+    !> A scene's RADAU5 setting (scene schema, group &solver).
+    subroutine radau5_apply_setting(self, setting, applied)
+        class(radau5_t), intent(inout) :: self
+        type(solver_setting_t), intent(in) :: setting
+        logical, intent(out) :: applied
+        applied = .true.
+        select case (setting%name)
+        case ('nit')
+            self%nit = setting%integer_value
+        case ('thet')
+            self%thet = setting%real_value
+        case ('fnewt')
+            self%fnewt = setting%real_value
+        case ('quot1')
+            self%quot1 = setting%real_value
+        case ('quot2')
+            self%quot2 = setting%real_value
+        case ('safe')
+            self%safe = setting%real_value
+        case ('fac_min')
+            self%fac_min = setting%real_value
+        case ('fac_max')
+            self%fac_max = setting%real_value
+        case ('controller')
+            self%controller = merge(radau5_controller_classical, radau5_controller_predictive, &
+                                    setting%string_value == 'classical')
+        case ('zero_start')
+            self%zero_start = setting%logical_value
+        case default
+            applied = .false.
+        end select
+    end subroutine radau5_apply_setting
 
     !> Integrate M y' = F(t, y) from (t, y) to t_end (docs/theory.md §5.5).
     subroutine radau5_integrate(self, problem, t, y, t_end, options, stats, status, sink, yp)

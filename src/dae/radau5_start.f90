@@ -7,6 +7,7 @@ module flexmbs_dae_radau5_start
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_text, only: real_text
+    use flexmbs_core_rules, only: rule_reason, safety_factor_rule
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         status_interrupted, reason_det_f, reason_user_function
     use flexmbs_linalg_matrix, only: storage_none, storage_identity, storage_dense, &
@@ -92,8 +93,8 @@ contains
             call bad(status, 'nit must be positive')
             return
         end if
-        if (self%safe <= 0.001_wp .or. self%safe >= 1.0_wp) then
-            call bad(status, 'safe must lie in (0.001, 1)')
+        if (len(rule_reason(safety_factor_rule, self%safe, .false.)) > 0) then
+            call bad(status, 'safe ' // rule_reason(safety_factor_rule, self%safe, .false.))
             return
         end if
         w%thet = self%thet

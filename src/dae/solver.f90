@@ -13,6 +13,7 @@ module flexmbs_dae_solver
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_sink, only: sink_t
+    use flexmbs_dae_solver_setting, only: solver_setting_t
     implicit none
     private
 
@@ -23,6 +24,7 @@ module flexmbs_dae_solver
         generic :: integrate => integrate_dae, integrate_system
         procedure(name_i), deferred :: name
         procedure :: step_counts => default_step_counts
+        procedure :: apply_setting => default_apply_setting
     end type dae_solver_t
 
     abstract interface
@@ -81,4 +83,15 @@ contains
         attempted = 0
         accepted = 0
     end subroutine default_step_counts
+
+    !> Take one of the solver's own settings of a scene (run/solver_factory);
+    !> `applied` is false for a setting of another solver, which the scene
+    !> may give and this solver ignores. A solver with settings of its own
+    !> overrides this; the values are checked when the integration starts.
+    subroutine default_apply_setting(self, setting, applied)
+        class(dae_solver_t), intent(inout) :: self
+        type(solver_setting_t), intent(in) :: setting
+        logical, intent(out) :: applied
+        applied = .false.
+    end subroutine default_apply_setting
 end module flexmbs_dae_solver

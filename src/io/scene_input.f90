@@ -3,6 +3,7 @@
 !> defaults (flexmbs_io_scene_schema) for the rest.
 module flexmbs_io_scene_input
     use flexmbs_core_kinds, only: wp
+    use flexmbs_dae_solver_setting, only: solver_setting_t
     use flexmbs_io_scene_schema, only: len_title, len_name, len_path, max_fixed_sets, &
         max_interfaces
     implicit none
@@ -176,28 +177,12 @@ module flexmbs_io_scene_input
         character(len=len_name) :: sparse_ordering !! KLU: 'auto' | 'amd' | 'nd'
         character(len=len_name) :: newton_system   !! 'condensed' | 'full'
         character(len=len_name) :: jacobian
-        !> A solver's own settings (below, down to mexax_base) count only
-        !> when given: the solver factory leaves every other at the solver
-        !> type's default, which is kept nowhere else. Their names:
-        character(len=24), allocatable :: solver_settings(:)
-        integer :: nit
-        real(wp) :: thet
-        real(wp) :: fnewt !! 0 = the solver's default
-        real(wp) :: quot1
-        real(wp) :: quot2
-        real(wp) :: safe
-        real(wp) :: fac_min
-        real(wp) :: fac_max
-        character(len=len_name) :: controller
-        logical :: zero_start
         integer :: pmax
-        logical :: initial_derivative !! DDASSL: y' by DDAINI
-        logical :: exclude_index23 !! DDASSL: index-2/3 out of the error test
-        logical :: netlib !! DDASSL: later netlib revision
-        integer :: max_extrapolation !! MEXAX: extrapolation columns (KDMAX), 2..12
-        character(len=len_name) :: mexax_base !! MEXAX's base method: 'midpoint' | 'euler'
-        !> MEXAX's order and step-size control: 'hairer' | 'deuflhard'
-        character(len=len_name) :: mexax_control
+        !> The solvers' own settings the scene gives (the schema's &solver
+        !> variables without a default), in the schema's order: the solver
+        !> factory hands them to the solver, and every other keeps the
+        !> solver type's default, which is kept nowhere else.
+        type(solver_setting_t), allocatable :: solver_settings(:)
         ! &output
         !> HDF5 file; '' = none. Derived from the input name when not given.
         character(len=:), allocatable :: output_file
@@ -228,7 +213,7 @@ module flexmbs_io_scene_input
         procedure :: has_body => scene_has_body
     end type scene_input_t
 
-    public :: setting_given, marker_index, flexible_index, material_of, nonlinear_body, &
+    public :: setting_given, given_setting, marker_index, flexible_index, material_of, nonlinear_body, &
         modal_body
 
 contains
@@ -238,8 +223,22 @@ contains
         type(scene_input_t), intent(in) :: scene
         character(len=*), intent(in) :: name
         setting_given = .false.
-        if (allocated(scene%solver_settings)) setting_given = any(scene%solver_settings == name)
+        if (allocated(scene%solver_settings)) &
+            setting_given = any(scene%solver_settings%name == name)
     end function setting_given
+
+    !> The solver setting `name` the scene gives (setting_given), or one
+    !> without a name.
+    pure function given_setting(scene, name) result(setting)
+        type(scene_input_t), intent(in) :: scene
+        character(len=*), intent(in) :: name
+        type(solver_setting_t) :: setting
+        integer :: k
+        if (.not. allocated(scene%solver_settings)) return
+        do k = 1, size(scene%solver_settings)
+            if (scene%solver_settings(k)%name == name) setting = scene%solver_settings(k)
+        end do
+    end function given_setting
 
     !> The index of the first marker called `name` in scene, 0 if none.
     pure integer function marker_index(scene, name)

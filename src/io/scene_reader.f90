@@ -4,7 +4,8 @@
 !> choices are lower-cased (they compare case-insensitively).
 module flexmbs_io_scene_reader
     use flexmbs_core_text, only: lower, int_text
-    use flexmbs_io_scene_schema, only: find_group
+    use flexmbs_io_scene_schema, only: find_group, schema, kind_real, kind_integer, kind_logical
+    use flexmbs_dae_solver_setting, only: solver_setting_t
     use flexmbs_io_scene_lexer, only: entry_t, span_t, has_entry, instance_ranges
     use flexmbs_io_scene_values, only: get, get_list
     use flexmbs_io_scene_input, only: scene_input_t
@@ -88,12 +89,6 @@ contains
         type(entry_t), intent(in) :: e(:)
         type(scene_input_t), intent(inout) :: scene
         character(len=*), parameter :: g = 'solver'
-        !> the solvers' own settings, which have no default here (scene_input)
-        character(len=24), parameter :: own_settings(16) = [character(len=24) :: 'nit', &
-            'thet', 'fnewt', 'quot1', 'quot2', 'safe', 'fac_min', 'fac_max', 'controller', &
-            'zero_start', 'initial_derivative', 'exclude_index23', 'netlib', &
-            'max_extrapolation', 'mexax_base', 'mexax_control']
-        integer :: k
         call get(e, g, 'name', scene%solver_name)
         scene%solver_name = lower(scene%solver_name)
         call get(e, g, 'rtol', scene%rtol)
@@ -109,29 +104,39 @@ contains
         scene%newton_system = lower(scene%newton_system)
         call get(e, g, 'jacobian', scene%jacobian)
         scene%jacobian = lower(scene%jacobian)
-        call get(e, g, 'nit', scene%nit)
-        call get(e, g, 'thet', scene%thet)
-        call get(e, g, 'fnewt', scene%fnewt)
-        call get(e, g, 'quot1', scene%quot1)
-        call get(e, g, 'quot2', scene%quot2)
-        call get(e, g, 'safe', scene%safe)
-        call get(e, g, 'fac_min', scene%fac_min)
-        call get(e, g, 'fac_max', scene%fac_max)
-        call get(e, g, 'controller', scene%controller)
-        scene%controller = lower(scene%controller)
-        call get(e, g, 'zero_start', scene%zero_start)
         call get(e, g, 'pmax', scene%pmax)
-        call get(e, g, 'initial_derivative', scene%initial_derivative)
-        call get(e, g, 'exclude_index23', scene%exclude_index23)
-        call get(e, g, 'netlib', scene%netlib)
-        call get(e, g, 'max_extrapolation', scene%max_extrapolation)
-        call get(e, g, 'mexax_base', scene%mexax_base)
-        scene%mexax_base = lower(scene%mexax_base)
-        call get(e, g, 'mexax_control', scene%mexax_control)
-        scene%mexax_control = lower(scene%mexax_control)
-        scene%solver_settings = pack(own_settings, [(has_entry(e, g, trim(own_settings(k))), &
-            k=1, size(own_settings))])
+        call read_solver_settings(e, scene)
     end subroutine read_solver
+
+    !> The solvers' own settings the scene gives: the &solver variables
+    !> without a default in the schema (their defaults are the solver
+    !> types'), each read as its kind says, a choice in lower case.
+    subroutine read_solver_settings(e, scene)
+        type(entry_t), intent(in) :: e(:)
+        type(scene_input_t), intent(inout) :: scene
+        character(len=*), parameter :: g = 'solver'
+        type(solver_setting_t) :: setting
+        integer :: v
+        allocate (scene%solver_settings(0))
+        do v = 1, size(schema)
+            if (schema(v)%group /= g .or. len_trim(schema(v)%default) > 0) cycle
+            if (.not. has_entry(e, g, trim(schema(v)%name))) cycle
+            setting = solver_setting_t(name=schema(v)%name)
+            select case (schema(v)%kind)
+            case (kind_real)
+                call get(e, g, trim(setting%name), setting%real_value)
+            case (kind_integer)
+                call get(e, g, trim(setting%name), setting%integer_value)
+            case (kind_logical)
+                call get(e, g, trim(setting%name), setting%logical_value)
+            case default
+                call get(e, g, trim(setting%name), setting%string_value)
+                if (len_trim(schema(v)%choices) > 0) &
+                    setting%string_value = lower(setting%string_value)
+            end select
+            scene%solver_settings = [scene%solver_settings, setting]
+        end do
+    end subroutine read_solver_settings
 
     !> `file` stays as written; resolving it is the checks' business.
     subroutine read_output(e, scene)

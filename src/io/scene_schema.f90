@@ -5,6 +5,7 @@
 module flexmbs_io_scene_schema
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_text, only: lower, nearest
+    use flexmbs_core_rules, only: min_tolerance, safety_factor_rule
     use flexmbs_run_catalogue, only: solver_choices, problem_choices
     implicit none
     private
@@ -19,9 +20,8 @@ module flexmbs_io_scene_schema
     integer, parameter, public :: max_fixed_sets = 6
     !> At most this many node-set names in `&flexible_body interfaces`.
     integer, parameter, public :: max_interfaces = 8
-    !> Smallest tolerance a scene or study may ask for: below it rounding
-    !> errors of double precision dominate every solver's error estimate.
-    real(wp), parameter, public :: min_tolerance = 1.0e-14_wp
+    ! core/rules: the rules' evaluation and the ranges the solvers share
+    public :: min_tolerance
 
     !> One variable. `rule` is '' (any value), 'positive', 'nonnegative',
     !> 'tolerance' ([1e-14, 1)) or an interval such as '(0,1]' or '[2,12]'
@@ -101,7 +101,7 @@ module flexmbs_io_scene_schema
             doc='RADAU5: keep the step when h_new/h lies in [quot1, quot2]'), &
         var_spec_t('solver', 'quot2', kind_real, rule='[1,inf)', &
             doc='RADAU5: see quot1'), &
-        var_spec_t('solver', 'safe', kind_real, rule='(0.001,1)', &
+        var_spec_t('solver', 'safe', kind_real, rule=safety_factor_rule, &
             doc='safety factor of the step size control'), &
         var_spec_t('solver', 'fac_min', kind_real, rule='(0,1]', &
             doc='smallest step size ratio'), &

@@ -10,12 +10,13 @@ module flexmbs_io_scene_values
     use flexmbs_io_input_errors, only: input_errors_t, excerpt
     use flexmbs_io_scene_schema, only: schema, find_var, string_length, kind_string, &
         kind_real, kind_integer, kind_logical, split_choices, choice_list, is_choice, &
-        did_you_mean, min_tolerance
+        did_you_mean
+    use flexmbs_core_rules, only: rule_reason
     use flexmbs_io_scene_lexer, only: entry_t, item_t, entry_index, is_digit, unquoted_length
     implicit none
     private
 
-    public :: check_types, check_rules, get, get_list, unquote, rule_reason, value_error, &
+    public :: check_types, check_rules, get, get_list, unquote, value_error, &
         required_error
 
     !> The value of `group`/`name` (occurrence `instance`): the entry's
@@ -90,74 +91,6 @@ contains
             end do
         end do
     end subroutine check_rules
-
-    !> Why `x` breaks `rule` ('' if it does not): 'positive',
-    !> 'nonnegative', 'tolerance' ([1e-14, 1)), 'abs_tolerance'
-    !> ([1e-14, inf)) or an interval '(a,b]' with `inf` for no bound.
-    pure function rule_reason(rule, x, integer_valued) result(reason)
-        character(len=*), intent(in) :: rule
-        real(wp), intent(in) :: x
-        logical, intent(in) :: integer_valued
-        character(len=:), allocatable :: reason
-        real(wp) :: a, b
-        integer :: comma
-        logical :: open_a, open_b
-        reason = ''
-        select case (rule)
-        case ('positive')
-            if (.not. x > 0.0_wp) reason = 'must be positive'
-        case ('nonnegative')
-            if (.not. x >= 0.0_wp) reason = 'must not be negative'
-        case ('tolerance', 'abs_tolerance')
-            if (.not. x > 0.0_wp) then
-                reason = 'must be positive'
-            else if (x < min_tolerance) then
-                reason = 'must be at least 1e-14 (below, rounding errors of double precision &
-                    &dominate the error estimates)'
-            else if (rule == 'tolerance' .and. .not. x < 1.0_wp) then
-                reason = 'must be less than 1'
-            end if
-        case default
-            comma = index(rule, ',')
-            open_a = rule(1:1) == '('
-            open_b = rule(len(rule):len(rule)) == ')'
-            a = bound(rule(2:comma - 1))
-            b = bound(rule(comma + 1:len(rule) - 1))
-            if ((open_a .and. .not. x > a) .or. (.not. open_a .and. .not. x >= a) .or. &
-                (open_b .and. .not. x < b) .or. (.not. open_b .and. .not. x <= b)) then
-                if (b == huge(1.0_wp)) then
-                    if (open_a) then
-                        reason = 'must be greater than ' // rule(2:comma - 1)
-                    else
-                        reason = 'must be at least ' // rule(2:comma - 1)
-                    end if
-                else if (a == -huge(1.0_wp)) then
-                    if (open_b) then
-                        reason = 'must be less than ' // rule(comma + 1:len(rule) - 1)
-                    else
-                        reason = 'must be at most ' // rule(comma + 1:len(rule) - 1)
-                    end if
-                else if (integer_valued .and. .not. open_a .and. .not. open_b) then
-                    reason = 'must lie in ' // rule(2:comma - 1) // '..' // &
-                        rule(comma + 1:len(rule) - 1)
-                else
-                    reason = 'must lie in ' // rule(1:comma) // ' ' // rule(comma + 1:)
-                end if
-            end if
-        end select
-    contains
-        pure real(wp) function bound(text)
-            character(len=*), intent(in) :: text
-            integer :: ios
-            if (text == 'inf') then
-                bound = huge(1.0_wp)
-            else if (text == '-inf') then
-                bound = -huge(1.0_wp)
-            else
-                read (text, *, iostat=ios) bound
-            end if
-        end function bound
-    end function rule_reason
 
     !> Report `reason` against variable `group`/`name` of occurrence
     !> `instance` (default 1): 'path: &group: name = value: reason (line n)'

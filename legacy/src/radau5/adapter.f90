@@ -16,6 +16,7 @@ module flexmbs_legacy_radau5_adapter
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_text, only: int_text
+    use flexmbs_core_rules, only: rule_reason, safety_factor_rule
     use flexmbs_core_status, only: status_t, status_ok, status_bad_input, status_interrupted, &
         reason_max_steps, reason_step_too_small, reason_singular_matrix
     use flexmbs_linalg_matrix, only: storage_none, storage_identity, storage_dense, storage_sparse
@@ -202,8 +203,9 @@ contains
         end if
         nm1 = n - m1
         safe = merge(defaults%safe, work(2), work(2) == 0.0_wp)
-        if (safe <= 0.001_wp .or. safe >= 1.0_wp) then
-            call reject('WORK(2) = SAFE = ' // rtoa(safe) // ': must lie in (0.001, 1)')
+        if (len(rule_reason(safety_factor_rule, safe, .false.)) > 0) then
+            call reject('WORK(2) = SAFE = ' // rtoa(safe) // ': ' // &
+                rule_reason(safety_factor_rule, safe, .false.))
             return
         end if
         thet = merge(defaults%thet, work(3), work(3) == 0.0_wp)
