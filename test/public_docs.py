@@ -387,8 +387,9 @@ for folder in [os.path.join(f, d) for f in FOLDERS
     total += count
     documented_count += count - len(missing)
     all_modules += nmodules
-    report(folder, missing, '%d modules and their public procedures and types documented '
-           '(%d items)' % (nmodules, count))
+    report(folder + ('/ (top level)' if top_only else ''), missing,
+           '%d module%s and %d public procedures, interfaces and types documented'
+           % (nmodules, '' if nmodules == 1 else 's', count - nmodules))
 
 # A public name that the scan did not find defined, declared or imported is
 # a declaration this parser does not understand.
@@ -396,8 +397,8 @@ report('parser-finds-every-public-name', unknown_names)
 report('parser-pairs-every-end', unbalanced)
 report('total', [] if documented_count == total else
        ['%d of %d public items undocumented' % (total - documented_count, total)],
-       '%d public procedures, interfaces, types and modules documented (%d modules)'
-       % (total, all_modules))
+       '%d public procedures, interfaces and types and %d modules documented'
+       % (total - all_modules, all_modules))
 
 print('%d passed, %d failed' % (passed, failed))
 sys.exit(1 if failed else 0)
