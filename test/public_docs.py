@@ -24,8 +24,10 @@ or FORD's `!!` line directly below its last line. Every module needs its own
 `!>` block too.
 
 Prints `pass public-docs/...` or `FAIL public-docs/...: why` lines (one check
-per source folder, naming each undocumented item as file:line:name) and
-`N passed, M failed` last; exits non-zero on failures.
+per source folder, naming each undocumented item as file:line:name; two
+checks of the parser itself: every name of a `public` statement is found
+defined, declared or imported, and every unit's end pairs with its start;
+the total) and `N passed, M failed` last; exits non-zero on failures.
 """
 import os
 import re
@@ -55,8 +57,9 @@ def report(name, problems, note=''):
 IDENT = re.compile(r'[A-Za-z_]\w*')
 
 
-def code_part(text):
-    """The text of a free-form line before its comment (strings respected)."""
+def unquoted(text):
+    """(index, character) of the characters of a line outside its character
+    literals (a doubled quote closes and reopens one: the same positions)."""
     quote = None
     for i, c in enumerate(text):
         if quote:
@@ -64,7 +67,14 @@ def code_part(text):
                 quote = None
         elif c in '\'"':
             quote = c
-        elif c == '!':
+        else:
+            yield i, c
+
+
+def code_part(text):
+    """The text of a free-form line before its comment (strings respected)."""
+    for i, c in unquoted(text):
+        if c == '!':
             return text[:i]
     return text
 
@@ -148,14 +158,9 @@ def statements(lines):
 
 
 def split_semicolons(code):
-    parts, quote, start = [], None, 0
-    for i, c in enumerate(code):
-        if quote:
-            if c == quote:
-                quote = None
-        elif c in '\'"':
-            quote = c
-        elif c == ';':
+    parts, start = [], 0
+    for i, c in unquoted(code):
+        if c == ';':
             parts.append(code[start:i])
             start = i + 1
     parts.append(code[start:])
