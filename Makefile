@@ -148,7 +148,8 @@ run: build
 # examples/ built the same way and run, one also against the shared library
 # (test/programs.sh), a project depending on flexmbs through fpm
 # (test/dependency.sh, test/fpm_dependency/), the architecture's rules
-# on the sources (test/layers.py), then the command-line
+# on the sources (test/layers.py), the documentation of every public
+# procedure and type (test/public_docs.py), then the command-line
 # checks of test/cli.sh, the documentation's links and generated scene
 # reference (test/docs.py), the ParaView and XDMF files read by VTK and
 # meshio (test/vtk_files.py, in $(PY_VENV)), the signals of test/kill.sh (python3-h5py reads
@@ -169,6 +170,8 @@ test: deps
 	    echo "exit $$?" >> $(BUILD)/test-dependency.log
 	@set -o pipefail; python3 test/layers.py 2>&1 | tee $(BUILD)/test-layers.log; \
 	    echo "exit $$?" >> $(BUILD)/test-layers.log
+	@set -o pipefail; python3 test/public_docs.py 2>&1 | tee $(BUILD)/test-public-docs.log; \
+	    echo "exit $$?" >> $(BUILD)/test-public-docs.log
 	@set -o pipefail; FPM="$(FPM)" bash test/cli.sh 2>&1 | tee $(BUILD)/test-cli.log; \
 	    echo "exit $$?" >> $(BUILD)/test-cli.log
 	@set -o pipefail; FLEXMBS_PKGCONFIG=$(PREFIX_DEBUG)/lib/pkgconfig python3 test/docs.py \
@@ -187,8 +190,9 @@ test: deps
 	    echo "exit $$?" >> $(BUILD)/test-fuzz.log
 	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log \
 	    $(BUILD)/test-programs.log $(BUILD)/test-dependency.log $(BUILD)/test-layers.log \
-	    $(BUILD)/test-cli.log $(BUILD)/test-docs.log $(BUILD)/test-vtk.log $(BUILD)/test-kill.log \
-	    $(BUILD)/test-examples.log $(BUILD)/test-tolerances.log $(BUILD)/test-fuzz.log
+	    $(BUILD)/test-public-docs.log $(BUILD)/test-cli.log $(BUILD)/test-docs.log \
+	    $(BUILD)/test-vtk.log $(BUILD)/test-kill.log $(BUILD)/test-examples.log \
+	    $(BUILD)/test-tolerances.log $(BUILD)/test-fuzz.log
 
 PROFILE     ?= debug
 PREFIX_USED ?= $(PREFIX_DEBUG)

@@ -124,6 +124,8 @@ contains
         if (.not. check) call sundials_failure(w, status, what, int(flag))
     end function check
 
+    !> Report a failed SUNDIALS call `what` (its flag when given, and the last
+    !> message IDA's error handler left in the run's data) as status_bad_input.
     subroutine sundials_failure(w, status, what, flag)
         type(ida_work_t), intent(in) :: w
         type(status_t), intent(inout) :: status
@@ -230,6 +232,8 @@ contains
         end if
     end subroutine collect_statistics
 
+    !> A quiet NaN: what the dense output returns when IDAGetDky fails, so that
+    !> a bad interpolation cannot pass for a value.
     real(wp) function ieee_nan()
         use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
         ieee_nan = ieee_value(1.0_wp, ieee_quiet_nan)

@@ -44,6 +44,9 @@ module flexmbs_dae_mechanical_problem
         type(csc_matrix_t) :: force_v        !! ∂f/∂v, nv x nv
     end type mechanical_patterns_t
 
+    !> A constrained mechanical system (the module's equations): kinematics T,
+    !> mass M, forces f, constraints g and G as deferred bindings; derivatives
+    !> and sparse forms with defaults that a problem may override.
     type, abstract, public :: mechanical_problem_t
         integer :: nq = 0 !! positions
         integer :: nv = 0 !! velocities

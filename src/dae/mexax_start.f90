@@ -71,6 +71,8 @@ contains
         call status%set(status_bad_input, 'mexax: ' // reason)
     end subroutine bad
 
+    !> The run stopped at the request of the output routine: status_interrupted
+    !> with the time reached.
     subroutine interrupted(r, status)
         type(mexax_run_t), intent(in) :: r
         type(status_t), intent(inout) :: status

@@ -6,6 +6,8 @@ module flexmbs_dae_options
     implicit none
     private
 
+    !> The options common to the solvers: tolerances (scalar or per
+    !> component), step and order limits, the linear solver and the Jacobian's source.
     type, public :: dae_options_t
         real(wp) :: rtol = 1.0e-6_wp
         real(wp) :: atol = 1.0e-6_wp

@@ -18,6 +18,9 @@ module flexmbs_dae_problem
 
     public :: problem_mass_matrix
 
+    !> A DAE M y' = F(t, y) with n unknowns: `rhs` is required, the Jacobian,
+    !> the mass matrix and the index information have defaults (identity M,
+    !> differenced J, index 1).
     type, abstract, public :: dae_problem_t
         integer :: n = 0 !! number of unknowns
     contains

@@ -199,6 +199,8 @@ contains
         end do
     end subroutine compute_scal
 
+    !> A quiet NaN: f0 after a failing evaluation, so that the next error
+    !> estimate is non-finite and the step is rejected.
     real(wp) function ieee_nan()
         use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
         ieee_nan = ieee_value(1.0_wp, ieee_quiet_nan)

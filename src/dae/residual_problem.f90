@@ -16,6 +16,8 @@ module flexmbs_dae_residual_problem
     implicit none
     private
 
+    !> A DAE G(t, y, y') = 0 with n unknowns: the residual and its partials
+    !> A = ∂G/∂y', B = −∂G/∂y are required; index information has defaults.
     type, abstract, public :: residual_problem_t
         integer :: n = 0 !! number of unknowns
     contains

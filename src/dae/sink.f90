@@ -27,6 +27,8 @@ module flexmbs_dae_sink
         end subroutine evaluate_i
     end interface
 
+    !> Where a solver's output goes: `output` at every requested time is
+    !> required; `step` after accepted steps and `finish` are optional no-ops.
     type, abstract, public :: sink_t
     contains
         procedure(output_i), deferred :: output

@@ -17,6 +17,8 @@ module flexmbs_dae_solver
     implicit none
     private
 
+    !> A DAE solver: `integrate` from (t, y) to t_end on a dae_problem_t or on a
+    !> mechanical problem with its formulation; `name` for messages and tables.
     type, abstract, public :: dae_solver_t
     contains
         procedure(integrate_i), deferred :: integrate_dae

@@ -7,6 +7,8 @@ module flexmbs_dae_stats
 
     public :: index3_warning, projection_refusal
 
+    !> The statistics of one integration, filled alike by every solver: steps,
+    !> evaluations, factorisations, solves, times and the causes of rejections.
     type, public :: dae_stats_t
         integer :: nst = 0     !! attempted steps (accepted + rejected + failed)
         integer :: nac = 0     !! accepted steps

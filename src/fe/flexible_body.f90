@@ -31,6 +31,9 @@ module flexmbs_fe_flexible_body
         type(status_t) :: status
     end type element_work_t
 
+    !> A meshed neo-Hookean body as a mechanical problem (the module's form):
+    !> its materials, quadrature data, free-dof numbering, the constant M and the
+    !> CSC patterns of ∂k/∂q and ∂k/∂v, and the workspaces of the assembly.
     type, extends(mechanical_problem_t), public :: flexible_body_t
         type(mesh_t) :: mesh
         type(hexahedron_t) :: hex

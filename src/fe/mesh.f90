@@ -20,6 +20,8 @@ module flexmbs_fe_mesh
         integer, allocatable :: elements(:)
     end type element_set_t
 
+    !> A hexahedral mesh (hex8 or hex27, nodes in VTK order): reference nodal
+    !> positions, connectivity and named node and element sets.
     type, public :: mesh_t
         integer :: nnode_element = 0                 !! 8 or 27
         real(wp), allocatable :: x(:, :)             !! (3, nodes) reference positions

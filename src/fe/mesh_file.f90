@@ -43,6 +43,8 @@ module flexmbs_fe_mesh_file
 
 contains
 
+    !> Read a mesh in the flexmbs text format (the module's grammar) from `path`;
+    !> an error names the file, the line and the reason and leaves `mesh` empty.
     subroutine read_mesh(path, mesh, status)
         character(len=*), intent(in) :: path
         type(mesh_t), intent(out) :: mesh

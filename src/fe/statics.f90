@@ -35,6 +35,8 @@ module flexmbs_fe_statics
     implicit none
     private
 
+    !> The tolerances and limits of a static solve: Newton's convergence
+    !> tests, the load increments and the line search (see the module).
     type, public :: static_options_t
         real(wp) :: residual_tolerance = 1.0e-10_wp  !! on ‖r‖∞ / ‖g‖∞
         real(wp) :: increment_tolerance = 1.0e-10_wp !! on ‖Δq‖∞ / body size

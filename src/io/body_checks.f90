@@ -18,6 +18,8 @@ module flexmbs_io_body_checks
 
 contains
 
+    !> Add to `errors` what is wrong with the scene's &flexible_body and &material
+    !> groups (the checks of the module), also a body given to a problem without one.
     subroutine check_body(scene, entries, errors)
         type(scene_input_t), intent(in) :: scene
         type(entry_t), intent(in) :: entries(:)

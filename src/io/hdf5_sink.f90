@@ -69,6 +69,8 @@ module flexmbs_io_hdf5_sink
         real(wp), allocatable :: buffer(:)  !! one record's values
     end type series_t
 
+    !> The HDF5 sink (the module's layout): the open file, its batches of
+    !> pending records, the named blocks of y and the derived series.
     type, extends(sink_t), public :: hdf5_sink_t
         character(len=:), allocatable :: path
         integer :: n = 0                 !! length of y

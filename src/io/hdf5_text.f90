@@ -155,6 +155,8 @@ contains
         call h5tclose_f(str_type, close_err)
     end subroutine write_string_attribute
 
+    !> Delete the attribute `name` of `obj` when it exists, so that it can be
+    !> written again with another type or size; err < 0 on an HDF5 failure.
     subroutine delete_attribute(obj, name, err)
         integer(hid_t), intent(in) :: obj
         character(len=*), intent(in) :: name

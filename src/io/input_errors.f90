@@ -13,6 +13,8 @@ module flexmbs_io_input_errors
         character(len=:), allocatable :: text
     end type message_t
 
+    !> The messages of one input file (at most max_errors kept) and the file's
+    !> path that prefixes them; `to_status` turns them into one status.
     type, public :: input_errors_t
         private
         character(len=:), allocatable :: path

@@ -29,6 +29,8 @@ module flexmbs_io_progress
         end function c_isatty
     end interface
 
+    !> The progress line (see the module): the run's time span, the state of
+    !> the display and the solver asked for its step counts.
     type, extends(sink_t), public :: progress_t
         logical :: enabled = .false.
         integer :: unit = error_unit

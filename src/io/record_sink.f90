@@ -8,6 +8,8 @@ module flexmbs_io_record_sink
     implicit none
     private
 
+    !> A sink that keeps every output (t, y) in memory: a study's runs and
+    !> their reference compared point by point, and tests.
     type, extends(sink_t), public :: record_sink_t
         integer :: records = 0
         real(wp), allocatable :: t(:)    !! (records)

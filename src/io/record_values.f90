@@ -8,6 +8,8 @@ module flexmbs_io_record_values
     implicit none
     private
 
+    !> Values computed from each record (t, y): `evaluate` fills a fixed number
+    !> of rows, which the HDF5 sink stores as a series.
     type, abstract, public :: record_values_t
     contains
         procedure(evaluate_i), deferred :: evaluate

@@ -560,11 +560,13 @@ contains
         has_entry = entry_index(entries, group, name, instance) > 0
     end function has_entry
 
+    !> True for an ASCII letter a-z, A-Z (names start with one).
     pure logical function is_letter(c)
         character, intent(in) :: c
         is_letter = (c >= 'a' .and. c <= 'z') .or. (c >= 'A' .and. c <= 'Z')
     end function is_letter
 
+    !> True for an ASCII digit 0-9.
     pure logical function is_digit(c)
         character, intent(in) :: c
         is_digit = c >= '0' .and. c <= '9'

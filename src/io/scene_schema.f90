@@ -358,6 +358,7 @@ module flexmbs_io_scene_schema
 
 contains
 
+    !> The index of group `name` in group_names, 0 when there is none.
     pure integer function find_group(name)
         character(len=*), intent(in) :: name
         integer :: g
@@ -367,6 +368,8 @@ contains
         end do
     end function find_group
 
+    !> The index of variable `name` of `group` in the schema table, 0 when the
+    !> schema has no such variable.
     pure integer function find_var(group, name)
         character(len=*), intent(in) :: group, name
         integer :: i

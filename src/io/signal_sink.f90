@@ -11,6 +11,8 @@ module flexmbs_io_signal_sink
     implicit none
     private
 
+    !> The sink that turns SIGINT and SIGTERM into a stop after the current step
+    !> (see the module); it has no state of its own.
     type, extends(sink_t), public :: signal_sink_t
     contains
         procedure :: output => signal_output

@@ -62,6 +62,8 @@ module flexmbs_io_vtk_sink
         type(modal_body_t), pointer :: modal => null()
     end type vtk_flexible_t
 
+    !> The ParaView sink (the module's files): the file prefix and what it draws,
+    !> flexible bodies, rigid bodies, chains and a system's joints.
     type, extends(sink_t), public :: vtk_sink_t
         character(len=:), allocatable :: prefix
         type(vtk_flexible_t), allocatable :: flexible(:) !! none: no mesh files

@@ -10,6 +10,7 @@ module flexmbs_linalg_lapack
     public :: dgesvd_quiet, dsyev_quiet, dggev3_quiet, dsygv_quiet
 
     interface
+        !> C ← α op(A) op(B) + β C in real arithmetic (BLAS).
         subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
             import :: wp
             character(len=1), intent(in) :: transa, transb
@@ -18,6 +19,7 @@ module flexmbs_linalg_lapack
             real(wp), intent(in) :: a(lda, *), b(ldb, *)
             real(wp), intent(inout) :: c(ldc, *)
         end subroutine dgemm
+        !> C ← α op(A) op(B) + β C in complex arithmetic (BLAS).
         subroutine zgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
             import :: wp
             character(len=1), intent(in) :: transa, transb
@@ -26,12 +28,14 @@ module flexmbs_linalg_lapack
             complex(wp), intent(in) :: a(lda, *), b(ldb, *)
             complex(wp), intent(inout) :: c(ldc, *)
         end subroutine zgemm
+        !> LU factorisation with partial pivoting of a real general matrix.
         subroutine dgetrf(m, n, a, lda, ipiv, info)
             import :: wp
             integer, intent(in) :: m, n, lda
             real(wp), intent(inout) :: a(lda, *)
             integer, intent(out) :: ipiv(*), info
         end subroutine dgetrf
+        !> Solve with the LU factors of dgetrf (trans: 'N' or 'T').
         subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
             import :: wp
             character, intent(in) :: trans
@@ -40,12 +44,14 @@ module flexmbs_linalg_lapack
             real(wp), intent(inout) :: b(ldb, *)
             integer, intent(out) :: info
         end subroutine dgetrs
+        !> LU factorisation with partial pivoting of a complex general matrix.
         subroutine zgetrf(m, n, a, lda, ipiv, info)
             import :: wp
             integer, intent(in) :: m, n, lda
             complex(wp), intent(inout) :: a(lda, *)
             integer, intent(out) :: ipiv(*), info
         end subroutine zgetrf
+        !> Solve with the LU factors of zgetrf (trans: 'N', 'T' or 'C').
         subroutine zgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
             import :: wp
             character, intent(in) :: trans
@@ -54,12 +60,15 @@ module flexmbs_linalg_lapack
             complex(wp), intent(inout) :: b(ldb, *)
             integer, intent(out) :: info
         end subroutine zgetrs
+        !> LU factorisation of a real band matrix (kl sub-, ku superdiagonals; ab
+        !> holds kl extra rows for the fill-in).
         subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
             import :: wp
             integer, intent(in) :: m, n, kl, ku, ldab
             real(wp), intent(inout) :: ab(ldab, *)
             integer, intent(out) :: ipiv(*), info
         end subroutine dgbtrf
+        !> Solve with the band LU factors of dgbtrf.
         subroutine dgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
             import :: wp
             character, intent(in) :: trans
@@ -68,12 +77,14 @@ module flexmbs_linalg_lapack
             real(wp), intent(inout) :: b(ldb, *)
             integer, intent(out) :: info
         end subroutine dgbtrs
+        !> LU factorisation of a complex band matrix (storage as in dgbtrf).
         subroutine zgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
             import :: wp
             integer, intent(in) :: m, n, kl, ku, ldab
             complex(wp), intent(inout) :: ab(ldab, *)
             integer, intent(out) :: ipiv(*), info
         end subroutine zgbtrf
+        !> Solve with the band LU factors of zgbtrf.
         subroutine zgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
             import :: wp
             character, intent(in) :: trans
@@ -82,6 +93,8 @@ module flexmbs_linalg_lapack
             complex(wp), intent(inout) :: b(ldb, *)
             integer, intent(out) :: info
         end subroutine zgbtrs
+        !> Singular value decomposition A = U Σ Vᵀ; callers use dgesvd_quiet,
+        !> which keeps the IEEE flags.
         subroutine dgesvd(jobu, jobvt, m, n, a, lda, s, u, ldu, vt, ldvt, work, lwork, info)
             import :: wp
             character, intent(in) :: jobu, jobvt
@@ -90,6 +103,8 @@ module flexmbs_linalg_lapack
             real(wp), intent(out) :: s(*), u(ldu, *), vt(ldvt, *), work(*)
             integer, intent(out) :: info
         end subroutine dgesvd
+        !> Eigenvalues (and vectors) of a real symmetric matrix; callers use
+        !> dsyev_quiet, which keeps the IEEE flags.
         subroutine dsyev(jobz, uplo, n, a, lda, w, work, lwork, info)
             import :: wp
             character, intent(in) :: jobz, uplo
@@ -106,6 +121,8 @@ module flexmbs_linalg_lapack
             real(wp), intent(out) :: w(*), work(*)
             integer, intent(out) :: info
         end subroutine dsygv
+        !> Generalised eigenvalues (α_r + i α_i) / β of the pencil (A, B), blocked
+        !> QZ; callers use dggev3_quiet, which keeps the IEEE flags.
         subroutine dggev3(jobvl, jobvr, n, a, lda, b, ldb, alphar, alphai, beta, vl, ldvl, &
                          vr, ldvr, work, lwork, info)
             import :: wp

@@ -61,6 +61,8 @@ module flexmbs_linalg_linear_solver
     end interface fill_nan
     public :: fill_nan
 
+    !> A solver of A = c M − J for real and complex shifts c (see the module):
+    !> its order n and the deferred init, factor, solve and name bindings.
     type, abstract, public :: linear_solver_t
         integer :: n = 0
     contains

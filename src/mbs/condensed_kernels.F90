@@ -14,15 +14,19 @@ module flexmbs_mbs_condensed_kernels
 
     public :: factor_blocks, w_values, s_values, condensed_solve
 
+    !> The dense LUs of c I − J_ee of the kinematic blocks, real or complex c.
     interface factor_blocks
         module procedure factor_blocks_real, factor_blocks_complex
     end interface factor_blocks
+    !> The values of W = P J_EK, real or complex.
     interface w_values
         module procedure w_values_real, w_values_complex
     end interface w_values
+    !> The values of the Schur complement S on its pattern, real or complex.
     interface s_values
         module procedure s_values_real, s_values_complex
     end interface s_values
+    !> b ← A⁻¹ b through the block LUs and the factorised S, real or complex.
     interface condensed_solve
         module procedure solve_real, solve_complex
     end interface condensed_solve

@@ -21,6 +21,8 @@ module flexmbs_mbs_dual
     !> Number of tangent directions carried by every dual number.
     integer, parameter, public :: dual_size = 16
 
+    !> A dual number: a value and its derivatives along up to dual_size seeded
+    !> directions (components left undefined; see the module).
     type, public :: dual_t
         real(wp) :: val !! value
         real(wp) :: der(dual_size) !! derivatives along the seeded directions
@@ -34,99 +36,134 @@ module flexmbs_mbs_dual
     public :: sqrt, exp, log, sin, cos, tan, asin, acos, atan, atan2, sinh, cosh, tanh, &
         abs, max, min, dot_product, matmul, sum, norm2
 
+    !> Sum of duals, of a dual and a real (either order), and unary plus.
     interface operator(+)
         module procedure add_dd, add_dr, add_rd, plus_d
     end interface
+    !> Difference of duals, of a dual and a real (either order), and negation.
     interface operator(-)
         module procedure sub_dd, sub_dr, sub_rd, minus_d
     end interface
+    !> Product by the product rule (dual · dual), or scaling by a real.
     interface operator(*)
         module procedure mul_dd, mul_dr, mul_rd
     end interface
+    !> Quotient by the quotient rule (dual / dual), or with a real on either side.
     interface operator(/)
         module procedure div_dd, div_dr, div_rd
     end interface
+    !> Power with an integer, real or dual exponent; the dual exponent takes
+    !> exp(b log a) and needs a > 0.
     interface operator(**)
         module procedure pow_di, pow_dr, pow_dd
     end interface
+    !> Comparisons look at the values only (the tangents do not take part), so
+    !> branches on duals follow the real computation.
     interface operator(==)
         module procedure eq_dd, eq_dr, eq_rd
     end interface
+    !> Inequality of values (tangents ignored).
     interface operator(/=)
         module procedure ne_dd, ne_dr, ne_rd
     end interface
+    !> Order of values (tangents ignored).
     interface operator(<)
         module procedure lt_dd, lt_dr, lt_rd
     end interface
+    !> Order of values (tangents ignored).
     interface operator(<=)
         module procedure le_dd, le_dr, le_rd
     end interface
+    !> Order of values (tangents ignored).
     interface operator(>)
         module procedure gt_dd, gt_dr, gt_rd
     end interface
+    !> Order of values (tangents ignored).
     interface operator(>=)
         module procedure ge_dd, ge_dr, ge_rd
     end interface
+    !> A real assigned to a dual: a constant, zero tangents.
     interface assignment(=)
         module procedure assign_r
     end interface
+    !> Square root; the tangent is Inf or NaN at 0, where sqrt has no derivative.
     interface sqrt
         module procedure sqrt_d
     end interface
+    !> Exponential: tangent exp(a) da.
     interface exp
         module procedure exp_d
     end interface
+    !> Natural logarithm: tangent da / a.
     interface log
         module procedure log_d
     end interface
+    !> Sine: tangent cos(a) da.
     interface sin
         module procedure sin_d
     end interface
+    !> Cosine: tangent −sin(a) da.
     interface cos
         module procedure cos_d
     end interface
+    !> Tangent function: derivative 1 + tan²(a).
     interface tan
         module procedure tan_d
     end interface
+    !> Arcsine: derivative 1 / sqrt(1 − a²), infinite at |a| = 1.
     interface asin
         module procedure asin_d
     end interface
+    !> Arccosine: derivative −1 / sqrt(1 − a²), infinite at |a| = 1.
     interface acos
         module procedure acos_d
     end interface
+    !> Arctangent: derivative 1 / (1 + a²).
     interface atan
         module procedure atan_d
     end interface
+    !> atan2(y, x) with dual or real arguments: derivative
+    !> (x dy − y dx) / (x² + y²).
     interface atan2
         module procedure atan2_dd, atan2_dr, atan2_rd
     end interface
+    !> Hyperbolic sine: derivative cosh(a).
     interface sinh
         module procedure sinh_d
     end interface
+    !> Hyperbolic cosine: derivative sinh(a).
     interface cosh
         module procedure cosh_d
     end interface
+    !> Hyperbolic tangent: derivative 1 − tanh²(a).
     interface tanh
         module procedure tanh_d
     end interface
+    !> |a|, with the derivative of the positive branch at 0.
     interface abs
         module procedure abs_d
     end interface
+    !> The larger value with its own tangents (a on ties), duals and reals mixed.
     interface max
         module procedure max_dd, max_dr, max_rd
     end interface
+    !> The smaller value with its own tangents (a on ties), duals and reals mixed.
     interface min
         module procedure min_dd, min_dr, min_rd
     end interface
+    !> Dot product of dual vectors, or of a dual and a real vector.
     interface dot_product
         module procedure dot_dd, dot_dr, dot_rd
     end interface
+    !> Matrix-vector and matrix-matrix products with dual and real operands.
     interface matmul
         module procedure matvec_dd, matvec_dr, matvec_rd, matmat_dd, matmat_dr, matmat_rd
     end interface
+    !> Sum of a dual vector.
     interface sum
         module procedure sum_d
     end interface
+    !> Euclidean norm of a dual vector; no derivative at the zero vector.
     interface norm2
         module procedure norm2_d
     end interface
@@ -162,6 +199,7 @@ contains
         d%der(1:size(der)) = der
     end function dual_seed
 
+    !> The value of a dual, its tangents dropped.
     elemental function dual_value(d) result(x)
         type(dual_t), intent(in) :: d
         real(wp) :: x

@@ -34,6 +34,8 @@ module flexmbs_mbs_flexible_marker
     real(wp), parameter :: identity3(3, 3) = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
         1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
 
+    !> A marker on a node set of a flexible body (the module's formulas): the
+    !> set, its reference offsets and weight, the marker's offset d and axes U0.
     type, public :: flexible_marker_t
         integer, allocatable :: nodes(:)          !! mesh node numbers of the set
         real(wp), allocatable :: dx_ref(:, :)     !! (3, |S|): X_a − X̄

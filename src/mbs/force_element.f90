@@ -68,6 +68,8 @@ module flexmbs_mbs_force_element
 
 contains
 
+    !> The scene's word for a force element kind ('spring_damper', 'rotational',
+    !> 'bushing', 'applied'; 'unknown' otherwise), for messages.
     pure function force_element_name(kind) result(name)
         integer, intent(in) :: kind
         character(len=:), allocatable :: name

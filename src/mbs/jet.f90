@@ -14,6 +14,8 @@ module flexmbs_mbs_jet
     implicit none
     private
 
+    !> A jet: f0 + f1 s + f2 s²/2, the value and the first two derivatives of
+    !> a quantity along one curve s.
     type, public :: jet_t
         real(wp) :: f0 !! value
         real(wp) :: f1 !! first derivative
@@ -23,33 +25,43 @@ module flexmbs_mbs_jet
     public :: operator(+), operator(-), operator(*), operator(/), operator(**)
     public :: assignment(=), sqrt, sin, cos, matmul
 
+    !> Sum of jets, of a jet and a real (either order), and unary plus.
     interface operator(+)
         module procedure add_jj, add_jr, add_rj, plus_j
     end interface
+    !> Difference of jets, of a jet and a real (either order), and negation.
     interface operator(-)
         module procedure sub_jj, sub_jr, sub_rj, minus_j
     end interface
+    !> Product by Leibniz's rule, (ab)'' = a''b + 2a'b' + ab'', or scaling by a real.
     interface operator(*)
         module procedure mul_jj, mul_jr, mul_rj
     end interface
+    !> Quotient of jets, or with a real on either side.
     interface operator(/)
         module procedure div_jj, div_jr, div_rj
     end interface
+    !> Integer power of a jet.
     interface operator(**)
         module procedure pow_ji
     end interface
+    !> A real assigned to a jet: a constant, zero derivatives.
     interface assignment(=)
         module procedure assign_r
     end interface
+    !> Square root of a jet (no derivatives at 0).
     interface sqrt
         module procedure sqrt_j
     end interface
+    !> Sine of a jet.
     interface sin
         module procedure sin_j
     end interface
+    !> Cosine of a jet.
     interface cos
         module procedure cos_j
     end interface
+    !> Matrix-vector and matrix-matrix products with jet and real operands.
     interface matmul
         module procedure matvec_jj, matvec_jr, matvec_rj, matmat_jj, matmat_jr, matmat_rj
     end interface

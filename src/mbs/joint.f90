@@ -36,6 +36,8 @@ module flexmbs_mbs_joint
     integer, parameter, public :: joint_part_convective = 2 !! (C v)_q T v
     integer, parameter, public :: joint_part_time_terms = 3 !! 2 C_t v + c_tt
 
+    !> A joint as a list of constraint primitives (see the module's table): its
+    !> kind, its rows and, for each primitive, its kind and the marker axes it uses.
     type, public :: joint_t
         integer :: kind = 0
         integer :: nprimitives = 0
@@ -100,6 +102,8 @@ contains
         call add(joint, kind, ki, kj)
     end subroutine new_primitive_joint
 
+    !> The scene's word for a joint kind ('spherical' ... 'fixed', 'primitive';
+    !> 'unknown' otherwise), for messages and the VTK joints' files.
     pure function joint_name(kind) result(name)
         integer, intent(in) :: kind
         character(len=:), allocatable :: name

@@ -51,6 +51,8 @@ module flexmbs_mbs_node_frame
     !> nodes per AD pass: 7 body directions + 3 × 3 node directions ≤ dual_size
     integer, parameter :: pass_nodes = (dual_size - body_nq) / 3
 
+    !> A frame held on a node set by six constraints (see the module), or on an
+    !> interface of a modal body: its node set and the offsets the system gives it.
     type, public :: node_frame_t
         integer :: flexible = 0            !! flexible body number
         integer :: body = 0                !! the frame's (massless) rigid body

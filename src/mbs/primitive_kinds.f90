@@ -36,6 +36,8 @@ contains
         end select
     end function primitive_rows
 
+    !> A primitive kind as words for messages ('dot-1', 'spherical', 'angle
+    !> driver', ...; 'unknown' otherwise).
     pure function primitive_name(kind) result(name)
         integer, intent(in) :: kind
         character(len=:), allocatable :: name

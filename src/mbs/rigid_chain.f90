@@ -71,6 +71,8 @@ module flexmbs_mbs_rigid_chain
         real(wp) :: axes(3, 3) = identity3        !! columns, in the body's frame
     end type chain_marker_t
 
+    !> A tree of rigid bodies in relative coordinates as a mechanical problem
+    !> (see the module): bodies, markers, gravity and the recursions' workspaces.
     type, extends(mechanical_problem_t), public :: rigid_chain_t
         type(chain_body_t), allocatable :: bodies(:)
         type(chain_marker_t), allocatable :: markers(:)

@@ -34,6 +34,8 @@ module flexmbs_problems_pendulum_chain
 
     real(wp), parameter :: half_pi = 0.5_wp * acos(-1.0_wp)
 
+    !> The chain of NB bars (see the module): NB and the bars' mass, half-length
+    !> and moment of inertia, all fixed by NB.
     type, extends(mechanical_problem_t), public :: pendulum_chain_t
         integer :: bodies = 0            !! NB
         real(wp) :: body_mass = 0.0_wp   !! m = 1/NB

@@ -11,6 +11,8 @@ module flexmbs_problems_van_der_pol
     implicit none
     private
 
+    !> Van der Pol's oscillator with stiffness parameter ε (eps), dense or
+    !> (sparse = .true.) CSC Jacobian.
     type, extends(dae_problem_t), public :: van_der_pol_t
         real(wp) :: eps = 1.0e-6_wp
         !> Report the Jacobian as CSC (to exercise the sparse path).
@@ -27,6 +29,8 @@ module flexmbs_problems_van_der_pol
 
 contains
 
+    !> The oscillator with parameter eps and n = 2; `sparse` (default false)
+    !> reports its Jacobian in CSC.
     function new_van_der_pol(eps, sparse) result(problem)
         real(wp), intent(in) :: eps
         logical, intent(in), optional :: sparse

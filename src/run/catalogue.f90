@@ -12,6 +12,8 @@ module flexmbs_run_catalogue
     integer, parameter, public :: solver_radau5 = 1, solver_ddassl = 2, solver_ida = 3, &
         solver_mexax = 4
 
+    !> One solver of the catalogue: its name in scenes, a one-line description
+    !> and the capabilities that the run and study layers ask about.
     type, public :: solver_info_t
         character(len=8) :: name = ''
         character(len=64) :: doc = ''
@@ -45,6 +47,8 @@ module flexmbs_run_catalogue
         problem_robertson = 3, problem_brusselator_1d = 4, problem_brusselator_2d = 5, &
         problem_flexible_body = 6, problem_multibody = 7, problem_rigid_chain = 8
 
+    !> One problem of the catalogue: its name in scenes and what it offers
+    !> (a mechanical form, bodies to draw, stabilisations to vary).
     type, public :: problem_info_t
         character(len=16) :: name = ''
         !> has a mechanical form (q, v, λ) that a mechanical_only solver integrates
@@ -94,6 +98,8 @@ contains
         if (id > 0) info = solvers(id)
     end function solver_info
 
+    !> The index of problem `name` in `problems` (leading blanks ignored), 0 when
+    !> there is none.
     pure integer function problem_id(name) result(id)
         character(len=*), intent(in) :: name
         do id = 1, size(problems)
@@ -102,6 +108,8 @@ contains
         id = 0
     end function problem_id
 
+    !> The catalogue's entry of problem `name`; the default entry (no name, no
+    !> capabilities) for an unknown name.
     pure function problem_info(name) result(info)
         character(len=*), intent(in) :: name
         type(problem_info_t) :: info
@@ -118,6 +126,7 @@ contains
         solver_projects = info%projects
     end function solver_projects
 
+    !> True when a study runs the solver at every p_max of its grid.
     pure logical function solver_pmax_grid(name)
         character(len=*), intent(in) :: name
         type(solver_info_t) :: info
@@ -139,6 +148,7 @@ contains
         name = ''
     end function pmax_grid_solver
 
+    !> True when the solver integrates only mechanical forms (MEXAX).
     pure logical function solver_mechanical_only(name)
         character(len=*), intent(in) :: name
         type(solver_info_t) :: info
@@ -146,6 +156,8 @@ contains
         solver_mechanical_only = info%mechanical_only
     end function solver_mechanical_only
 
+    !> True when a study varies the problem's stabilisation and constraint
+    !> derivatives (false for an unknown name).
     pure logical function problem_stabilisations(name)
         character(len=*), intent(in) :: name
         type(problem_info_t) :: info

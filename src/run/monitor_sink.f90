@@ -24,6 +24,8 @@ module flexmbs_run_monitor_sink
     implicit none
     private
 
+    !> The monitor (see the module): the formulated problem it watches and its
+    !> table of drift and energy, with joint reactions for multibody systems.
     type, extends(sink_t), public :: monitor_sink_t
         type(formulation_t), pointer :: formulation => null()
         class(mechanical_problem_t), pointer :: mechanical => null()

@@ -22,6 +22,8 @@ module flexmbs_run_plan
     implicit none
     private
 
+    !> A checked run (see the module): problem, mechanical form, solver, options,
+    !> initial state, the named blocks of y and what the output needs to know.
     type, public :: run_plan_t
         class(dae_problem_t), allocatable :: problem
         !> the mechanical form, for mechanical scenes (`problem` is then its

@@ -14,6 +14,8 @@ module flexmbs_run_step_sink
     !> First capacity of the step arrays; they double when full.
     integer, parameter :: first_capacity = 1024
 
+    !> The accepted steps of a run (size, end and order) and optionally the state
+    !> at t_state (see the module).
     type, extends(sink_t), public :: step_sink_t
         integer :: steps = 0                 !! accepted steps kept
         real(wp), allocatable :: h(:)        !! step sizes (1:steps)

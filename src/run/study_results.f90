@@ -64,12 +64,16 @@ contains
         path = folder // '/point_' // int_text(k) // '.log'
     end function log_path
 
+    !> FOLDER/array.sbatch: the script of the Slurm array job that
+    !> `sweep --slurm` writes into the study's results folder.
     pure function array_script_path(folder) result(path)
         character(len=*), intent(in) :: folder
         character(len=:), allocatable :: path
         path = folder // '/array.sbatch'
     end function array_script_path
 
+    !> FOLDER/merge.sbatch: the script of the merge job (`sweep STUDY --merge`,
+    !> after the array job) in the study's results folder.
     pure function merge_script_path(folder) result(path)
         character(len=*), intent(in) :: folder
         character(len=:), allocatable :: path
