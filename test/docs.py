@@ -183,7 +183,7 @@ def main():
     with open(index, encoding='utf-8') as f:
         listed = set(LINK.findall(f.read()))
     missing = [os.path.basename(p) for p in files
-               if os.path.dirname(p).endswith('docs') and p != index
+               if os.path.basename(os.path.dirname(p)) == 'docs' and p != index
                and os.path.basename(p) not in listed]
     check('index-lists-every-page', ['docs/README.md does not list ' + m for m in missing])
 
