@@ -10,6 +10,11 @@
   src/, app/ and bench/ the code asks the catalogue by capability.
 - bench/ and the command line build solvers through the catalogue's
   factories: bench/ uses no solver module's type.
+- The types of src/mbs/ and src/fe/ keep their parts: src/run/ and src/io/
+  reach into their data components (`var%component`, `var` declared of such
+  a type, the component not a type-bound procedure) at most REACH_IN_BOUND
+  times; the bound only comes down, towards 10, each with a comment saying
+  why (issue 35).
 
 Prints `pass layers/...` or `FAIL layers/...: why` lines and
 `N passed, M failed` last; exits non-zero on failures.
@@ -125,6 +130,63 @@ pchoices = re.search(r"problem_choices\s*=\s*'([^']*)'", catalogue, re.S)
 if not pchoices or re.sub(r"&\s*&", '', pchoices.group(1)).split('|') != pnames:
     problems.append('problem_choices differs from the table %s' % pnames)
 report('catalogue-names-are-the-solvers-names', problems)
+
+# Reach-ins from run/ and io/ into the components of mbs/ and fe/ types.
+REACH_IN_BOUND = 300
+
+
+def type_parts(folders):
+    """{type name: (data components, bindings)} of the derived types defined
+    in `folders`."""
+    parts = {}
+    start = re.compile(r'type\s*(?:,\s*[^:]*)?::\s*(\w+)\s*$', re.I)
+    for rel, path in sources(*folders):
+        current, bound = None, False
+        for line in open(path, encoding='utf-8'):
+            code = line.split('!')[0].strip()
+            m = start.match(code)
+            if m:
+                current, bound = m.group(1).lower(), False
+                parts[current] = (set(), set())
+                continue
+            if current is None:
+                continue
+            if re.match(r'end\s*type\b', code, re.I):
+                current = None
+            elif code.lower() == 'contains':
+                bound = True
+            elif '::' in code:
+                names = [re.match(r'\s*(\w+)', part) for part in
+                         re.split(r',(?![^()]*\))', code.split('::', 1)[1])]
+                target = parts[current][1] if bound else parts[current][0]
+                target.update(n.group(1).lower() for n in names if n)
+    return parts
+
+
+parts = type_parts(('src/mbs', 'src/fe'))
+declared = re.compile(r'(?:type|class)\s*\(\s*(\w+)\s*\)[^:\n]*::\s*([^\n!]*)', re.I)
+reference = re.compile(r'\b(\w+)\s*(?:\([^()]*(?:\([^()]*\)[^()]*)*\))?\s*%\s*(\w+)')
+reach_ins = []
+for rel, path in sources('src/run', 'src/io'):
+    text = open(path, encoding='utf-8').read()
+    kinds = {}
+    for m in declared.finditer(text):
+        if m.group(1).lower() in parts:
+            for part in re.split(r',(?![^()]*\))', m.group(2)):
+                n = re.match(r'\s*(\w+)', part)
+                if n:
+                    kinds[n.group(1).lower()] = m.group(1).lower()
+    for k, line in enumerate(text.split('\n'), 1):
+        for m in reference.finditer(line.split('!')[0]):
+            var, component = m.group(1).lower(), m.group(2).lower()
+            if var in kinds and component in parts[kinds[var]][0]:
+                reach_ins.append('%s:%d %s%%%s (%s)' % (rel, k, var, component, kinds[var]))
+print('    %d reach-ins from run/ and io/ into mbs/ and fe/ components (bound %d)'
+      % (len(reach_ins), REACH_IN_BOUND))
+report('run-and-io-keep-out-of-mbs-and-fe-components',
+       [] if len(reach_ins) <= REACH_IN_BOUND else
+       ['%d reach-ins, more than %d: %s' % (len(reach_ins), REACH_IN_BOUND, r)
+        for r in reach_ins])
 
 print('%d passed, %d failed' % (passed, failed))
 sys.exit(1 if failed else 0)
