@@ -149,7 +149,8 @@ run: build
 # (test/programs.sh), a project depending on flexmbs through fpm
 # (test/dependency.sh, test/fpm_dependency/), the architecture's rules
 # on the sources (test/layers.py), the documentation of every public
-# procedure and type (test/public_docs.py), then the command-line
+# procedure and type (test/public_docs.py), the typed scene generated from
+# the schema and current (test/scene_records.py), then the command-line
 # checks of test/cli.sh, the documentation's links and generated scene
 # reference (test/docs.py), the ParaView and XDMF files read by VTK and
 # meshio (test/vtk_files.py, in $(PY_VENV)), the signals of test/kill.sh (python3-h5py reads
@@ -172,6 +173,8 @@ test: deps
 	    echo "exit $$?" >> $(BUILD)/test-layers.log
 	@set -o pipefail; python3 test/public_docs.py 2>&1 | tee $(BUILD)/test-public-docs.log; \
 	    echo "exit $$?" >> $(BUILD)/test-public-docs.log
+	@set -o pipefail; python3 test/scene_records.py 2>&1 | tee $(BUILD)/test-scene-records.log; \
+	    echo "exit $$?" >> $(BUILD)/test-scene-records.log
 	@set -o pipefail; FPM="$(FPM)" bash test/cli.sh 2>&1 | tee $(BUILD)/test-cli.log; \
 	    echo "exit $$?" >> $(BUILD)/test-cli.log
 	@set -o pipefail; FLEXMBS_PKGCONFIG=$(PREFIX_DEBUG)/lib/pkgconfig python3 test/docs.py \
@@ -190,7 +193,7 @@ test: deps
 	    echo "exit $$?" >> $(BUILD)/test-fuzz.log
 	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log \
 	    $(BUILD)/test-programs.log $(BUILD)/test-dependency.log $(BUILD)/test-layers.log \
-	    $(BUILD)/test-public-docs.log $(BUILD)/test-cli.log $(BUILD)/test-docs.log \
+	    $(BUILD)/test-public-docs.log $(BUILD)/test-scene-records.log $(BUILD)/test-cli.log $(BUILD)/test-docs.log \
 	    $(BUILD)/test-vtk.log $(BUILD)/test-kill.log $(BUILD)/test-examples.log \
 	    $(BUILD)/test-tolerances.log $(BUILD)/test-fuzz.log
 

@@ -6,7 +6,8 @@
 - A solver's name ('radau5', 'ddassl', 'ida', 'mexax') is written as a
   string only in the solver's own modules in src/dae/ (<solver>.f90 and
   the <solver>_*.f90 it is split into), in the catalogue
-  (src/run/catalogue.f90) and in the scene schema; everywhere else in
+  (src/run/catalogue.f90) and in the scene schema (with the typed scene
+  generated from it, src/io/scene_records.f90); everywhere else in
   src/, app/ and bench/ the code asks the catalogue by capability.
 - bench/ and the command line build solvers through the catalogue's
   factories: bench/ uses no solver module's type.
@@ -27,8 +28,10 @@ ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..')
 SOLVERS = ('radau5', 'ddassl', 'ida', 'mexax')
 SOLVER_MODULE = re.compile(r'^\s*use\s+flexmbs_dae_(radau5|ddassl|ida|mexax)\b', re.I)
 RUN_MODULE = re.compile(r'^\s*use\s+(flexmbs_run_\w+)', re.I)
+# (io/scene_records is generated from the schema's table: test/scene_records.py)
 OWNERS = {'src/dae/radau5.f90', 'src/dae/ddassl.f90', 'src/dae/ida.f90',
-          'src/dae/mexax.f90', 'src/run/catalogue.f90', 'src/io/scene_schema.f90'}
+          'src/dae/mexax.f90', 'src/run/catalogue.f90', 'src/io/scene_schema.f90',
+          'src/io/scene_records.f90'}
 
 passed = failed = 0
 

@@ -405,7 +405,7 @@ contains
         character(len=*), intent(in) :: name
         select case (name)
         case ('title'); string_length = len_title
-        case ('file', 'table', 'mesh_file', 'scene', 'reference_file', 'vtk')
+        case ('file', 'table', 'mesh_file', 'scene', 'reference_file', 'vtk', 'modes_cache')
             string_length = len_path
         case default; string_length = len_name
         end select
