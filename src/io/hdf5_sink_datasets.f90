@@ -8,10 +8,7 @@ contains
 
     !> Store a text as a string attribute of '/' (a scalar string dataset
     !> when it is too large for an attribute), replacing an earlier one.
-    module subroutine sink_write_text(self, name, text, status)
-        class(hdf5_sink_t), intent(inout) :: self
-        character(len=*), intent(in) :: name, text
-        type(status_t), intent(out) :: status
+    module procedure sink_write_text
         integer(hid_t) :: str_type, space, dset
         integer :: err
         if (.not. self%is_open) then
@@ -32,15 +29,11 @@ contains
                 'stored in dataset /' // name, err)
         end if
         if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot write ' // name)
-    end subroutine sink_write_text
+    end procedure sink_write_text
 
     !> A 2-D real dataset /name (rows, columns), e.g. the monitor table
     !> (groups of a path created as needed).
-    module subroutine sink_write_matrix(self, name, values, status)
-        class(hdf5_sink_t), intent(inout) :: self
-        character(len=*), intent(in) :: name
-        real(wp), intent(in) :: values(:, :)
-        type(status_t), intent(out) :: status
+    module procedure sink_write_matrix
         integer(hsize_t) :: dims(2)
         integer(hid_t) :: dset
         integer :: err
@@ -48,14 +41,10 @@ contains
         call new_dataset(self, name, H5T_NATIVE_DOUBLE, dims, dset, err, status)
         if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, err)
         call close_dataset(self, name, dset, err, status)
-    end subroutine sink_write_matrix
+    end procedure sink_write_matrix
 
     !> A 1-D real dataset /name, e.g. the energy at each record.
-    module subroutine sink_write_vector(self, name, values, status)
-        class(hdf5_sink_t), intent(inout) :: self
-        character(len=*), intent(in) :: name
-        real(wp), intent(in) :: values(:)
-        type(status_t), intent(out) :: status
+    module procedure sink_write_vector
         integer(hsize_t) :: dims(1)
         integer(hid_t) :: dset
         integer :: err
@@ -63,15 +52,11 @@ contains
         call new_dataset(self, name, H5T_NATIVE_DOUBLE, dims, dset, err, status)
         if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_DOUBLE, values, dims, err)
         call close_dataset(self, name, dset, err, status)
-    end subroutine sink_write_vector
+    end procedure sink_write_vector
 
     !> A 2-D integer dataset /name (rows, columns), e.g. a connectivity
     !> (groups of a path created as needed).
-    module subroutine sink_write_integers(self, name, values, status)
-        class(hdf5_sink_t), intent(inout) :: self
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: values(:, :)
-        type(status_t), intent(out) :: status
+    module procedure sink_write_integers
         integer(hsize_t) :: dims(2)
         integer(hid_t) :: dset
         integer :: err
@@ -79,14 +64,10 @@ contains
         call new_dataset(self, name, H5T_NATIVE_INTEGER, dims, dset, err, status)
         if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_INTEGER, values, dims, err)
         call close_dataset(self, name, dset, err, status)
-    end subroutine sink_write_integers
+    end procedure sink_write_integers
 
     !> A 1-D integer dataset /name, e.g. a node set.
-    module subroutine sink_write_integer_list(self, name, values, status)
-        class(hdf5_sink_t), intent(inout) :: self
-        character(len=*), intent(in) :: name
-        integer, intent(in) :: values(:)
-        type(status_t), intent(out) :: status
+    module procedure sink_write_integer_list
         integer(hsize_t) :: dims(1)
         integer(hid_t) :: dset
         integer :: err
@@ -94,15 +75,11 @@ contains
         call new_dataset(self, name, H5T_NATIVE_INTEGER, dims, dset, err, status)
         if (err >= 0) call h5dwrite_f(dset, H5T_NATIVE_INTEGER, values, dims, err)
         call close_dataset(self, name, dset, err, status)
-    end subroutine sink_write_integer_list
+    end procedure sink_write_integer_list
 
     !> A 1-D dataset of UTF-8 strings (variable length: h5py reads str) at
     !> `path`, e.g. the label of every component of /y.
-    module subroutine sink_write_strings(self, path, strings, status)
-        class(hdf5_sink_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        character(len=*), intent(in) :: strings(:)
-        type(status_t), intent(out) :: status
+    module procedure sink_write_strings
         character(kind=c_char, len=len(strings) + 1), allocatable, target :: text(:)
         type(c_ptr), allocatable, target :: pointers(:)
         integer(hid_t) :: str_type, dset
@@ -119,13 +96,10 @@ contains
             call h5dwrite_f(dset, str_type, c_loc(pointers(1)), err)
         call close_dataset(self, path, dset, err, status)
         call h5tclose_f(str_type, close_err)
-    end subroutine sink_write_strings
+    end procedure sink_write_strings
 
     !> A string attribute `name` = `text` of the dataset or group at `path`.
-    module subroutine sink_annotate(self, path, name, text, status)
-        class(hdf5_sink_t), intent(inout) :: self
-        character(len=*), intent(in) :: path, name, text
-        type(status_t), intent(out) :: status
+    module procedure sink_annotate
         integer(hid_t) :: obj
         integer :: err, close_err
         call h5oopen_f(self%file, path, obj, err)
@@ -135,7 +109,7 @@ contains
         end if
         if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot annotate /' &
                                      // path)
-    end subroutine sink_annotate
+    end procedure sink_annotate
 
     !> A new dataset `name` of type `dtype` and shape `dims`, the groups of
     !> its path made as needed; err < 0 (and `status` says why when the file

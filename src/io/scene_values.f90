@@ -48,13 +48,20 @@ contains
                 ! in a list, say which value is wrong
                 if (size(entries(i)%items) > 1) reason = 'value ' // int_text(j) // ' (' // &
                     excerpt(entries(i)%items(j)%text) // ') ' // reason
-                call errors%add_value(entries(i)%group, entries(i)%name, entries(i)%value, &
-                                      reason, entries(i)%line)
-                entries(i)%bad = .true.
+                call reject(entries(i), reason, errors)
                 exit
             end do
         end do
     end subroutine check_types
+
+    ! Report a wrong value of `entry` and mark the entry bad (later checks skip it).
+    subroutine reject(entry, reason, errors)
+        type(entry_t), intent(inout) :: entry
+        character(len=*), intent(in) :: reason
+        type(input_errors_t), intent(inout) :: errors
+        call errors%add_value(entry%group, entry%name, entry%value, reason, entry%line)
+        entry%bad = .true.
+    end subroutine reject
 
     !> Every valid value against its variable's rule and choices.
     subroutine check_rules(entries, errors)
@@ -84,9 +91,7 @@ contains
                 ! in a list of strings, say which one
                 if (size(entries(i)%items) > 1 .and. schema(spec)%kind == kind_string) &
                     reason = '''' // excerpt(text) // ''': ' // reason
-                call errors%add_value(entries(i)%group, entries(i)%name, entries(i)%value, &
-                                      reason, entries(i)%line)
-                entries(i)%bad = .true.
+                call reject(entries(i), reason, errors)
                 exit
             end do
         end do
@@ -277,16 +282,15 @@ contains
         end do
     end function value_text
 
+    ! A scalar is read as the first value of a list (the same list-directed read).
     subroutine get_real(entries, group, name, x, instance)
         type(entry_t), intent(in) :: entries(:)
         character(len=*), intent(in) :: group, name
         real(wp), intent(out) :: x
         integer, intent(in), optional :: instance
-        character(len=:), allocatable :: text
-        integer :: ios
-        text = value_text(entries, group, name, instance)
-        x = 0.0_wp
-        if (len(text) > 0) read (text, *, iostat=ios) x
+        real(wp) :: first(1)
+        call get_real_array(entries, group, name, first, instance)
+        x = first(1)
     end subroutine get_real
 
     subroutine get_real_array(entries, group, name, x, instance)
@@ -301,16 +305,15 @@ contains
         if (len(text) > 0) read (text, *, iostat=ios) x
     end subroutine get_real_array
 
+    ! As get_real.
     subroutine get_integer(entries, group, name, m, instance)
         type(entry_t), intent(in) :: entries(:)
         character(len=*), intent(in) :: group, name
         integer, intent(out) :: m
         integer, intent(in), optional :: instance
-        character(len=:), allocatable :: text
-        integer :: ios
-        text = value_text(entries, group, name, instance)
-        m = 0
-        if (len(text) > 0) read (text, *, iostat=ios) m
+        integer :: first(1)
+        call get_integer_array(entries, group, name, first, instance)
+        m = first(1)
     end subroutine get_integer
 
     subroutine get_integer_array(entries, group, name, m, instance)

@@ -53,11 +53,9 @@ contains
         type(matrix_t), intent(in) :: mass, jac
         type(status_t), intent(out) :: status
 
-        call self%pattern%build(mass, jac, who, status)
+        call self%pattern%build(mass, jac, who, status, self%values, self%zvalues)
         if (.not. status%ok()) return
         self%n = self%pattern%order()
-        call self%pattern%value_arrays(self%values, self%zvalues, who, status)
-        if (.not. status%ok()) return
         call self%lu%analyse(self%n, self%pattern%column_pointers(), &
             self%pattern%row_indices(), status, self%ordering)
     end subroutine klu_solver_init

@@ -93,47 +93,14 @@ module flexmbs_linalg_lapack
             complex(wp), intent(inout) :: b(ldb, *)
             integer, intent(out) :: info
         end subroutine zgbtrs
-        !> Singular value decomposition A = U Σ Vᵀ; callers use dgesvd_quiet,
-        !> which keeps the IEEE flags.
-        subroutine dgesvd(jobu, jobvt, m, n, a, lda, s, u, ldu, vt, ldvt, work, lwork, info)
-            import :: wp
-            character, intent(in) :: jobu, jobvt
-            integer, intent(in) :: m, n, lda, ldu, ldvt, lwork
-            real(wp), intent(inout) :: a(lda, *)
-            real(wp), intent(out) :: s(*), u(ldu, *), vt(ldvt, *), work(*)
-            integer, intent(out) :: info
-        end subroutine dgesvd
-        !> Eigenvalues (and vectors) of a real symmetric matrix; callers use
-        !> dsyev_quiet, which keeps the IEEE flags.
-        subroutine dsyev(jobz, uplo, n, a, lda, w, work, lwork, info)
-            import :: wp
-            character, intent(in) :: jobz, uplo
-            integer, intent(in) :: n, lda, lwork
-            real(wp), intent(inout) :: a(lda, *)
-            real(wp), intent(out) :: w(*), work(*)
-            integer, intent(out) :: info
-        end subroutine dsyev
-        subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
-            import :: wp
-            integer, intent(in) :: itype, n, lda, ldb, lwork
-            character, intent(in) :: jobz, uplo
-            real(wp), intent(inout) :: a(lda, *), b(ldb, *)
-            real(wp), intent(out) :: w(*), work(*)
-            integer, intent(out) :: info
-        end subroutine dsygv
-        !> Generalised eigenvalues (α_r + i α_i) / β of the pencil (A, B), blocked
-        !> QZ; callers use dggev3_quiet, which keeps the IEEE flags.
-        subroutine dggev3(jobvl, jobvr, n, a, lda, b, ldb, alphar, alphai, beta, vl, ldvl, &
-                         vr, ldvr, work, lwork, info)
-            import :: wp
-            character, intent(in) :: jobvl, jobvr
-            integer, intent(in) :: n, lda, ldb, ldvl, ldvr, lwork
-            real(wp), intent(inout) :: a(lda, *), b(ldb, *)
-            real(wp), intent(out) :: alphar(*), alphai(*), beta(*), vl(ldvl, *), vr(ldvr, *)
-            real(wp), intent(out) :: work(*)
-            integer, intent(out) :: info
-        end subroutine dggev3
     end interface
+
+    ! LAPACK routines with a quiet wrapper below: each has its wrapper's
+    ! characteristics, declared once, in the wrapper.
+    procedure(dgesvd_quiet) :: dgesvd
+    procedure(dsyev_quiet) :: dsyev
+    procedure(dsygv_quiet) :: dsygv
+    procedure(dggev3_quiet) :: dggev3
 
 contains
 

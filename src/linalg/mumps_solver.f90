@@ -56,11 +56,9 @@ contains
         type(matrix_t), intent(in) :: mass, jac
         type(status_t), intent(out) :: status
 
-        call self%pattern%build(mass, jac, who, status)
+        call self%pattern%build(mass, jac, who, status, self%values, self%zvalues)
         if (.not. status%ok()) return
         self%n = self%pattern%order()
-        call self%pattern%value_arrays(self%values, self%zvalues, who, status)
-        if (.not. status%ok()) return
         call analyse(self%lu, self, status)
         if (.not. status%ok()) return
         call analyse(self%zlu, self, status)

@@ -45,20 +45,23 @@ module flexmbs_linalg_shifted_pattern
         procedure :: complex_values => pattern_complex_values
         procedure :: order => pattern_order
         procedure :: nonzeros => pattern_nonzeros
-        procedure :: value_arrays => pattern_value_arrays
         procedure :: column_pointers => pattern_column_pointers
         procedure :: row_indices => pattern_row_indices
     end type shifted_pattern_t
 
 contains
 
-    !> Build the union pattern of M, J and the diagonal with its slot maps.
+    !> Build the union pattern of M, J and the diagonal with its slot maps;
+    !> with `values` and `zvalues`, also the solver's real and complex arrays
+    !> of one value per slot for c*M - J (allocated once, here).
     !> `who` starts every message ('klu solver', 'mumps solver').
-    subroutine pattern_build(self, mass, jac, who, status)
+    subroutine pattern_build(self, mass, jac, who, status, values, zvalues)
         class(shifted_pattern_t), intent(inout) :: self
         type(matrix_t), intent(in) :: mass, jac
         character(len=*), intent(in) :: who
         type(status_t), intent(out) :: status
+        real(wp), allocatable, intent(out), optional :: values(:)
+        complex(wp), allocatable, intent(out), optional :: zvalues(:)
         integer :: n, stat
 
         n = jac%n
@@ -96,6 +99,8 @@ contains
             return
         end if
         self%n = n
+        if (present(values) .and. present(zvalues)) &
+            call value_arrays(self, values, zvalues, who, status)
     end subroutine pattern_build
 
     !> Orders and storages must agree; a sparse LU needs J itself, not a
@@ -341,10 +346,8 @@ contains
         pattern_order = self%n
     end function pattern_order
 
-    !> Slots of the union pattern (0 before build).
-    !> Real and complex arrays of one value per slot, for the solvers' c*M - J
-    !> (allocated once, at init).
-    subroutine pattern_value_arrays(self, values, zvalues, who, status)
+    ! Real and complex arrays of one value per slot, for the solvers' c*M - J.
+    subroutine value_arrays(self, values, zvalues, who, status)
         class(shifted_pattern_t), intent(in) :: self
         real(wp), allocatable, intent(out) :: values(:)
         complex(wp), allocatable, intent(out) :: zvalues(:)
@@ -357,8 +360,9 @@ contains
             call out_of_memory(status, who // ' values', 3 * self%nonzeros(), 8)
             if (allocated(values)) deallocate (values)
         end if
-    end subroutine pattern_value_arrays
+    end subroutine value_arrays
 
+    !> Slots of the union pattern (0 before build).
     pure integer(i8) function pattern_nonzeros(self)
         class(shifted_pattern_t), intent(in) :: self
         pattern_nonzeros = 0

@@ -72,20 +72,7 @@ contains
     !> The body of the external DDASSL: same arguments, same meanings.
     subroutine ddassl_classic(res, neq, t, y, yprime, tout, info, rtol, atol, idid, rwork, lrw, &
         iwork, liw, rpar, ipar, jac)
-        procedure(ddassl_res_i) :: res
-        integer, intent(in) :: neq
-        real(wp), intent(inout) :: t
-        real(wp), intent(inout) :: y(*), yprime(*)
-        real(wp), intent(in) :: tout
-        integer, intent(inout) :: info(15)
-        real(wp), intent(inout) :: rtol(*), atol(*)
-        integer, intent(out) :: idid
-        integer, intent(in) :: lrw, liw
-        real(wp), intent(inout) :: rwork(lrw)
-        integer, intent(inout) :: iwork(liw)
-        real(wp), intent(inout), target :: rpar(*)
-        integer, intent(inout), target :: ipar(*)
-        procedure(ddassl_jac_i) :: jac
+        include 'ddassl_arguments.inc'
 
         type(session_t), pointer :: ses
         type(dae_options_t) :: options

@@ -46,20 +46,7 @@ module flexmbs_legacy_ddassl_interface
         subroutine ddassl(res, neq, t, y, yprime, tout, info, rtol, atol, idid, rwork, lrw, &
             iwork, liw, rpar, ipar, jac)
             import :: wp, ddassl_res_i, ddassl_jac_i
-            procedure(ddassl_res_i) :: res
-            integer, intent(in) :: neq
-            real(wp), intent(inout) :: t
-            real(wp), intent(inout) :: y(*), yprime(*)
-            real(wp), intent(in) :: tout
-            integer, intent(inout) :: info(15)
-            real(wp), intent(inout) :: rtol(*), atol(*)
-            integer, intent(out) :: idid
-            integer, intent(in) :: lrw, liw
-            real(wp), intent(inout) :: rwork(lrw)
-            integer, intent(inout) :: iwork(liw)
-            real(wp), intent(inout), target :: rpar(*)
-            integer, intent(inout), target :: ipar(*)
-            procedure(ddassl_jac_i) :: jac
+            include 'ddassl_arguments.inc'
         end subroutine ddassl
     end interface
 end module flexmbs_legacy_ddassl_interface

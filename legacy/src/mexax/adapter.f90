@@ -26,8 +26,9 @@ module flexmbs_legacy_mexax_adapter
         mexax_dense_t, mexax_failed_projection, mexax_max_columns, mexax_control_hairer
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
-    use flexmbs_dae_sink, only: sink_t, dense_output_t
+    use flexmbs_dae_sink, only: dense_output_t
     use flexmbs_legacy_mexax_interface, only: mexax_fprob_i, mexax_solout_i
+    use flexmbs_legacy_common_solout_sink, only: solout_sink_t
     implicit none
     private
 
@@ -73,34 +74,21 @@ module flexmbs_legacy_mexax_adapter
     end type classic_mechanical_t
 
     !> SOLOUT after every accepted step (MXJOB(30) = 1).
-    type, extends(sink_t) :: classic_sink_t
+    type, extends(solout_sink_t) :: classic_sink_t
         procedure(mexax_solout_i), pointer, nopass :: solout => null()
         integer :: np = 0, nv = 0, nl = 0, nu = 0
         real(wp), allocatable :: u(:)
         integer :: info(50) = 0
     contains
-        procedure :: output => classic_output
-        procedure :: wants_steps => classic_wants_steps
-        procedure :: step => classic_step
+        procedure :: call_solout => classic_solout
     end type classic_sink_t
 
 contains
 
     !> The body of the external MEXAX: same arguments, same meanings.
     subroutine mexax_classic(np, nv, nl, ng, nu, fprob, t, tfin, p, v, u, a, rlam, itol, rtol, &
-        atol, h, mxjob, ierr, liwk, lrwk, solout)
-        integer, intent(in) :: np, nv, nl, ng, nu
-        procedure(mexax_fprob_i) :: fprob
-        real(wp), intent(inout) :: t
-        real(wp), intent(in) :: tfin
-        real(wp), intent(inout) :: p(*), v(*), u(*), a(*), rlam(*)
-        integer, intent(in) :: itol
-        real(wp), intent(in) :: rtol(*), atol(*)
-        real(wp), intent(inout) :: h
-        integer, intent(inout) :: mxjob(*)
-        integer, intent(out) :: ierr
-        integer, intent(in) :: liwk, lrwk
-        procedure(mexax_solout_i) :: solout
+        atol, h, mxjob, ierr, liwk, iwk, lrwk, rwk, solout, denout, fswit)
+        include 'mexax_arguments.inc'
 
         type(classic_mechanical_t) :: problem
         type(classic_sink_t) :: sink
@@ -425,27 +413,15 @@ contains
         gt = self%gi(1:size(gt))
     end subroutine classic_constraint_time_derivative
 
-    subroutine classic_output(self, t, y, status)
-        class(classic_sink_t), intent(inout) :: self
-        real(wp), intent(in) :: t, y(:)
-        type(status_t), intent(inout) :: status
-    end subroutine classic_output
-
-    logical function classic_wants_steps(self)
-        class(classic_sink_t), intent(in) :: self
-        classic_wants_steps = associated(self%solout)
-    end function classic_wants_steps
-
     !> SOLOUT with y = (p, v, λ) and a from the dense output of the step.
-    subroutine classic_step(self, nr, t_old, t, y, dense, stop, status)
+    subroutine classic_solout(self, nr, t_old, t, y, dense, irtrn)
         class(classic_sink_t), intent(inout) :: self
         integer, intent(in) :: nr
         real(wp), intent(in) :: t_old, t, y(:)
         class(dense_output_t), intent(in) :: dense
-        logical, intent(inout) :: stop
-        type(status_t), intent(inout) :: status
+        integer, intent(inout) :: irtrn
         real(wp) :: acc(self%nv), lam(max(1, self%nl))
-        integer :: irtrn, np, nv
+        integer :: np, nv
         np = self%np
         nv = self%nv
         acc = 0.0_wp
@@ -456,9 +432,7 @@ contains
         lam = 0.0_wp
         if (self%nl > 0) lam(1:self%nl) = y(np + nv + 1:np + nv + self%nl)
         self%info(1) = nr
-        irtrn = 0
         call self%solout(np, nv, self%nu, self%nl, t, y(1:np), y(np + 1:np + nv), self%u, acc, &
             lam, self%info, irtrn)
-        if (irtrn < 0) stop = .true.
-    end subroutine classic_step
+    end subroutine classic_solout
 end module flexmbs_legacy_mexax_adapter

@@ -11,7 +11,7 @@ module flexmbs_legacy_mexax_interface
     implicit none
     private
 
-    public :: mexax_fprob_i, mexax_solout_i, mexax, mexx
+    public :: mexax_fprob_i, mexax_solout_i, mexax_i, mexax, mexx
 
     abstract interface
         !> `FPROB`: evaluate exactly the items whose flag is set (§3.9):
@@ -52,47 +52,15 @@ module flexmbs_legacy_mexax_interface
         end subroutine mexax_solout_i
     end interface
 
-    interface
+    abstract interface
         !> The classic MEXAX calling sequence (docs/solvers.md, MEXAX).
-        subroutine mexax(np, nv, nl, ng, nu, fprob, t, tfin, p, v, u, a, rlam, itol, rtol, &
+        subroutine mexax_i(np, nv, nl, ng, nu, fprob, t, tfin, p, v, u, a, rlam, itol, rtol, &
             atol, h, mxjob, ierr, liwk, iwk, lrwk, rwk, solout, denout, fswit)
             import :: wp, mexax_fprob_i, mexax_solout_i
-            integer, intent(in) :: np, nv, nl, ng, nu
-            procedure(mexax_fprob_i) :: fprob
-            real(wp), intent(inout) :: t
-            real(wp), intent(in) :: tfin
-            real(wp), intent(inout) :: p(*), v(*), u(*), a(*), rlam(*)
-            integer, intent(in) :: itol
-            real(wp), intent(in) :: rtol(*), atol(*)
-            real(wp), intent(inout) :: h
-            integer, intent(inout) :: mxjob(*)
-            integer, intent(out) :: ierr
-            integer, intent(in) :: liwk, lrwk
-            integer, intent(inout) :: iwk(liwk)
-            real(wp), intent(inout) :: rwk(lrwk)
-            procedure(mexax_solout_i) :: solout
-            external :: denout, fswit
-        end subroutine mexax
-
-        !> As MEXX, the same routine under the original's name.
-        subroutine mexx(np, nv, nl, ng, nu, fprob, t, tfin, p, v, u, a, rlam, itol, rtol, &
-            atol, h, mxjob, ierr, liwk, iwk, lrwk, rwk, solout, denout, fswit)
-            import :: wp, mexax_fprob_i, mexax_solout_i
-            integer, intent(in) :: np, nv, nl, ng, nu
-            procedure(mexax_fprob_i) :: fprob
-            real(wp), intent(inout) :: t
-            real(wp), intent(in) :: tfin
-            real(wp), intent(inout) :: p(*), v(*), u(*), a(*), rlam(*)
-            integer, intent(in) :: itol
-            real(wp), intent(in) :: rtol(*), atol(*)
-            real(wp), intent(inout) :: h
-            integer, intent(inout) :: mxjob(*)
-            integer, intent(out) :: ierr
-            integer, intent(in) :: liwk, lrwk
-            integer, intent(inout) :: iwk(liwk)
-            real(wp), intent(inout) :: rwk(lrwk)
-            procedure(mexax_solout_i) :: solout
-            external :: denout, fswit
-        end subroutine mexx
+            include 'mexax_arguments.inc'
+        end subroutine mexax_i
     end interface
+
+    !> MEXAX and MEXX, the original's two names of one routine.
+    procedure(mexax_i) :: mexax, mexx
 end module flexmbs_legacy_mexax_interface

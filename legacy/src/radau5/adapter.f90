@@ -24,10 +24,11 @@ module flexmbs_legacy_radau5_adapter
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
-    use flexmbs_dae_sink, only: sink_t, dense_output_t
+    use flexmbs_dae_sink, only: dense_output_t
     use flexmbs_dae_radau5, only: radau5_t, radau5_dense_t
     use flexmbs_legacy_radau5_interface, only: radau5_fcn_i, radau5_jac_i, radau5_mas_i, &
         radau5_solout_i
+    use flexmbs_legacy_common_solout_sink, only: solout_sink_t
     implicit none
     private
 
@@ -84,16 +85,14 @@ module flexmbs_legacy_radau5_adapter
     end type classic_problem_t
 
     !> SOLOUT as a step sink; CONTR5 reads the state it stores.
-    type, extends(sink_t) :: classic_sink_t
+    type, extends(solout_sink_t) :: classic_sink_t
         procedure(radau5_solout_i), pointer, nopass :: solout => null()
         real(wp), pointer, contiguous :: rpar(:) => null()
         integer, pointer, contiguous :: ipar(:) => null()
         integer :: n = 0
         real(wp), allocatable :: y(:), cont(:)  !! copies handed to SOLOUT
     contains
-        procedure :: output => sink_output
-        procedure :: wants_steps => sink_wants_steps
-        procedure :: step => sink_step
+        procedure :: call_solout => sink_solout
     end type classic_sink_t
 
     ! Dense output of the latest SOLOUT call, read by CONTR5 (the original's
@@ -106,25 +105,7 @@ contains
     !> The body of the external RADAU5: same arguments, same meanings.
     subroutine radau5_classic(n, fcn, x, y, xend, h, rtol, atol, itol, jac, ijac, mljac, mujac, &
         mas, imas, mlmas, mumas, solout, iout, work, lwork, iwork, liwork, rpar, ipar, idid)
-        integer, intent(in) :: n
-        procedure(radau5_fcn_i) :: fcn
-        real(wp), intent(inout) :: x
-        real(wp), intent(inout) :: y(n)
-        real(wp), intent(in) :: xend
-        real(wp), intent(inout) :: h
-        real(wp), intent(in) :: rtol(*), atol(*)
-        integer, intent(in) :: itol
-        procedure(radau5_jac_i) :: jac
-        integer, intent(in) :: ijac, mljac, mujac
-        procedure(radau5_mas_i) :: mas
-        integer, intent(in) :: imas, mlmas, mumas
-        procedure(radau5_solout_i) :: solout
-        integer, intent(in) :: iout, lwork, liwork
-        real(wp), intent(inout) :: work(*)
-        integer, intent(inout) :: iwork(*)
-        real(wp), intent(inout), target :: rpar(*)
-        integer, intent(inout), target :: ipar(*)
-        integer, intent(out) :: idid
+        include 'radau5_arguments.inc'
 
         type(classic_problem_t) :: problem
         type(classic_sink_t) :: sink
@@ -717,28 +698,15 @@ contains
 
     ! ------------------------------------------------------------------- sink
 
-    subroutine sink_output(self, t, y, status)
-        class(classic_sink_t), intent(inout) :: self
-        real(wp), intent(in) :: t, y(:)
-        type(status_t), intent(inout) :: status
-        ! SOLOUT sees steps only; no output times are requested.
-    end subroutine sink_output
-
-    logical function sink_wants_steps(self)
-        class(classic_sink_t), intent(in) :: self
-        sink_wants_steps = .true.
-    end function sink_wants_steps
-
     !> Store the step's dense output for CONTR5, then call SOLOUT with
     !> CONT = (y⁺, q1, q2, q3) and copies of x, xold and y.
-    subroutine sink_step(self, nr, t_old, t, y, dense, stop, status)
+    subroutine sink_solout(self, nr, t_old, t, y, dense, irtrn)
         class(classic_sink_t), intent(inout) :: self
         integer, intent(in) :: nr
         real(wp), intent(in) :: t_old, t, y(:)
         class(dense_output_t), intent(in) :: dense
-        logical, intent(inout) :: stop
-        type(status_t), intent(inout) :: status
-        integer :: k, n, nrloc, nloc, lrc, irtrn
+        integer, intent(inout) :: irtrn
+        integer :: k, n, nrloc, nloc, lrc
         real(wp) :: xold, x
         n = self%n
         select type (dense)
@@ -765,10 +733,8 @@ contains
         x = t
         nloc = n
         lrc = 4 * n
-        irtrn = 0
         call self%solout(nrloc, xold, x, self%y, self%cont, lrc, nloc, self%rpar, self%ipar, irtrn)
-        if (irtrn < 0) stop = .true.
-    end subroutine sink_step
+    end subroutine sink_solout
 
     ! ---------------------------------------------------------------- helpers
 

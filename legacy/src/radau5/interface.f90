@@ -72,25 +72,7 @@ module flexmbs_legacy_radau5_interface
         subroutine radau5(n, fcn, x, y, xend, h, rtol, atol, itol, jac, ijac, mljac, mujac, &
             mas, imas, mlmas, mumas, solout, iout, work, lwork, iwork, liwork, rpar, ipar, idid)
             import :: wp, radau5_fcn_i, radau5_jac_i, radau5_mas_i, radau5_solout_i
-            integer, intent(in) :: n
-            procedure(radau5_fcn_i) :: fcn
-            real(wp), intent(inout) :: x
-            real(wp), intent(inout) :: y(n)
-            real(wp), intent(in) :: xend
-            real(wp), intent(inout) :: h
-            real(wp), intent(in) :: rtol(*), atol(*)
-            integer, intent(in) :: itol
-            procedure(radau5_jac_i) :: jac
-            integer, intent(in) :: ijac, mljac, mujac
-            procedure(radau5_mas_i) :: mas
-            integer, intent(in) :: imas, mlmas, mumas
-            procedure(radau5_solout_i) :: solout
-            integer, intent(in) :: iout, lwork, liwork
-            real(wp), intent(inout) :: work(*)
-            integer, intent(inout) :: iwork(*)
-            real(wp), intent(inout), target :: rpar(*)
-            integer, intent(inout), target :: ipar(*)
-            integer, intent(out) :: idid
+            include 'radau5_arguments.inc'
         end subroutine radau5
 
         !> Component i of the dense output of the latest SOLOUT call at s.
