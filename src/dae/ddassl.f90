@@ -168,13 +168,7 @@ contains
     subroutine ddassl_integrate(self, problem, t, y, t_end, options, stats, status, sink, yp)
         class(ddassl_t), intent(inout) :: self
         class(dae_problem_t), intent(inout) :: problem
-        real(wp), intent(inout) :: t
-        real(wp), intent(inout) :: y(:)
-        real(wp), intent(in) :: t_end
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(out) :: stats
-        type(status_t), intent(out) :: status
-        class(sink_t), intent(inout), optional :: sink
+        include 'integrate_arguments.inc'
         real(wp), intent(inout), optional :: yp(:)
         call run_dae(self, problem, t, y, t_end, options, stats, status, sink, yp)
     end subroutine ddassl_integrate
@@ -183,13 +177,7 @@ contains
     subroutine run_dae(self, problem, t, y, t_end, options, stats, status, sink, yp)
         class(ddassl_t), intent(inout) :: self
         class(dae_problem_t), intent(inout), target :: problem
-        real(wp), intent(inout) :: t
-        real(wp), intent(inout) :: y(:)
-        real(wp), intent(in) :: t_end
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(out) :: stats
-        type(status_t), intent(out) :: status
-        class(sink_t), intent(inout), optional :: sink
+        include 'integrate_arguments.inc'
         real(wp), intent(inout), optional :: yp(:)
         type(dae_residual_t) :: res
         real(wp), allocatable :: ypw(:)

@@ -107,13 +107,7 @@ contains
     subroutine mexax_integrate(self, problem, t, y, t_end, options, stats, status, sink, yp)
         class(mexax_t), intent(inout) :: self
         class(dae_problem_t), intent(inout) :: problem
-        real(wp), intent(inout) :: t
-        real(wp), intent(inout) :: y(:)
-        real(wp), intent(in) :: t_end
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(out) :: stats
-        type(status_t), intent(out) :: status
-        class(sink_t), intent(inout), optional :: sink
+        include 'integrate_arguments.inc'
         real(wp), intent(inout), optional :: yp(:)
         stats%t_reached = t
         call status%set(status_bad_input, 'mexax: integrates mechanical problems only &
@@ -129,13 +123,7 @@ contains
         class(mexax_t), intent(inout) :: self
         class(mechanical_problem_t), intent(inout) :: mechanical
         class(dae_problem_t), intent(inout) :: formulation
-        real(wp), intent(inout) :: t
-        real(wp), intent(inout) :: y(:)
-        real(wp), intent(in) :: t_end
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(out) :: stats
-        type(status_t), intent(out) :: status
-        class(sink_t), intent(inout), optional :: sink
+        include 'integrate_arguments.inc'
         integer :: nq, nv, nc
         nq = mechanical%nq
         nv = mechanical%nv

@@ -100,13 +100,7 @@ contains
     subroutine radau5_integrate(self, problem, t, y, t_end, options, stats, status, sink, yp)
         class(radau5_t), intent(inout) :: self
         class(dae_problem_t), intent(inout) :: problem
-        real(wp), intent(inout) :: t
-        real(wp), intent(inout) :: y(:)
-        real(wp), intent(in) :: t_end
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(out) :: stats
-        type(status_t), intent(out) :: status
-        class(sink_t), intent(inout), optional :: sink
+        include 'integrate_arguments.inc'
         real(wp), intent(inout), optional :: yp(:)
         type(radau5_work_t) :: w  !! the integration's state and workspace
 

@@ -38,13 +38,7 @@ module flexmbs_dae_solver
                 status_t, sink_t, wp
             class(dae_solver_t), intent(inout) :: self
             class(dae_problem_t), intent(inout) :: problem
-            real(wp), intent(inout) :: t
-            real(wp), intent(inout) :: y(:)
-            real(wp), intent(in) :: t_end
-            type(dae_options_t), intent(in) :: options
-            type(dae_stats_t), intent(out) :: stats
-            type(status_t), intent(out) :: status
-            class(sink_t), intent(inout), optional :: sink
+            include 'integrate_arguments.inc'
             real(wp), intent(inout), optional :: yp(:)
         end subroutine integrate_i
         function name_i(self) result(name)
@@ -67,13 +61,7 @@ contains
         class(dae_solver_t), intent(inout) :: self
         class(mechanical_problem_t), intent(inout) :: mechanical
         class(dae_problem_t), intent(inout) :: formulation
-        real(wp), intent(inout) :: t
-        real(wp), intent(inout) :: y(:)
-        real(wp), intent(in) :: t_end
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(out) :: stats
-        type(status_t), intent(out) :: status
-        class(sink_t), intent(inout), optional :: sink
+        include 'integrate_arguments.inc'
         call self%integrate_dae(formulation, t, y, t_end, options, stats, status, sink)
     end subroutine default_integrate_system
 
