@@ -5,11 +5,6 @@ module flexmbs_mbs_rotation
     use flexmbs_core_kinds, only: wp
     implicit none
     private
-    public :: skew, cross, quat_g, quat_l, rotation_matrix, quat_rate_matrix, &
-        quat_product, quat_conjugate, quat_from_axis_angle, quat_normalize, &
-        rotated_vector_jacobian, rotated_vector_transpose_jacobian
-
-contains
 
 #define SCALAR real(wp)
 #include "rotation.inc"

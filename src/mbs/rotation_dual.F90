@@ -6,11 +6,6 @@ module flexmbs_mbs_rotation_dual
         operator(/), operator(**), assignment(=), sqrt, sin, cos
     implicit none
     private
-    public :: skew, cross, quat_g, quat_l, rotation_matrix, quat_rate_matrix, &
-        quat_product, quat_conjugate, quat_from_axis_angle, quat_normalize, &
-        rotated_vector_jacobian, rotated_vector_transpose_jacobian
-
-contains
 
 #define SCALAR type(dual_t)
 #include "rotation.inc"
