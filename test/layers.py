@@ -10,6 +10,8 @@
   src/, app/ and bench/ the code asks the catalogue by capability.
 - bench/ and the command line build solvers through the catalogue's
   factories: bench/ uses no solver module's type.
+- The scene schema's joint types (joint_choices) are those of the table
+  of joint types (src/mbs/joint_types.f90).
 
 Prints `pass layers/...` or `FAIL layers/...: why` lines and
 `N passed, M failed` last; exits non-zero on failures.
@@ -125,6 +127,19 @@ pchoices = re.search(r"problem_choices\s*=\s*'([^']*)'", catalogue, re.S)
 if not pchoices or re.sub(r"&\s*&", '', pchoices.group(1)).split('|') != pnames:
     problems.append('problem_choices differs from the table %s' % pnames)
 report('catalogue-names-are-the-solvers-names', problems)
+
+# The scene's joint types are the table's: joint_choices lists, in order,
+# the entries of flexmbs_mbs_joint_types that have primitives of their own.
+table = open(os.path.join(ROOT, 'src/mbs/joint_types.f90'), encoding='utf-8').read()
+jnames = re.findall(r"joint_type_t\('(\w+)',\s*\[", table)
+jchoices = re.search(r"joint_choices\s*=\s*&?\s*'([^']*)'", table)
+problems = []
+if not jnames:
+    problems.append('no joint types found in src/mbs/joint_types.f90')
+if not jchoices or jchoices.group(1).split('|') != jnames:
+    problems.append('joint_choices %r differs from the table %s'
+                    % (jchoices.group(1) if jchoices else None, jnames))
+report('joint-choices-are-the-joint-table', problems)
 
 print('%d passed, %d failed' % (passed, failed))
 sys.exit(1 if failed else 0)
