@@ -54,12 +54,12 @@ contains
 
     !> A joint removes 6 minus its freedoms of relative motion (spherical:
     !> 3 rotations; revolute 1; cylindrical 2; prismatic 1; universal 2;
-    !> fixed 0).
+    !> fixed 0; planar: 2 translations and the rotation about the normal).
     subroutine test_rows(error)
         type(error_t), allocatable, intent(out) :: error
-        character(len=*), parameter :: names(6) = [character(len=12) :: 'spherical', &
-            'revolute', 'cylindrical', 'prismatic', 'universal', 'fixed']
-        integer, parameter :: freedoms(6) = [3, 1, 2, 1, 2, 0]
+        character(len=*), parameter :: names(7) = [character(len=12) :: 'spherical', &
+            'revolute', 'cylindrical', 'prismatic', 'universal', 'fixed', 'planar']
+        integer, parameter :: freedoms(7) = [3, 1, 2, 1, 2, 0, 3]
         type(joint_t) :: joint
         type(status_t) :: status
         integer :: k, kind

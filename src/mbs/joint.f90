@@ -9,13 +9,13 @@ module flexmbs_mbs_joint
     use flexmbs_mbs_primitive_kinds, only: primitive_rows
     use flexmbs_mbs_joint_types, only: joint_types, joint_primitive_t, joint_choices, &
         joint_name, max_joint_primitives, joint_spherical, joint_revolute, joint_cylindrical, &
-        joint_prismatic, joint_universal, joint_fixed, joint_primitive
+        joint_prismatic, joint_universal, joint_fixed, joint_primitive, joint_planar
     implicit none
     private
 
     ! the joint kinds, as the table numbers them, for the users of joints
     public :: max_joint_primitives, joint_spherical, joint_revolute, joint_cylindrical, &
-        joint_prismatic, joint_universal, joint_fixed, joint_primitive
+        joint_prismatic, joint_universal, joint_fixed, joint_primitive, joint_planar
 
     !> The parts of a joint evaluated by joint_rows.
     integer, parameter, public :: joint_part_time_derivative = 1 !! c_t

@@ -56,6 +56,7 @@ module flexmbs_mbs_joint_types
     integer, parameter, public :: joint_fixed = 6
     !> A joint of one primitive (new_primitive_joint).
     integer, parameter, public :: joint_primitive = 7
+    integer, parameter, public :: joint_planar = 8
 
     type(joint_primitive_t), parameter :: none = joint_primitive_t()
     type(joint_primitive_t), parameter :: spherical = joint_primitive_t(primitive_spherical)
@@ -69,9 +70,10 @@ module flexmbs_mbs_joint_types
     !> x_j - x_i normal to x_i, y_i, z_i
     type(joint_primitive_t), parameter :: offset_normal_x_i = joint_primitive_t(primitive_dot2, 1)
     type(joint_primitive_t), parameter :: offset_normal_y_i = joint_primitive_t(primitive_dot2, 2)
+    type(joint_primitive_t), parameter :: offset_normal_z_i = joint_primitive_t(primitive_dot2, 3)
 
     !> The table (module header), indexed by joint kind.
-    type(joint_type_t), parameter, public :: joint_types(7) = [ &
+    type(joint_type_t), parameter, public :: joint_types(8) = [ &
         joint_type_t('spherical', [spherical, none, none, none, none, none]), &
         joint_type_t('revolute', [spherical, z_j_normal_x_i, z_j_normal_y_i, none, none, &
             none], angle=.true.), &
@@ -83,12 +85,14 @@ module flexmbs_mbs_joint_types
         joint_type_t('universal', [spherical, z_i_normal_z_j, none, none, none, none]), &
         joint_type_t('fixed', [spherical, z_j_normal_x_i, z_j_normal_y_i, x_i_normal_y_j, none, &
             none]), &
-        joint_type_t('primitive')]
+        joint_type_t('primitive'), &
+        joint_type_t('planar', [z_j_normal_x_i, z_j_normal_y_i, offset_normal_z_i, none, none, &
+            none], angle=.true., displaced=[.true., .true., .false.])]
 
     !> The names of the joint types a scene's `&joint` may give, as the
     !> scene schema lists choices (test/layers.py checks it against the table).
     character(len=*), parameter, public :: joint_choices = &
-        'spherical|revolute|cylindrical|prismatic|universal|fixed'
+        'spherical|revolute|cylindrical|prismatic|universal|fixed|planar'
 
     public :: joint_kind, joint_name, joint_type_rows, joint_type_of
 
