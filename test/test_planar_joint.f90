@@ -1,8 +1,9 @@
 !> The planar joint (src/mbs/joint_types.f90: z axes parallel, marker j's
 !> origin in marker i's xy plane): its hand-coded derivatives against
-!> central differences (against AD: mbs_system/ad_vs_analytic), and inputs/planar_slider.nml (a free puck
-!> on a tilted plane) against the closed form of its motion with every
-!> solver, its named outputs (/joints/slider/angle, displacement) included.
+!> central differences (against AD: mbs_system/ad_vs_analytic), and
+!> inputs/planar_slider.nml (a free puck on a tilted plane) against the
+!> closed form of its motion with every solver, its named outputs
+!> (/joints/slider/angle, displacement) included.
 module test_planar_joint
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t
