@@ -49,7 +49,7 @@ module flexmbs
     use flexmbs_io_vtk_sink, only: vtk_sink_t
     use flexmbs_mbs_flexible_marker, only: flexible_marker_t, new_flexible_marker
     use flexmbs_mbs_joint, only: joint_spherical, joint_revolute, joint_cylindrical, &
-        joint_prismatic, joint_universal, joint_fixed
+        joint_prismatic, joint_universal, joint_fixed, joint_planar
     use flexmbs_dae_mexax, only: mexax_t
     use flexmbs_io_namelist, only: scene_input_t, read_scene, parse_scene, scene_dae_options
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t

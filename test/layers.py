@@ -16,6 +16,8 @@
   a type, the component not a type-bound procedure) at most REACH_IN_BOUND
   times; the bound only comes down, towards 10, each with a comment saying
   why (issue 35).
+- The scene schema's joint types (joint_choices) are those of the table
+  of joint types (src/mbs/joint_types.f90).
 
 Prints `pass layers/...` or `FAIL layers/...: why` lines and
 `N passed, M failed` last; exits non-zero on failures.
@@ -190,6 +192,19 @@ report('run-and-io-keep-out-of-mbs-and-fe-components',
        [] if len(reach_ins) <= REACH_IN_BOUND else
        ['%d reach-ins, more than %d: %s' % (len(reach_ins), REACH_IN_BOUND, r)
         for r in reach_ins])
+
+# The scene's joint types are the table's: joint_choices lists, in order,
+# the entries of flexmbs_mbs_joint_types that have primitives of their own.
+table = open(os.path.join(ROOT, 'src/mbs/joint_types.f90'), encoding='utf-8').read()
+jnames = re.findall(r"joint_type_t\('(\w+)',\s*\[", table)
+jchoices = re.search(r"joint_choices\s*=\s*&?\s*'([^']*)'", table)
+problems = []
+if not jnames:
+    problems.append('no joint types found in src/mbs/joint_types.f90')
+if not jchoices or jchoices.group(1).split('|') != jnames:
+    problems.append('joint_choices %r differs from the table %s'
+                    % (jchoices.group(1) if jchoices else None, jnames))
+report('joint-choices-are-the-joint-table', problems)
 
 print('%d passed, %d failed' % (passed, failed))
 sys.exit(1 if failed else 0)

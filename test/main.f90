@@ -34,6 +34,8 @@ program flexmbs_tests
     use test_formulation, only: collect_formulation
     use test_rigid_body, only: collect_rigid_body
     use test_mbs_system, only: collect_mbs_system
+    use test_joint_types, only: collect_joint_types
+    use test_planar_joint, only: collect_planar_joint
     use test_force_elements, only: collect_force_elements
     use test_bushing_mount, only: collect_bushing_mount
     use test_mechanisms, only: collect_mechanisms
@@ -102,6 +104,8 @@ program flexmbs_tests
     call run_suite('formulation', collect_formulation(), filter, npassed, nfailed)
     call run_suite('rigid_body', collect_rigid_body(), filter, npassed, nfailed)
     call run_suite('mbs_system', collect_mbs_system(), filter, npassed, nfailed)
+    call run_suite('joint_types', collect_joint_types(), filter, npassed, nfailed)
+    call run_suite('planar_joint', collect_planar_joint(), filter, npassed, nfailed)
     call run_suite('force_elements', collect_force_elements(), filter, npassed, nfailed)
     call run_suite('bushing_mount', collect_bushing_mount(), filter, npassed, nfailed)
     call run_suite('mechanisms', collect_mechanisms(), filter, npassed, nfailed)

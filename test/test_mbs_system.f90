@@ -16,7 +16,7 @@ module test_mbs_system
     use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle, cross
     use flexmbs_mbs_rigid_body, only: rigid_body_t
     use flexmbs_mbs_joint, only: joint_spherical, joint_revolute, joint_cylindrical, &
-        joint_prismatic, joint_universal, joint_fixed, joint_primitive
+        joint_prismatic, joint_universal, joint_fixed, joint_primitive, joint_planar
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t
     use flexmbs_mbs_primitive_kinds, only: primitive_distance, primitive_dot1
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &
@@ -26,7 +26,7 @@ module test_mbs_system
     use testing, only: test_case_t, new_test, error_t, check
     implicit none
     private
-    public :: collect_mbs_system, test_body, random_state, integrate, rel_err
+    public :: collect_mbs_system, test_body, random_state, integrate, rel_err, random_marker, unit
 
     !> The issue's bound: AD against hand-coded, relative to the largest entry (floor 1).
     real(wp), parameter :: tol_ad = 1.0e-12_wp
@@ -65,6 +65,7 @@ contains
                                      0.0_wp, 0.2_wp, 4.0_wp], [3, 3])
     end function test_body
 
+    !> A marker on `body` at a random position with random axes.
     function random_marker(rng, body) result(m)
         type(random_state_t), intent(inout) :: rng
         integer, intent(in) :: body
@@ -81,16 +82,17 @@ contains
         character(len=*), intent(in) :: derivatives
         type(status_t), intent(out) :: status
         type(mbs_system_t) :: sys
-        type(marker_t) :: markers(12)
-        type(mbs_joint_t) :: joints(6)
-        integer, parameter :: bodies_of(12) = [0, 1, 1, 2, 2, 3, 3, 0, 1, 3, 2, 0]
+        type(marker_t) :: markers(14)
+        type(mbs_joint_t) :: joints(7)
+        integer, parameter :: bodies_of(14) = [0, 1, 1, 2, 2, 3, 3, 0, 1, 3, 2, 0, 3, 1]
         integer :: k
-        do k = 1, 12
+        do k = 1, 14
             markers(k) = random_marker(rng, bodies_of(k))
         end do
         joints = [mbs_joint_t(joint_spherical, 1, 2), mbs_joint_t(joint_revolute, 3, 4), &
                   mbs_joint_t(joint_cylindrical, 5, 6), mbs_joint_t(joint_prismatic, 7, 8), &
-                  mbs_joint_t(joint_universal, 9, 10), mbs_joint_t(joint_fixed, 11, 12)]
+                  mbs_joint_t(joint_universal, 9, 10), mbs_joint_t(joint_fixed, 11, 12), &
+                  mbs_joint_t(joint_planar, 13, 14)]
         sys = new_mbs_system([test_body(1.0_wp, 1.0_wp), test_body(2.0_wp, 0.5_wp), &
                               test_body(0.5_wp, 2.0_wp)], markers, joints, &
                              gravity=[0.0_wp, 0.0_wp, -g_earth], &
@@ -160,7 +162,7 @@ contains
         if (allocated(error)) return
         rng = rng_a
         nc = hand%nc
-        call check(error, nc == 3 + 5 + 4 + 5 + 4 + 6, 'row count')
+        call check(error, nc == 3 + 5 + 4 + 5 + 4 + 6 + 3, 'row count')
         allocate (ch(nc), cd(nc), gh(nc, 18), gd(nc, 18), qh(nc, 21), qd(nc, 21), th(nc), &
                   td(nc), yh(nc), yd(nc), gt(nc, 18))
         e_g = 0
@@ -200,6 +202,7 @@ contains
         call check(error, max(e_c, e_g, e_q, e_t, e_y, e_gt) <= tol_ad, trim(msg))
     end subroutine ad_vs_analytic
 
+    !> The unit vector e_j of length n.
     pure function unit(n, j) result(e)
         integer, intent(in) :: n, j
         real(wp) :: e(n)
@@ -216,7 +219,7 @@ contains
         type(mbs_system_t), target :: sys
         type(formulation_t) :: gen
         type(status_t) :: status
-        type(marker_t) :: markers(4)
+        type(marker_t) :: markers(6)
         real(wp), allocatable :: y(:), jac(:, :), jfd(:, :)
         integer :: mode, form, j
         character(len=8), parameter :: modes(2) = ['analytic', 'ad      ']
@@ -226,10 +229,11 @@ contains
         do mode = 1, 2
             rng = rng0
             markers = [random_marker(rng, 0), random_marker(rng, 1), random_marker(rng, 1), &
-                       random_marker(rng, 2)]
+                       random_marker(rng, 2), random_marker(rng, 0), random_marker(rng, 2)]
             sys = new_mbs_system([test_body(1.0_wp, 1.0_wp), test_body(2.0_wp, 0.5_wp)], &
                                  markers, [mbs_joint_t(joint_revolute, 1, 2), &
-                                           mbs_joint_t(joint_universal, 3, 4)], &
+                                           mbs_joint_t(joint_universal, 3, 4), &
+                                           mbs_joint_t(joint_planar, 5, 6)], &
                                  gravity=[0.0_wp, -g_earth, 0.0_wp], &
                                  constraint_derivatives=trim(modes(mode)), status=status)
             call check(error, status%ok(), status%text())

@@ -15,7 +15,7 @@ module test_multibody_scene
     use testing, only: test_case_t, new_test, error_t, check
     implicit none
     private
-    public :: collect_multibody_scene, read_matrix, expect
+    public :: collect_multibody_scene, read_matrix, expect, run_file
 
     character(len=*), parameter :: nl = new_line('a')
 

@@ -42,6 +42,10 @@ REASONS = [
      'a universal joint in a planar mechanism loaded in its plane: the one '
      'moment it can carry (about the normal of its two axes) lies in the '
      'plane and is not loaded'),
+    (r'planar_slider', r'joints/slider/reaction_torque_j',
+     'the puck spins about a principal axis (the normal) and the joint holds '
+     'it at its centre of mass: the reaction is the normal force through '
+     'marker j, and no torque keeps the spin axis'),
     (r'bushing_mount', r'forces/shaker/torque_i',
      "the shaker is an 'applied' point force: no torque on its marker"),
     (r'arm_with_pad', r'chains/base/velocity',

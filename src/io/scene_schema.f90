@@ -7,6 +7,7 @@ module flexmbs_io_scene_schema
     use flexmbs_core_text, only: lower, nearest
     use flexmbs_core_rules, only: min_tolerance, safety_factor_rule
     use flexmbs_run_catalogue, only: solver_choices, problem_choices
+    use flexmbs_mbs_joint_types, only: joint_choices
     implicit none
     private
 
@@ -234,8 +235,8 @@ module flexmbs_io_scene_schema
         var_spec_t('marker', 'node_set', kind_string, &
             doc='the flexible body''s nodes it follows: centroid, or if needed a fitted frame'), &
         var_spec_t('joint', 'name', kind_string, doc='unique name (default: joint N)'), &
-        var_spec_t('joint', 'type', kind_string, choices='spherical|revolute|cylindrical|&
-            &prismatic|universal|fixed|attach', doc='joint type, required'), &
+        var_spec_t('joint', 'type', kind_string, choices=joint_choices // '|attach', &
+            doc='joint type, required'), &
         var_spec_t('joint', 'marker_i', kind_string, doc='first marker'), &
         var_spec_t('joint', 'marker_j', kind_string, doc='second marker'), &
         var_spec_t('driver', 'name', kind_string, doc='unique name (default: driver N)'), &

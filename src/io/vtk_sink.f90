@@ -46,7 +46,7 @@ module flexmbs_io_vtk_sink
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     use flexmbs_mbs_system, only: mbs_system_t
     use flexmbs_mbs_formulation, only: formulation_t
-    use flexmbs_mbs_joint, only: joint_primitive, joint_name
+    use flexmbs_mbs_joint_types, only: joint_primitive, joint_name
     use flexmbs_mbs_primitive_kinds, only: primitive_name, primitive_angle_driver, &
         primitive_translation_driver, primitive_dot2
     implicit none

@@ -20,8 +20,8 @@ module flexmbs_run_multibody_builder
     use flexmbs_mbs_rotation, only: rotation_matrix, quat_from_axis_angle, cross
     use flexmbs_mbs_rigid_body, only: rigid_body_t
     use flexmbs_mbs_inertia, only: inertia_tensor, inertia_defect
-    use flexmbs_mbs_joint, only: joint_spherical, joint_revolute, joint_cylindrical, &
-        joint_prismatic, joint_universal, joint_fixed, joint_primitive
+    use flexmbs_mbs_joint, only: joint_spherical, joint_primitive
+    use flexmbs_mbs_joint_types, only: joint_kind, joint_choices
     use flexmbs_mbs_primitive_kinds, only: primitive_angle_driver, &
         primitive_translation_driver, primitive_distance
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
@@ -213,6 +213,12 @@ contains
         do i = 1, size(scene%joints)
             associate (jt => scene%joints(i))
                 if (jt%type /= 'attach') then
+                    if (joint_kind(jt%type) == 0) then
+                        call status%set(status_bad_input, scene%path // ': &joint ''' // &
+                            trim(jt%name) // ''': type = ''' // trim(jt%type) // ''': no joint &
+                            &type of that name; use one of ' // joint_choices // '|attach')
+                        return
+                    end if
                     joints = [joints, mbs_joint_t(joint_kind(jt%type), &
                         marker_index(scene, jt%marker_i), marker_index(scene, jt%marker_j))]
                     labels = [character(len=80) :: labels, '&joint ''' // trim(jt%name) // '''']
@@ -565,18 +571,6 @@ contains
         a(:, 1) = a(:, 1) / norm2(a(:, 1))
         a(:, 2) = cross(a(:, 3), a(:, 1))
     end function axes_from
-
-    pure integer function joint_kind(name)
-        character(len=*), intent(in) :: name
-        select case (trim(name))
-        case ('spherical'); joint_kind = joint_spherical
-        case ('revolute'); joint_kind = joint_revolute
-        case ('cylindrical'); joint_kind = joint_cylindrical
-        case ('prismatic'); joint_kind = joint_prismatic
-        case ('universal'); joint_kind = joint_universal
-        case default; joint_kind = joint_fixed
-        end select
-    end function joint_kind
 
     pure integer function driver_kind(name)
         character(len=*), intent(in) :: name

@@ -10,8 +10,11 @@
 !>   /joints/<name>/reaction_torque   (3)  N m    of marker i, world frame, about
 !>                                                 the marker (also /drivers/<name>/)
 !>   /joints/<name>/reaction_force_j, reaction_torque_j: the same on marker j's body
-!>   /joints/<name>/angle             (1)  rad    revolute, cylindrical: x_j from x_i about z_i
-!>   /joints/<name>/displacement      (1)  m      prismatic, cylindrical: along z_i
+!>   /joints/<name>/angle             (1)  rad    revolute, cylindrical, planar: x_j from x_i
+!>                                                 about z_i
+!>   /joints/<name>/displacement      (1)  m      prismatic, cylindrical: along z_i;
+!>                                    (2)         planar: along x_i and y_i
+!>                                                 (as flexmbs_mbs_joint_types says)
 !>   /forces/<name>/force_i, torque_i (3)  N, N m the force element's on marker i's
 !>                                                 body (world frame, about the marker);
 !>                                                 force_j, torque_j: on marker j's
@@ -40,7 +43,7 @@ module flexmbs_run_named_output
     use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_mbs_rigid_body, only: rigid_body_nq, rigid_body_nv
     use flexmbs_mbs_system, only: mbs_system_t
-    use flexmbs_mbs_joint, only: joint_revolute, joint_cylindrical, joint_prismatic
+    use flexmbs_mbs_joint_types, only: joint_has_angle, joint_displaced_axes
     use flexmbs_mbs_primitive_kinds, only: primitive_rows, primitive_dot1, &
         primitive_angle_driver, primitive_distance
     use flexmbs_core_text, only: int_text
@@ -97,14 +100,16 @@ module flexmbs_run_named_output
         procedure :: evaluate => link_evaluate
     end type link_values_t
 
-    !> The coordinate of joint `joint` between its markers: the angle of a
-    !> revolute or cylindrical joint (marker j's x axis from marker i's,
-    !> about marker i's z, continued from record to record), or the
-    !> displacement of a prismatic or cylindrical one along marker i's z.
+    !> The coordinates of joint `joint` between its markers, as its type has
+    !> them: the angle (marker j's x axis from marker i's, about marker i's
+    !> z, continued from record to record), or the displacement x_j - x_i
+    !> along marker i's axes (`displaced`).
     type, extends(record_values_t) :: coordinate_values_t
         type(mbs_system_t), pointer :: system => null()
         integer :: joint = 0, oq = 0
         logical :: angle = .true.
+        !> the displacement's components: along marker i's axis k where displaced(k)
+        logical :: displaced(3) = .false.
         logical :: started = .false.
         real(wp) :: last = 0.0_wp
     contains
@@ -207,24 +212,28 @@ contains
             end select
         end subroutine add_standalone
 
-        !> angle and/or displacement of joint k of the kinds that have them
+        !> angle and/or displacement of joint k as its type has them
         subroutine add_coordinates(kind)
             integer, intent(in) :: kind
+            logical :: displaced(3)
             if (.not. status%ok()) return
+            displaced = joint_displaced_axes(kind)
             coordinate%system => reaction%system
             coordinate%joint = k
             coordinate%oq = reaction%oq
-            if (kind == joint_revolute .or. kind == joint_cylindrical) then
+            coordinate%displaced = displaced
+            if (joint_has_angle(kind)) then
                 coordinate%angle = .true.
                 call h5%add_series(base // 'angle', 1, 'rad', coordinate, status, 'marker &
                     &j''s x axis from marker i''s, about marker i''s z axis (continued past &
                     &+-pi)')
             end if
             if (.not. status%ok()) return
-            if (kind == joint_prismatic .or. kind == joint_cylindrical) then
+            if (any(displaced)) then
                 coordinate%angle = .false.
-                call h5%add_series(base // 'displacement', 1, 'm', coordinate, status, &
-                    'of marker j from marker i along marker i''s z axis')
+                call h5%add_series(base // 'displacement', count(displaced), 'm', &
+                    coordinate, status, 'of marker j from marker i along marker i''s ' // &
+                    axes_text(displaced))
             end if
         end subroutine add_coordinates
 
@@ -574,6 +583,7 @@ contains
         real(wp), intent(out) :: values(:)
         type(status_t), intent(inout) :: status
         real(wp) :: xi(3), xj(3), ai(3, 3), aj(3, 3), angle
+        integer :: k
         real(wp), parameter :: two_pi = 8.0_wp * atan(1.0_wp)
         associate (sys => self%system, jt => self%system%joints(self%joint))
             call sys%marker_pose(jt%marker_i, y(self%oq + 1:self%oq + sys%nq), xi, ai)
@@ -587,9 +597,24 @@ contains
             self%started = .true.
             values(1) = angle
         else
-            values(1) = dot_product(xj - xi, ai(:, 3))
+            values = pack([(dot_product(xj - xi, ai(:, k)), k=1, 3)], self%displaced)
         end if
     end subroutine coordinate_evaluate
+
+    !> 'z axis', 'x and y axes': the axes where `along` is true.
+    pure function axes_text(along) result(text)
+        logical, intent(in) :: along(3)
+        character(len=:), allocatable :: text
+        character(len=1), parameter :: xyz(3) = ['x', 'y', 'z']
+        integer :: k
+        text = ''
+        do k = 1, 3
+            if (.not. along(k)) cycle
+            if (len(text) > 0) text = text // ' and '
+            text = text // xyz(k)
+        end do
+        text = text // merge(' axes', ' axis', count(along) > 1)
+    end function axes_text
 
     subroutine body_evaluate(self, t, y, values, status)
         class(body_values_t), intent(inout) :: self

@@ -12,7 +12,7 @@ module flexmbs_run_summary
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, chain_joint_prismatic, &
         chain_joint_spherical
     use flexmbs_mbs_system, only: mbs_system_t
-    use flexmbs_mbs_joint, only: joint_revolute, joint_cylindrical, joint_prismatic
+    use flexmbs_mbs_joint_types, only: joint_has_angle, joint_displaced_axes
     use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_io_namelist, only: scene_input_t
@@ -120,7 +120,9 @@ contains
             ' deg about (' // axis_text(qb(4:7)) // ')' // nl
     end function body_line
 
-    !> A revolute or cylindrical joint's angle, a prismatic one's displacement.
+    !> A joint's angle and displacement as its type has them (a revolute
+    !> joint's angle, a prismatic one's displacement, a planar one's angle
+    !> and (x, y) in marker i's plane); nothing for the other types.
     function joint_line(sys, k, group_name, q) result(line)
         type(mbs_system_t), intent(in) :: sys
         integer, intent(in) :: k
@@ -128,22 +130,29 @@ contains
         real(wp), intent(in) :: q(:)
         character(len=:), allocatable :: line
         real(wp) :: xi(3), xj(3), ai(3, 3), aj(3, 3)
-        character(len=:), allocatable :: name
+        logical :: angle, displaced(3)
+        character(len=:), allocatable :: name, values
+        integer :: a
         line = ''
         name = trim(group_name(index(group_name, '/') + 1:))
         associate (jt => sys%joints(k))
-            select case (jt%joint%kind)
-            case (joint_revolute, joint_cylindrical, joint_prismatic)
-                call sys%marker_pose(jt%marker_i, q, xi, ai)
-                call sys%marker_pose(jt%marker_j, q, xj, aj)
-            case default
-                return
-            end select
-            if (jt%joint%kind /= joint_prismatic) line = '  ' // name // ': angle ' // &
-                fixed(joint_angle(ai, aj) * degrees, 2) // ' deg' // nl
-            if (jt%joint%kind /= joint_revolute) line = line // '  ' // name // &
-                ': displacement ' // fixed(dot_product(xj - xi, ai(:, 3)), 4) // ' m' // nl
+            angle = joint_has_angle(jt%joint%kind)
+            displaced = joint_displaced_axes(jt%joint%kind)
+            if (.not. (angle .or. any(displaced))) return
+            call sys%marker_pose(jt%marker_i, q, xi, ai)
+            call sys%marker_pose(jt%marker_j, q, xj, aj)
         end associate
+        if (angle) line = '  ' // name // ': angle ' // &
+            fixed(joint_angle(ai, aj) * degrees, 2) // ' deg' // nl
+        if (.not. any(displaced)) return
+        values = ''
+        do a = 1, 3
+            if (.not. displaced(a)) cycle
+            if (len(values) > 0) values = values // ', '
+            values = values // fixed(dot_product(xj - xi, ai(:, a)), 4)
+        end do
+        if (count(displaced) > 1) values = '(' // values // ')'
+        line = line // '  ' // name // ': displacement ' // values // ' m' // nl
     end function joint_line
 
     !> 'coupler: largest displacement D m (node N), largest von Mises stress S Pa'
