@@ -174,7 +174,8 @@ def declaration(v):
         name += ' = ' + literal(v, v['default'])
     elif v['kind'] == 'kind_string' and not v['list']:
         name += " = ''"
-    doc = v['doc']
+    # led by its group: FORD would take a leading 'word:' for a metadata key
+    doc = '&%s: %s' % (v['group'], v['doc'])
     if v['unit']:
         doc += ' [%s]' % v['unit']
     line = '        %s :: %s' % (head, name)

@@ -25,206 +25,222 @@ module flexmbs_io_scene_records
     !> &simulation, &solver, &output.
     type, public :: scene_record_t
         ! &simulation
-        character(len=len_title) :: title = '' !! free text, stored with the result
-        !> what to integrate (default: from the groups given)
+        character(len=len_title) :: title = '' !! &simulation: free text, stored with the result
+        !> &simulation: what to integrate (default: from the groups given)
         character(len=len_name) :: problem = ''
-        real(wp) :: t_start = 0.0_wp !! start time [s]
-        real(wp) :: t_end !! end time, required, greater than t_start [s]
-        real(wp) :: vdp_eps = 1e-6_wp !! van der Pol: stiffness parameter
-        real(wp) :: vdp_y1 = 2.0_wp !! van der Pol: y1(0)
-        real(wp) :: vdp_y2 = -0.66_wp !! van der Pol: y2(0)
-        character(len=len_name) :: pendulum_formulation = 'index2' !! pendulum: DAE formulation
-        real(wp) :: pendulum_length = 1.0_wp !! pendulum: length [m]
-        real(wp) :: pendulum_mass = 1.0_wp !! pendulum: mass [kg]
-        !> pendulum: initial angle from the downward vertical, at rest [rad]
+        real(wp) :: t_start = 0.0_wp !! &simulation: start time [s]
+        real(wp) :: t_end !! &simulation: end time, required, greater than t_start [s]
+        real(wp) :: vdp_eps = 1e-6_wp !! &simulation: van der Pol: stiffness parameter
+        real(wp) :: vdp_y1 = 2.0_wp !! &simulation: van der Pol: y1(0)
+        real(wp) :: vdp_y2 = -0.66_wp !! &simulation: van der Pol: y2(0)
+        !> &simulation: pendulum: DAE formulation
+        character(len=len_name) :: pendulum_formulation = 'index2'
+        real(wp) :: pendulum_length = 1.0_wp !! &simulation: pendulum: length [m]
+        real(wp) :: pendulum_mass = 1.0_wp !! &simulation: pendulum: mass [kg]
+        !> &simulation: pendulum: initial angle from the downward vertical, at rest [rad]
         real(wp) :: pendulum_angle = 1.5707963267948966_wp
-        !> pendulum: project onto both constraints after each step
+        !> &simulation: pendulum: project onto both constraints after each step
         logical :: pendulum_projection = .false.
-        real(wp) :: gravity = 9.81_wp !! pendulum: gravity, acting downwards [m/s^2]
-        integer :: npoints = 100 !! Brusselator: grid points per direction
+        real(wp) :: gravity = 9.81_wp !! &simulation: pendulum: gravity, acting downwards [m/s^2]
+        integer :: npoints = 100 !! &simulation: Brusselator: grid points per direction
         ! &solver
-        character(len=len_name) :: solver_name = 'radau5' !! the integrator
-        real(wp) :: rtol = 1e-6_wp !! relative tolerance
-        real(wp) :: atol = 1e-6_wp !! absolute tolerance
-        real(wp) :: h0 = 0.0_wp !! initial step (0: automatic) [s]
-        real(wp) :: hmax = 0.0_wp !! largest step (0: the whole interval) [s]
-        integer :: max_steps = 100000 !! most steps before the run stops
-        !> linear algebra of the Newton matrices: auto, dense, klu, band or mumps
+        character(len=len_name) :: solver_name = 'radau5' !! &solver: the integrator
+        real(wp) :: rtol = 1e-6_wp !! &solver: relative tolerance
+        real(wp) :: atol = 1e-6_wp !! &solver: absolute tolerance
+        real(wp) :: h0 = 0.0_wp !! &solver: initial step (0: automatic) [s]
+        real(wp) :: hmax = 0.0_wp !! &solver: largest step (0: the whole interval) [s]
+        integer :: max_steps = 100000 !! &solver: most steps before the run stops
+        !> &solver: linear algebra of the Newton matrices: auto, dense, klu, band or mumps
         character(len=len_name) :: linear_solver = 'auto'
-        character(len=len_name) :: sparse_ordering = 'auto' !! KLU fill-reducing ordering
-        !> mechanical scenes: factor the Newton matrix condensed to velocities and multipliers, or
-        !> the full first-order one
+        character(len=len_name) :: sparse_ordering = 'auto' !! &solver: KLU fill-reducing ordering
+        !> &solver: mechanical scenes: factor the Newton matrix condensed to velocities and
+        !> multipliers, or the full first-order one
         character(len=len_name) :: newton_system = 'condensed'
-        character(len=len_name) :: jacobian = 'analytic' !! Jacobian: analytic or finite differences
-        integer :: pmax = 5 !! largest order (BDF: 1..5)
+        !> &solver: Jacobian: analytic or finite differences
+        character(len=len_name) :: jacobian = 'analytic'
+        integer :: pmax = 5 !! &solver: largest order (BDF: 1..5)
         ! &output
-        !> HDF5 result (default: the scene's name with .h5; 'none': no file)
+        !> &output: HDF5 result (default: the scene's name with .h5; 'none': no file)
         character(len=len_path) :: file = ''
-        integer :: n_output = 101 !! equidistant output times, t_start and t_end included
-        logical :: every_step = .false. !! also record every accepted step
-        character(len=len_path) :: table = '' !! a table of the outputs (.md, .csv, .tex)
-        logical :: reasons = .false. !! the table also counts the rejected steps by cause
-        logical :: progress = .true. !! progress display on standard error
-        !> ParaView files PREFIX.pvd, PREFIX_NNNN.vtu, PREFIX_bodies|joints_NNNN.vtu
+        integer :: n_output = 101 !! &output: equidistant output times, t_start and t_end included
+        logical :: every_step = .false. !! &output: also record every accepted step
+        character(len=len_path) :: table = '' !! &output: a table of the outputs (.md, .csv, .tex)
+        logical :: reasons = .false. !! &output: the table also counts the rejected steps by cause
+        logical :: progress = .true. !! &output: progress display on standard error
+        !> &output: ParaView files PREFIX.pvd, PREFIX_NNNN.vtu, PREFIX_bodies|joints_NNNN.vtu
         character(len=len_path) :: vtk = ''
-        !> the .vtu files' arrays: binary (appended, base64) or text
+        !> &output: the .vtu files' arrays: binary (appended, base64) or text
         character(len=len_name) :: vtk_format = 'binary'
     end type scene_record_t
 
     !> &flexible_body.
     type, public :: flexible_body_record_t
-        !> unique name (default: body; body N when there are several)
+        !> &flexible_body: unique name (default: body; body N when there are several)
         character(len=len_name) :: name = 'body'
-        character(len=len_name) :: element = 'hex8' !! element type of a box mesh
-        character(len=len_path) :: mesh_file = '' !! mesh file (default: a box mesh)
-        integer :: divisions(3) = [1, 1, 1] !! box: elements per direction
-        real(wp) :: lengths(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! box: edge lengths, required [m]
-        real(wp) :: origin(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! box: lower corner [m]
-        !> node sets held at their reference position
+        character(len=len_name) :: element = 'hex8' !! &flexible_body: element type of a box mesh
+        character(len=len_path) :: mesh_file = '' !! &flexible_body: mesh file (default: a box mesh)
+        integer :: divisions(3) = [1, 1, 1] !! &flexible_body: box: elements per direction
+        !> &flexible_body: box: edge lengths, required [m]
+        real(wp) :: lengths(3) = [0.0_wp, 0.0_wp, 0.0_wp]
+        real(wp) :: origin(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! &flexible_body: box: lower corner [m]
+        !> &flexible_body: node sets held at their reference position
         character(len=len_name) :: fixed(max_fixed_sets) = ''
-        character(len=len_name) :: load_set = '' !! node set carrying load
-        real(wp) :: load(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! total force on load_set [N]
-        real(wp) :: gravity(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! gravity on the body [m/s^2]
-        !> initial velocity (a rigid field) [m/s]
+        character(len=len_name) :: load_set = '' !! &flexible_body: node set carrying load
+        !> &flexible_body: total force on load_set [N]
+        real(wp) :: load(3) = [0.0_wp, 0.0_wp, 0.0_wp]
+        !> &flexible_body: gravity on the body [m/s^2]
+        real(wp) :: gravity(3) = [0.0_wp, 0.0_wp, 0.0_wp]
+        !> &flexible_body: initial velocity (a rigid field) [m/s]
         real(wp) :: initial_velocity(3) = [0.0_wp, 0.0_wp, 0.0_wp]
-        !> initial angular velocity about the centroid [rad/s]
+        !> &flexible_body: initial angular velocity about the centroid [rad/s]
         real(wp) :: initial_angular_velocity(3) = [0.0_wp, 0.0_wp, 0.0_wp]
-        !> DAE formulation (problem = flexible_body)
+        !> &flexible_body: DAE formulation (problem = flexible_body)
         character(len=len_name) :: formulation = 'index2'
-        !> nonlinear finite elements, or modal: a floating frame with Craig-Bampton modes of the
-        !> same mesh (problem = multibody)
+        !> &flexible_body: nonlinear finite elements, or modal: a floating frame with Craig-Bampton
+        !> modes of the same mesh (problem = multibody)
         character(len=len_name) :: model = 'nonlinear'
-        !> modal: fixed-interface normal modes k (6 static modes per interface come with them)
+        !> &flexible_body: modal: fixed-interface normal modes k (6 static modes per interface come
+        !> with them)
         integer :: modes = 8
-        !> modal: the node sets joints and markers use, each moving rigidly (default: the node sets
-        !> of its markers)
+        !> &flexible_body: modal: the node sets joints and markers use, each moving rigidly
+        !> (default: the node sets of its markers)
         character(len=len_name) :: interfaces(max_interfaces) = ''
-        !> modal: eigen-solver of the fixed-interface modes (auto: dense up to 1200 interior
-        !> coordinates)
+        !> &flexible_body: modal: eigen-solver of the fixed-interface modes (auto: dense up to 1200
+        !> interior coordinates)
         character(len=len_name) :: modes_method = 'auto'
-        !> modal: HDF5 file keeping the basis, reused when mesh, materials, interfaces and modes
-        !> match (default: none)
+        !> &flexible_body: modal: HDF5 file keeping the basis, reused when mesh, materials,
+        !> interfaces and modes match (default: none)
         character(len=len_path) :: modes_cache = ''
     end type flexible_body_record_t
 
     !> &material.
     type, public :: material_record_t
-        character(len=len_name) :: name = '' !! for messages (default: material N)
-        real(wp) :: youngs_modulus !! Young's modulus E, required [Pa]
-        real(wp) :: poisson_ratio = 0.3_wp !! Poisson's ratio
-        real(wp) :: density !! mass density, required [kg/m^3]
-        !> viscosity (0: undamped; above 1e20 its stresses overflow) [Pa s]
+        character(len=len_name) :: name = '' !! &material: for messages (default: material N)
+        real(wp) :: youngs_modulus !! &material: Young's modulus E, required [Pa]
+        real(wp) :: poisson_ratio = 0.3_wp !! &material: Poisson's ratio
+        real(wp) :: density !! &material: mass density, required [kg/m^3]
+        !> &material: viscosity (0: undamped; above 1e20 its stresses overflow) [Pa s]
         real(wp) :: viscosity = 0.0_wp
-        !> element set (default: the elements no other material names)
+        !> &material: element set (default: the elements no other material names)
         character(len=len_name) :: elements = ''
-        !> its &flexible_body (default: the only one; required with several)
+        !> &material: its &flexible_body (default: the only one; required with several)
         character(len=len_name) :: body = ''
     end type material_record_t
 
     !> &multibody.
     type, public :: multibody_record_t
-        character(len=len_name) :: formulation = 'ggl' !! DAE formulation of the joints
-        real(wp) :: gravity(3) = [0.0_wp, -9.81_wp, 0.0_wp] !! gravity [m/s^2]
-        !> joint and force-element derivatives: hand-coded or AD
+        character(len=len_name) :: formulation = 'ggl' !! &multibody: DAE formulation of the joints
+        real(wp) :: gravity(3) = [0.0_wp, -9.81_wp, 0.0_wp] !! &multibody: gravity [m/s^2]
+        !> &multibody: joint and force-element derivatives: hand-coded or AD
         character(len=len_name) :: constraint_derivatives = 'analytic'
-        logical :: projection = .false. !! coordinate projection after each step
-        !> largest move of a body by the initial assembly [m]
+        logical :: projection = .false. !! &multibody: coordinate projection after each step
+        !> &multibody: largest move of a body by the initial assembly [m]
         real(wp) :: assembly_tolerance = 1e-3_wp
     end type multibody_record_t
 
     !> &rigid_body.
     type, public :: rigid_body_record_t
-        character(len=len_name) :: name = '' !! unique name (default: body N)
-        real(wp) :: mass !! mass, required [kg]
-        real(wp) :: inertia(3) !! Jxx, Jyy, Jzz about the centre of mass, required [kg m^2]
-        real(wp) :: inertia_products(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! Jxy, Jyz, Jxz [kg m^2]
-        real(wp) :: position(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! centre of mass [m]
-        real(wp) :: rotation_axis(3) = [0.0_wp, 0.0_wp, 1.0_wp] !! initial rotation: axis
-        real(wp) :: rotation_angle = 0.0_wp !! initial rotation: angle [rad]
-        real(wp) :: velocity(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! initial velocity [m/s]
-        !> initial angular velocity, world frame [rad/s]
+        character(len=len_name) :: name = '' !! &rigid_body: unique name (default: body N)
+        real(wp) :: mass !! &rigid_body: mass, required [kg]
+        !> &rigid_body: Jxx, Jyy, Jzz about the centre of mass, required [kg m^2]
+        real(wp) :: inertia(3)
+        !> &rigid_body: Jxy, Jyz, Jxz [kg m^2]
+        real(wp) :: inertia_products(3) = [0.0_wp, 0.0_wp, 0.0_wp]
+        real(wp) :: position(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! &rigid_body: centre of mass [m]
+        !> &rigid_body: initial rotation: axis
+        real(wp) :: rotation_axis(3) = [0.0_wp, 0.0_wp, 1.0_wp]
+        real(wp) :: rotation_angle = 0.0_wp !! &rigid_body: initial rotation: angle [rad]
+        real(wp) :: velocity(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! &rigid_body: initial velocity [m/s]
+        !> &rigid_body: initial angular velocity, world frame [rad/s]
         real(wp) :: angular_velocity(3) = [0.0_wp, 0.0_wp, 0.0_wp]
     end type rigid_body_record_t
 
     !> &marker.
     type, public :: marker_record_t
-        character(len=len_name) :: name = '' !! unique name (default: marker N)
-        character(len=len_name) :: body = 'ground' !! the body it sits on
-        !> in the body's frame (node sets: their centroid; given, a node frame) [m]
+        character(len=len_name) :: name = '' !! &marker: unique name (default: marker N)
+        character(len=len_name) :: body = 'ground' !! &marker: the body it sits on
+        !> &marker: in the body's frame (node sets: their centroid; given, a node frame) [m]
         real(wp) :: position(3) = [0.0_wp, 0.0_wp, 0.0_wp]
-        real(wp) :: z_axis(3) = [0.0_wp, 0.0_wp, 1.0_wp] !! z axis
-        real(wp) :: x_axis(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! x axis (0: any normal to z)
-        !> the flexible body's nodes it follows: centroid, or if needed a fitted frame
+        real(wp) :: z_axis(3) = [0.0_wp, 0.0_wp, 1.0_wp] !! &marker: z axis
+        real(wp) :: x_axis(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! &marker: x axis (0: any normal to z)
+        !> &marker: the flexible body's nodes it follows: centroid, or if needed a fitted frame
         character(len=len_name) :: node_set = ''
     end type marker_record_t
 
     !> &joint.
     type, public :: joint_record_t
-        character(len=len_name) :: name = '' !! unique name (default: joint N)
-        character(len=len_name) :: type = '' !! joint type, required
-        character(len=len_name) :: marker_i = '' !! first marker
-        character(len=len_name) :: marker_j = '' !! second marker
+        character(len=len_name) :: name = '' !! &joint: unique name (default: joint N)
+        character(len=len_name) :: type = '' !! &joint: joint type, required
+        character(len=len_name) :: marker_i = '' !! &joint: first marker
+        character(len=len_name) :: marker_j = '' !! &joint: second marker
     end type joint_record_t
 
     !> &driver.
     type, public :: driver_record_t
-        character(len=len_name) :: name = '' !! unique name (default: driver N)
-        character(len=len_name) :: type = '' !! what it drives, required
-        character(len=len_name) :: marker_i = '' !! first marker
-        character(len=len_name) :: marker_j = '' !! second marker
-        integer :: axis_i = 1 !! axis of marker_i (1, 2, 3: x, y, z)
-        integer :: axis_j = 1 !! axis of marker_j
-        !> s = c0 + c1 t + c2 t^2 + c3 t^3 ...
+        character(len=len_name) :: name = '' !! &driver: unique name (default: driver N)
+        character(len=len_name) :: type = '' !! &driver: what it drives, required
+        character(len=len_name) :: marker_i = '' !! &driver: first marker
+        character(len=len_name) :: marker_j = '' !! &driver: second marker
+        integer :: axis_i = 1 !! &driver: axis of marker_i (1, 2, 3: x, y, z)
+        integer :: axis_j = 1 !! &driver: axis of marker_j
+        !> &driver: s = c0 + c1 t + c2 t^2 + c3 t^3 ...
         real(wp) :: coefficients(4) = [0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
-        real(wp) :: amplitude = 0.0_wp !! ... + a sin(w t + phi)
-        real(wp) :: frequency = 0.0_wp !! w [rad/s]
-        real(wp) :: phase = 0.0_wp !! phi [rad]
-        !> ... + a ramp then hold: the rate rises smoothly from 0 to ramp_rate over ramp_time, then
-        !> holds (rad/s for angle drivers, m/s else)
+        real(wp) :: amplitude = 0.0_wp !! &driver: ... + a sin(w t + phi)
+        real(wp) :: frequency = 0.0_wp !! &driver: w [rad/s]
+        real(wp) :: phase = 0.0_wp !! &driver: phi [rad]
+        !> &driver: ... + a ramp then hold: the rate rises smoothly from 0 to ramp_rate over
+        !> ramp_time, then holds (rad/s for angle drivers, m/s else)
         real(wp) :: ramp_rate = 0.0_wp
-        real(wp) :: ramp_time = 0.0_wp !! the ramp's duration, positive with ramp_rate [s]
+        real(wp) :: ramp_time = 0.0_wp !! &driver: the ramp's duration, positive with ramp_rate [s]
     end type driver_record_t
 
     !> &force.
     type, public :: force_record_t
-        character(len=len_name) :: name = '' !! unique name (default: force N)
-        character(len=len_name) :: type = '' !! the element, required
-        character(len=len_name) :: marker_i = '' !! first marker (applied: the one)
-        character(len=len_name) :: marker_j = '' !! second marker (not for applied)
-        real(wp) :: free_length = 0.0_wp !! spring_damper: unstretched length [m]
-        real(wp) :: free_angle = 0.0_wp !! rotational: angle of zero torque [rad]
-        !> k1..k5 of k1 e + k2 e^2 ..., rotational k, bushing diag K (6)
+        character(len=len_name) :: name = '' !! &force: unique name (default: force N)
+        character(len=len_name) :: type = '' !! &force: the element, required
+        character(len=len_name) :: marker_i = '' !! &force: first marker (applied: the one)
+        character(len=len_name) :: marker_j = '' !! &force: second marker (not for applied)
+        real(wp) :: free_length = 0.0_wp !! &force: spring_damper: unstretched length [m]
+        real(wp) :: free_angle = 0.0_wp !! &force: rotational: angle of zero torque [rad]
+        !> &force: k1..k5 of k1 e + k2 e^2 ..., rotational k, bushing diag K (6)
         real(wp), allocatable :: stiffness(:)
-        real(wp), allocatable :: damping(:) !! c (spring_damper, rotational), bushing diag C (6)
-        real(wp) :: stiffness_matrix(36) !! bushing: full K, row by row (in place of stiffness)
-        real(wp) :: damping_matrix(36) !! bushing: full C, row by row (in place of damping)
-        real(wp) :: force(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! applied: F, times s(t) [N]
-        real(wp) :: torque(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! applied: n, times s(t) [N m]
-        character(len=len_name) :: frame = 'world' !! applied: axes of force and torque
-        !> applied: s = c0 + c1 t + c2 t^2 + c3 t^3 ...
+        !> &force: c (spring_damper, rotational), bushing diag C (6)
+        real(wp), allocatable :: damping(:)
+        !> &force: bushing: full K, row by row (in place of stiffness)
+        real(wp) :: stiffness_matrix(36)
+        real(wp) :: damping_matrix(36) !! &force: bushing: full C, row by row (in place of damping)
+        real(wp) :: force(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! &force: applied: F, times s(t) [N]
+        real(wp) :: torque(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! &force: applied: n, times s(t) [N m]
+        character(len=len_name) :: frame = 'world' !! &force: applied: axes of force and torque
+        !> &force: applied: s = c0 + c1 t + c2 t^2 + c3 t^3 ...
         real(wp) :: coefficients(4) = [0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
-        real(wp) :: amplitude = 0.0_wp !! applied: ... + a sin(w t + phi)
-        real(wp) :: frequency = 0.0_wp !! applied: w [rad/s]
-        real(wp) :: phase = 0.0_wp !! applied: phi [rad]
+        real(wp) :: amplitude = 0.0_wp !! &force: applied: ... + a sin(w t + phi)
+        real(wp) :: frequency = 0.0_wp !! &force: applied: w [rad/s]
+        real(wp) :: phase = 0.0_wp !! &force: applied: phi [rad]
     end type force_record_t
 
     !> &rigid_chain.
     type, public :: rigid_chain_record_t
-        character(len=len_name) :: name = '' !! unique name (default: link N)
-        character(len=len_name) :: parent = 'ground' !! 'ground' or an earlier link
-        character(len=len_name) :: joint = 'revolute' !! joint to the parent
-        real(wp) :: joint_position(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! joint in the parent's frame [m]
-        real(wp) :: joint_axis(3) = [0.0_wp, 0.0_wp, 1.0_wp] !! joint axis, parent's frame
-        real(wp) :: centre(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! centre of mass, own frame [m]
-        real(wp) :: mass !! mass, required [kg]
-        real(wp) :: inertia(3) !! about the centre of mass, required [kg m^2]
-        real(wp) :: inertia_products(3) = [0.0_wp, 0.0_wp, 0.0_wp] !! Jxy, Jyz, Jxz [kg m^2]
-        real(wp) :: coordinate = 0.0_wp !! initial joint coordinate (rad or m)
-        real(wp) :: rate = 0.0_wp !! initial joint rate (rad/s or m/s)
-        !> spherical: initial relative rotation axis
+        character(len=len_name) :: name = '' !! &rigid_chain: unique name (default: link N)
+        character(len=len_name) :: parent = 'ground' !! &rigid_chain: 'ground' or an earlier link
+        character(len=len_name) :: joint = 'revolute' !! &rigid_chain: joint to the parent
+        !> &rigid_chain: joint in the parent's frame [m]
+        real(wp) :: joint_position(3) = [0.0_wp, 0.0_wp, 0.0_wp]
+        !> &rigid_chain: joint axis, parent's frame
+        real(wp) :: joint_axis(3) = [0.0_wp, 0.0_wp, 1.0_wp]
+        !> &rigid_chain: centre of mass, own frame [m]
+        real(wp) :: centre(3) = [0.0_wp, 0.0_wp, 0.0_wp]
+        real(wp) :: mass !! &rigid_chain: mass, required [kg]
+        real(wp) :: inertia(3) !! &rigid_chain: about the centre of mass, required [kg m^2]
+        !> &rigid_chain: Jxy, Jyz, Jxz [kg m^2]
+        real(wp) :: inertia_products(3) = [0.0_wp, 0.0_wp, 0.0_wp]
+        real(wp) :: coordinate = 0.0_wp !! &rigid_chain: initial joint coordinate (rad or m)
+        real(wp) :: rate = 0.0_wp !! &rigid_chain: initial joint rate (rad/s or m/s)
+        !> &rigid_chain: spherical: initial relative rotation axis
         real(wp) :: rotation_axis(3) = [0.0_wp, 0.0_wp, 1.0_wp]
-        real(wp) :: rotation_angle = 0.0_wp !! spherical: initial relative rotation angle [rad]
-        !> spherical: initial angular velocity, own frame [rad/s]
+        !> &rigid_chain: spherical: initial relative rotation angle [rad]
+        real(wp) :: rotation_angle = 0.0_wp
+        !> &rigid_chain: spherical: initial angular velocity, own frame [rad/s]
         real(wp) :: angular_rate(3) = [0.0_wp, 0.0_wp, 0.0_wp]
     end type rigid_chain_record_t
 
