@@ -137,7 +137,7 @@ if not pchoices or re.sub(r"&\s*&", '', pchoices.group(1)).split('|') != pnames:
 report('catalogue-names-are-the-solvers-names', problems)
 
 # Reach-ins from run/ and io/ into the components of mbs/ and fe/ types.
-REACH_IN_BOUND = 300
+REACH_IN_BOUND = 166
 
 
 def type_parts(folders):

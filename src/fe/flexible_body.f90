@@ -92,6 +92,13 @@ module flexmbs_fe_flexible_body
         procedure :: force_derivatives_sparse => body_force_derivatives_sparse
         procedure :: constraint_jacobian_derivatives_sparse => body_no_second_derivatives
         procedure :: constraint_curvature_derivatives_sparse => body_no_curvature_derivatives
+        procedure :: reference_mesh => body_reference_mesh
+        procedure :: node_set => body_node_set
+        procedure :: centroid => body_centroid
+        procedure :: node_dofs => body_node_dofs
+        procedure :: applied_work => body_applied_work
+        procedure :: nodal_values => body_nodal_values
+        procedure :: displacements_of => body_displacements_of
     end type flexible_body_t
 
     public :: new_flexible_body
@@ -573,6 +580,76 @@ contains
             e = e - dot_product(self%applied_force, q - self%free_positions())
         end if
     end function body_total_energy
+
+    !> The body's mesh (reference configuration, sets), a copy.
+    function body_reference_mesh(self) result(mesh)
+        class(flexible_body_t), intent(in) :: self
+        type(mesh_t) :: mesh
+        mesh = self%mesh
+    end function body_reference_mesh
+
+    !> The nodes of the mesh's node set `name` (flexmbs_fe_mesh's node_set).
+    subroutine body_node_set(self, name, nodes, status)
+        class(flexible_body_t), intent(in) :: self
+        character(len=*), intent(in) :: name
+        integer, allocatable, intent(out) :: nodes(:)
+        type(status_t), intent(out) :: status
+        call self%mesh%node_set(name, nodes, status)
+    end subroutine body_node_set
+
+    !> The mean of the mesh's reference positions.
+    pure function body_centroid(self) result(c)
+        class(flexible_body_t), intent(in) :: self
+        real(wp) :: c(3)
+        c = self%mesh%centroid()
+    end function body_centroid
+
+    !> The free dofs (numbers in q and v) of node `node`'s x, y, z; 0 where held.
+    pure function body_node_dofs(self, node) result(dofs)
+        class(flexible_body_t), intent(in) :: self
+        integer, intent(in) :: node
+        integer :: dofs(3)
+        dofs = self%dof(:, node)
+    end function body_node_dofs
+
+    !> The work f·(q − q_ref) of the constant applied forces (gravity, loads).
+    real(wp) function body_applied_work(self, q, q_ref) result(w)
+        class(flexible_body_t), intent(in) :: self
+        real(wp), intent(in) :: q(:), q_ref(:)
+        w = dot_product(self%applied_force, q - q_ref)
+    end function body_applied_work
+
+    !> Every node's displacement w − X (`displacement`) or velocity w (node
+    !> by node x y z) from the free positions or velocities `w`; 0 for a
+    !> held coordinate.
+    pure subroutine body_nodal_values(self, w, displacement, values)
+        class(flexible_body_t), intent(in) :: self
+        real(wp), intent(in) :: w(:)
+        logical, intent(in) :: displacement
+        real(wp), intent(out) :: values(:)  !! (3 nodes)
+        integer :: i, j, d
+        do i = 1, size(self%dof, 2)
+            do j = 1, 3
+                d = self%dof(j, i)
+                if (d == 0) then
+                    values(3 * (i - 1) + j) = 0.0_wp
+                else if (displacement) then
+                    values(3 * (i - 1) + j) = w(d) - self%mesh%x(j, i)
+                else
+                    values(3 * (i - 1) + j) = w(d)
+                end if
+            end do
+        end do
+    end subroutine body_nodal_values
+
+    !> The displacement x − X of nodal positions `x` (every node, node by
+    !> node x y z) from the reference.
+    pure subroutine body_displacements_of(self, x, values)
+        class(flexible_body_t), intent(in) :: self
+        real(wp), intent(in) :: x(:)        !! (3 nodes)
+        real(wp), intent(out) :: values(:)  !! (3 nodes)
+        values = x - reshape(self%mesh%x, [size(values)])
+    end subroutine body_displacements_of
 
     !> det F > 0 at every quadrature point of every element; otherwise a
     !> solver failure with reason_det_f naming the element.

@@ -34,6 +34,17 @@ module flexmbs_fe_mesh
         procedure :: node_set => mesh_node_set
         procedure :: element_set => mesh_element_set
         procedure :: check => mesh_check
+        procedure :: nodes_per_element => mesh_nodes_per_element
+        procedure :: reference_positions => mesh_reference_positions
+        procedure :: reference_position => mesh_reference_position
+        procedure :: centroid => mesh_centroid
+        procedure :: element_nodes => mesh_element_nodes
+        procedure :: node_set_count => mesh_node_set_count
+        procedure :: node_set_name => mesh_node_set_name
+        procedure :: node_set_nodes => mesh_node_set_nodes
+        procedure :: element_set_count => mesh_element_set_count
+        procedure :: element_set_name => mesh_element_set_name
+        procedure :: element_set_elements => mesh_element_set_elements
     end type mesh_t
 
 contains
@@ -49,6 +60,87 @@ contains
         mesh_element_count = 0
         if (allocated(self%connectivity)) mesh_element_count = size(self%connectivity, 2)
     end function mesh_element_count
+
+    !> 8 or 27.
+    pure integer function mesh_nodes_per_element(self) result(n)
+        class(mesh_t), intent(in) :: self
+        n = self%nnode_element
+    end function mesh_nodes_per_element
+
+    !> Every node's reference position (3, nodes).
+    pure function mesh_reference_positions(self) result(x)
+        class(mesh_t), intent(in) :: self
+        real(wp), allocatable :: x(:, :)
+        x = self%x
+    end function mesh_reference_positions
+
+    !> Node `node`'s reference position.
+    pure function mesh_reference_position(self, node) result(x)
+        class(mesh_t), intent(in) :: self
+        integer, intent(in) :: node
+        real(wp) :: x(3)
+        x = self%x(:, node)
+    end function mesh_reference_position
+
+    !> The mean of the reference positions (every node weighted alike).
+    pure function mesh_centroid(self) result(c)
+        class(mesh_t), intent(in) :: self
+        real(wp) :: c(3)
+        c = sum(self%x, dim=2) / real(self%node_count(), wp)
+    end function mesh_centroid
+
+    !> The nodes of each element (nodes_per_element, elements).
+    pure function mesh_element_nodes(self) result(nodes)
+        class(mesh_t), intent(in) :: self
+        integer, allocatable :: nodes(:, :)
+        nodes = self%connectivity
+    end function mesh_element_nodes
+
+    !> The number of named node sets.
+    pure integer function mesh_node_set_count(self) result(n)
+        class(mesh_t), intent(in) :: self
+        n = 0
+        if (allocated(self%node_sets)) n = size(self%node_sets)
+    end function mesh_node_set_count
+
+    !> The name of node set k (1..node_set_count).
+    pure function mesh_node_set_name(self, k) result(name)
+        class(mesh_t), intent(in) :: self
+        integer, intent(in) :: k
+        character(len=:), allocatable :: name
+        name = self%node_sets(k)%name
+    end function mesh_node_set_name
+
+    !> The nodes of node set k (1..node_set_count).
+    pure function mesh_node_set_nodes(self, k) result(nodes)
+        class(mesh_t), intent(in) :: self
+        integer, intent(in) :: k
+        integer, allocatable :: nodes(:)
+        nodes = self%node_sets(k)%nodes
+    end function mesh_node_set_nodes
+
+    !> The number of named element sets.
+    pure integer function mesh_element_set_count(self) result(n)
+        class(mesh_t), intent(in) :: self
+        n = 0
+        if (allocated(self%element_sets)) n = size(self%element_sets)
+    end function mesh_element_set_count
+
+    !> The name of element set k (1..element_set_count).
+    pure function mesh_element_set_name(self, k) result(name)
+        class(mesh_t), intent(in) :: self
+        integer, intent(in) :: k
+        character(len=:), allocatable :: name
+        name = self%element_sets(k)%name
+    end function mesh_element_set_name
+
+    !> The elements of element set k (1..element_set_count).
+    pure function mesh_element_set_elements(self, k) result(elements)
+        class(mesh_t), intent(in) :: self
+        integer, intent(in) :: k
+        integer, allocatable :: elements(:)
+        elements = self%element_sets(k)%elements
+    end function mesh_element_set_elements
 
     !> The nodes of the set called `name`; bad input naming the set if absent.
     subroutine mesh_node_set(self, name, nodes, status)

@@ -31,6 +31,7 @@ module flexmbs_fe_modal_basis
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_text, only: int_text, real_text
+    use flexmbs_core_sha256, only: sha256_hex
     use flexmbs_linalg_csc, only: csc_matrix_t
     use flexmbs_linalg_matrix, only: matrix_t, storage_sparse
     use flexmbs_linalg_sub_block, only: sub_block_t
@@ -43,7 +44,11 @@ module flexmbs_fe_modal_basis
     implicit none
     private
 
-    public :: craig_bampton, rigid_motions
+    public :: craig_bampton, rigid_motions, basis_fingerprint
+
+    !> The version of the basis the fingerprint covers: a change of the
+    !> algorithm that changes the shapes changes it, so old caches are redone.
+    character(len=*), parameter :: basis_version = 'craig-bampton 1'
 
     !> Gram eigenvalues below this fraction of the largest are the removed
     !> rigid directions (round-off: 1e-16 relative; the smallest kept ones
@@ -70,9 +75,110 @@ module flexmbs_fe_modal_basis
         real(wp), allocatable :: interface_centre(:, :) !! (3, interfaces) X_cj, mesh frame
         real(wp), allocatable :: fixed_frequencies(:)   !! ω of the k fixed-interface modes
         character(len=:), allocatable :: eigen_method   !! 'dense' | 'arpack' as used
+    contains
+        procedure :: export_parts => basis_export_parts
+        procedure :: import_parts => basis_import_parts
     end type modal_basis_t
 
 contains
+
+    !> The arrays that make the basis (a cache file keeps them; see the
+    !> type's components for their meaning and shapes).
+    subroutine basis_export_parts(self, eigen_method, frequencies, shapes, damping, &
+                                  interface_centre, interface_motion, fixed_frequencies)
+        class(modal_basis_t), intent(in) :: self
+        character(len=:), allocatable, intent(out) :: eigen_method
+        real(wp), allocatable, intent(out) :: frequencies(:), shapes(:, :), damping(:, :), &
+            interface_centre(:, :), interface_motion(:, :, :), fixed_frequencies(:)
+        eigen_method = self%eigen_method
+        frequencies = self%frequencies
+        shapes = self%shapes
+        damping = self%damping
+        interface_centre = self%interface_centre
+        interface_motion = self%interface_motion
+        fixed_frequencies = self%fixed_frequencies
+    end subroutine basis_export_parts
+
+    !> The basis made of the arrays export_parts gives (read back from a
+    !> cache); count and nodes follow from their shapes. Without
+    !> `eigen_method` the basis keeps its own.
+    subroutine basis_import_parts(self, frequencies, shapes, damping, interface_centre, &
+                                  interface_motion, fixed_frequencies, eigen_method)
+        class(modal_basis_t), intent(inout) :: self
+        real(wp), intent(in) :: frequencies(:), shapes(:, :), damping(:, :), &
+            interface_centre(:, :), interface_motion(:, :, :), fixed_frequencies(:)
+        character(len=*), intent(in), optional :: eigen_method
+        if (present(eigen_method)) self%eigen_method = eigen_method
+        self%frequencies = frequencies
+        self%shapes = shapes
+        self%damping = damping
+        self%interface_centre = interface_centre
+        self%interface_motion = interface_motion
+        self%fixed_frequencies = fixed_frequencies
+        self%count = size(frequencies)
+        self%nodes = size(shapes, 1) / 3
+    end subroutine basis_import_parts
+
+    !> The SHA-256 of what craig_bampton's basis depends on: the basis
+    !> version, k = `modes`, the element type, every node's position and
+    !> element's nodes (bit for bit), every element's material constants,
+    !> the interfaces' names and nodes. The text is filled in place (long
+    !> meshes: no repeated concatenation).
+    function basis_fingerprint(body, interfaces, modes) result(digest)
+        type(flexible_body_t), intent(in) :: body
+        type(node_set_t), intent(in) :: interfaces(:)
+        integer, intent(in) :: modes
+        character(len=:), allocatable :: digest
+        character(len=:), allocatable :: text
+        integer :: i, j, n, at
+        n = 64 + 17 * (size(body%mesh%x) + 4 * size(body%materials)) + &
+            12 * (size(body%mesh%connectivity) + size(body%element_material))
+        do j = 1, size(interfaces)
+            n = n + len(interfaces(j)%name) + 12 * size(interfaces(j)%nodes) + 2
+        end do
+        allocate (character(len=n) :: text)
+        at = 0
+        call put(basis_version // ' k=' // int_text(modes) // ' nnode=' // &
+                 int_text(body%mesh%nnode_element) // ';')
+        do j = 1, size(body%mesh%x, 2)
+            do i = 1, 3
+                call put(hex(body%mesh%x(i, j)))
+            end do
+        end do
+        call put(';')
+        do j = 1, size(body%mesh%connectivity, 2)
+            do i = 1, size(body%mesh%connectivity, 1)
+                call put(int_text(body%mesh%connectivity(i, j)) // ',')
+            end do
+        end do
+        call put(';')
+        do j = 1, size(body%element_material)
+            call put(int_text(body%element_material(j)) // ',')
+        end do
+        do j = 1, size(body%materials)
+            associate (m => body%materials(j))
+                call put(';' // hex(m%mu) // hex(m%lambda) // hex(m%beta) // hex(m%density))
+            end associate
+        end do
+        do j = 1, size(interfaces)
+            call put(';' // interfaces(j)%name // ':')
+            do i = 1, size(interfaces(j)%nodes)
+                call put(int_text(interfaces(j)%nodes(i)) // ',')
+            end do
+        end do
+        digest = sha256_hex(text(1:at))
+    contains
+        subroutine put(part)
+            character(len=*), intent(in) :: part
+            text(at + 1:at + len(part)) = part
+            at = at + len(part)
+        end subroutine put
+        function hex(x) result(w)
+            real(wp), intent(in) :: x
+            character(len=17) :: w
+            write (w, '(z16.16,a)') transfer(x, 1_i8), ','
+        end function hex
+    end function basis_fingerprint
 
     !> The Craig–Bampton basis of `body` (free: no fixed node or component)
     !> with k = `modes` fixed-interface modes and the interface node sets

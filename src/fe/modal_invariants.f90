@@ -16,10 +16,18 @@
 module flexmbs_fe_modal_invariants
     use flexmbs_core_kinds, only: wp
     use flexmbs_linalg_csc, only: csc_matrix_t
+    use flexmbs_fe_flexible_body, only: flexible_body_t
+    use flexmbs_fe_modal_basis, only: modal_basis_t
     implicit none
     private
 
     public :: modal_invariants
+
+    !> The invariants of a basis: from the mass matrix, positions and
+    !> shapes, or from the FE body and its modal basis.
+    interface modal_invariants
+        module procedure invariants_of_shapes, invariants_of_basis
+    end interface modal_invariants
 
     !> The invariants of one modal body.
     type, public :: modal_invariants_t
@@ -36,7 +44,7 @@ contains
     !> The invariants of the shapes (3 nodes x n, node by node x y z) on the
     !> mesh positions x with the consistent mass matrix `mass` (3 nodes x 3
     !> nodes, every node free).
-    function modal_invariants(mass, x, shapes) result(inv)
+    function invariants_of_shapes(mass, x, shapes) result(inv)
         type(csc_matrix_t), intent(in) :: mass
         real(wp), intent(in) :: x(:, :)
         real(wp), intent(in) :: shapes(:, :)
@@ -73,7 +81,16 @@ contains
                 inv%products(:, :, l, k) = transpose(inv%products(:, :, k, l))
             end do
         end do
-    end function modal_invariants
+    end function invariants_of_shapes
+
+    !> The invariants of `basis`'s shapes on the FE body `body` it was
+    !> computed from (its consistent mass and reference positions).
+    function invariants_of_basis(body, basis) result(inv)
+        type(flexible_body_t), intent(in) :: body
+        type(modal_basis_t), intent(in) :: basis
+        type(modal_invariants_t) :: inv
+        inv = invariants_of_shapes(body%mass_matrix, body%mesh%x, basis%shapes)
+    end function invariants_of_basis
 
     !> Σ_i a_i (M b)_iᵀ for nodal vectors a and mb = M b (node by node).
     pure function density_product(a, mb) result(p)

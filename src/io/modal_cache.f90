@@ -35,11 +35,12 @@ contains
         logical, intent(out) :: found
         type(status_t), intent(out) :: status
         integer(hid_t) :: file
-        character(len=:), allocatable :: text
-        real(wp), allocatable :: flat(:)
+        character(len=:), allocatable :: text, method
+        real(wp), allocatable :: flat(:), frequencies(:), shapes(:, :), damping(:, :), &
+            centre(:, :), motion(:, :, :), fixed(:)
         integer(hsize_t) :: dims(3)
         integer :: err, close_err, n, ni
-        logical :: exists, is_hdf5
+        logical :: exists, is_hdf5, known_method
         found = .false.
         inquire (file=path, exist=exists)
         if (.not. exists) return
@@ -64,29 +65,31 @@ contains
             call h5fclose_f(file, close_err)
             return
         end if
-        call read_string_attribute(file, 'eigen_method', text, err)
-        if (err >= 0) basis%eigen_method = text
-        call read_real(file, 'frequencies', flat, dims, err)
+        call read_string_attribute(file, 'eigen_method', method, err)
+        known_method = err >= 0
+        call read_real(file, 'frequencies', frequencies, dims, err)
         n = int(dims(1))
-        if (err >= 0) basis%frequencies = flat
         if (err >= 0) call read_real(file, 'shapes', flat, dims, err)
-        if (err >= 0) basis%shapes = reshape(flat, [int(dims(1)), n])
+        if (err >= 0) shapes = reshape(flat, [int(dims(1)), n])
         if (err >= 0) call read_real(file, 'damping', flat, dims, err)
-        if (err >= 0) basis%damping = reshape(flat, [n, n])
+        if (err >= 0) damping = reshape(flat, [n, n])
         if (err >= 0) call read_real(file, 'interface_centre', flat, dims, err)
         ni = int(dims(2))
-        if (err >= 0) basis%interface_centre = reshape(flat, [3, ni])
+        if (err >= 0) centre = reshape(flat, [3, ni])
         if (err >= 0) call read_real(file, 'interface_motion', flat, dims, err)
-        if (err >= 0) basis%interface_motion = reshape(flat, [6, n, ni])
-        if (err >= 0) call read_real(file, 'fixed_frequencies', flat, dims, err)
-        if (err >= 0) basis%fixed_frequencies = flat
+        if (err >= 0) motion = reshape(flat, [6, n, ni])
+        if (err >= 0) call read_real(file, 'fixed_frequencies', fixed, dims, err)
         call h5fclose_f(file, close_err)
         if (err < 0) then
             call status%set(status_io_error, path // ': modes_cache: cannot read the basis')
             return
         end if
-        basis%count = n
-        basis%nodes = size(basis%shapes, 1) / 3
+        if (known_method) then
+            call basis%import_parts(frequencies, shapes, damping, centre, motion, fixed, &
+                                    eigen_method=method)
+        else
+            call basis%import_parts(frequencies, shapes, damping, centre, motion, fixed)
+        end if
         found = .true.
     end subroutine read_modal_cache
 
@@ -97,8 +100,12 @@ contains
         type(status_t), intent(out) :: status
         integer(hid_t) :: file
         integer :: err, close_err, n, ni
-        n = basis%count
-        ni = size(basis%interface_centre, 2)
+        character(len=:), allocatable :: method
+        real(wp), allocatable :: frequencies(:), shapes(:, :), damping(:, :), &
+            centre(:, :), motion(:, :, :), fixed(:)
+        call basis%export_parts(method, frequencies, shapes, damping, centre, motion, fixed)
+        n = size(frequencies)
+        ni = size(centre, 2)
         call h5open_f(err)
         call h5fcreate_f(path, H5F_ACC_TRUNC_F, file, err)
         if (err < 0) then
@@ -107,21 +114,20 @@ contains
         end if
         call write_string_attribute(file, 'kind', cache_kind, err)
         if (err >= 0) call write_string_attribute(file, 'fingerprint', fingerprint, err)
-        if (err >= 0) call write_string_attribute(file, 'eigen_method', basis%eigen_method, err)
+        if (err >= 0) call write_string_attribute(file, 'eigen_method', method, err)
         if (err >= 0) call write_string_attribute(file, 'written_by', written_by, err)
-        if (err >= 0) call write_real(file, 'frequencies', basis%frequencies, &
-                                      [int(n, hsize_t)], err)
-        if (err >= 0) call write_real(file, 'shapes', reshape(basis%shapes, [size(basis%shapes)]), &
-                                      [int(size(basis%shapes, 1), hsize_t), int(n, hsize_t)], err)
-        if (err >= 0) call write_real(file, 'damping', reshape(basis%damping, [n * n]), &
+        if (err >= 0) call write_real(file, 'frequencies', frequencies, [int(n, hsize_t)], err)
+        if (err >= 0) call write_real(file, 'shapes', reshape(shapes, [size(shapes)]), &
+                                      [int(size(shapes, 1), hsize_t), int(n, hsize_t)], err)
+        if (err >= 0) call write_real(file, 'damping', reshape(damping, [n * n]), &
                                       [int(n, hsize_t), int(n, hsize_t)], err)
         if (err >= 0) call write_real(file, 'interface_centre', &
-            reshape(basis%interface_centre, [3 * ni]), [3_hsize_t, int(ni, hsize_t)], err)
+            reshape(centre, [3 * ni]), [3_hsize_t, int(ni, hsize_t)], err)
         if (err >= 0) call write_real(file, 'interface_motion', &
-            reshape(basis%interface_motion, [6 * n * ni]), &
+            reshape(motion, [6 * n * ni]), &
             [6_hsize_t, int(n, hsize_t), int(ni, hsize_t)], err)
-        if (err >= 0) call write_real(file, 'fixed_frequencies', basis%fixed_frequencies, &
-                                      [int(size(basis%fixed_frequencies), hsize_t)], err)
+        if (err >= 0) call write_real(file, 'fixed_frequencies', fixed, &
+                                      [int(size(fixed), hsize_t)], err)
         call h5fclose_f(file, close_err)
         if (err < 0 .or. close_err < 0) call status%set(status_io_error, path // &
             ': modes_cache: cannot write the basis')

@@ -72,6 +72,11 @@ module flexmbs_mbs_formulation
     integer, parameter, public :: formulation_index3 = 3
     integer, parameter, public :: formulation_ggl = 4
 
+    !> The blocks of y, for formulation_t's offset, block_size and last:
+    !> positions q, velocities v, accelerations a, multipliers λ, GGL's μ.
+    integer, parameter, public :: block_q = 1, block_v = 2, block_a = 3, &
+        block_lambda = 4, block_mu = 5
+
     ! docs/theory.md §7.4: convergence bound and iteration limit of the
     ! position projection.
     real(wp), parameter :: projection_epsreq = 1.0e-2_wp
@@ -82,33 +87,40 @@ module flexmbs_mbs_formulation
         class(mechanical_problem_t), pointer :: mechanical => null()
         integer :: form = formulation_index2
         logical :: accelerations = .true.  !! layout (q, v, a, λ[, μ]) or (q, v, λ[, μ])
-        real(wp) :: baumgarte_zeta = 0.0_wp  !! index 1: damping ratio ζ
-        real(wp) :: baumgarte_omega = 0.0_wp !! index 1: frequency ω (0: no Baumgarte)
+        real(wp), private :: baumgarte_zeta = 0.0_wp  !! index 1: damping ratio ζ
+        !> index 1: frequency ω (0: no Baumgarte)
+        real(wp), private :: baumgarte_omega = 0.0_wp
         logical :: projection = .false.      !! offer the projection hook
-        integer :: velocity_interval = 1     !! project velocities every k-th call
+        integer, private :: velocity_interval = 1 !! project velocities every k-th call
         real(wp) :: projection_rtol = 1.0e-6_wp !! weights rtol |q| + atol of §6
         real(wp) :: projection_atol = 1.0e-6_wp
-        integer :: projection_calls = 0
+        integer, private :: projection_calls = 0
         integer :: nq = 0, nv = 0, nc = 0
-        integer :: oq = 0, ov = 0, oa = 0, ol = 0, om = 0 !! offsets of the blocks in y
-        real(wp), allocatable :: q_mass(:)   !! where the constant M is evaluated
+        !> offsets of the blocks in y (for the outer layers: offset, block_size, last)
+        integer :: oq = 0, ov = 0, oa = 0, ol = 0, om = 0
+        real(wp), allocatable, private :: q_mass(:)   !! where the constant M is evaluated
         ! workspaces, allocated once by the constructor
-        real(wp), allocatable :: m(:, :), gmat(:, :), force(:), w(:), b(:), c(:), ct(:)
-        real(wp), allocatable :: qq(:, :), vq(:, :), vv(:, :), cq(:, :), cq2(:, :), cv(:, :)
-        real(wp), allocatable :: gtlq(:, :), minv_gt(:, :), tq(:), q0(:), mass_lu(:, :)
-        real(wp), allocatable :: kkt_rhs(:)
+        real(wp), allocatable, private :: m(:, :), gmat(:, :), force(:), w(:), b(:), c(:), &
+            ct(:)
+        real(wp), allocatable, private :: qq(:, :), vq(:, :), vv(:, :), cq(:, :), cq2(:, :), &
+            cv(:, :)
+        real(wp), allocatable, private :: gtlq(:, :), minv_gt(:, :), tq(:), q0(:), &
+            mass_lu(:, :)
+        real(wp), allocatable, private :: kkt_rhs(:)
         !> consistent_multipliers' last state (t, q, v), its λ, and its
         !> right-hand side and iterate (size nv + nc)
-        real(wp) :: multipliers_t = huge(1.0_wp)
-        real(wp), allocatable :: multipliers_state(:), multipliers(:), kkt_b(:), kkt_x(:)
-        logical :: kkt_factored = .false.    !! a factorization of K at some q is held
-        integer, allocatable :: mass_pivots(:)
-        type(saddle_point_t) :: kkt          !! dense [M Gᵀ; G 0] (the sparse one is in sp)
-        logical :: mass_factored = .false.
+        real(wp), private :: multipliers_t = huge(1.0_wp)
+        real(wp), allocatable, private :: multipliers_state(:), multipliers(:), kkt_b(:), &
+            kkt_x(:)
+        logical, private :: kkt_factored = .false.    !! a factorization of K at some q is held
+        integer, allocatable, private :: mass_pivots(:)
+        !> dense [M Gᵀ; G 0] (the sparse one is in sp)
+        type(saddle_point_t), private :: kkt
+        logical, private :: mass_factored = .false.
         logical :: sparse = .false.          !! the sparse path (module header)
         !> allocated on the sparse path only. Allocatable: gfortran 12's
         !> finalization wrapper skipped a matrix of a non-allocatable sp (trq)
-        type(sparse_formulation_t), allocatable :: sp
+        type(sparse_formulation_t), allocatable, private :: sp
     contains
         procedure :: rhs => formulation_rhs
         procedure :: jacobian_storage => formulation_jacobian_storage
@@ -123,6 +135,9 @@ module flexmbs_mbs_formulation
         procedure :: differential_flags => formulation_differential_flags
         procedure :: multiplier_flags => formulation_multiplier_flags
         procedure :: has_projection => formulation_has_projection
+        procedure :: offset => formulation_offset
+        procedure :: block_size => formulation_block_size
+        procedure :: last => formulation_last
         procedure :: project => formulation_project
         procedure :: consistent_initial => formulation_consistent_initial
         procedure :: consistent_multipliers => formulation_consistent_multipliers
@@ -652,6 +667,54 @@ contains
         class(formulation_t), intent(in) :: self
         formulation_has_projection = self%projection
     end function formulation_has_projection
+
+    !> Where block `block` (block_q, _v, _a, _lambda, _mu) starts in y: its
+    !> entries are y(offset + 1:offset + block_size); -1 for another number.
+    pure integer function formulation_offset(self, block) result(offset)
+        class(formulation_t), intent(in) :: self
+        integer, intent(in) :: block
+        select case (block)
+        case (block_q)
+            offset = self%oq
+        case (block_v)
+            offset = self%ov
+        case (block_a)
+            offset = self%oa
+        case (block_lambda)
+            offset = self%ol
+        case (block_mu)
+            offset = self%om
+        case default
+            offset = -1
+        end select
+    end function formulation_offset
+
+    !> The length of block `block` in y: 0 for a block the layout has not
+    !> (a without accelerations, μ outside GGL) and for another number.
+    pure integer function formulation_block_size(self, block) result(n)
+        class(formulation_t), intent(in) :: self
+        integer, intent(in) :: block
+        n = 0
+        select case (block)
+        case (block_q)
+            n = self%nq
+        case (block_v)
+            n = self%nv
+        case (block_a)
+            if (self%accelerations) n = self%nv
+        case (block_lambda)
+            n = self%nc
+        case (block_mu)
+            if (self%form == formulation_ggl) n = self%nc
+        end select
+    end function formulation_block_size
+
+    !> The last entry of block `block` in y, offset + block_size.
+    pure integer function formulation_last(self, block) result(last)
+        class(formulation_t), intent(in) :: self
+        integer, intent(in) :: block
+        last = self%offset(block) + self%block_size(block)
+    end function formulation_last
 
     !> Eqs. (11)-(12) after an accepted step (module header).
     subroutine formulation_project(self, t, y, status)

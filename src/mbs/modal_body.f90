@@ -68,7 +68,7 @@ module flexmbs_mbs_modal_body
         !> (3, nodes), the shapes (3 nodes, n), and the FE body of the same
         !> mesh and materials (element stresses of the reconstructed field)
         real(wp), allocatable :: reference(:, :), shapes(:, :)
-        real(wp) :: centre(3) = 0.0_wp
+        real(wp), private :: centre(3) = 0.0_wp !! reference_centre
         type(flexible_body_t), allocatable :: fe
         ! workspace: A_l (3, 3, n), filled by moments()
         real(wp), allocatable :: a(:, :, :)
@@ -89,6 +89,8 @@ module flexmbs_mbs_modal_body
         procedure :: interface_pose => modal_interface_pose
         procedure :: node_positions => modal_node_positions
         procedure :: node_velocities => modal_node_velocities
+        procedure :: frequencies => modal_frequencies
+        procedure :: reference_centre => modal_reference_centre
     end type modal_body_t
 
 contains
@@ -173,6 +175,21 @@ contains
                                                   sd(3 * i - 2:3 * i))
         end do
     end subroutine modal_node_velocities
+
+    !> The body's own frequencies ω_l [rad/s], one per modal coordinate.
+    pure function modal_frequencies(self) result(omega)
+        class(modal_body_t), intent(in) :: self
+        real(wp), allocatable :: omega(:)
+        omega = sqrt(self%stiffness)
+    end function modal_frequencies
+
+    !> The reference centre of mass in the mesh's frame: where the body's
+    !> frame starts (r at η = 0).
+    pure function modal_reference_centre(self) result(centre)
+        class(modal_body_t), intent(in) :: self
+        real(wp) :: centre(3)
+        centre = self%centre
+    end function modal_reference_centre
 
     !> (a₂₃ − a₃₂, a₃₁ − a₁₃, a₁₂ − a₂₁): ∫ρ a × b for a = ∫ρ a bᵀ.
     pure function axial(a) result(w)

@@ -111,7 +111,7 @@ module flexmbs_mbs_rigid_chain
         procedure :: force_derivatives => chain_force_derivatives
     end type rigid_chain_t
 
-    public :: new_rigid_chain
+    public :: new_rigid_chain, new_chain_body
 
     interface
         !> ∂(M(q) w)/∂q, nv x nq (rigid_chain_derivatives).
@@ -141,6 +141,22 @@ module flexmbs_mbs_rigid_chain
     end interface
 
 contains
+
+    !> A chain body (the components' meanings are chain_body_t's); its joint
+    !> rotation R0_i stays the identity.
+    pure function new_chain_body(parent, joint, joint_position, axis, centre, mass, &
+                                 inertia) result(body)
+        integer, intent(in) :: parent, joint
+        real(wp), intent(in) :: joint_position(3), axis(3), centre(3), mass, inertia(3, 3)
+        type(chain_body_t) :: body
+        body%parent = parent
+        body%joint = joint
+        body%joint_position = joint_position
+        body%axis = axis
+        body%centre = centre
+        body%mass = mass
+        body%inertia = inertia
+    end function new_chain_body
 
     !> A chain of `bodies` (each body's parent listed before it) with
     !> `markers`, under `gravity`.

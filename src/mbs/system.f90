@@ -276,6 +276,16 @@ module flexmbs_mbs_system
         procedure :: energy => system_energy
         procedure :: total_energy => system_total_energy
         procedure :: momenta => system_momenta
+        procedure :: chain_count => system_chain_count
+        procedure :: link_count => system_link_count
+        procedure :: link_coordinates => system_link_coordinates
+        procedure :: flexible_count => system_flexible_count
+        procedure :: flexible_coordinates => system_flexible_coordinates
+        procedure :: joint_count => system_joint_count
+        procedure :: joint_bodies => system_joint_bodies
+        procedure :: joint_rows => system_joint_rows
+        procedure :: element_count => system_element_count
+        procedure :: element_bodies => system_element_bodies
     end type mbs_system_t
 
     public :: new_mbs_system, driver_t, driver_values, node_frame_t, force_element_t
@@ -757,6 +767,58 @@ module flexmbs_mbs_system
             type(modal_body_t), intent(in), optional :: modal(:)
             type(mbs_system_t) :: self
         end function new_mbs_system
+
+        ! The system's parts as the outer layers see them (system_views).
+        !> The number of rigid chains.
+        pure integer module function system_chain_count(self) result(n)
+            class(mbs_system_t), intent(in) :: self
+        end function system_chain_count
+        !> The number of links (bodies) of chain c.
+        pure integer module function system_link_count(self, c) result(n)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: c
+        end function system_link_count
+        !> The joint coordinates of link i of chain c: q(offset + 1:offset + n).
+        pure module subroutine system_link_coordinates(self, c, i, offset, n)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: c, i
+            integer, intent(out) :: offset, n
+        end subroutine system_link_coordinates
+        !> The number of (nonlinear) flexible bodies.
+        pure integer module function system_flexible_count(self) result(n)
+            class(mbs_system_t), intent(in) :: self
+        end function system_flexible_count
+        !> The free nodal coordinates of flexible body i: q(offset + 1:offset + n).
+        pure module subroutine system_flexible_coordinates(self, i, offset, n)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: i
+            integer, intent(out) :: offset, n
+        end subroutine system_flexible_coordinates
+        !> The number of joints (node frames not counted).
+        pure integer module function system_joint_count(self) result(n)
+            class(mbs_system_t), intent(in) :: self
+        end function system_joint_count
+        !> The bodies of joint j's markers i and j (their `body`: 0 the ground).
+        pure module function system_joint_bodies(self, j) result(bodies)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: j
+            integer :: bodies(2)
+        end function system_joint_bodies
+        !> The number of constraint rows of joint j (from joint_first_row on).
+        pure integer module function system_joint_rows(self, j) result(n)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: j
+        end function system_joint_rows
+        !> The number of force elements.
+        pure integer module function system_element_count(self) result(n)
+            class(mbs_system_t), intent(in) :: self
+        end function system_element_count
+        !> The bodies force element k acts on: 1 (an applied load, marker i's)
+        !> or 2 (between markers i and j).
+        pure integer module function system_element_bodies(self, k) result(n)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: k
+        end function system_element_bodies
     end interface
 
 contains

@@ -48,23 +48,21 @@ contains
             call note('rigid body ''' // trim(scene%rigid_bodies(i)%name) // '''', &
                       real_text(move) // ' m, ' // real_text(angle) // ' rad', max(move, angle), i)
         end do
-        do c = 1, size(sys%chains)
+        do c = 1, sys%chain_count()
             names = link_names(scene, c)
-            do i = 1, size(sys%chains(c)%bodies)
-                off = sys%chain_q(c) + sys%chains(c)%iq(i)
-                k = sys%chains(c)%iq(i + 1) - sys%chains(c)%iq(i)
+            do i = 1, sys%link_count(c)
+                call sys%link_coordinates(c, i, off, k)
                 move = maxval(abs(q(off + 1:off + k) - q0(off + 1:off + k)))
                 call note('link ''' // trim(names(i)) // '''', &
                           real_text(move) // ' (joint coordinate)', move, 0)
             end do
         end do
-        do i = 1, size(sys%flex)
-            associate (f => sys%flex_q(i), n => sys%flex(i)%nq)
-                move = maxval([0.0_wp, abs(q(f + 1:f + n) - q0(f + 1:f + n))])
-                call note('flexible body ''' // trim(scene%bodies(nonlinear_body(scene, i))%name) &
-                          // '''', &
-                          real_text(move) // ' m (largest node move)', move, 0)
-            end associate
+        do i = 1, sys%flexible_count()
+            call sys%flexible_coordinates(i, off, k)
+            move = maxval([0.0_wp, abs(q(off + 1:off + k) - q0(off + 1:off + k))])
+            call note('flexible body ''' // trim(scene%bodies(nonlinear_body(scene, i))%name) &
+                      // '''', &
+                      real_text(move) // ' m (largest node move)', move, 0)
         end do
         if (worst <= scene%multibody%assembly_tolerance) return
         call status%set(status_bad_input, scene%path // ': &multibody: assembly_tolerance = ' &
@@ -97,17 +95,16 @@ contains
             integer :: j, row, best_joint
             type(status_t) :: local
             hint = ''
-            if (body == 0 .or. size(sys%joints) == 0) return
+            if (body == 0 .or. sys%joint_count() == 0) return
             allocate (c(sys%nc))
             call sys%constraint(t, q0, c, local)
             if (.not. local%ok()) return
             best = -1.0_wp
             best_joint = 0
-            do j = 1, size(sys%joints)
-                if (sys%markers(sys%joints(j)%marker_i)%body /= body .and. &
-                    sys%markers(sys%joints(j)%marker_j)%body /= body) cycle
+            do j = 1, sys%joint_count()
+                if (all(sys%joint_bodies(j) /= body)) cycle
                 row = sys%joint_first_row(j)
-                r = maxval([0.0_wp, abs(c(row:row + sys%joints(j)%joint%nrows - 1))])
+                r = maxval([0.0_wp, abs(c(row:row + sys%joint_rows(j) - 1))])
                 if (r > best) then
                     best = r
                     best_joint = j

@@ -43,7 +43,7 @@ contains
         integer, allocatable :: element_material(:), fixed(:), set(:)
         character(len=:), allocatable :: where
         real(wp) :: centroid(3), w(3)
-        integer :: k, i, nfree, nnode_element, stat
+        integer :: k, i, nfree, nnode_element, stat, dofs(3)
 
         where = scene%path // ': &flexible_body: '
         if (size(scene%bodies) > 1) where = scene%path // ': &flexible_body ''' // &
@@ -59,10 +59,10 @@ contains
                         int_text(b%line) // ')')
                     return
                 end if
-                if (mesh%nnode_element /= nnode_element) then
+                if (mesh%nodes_per_element() /= nnode_element) then
                     call status%set(status_bad_input, where // 'element = ''' // &
                         trim(b%element) // ''': the mesh file ''' // trim(b%mesh_file) // &
-                        ''' has ' // int_text(mesh%nnode_element) // '-node elements')
+                        ''' has ' // int_text(mesh%nodes_per_element()) // '-node elements')
                     return
                 end if
             else
@@ -102,14 +102,14 @@ contains
                         trim(b%load_set) // ''': ' // status%text())
                     return
                 end if
-                nfree = count([(any(body%dof(:, set(i)) > 0), i = 1, size(set))])
+                nfree = count([(any(body%node_dofs(set(i)) > 0), i = 1, size(set))])
                 if (nfree == 0) then
                     call status%set(status_bad_input, where // 'load_set = ''' // &
                         trim(b%load_set) // ''': every node of the set is fixed')
                     return
                 end if
                 do i = 1, size(set)
-                    if (.not. any(body%dof(:, set(i)) > 0)) cycle
+                    if (.not. any(body%node_dofs(set(i)) > 0)) cycle
                     call body%add_nodal_load(set(i), b%load / real(nfree, wp), status)
                     if (.not. status%ok()) then
                         call status%set(status_bad_input, where // 'load: ' // status%text())
@@ -124,12 +124,13 @@ contains
                 call out_of_memory(status, where // 'initial velocities', int(body%nv, i8), 8)
                 return
             end if
-            centroid = sum(mesh%x, dim=2) / real(mesh%node_count(), wp)
+            centroid = mesh%centroid()
             do i = 1, mesh%node_count()
                 w = b%initial_velocity + cross(b%initial_angular_velocity, &
-                                               mesh%x(:, i) - centroid)
+                                               mesh%reference_position(i) - centroid)
+                dofs = body%node_dofs(i)
                 do k = 1, 3
-                    if (body%dof(k, i) > 0) v0(body%dof(k, i)) = w(k)
+                    if (dofs(k) > 0) v0(dofs(k)) = w(k)
                 end do
             end do
         end associate
@@ -217,7 +218,7 @@ contains
         type(status_t), intent(inout) :: status
         energies(1) = body%strain_energy(q, status)
         energies(2) = body%kinetic_energy(v)
-        energies(3) = energies(1) + energies(2) - dot_product(body%applied_force, q - q_ref)
+        energies(3) = energies(1) + energies(2) - body%applied_work(q, q_ref)
     end subroutine body_energies
 
     pure function at(line) result(text)

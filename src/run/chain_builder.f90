@@ -13,7 +13,7 @@ module flexmbs_run_chain_builder
     use flexmbs_core_text, only: int_text
     use flexmbs_mbs_inertia, only: inertia_tensor, inertia_defect
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, new_rigid_chain, chain_body_t, &
-        chain_joint_revolute, chain_joint_prismatic, chain_joint_spherical
+        new_chain_body, chain_joint_revolute, chain_joint_prismatic, chain_joint_spherical
     use flexmbs_mbs_rotation, only: quat_from_axis_angle
     use flexmbs_io_namelist, only: scene_input_t
     implicit none
@@ -137,32 +137,31 @@ contains
         type(status_t), intent(out) :: status
         type(chain_body_t), allocatable :: bodies(:)
         character(len=:), allocatable :: defect
-        integer :: i, j
+        real(wp) :: inertia(3, 3)
+        integer :: i, j, parent, joint
         allocate (bodies(size(links)), q0(0), v0(0))
         do i = 1, size(bodies)
             associate (c => scene%chain(links(i)))
-                bodies(i)%parent = 0
+                parent = 0
                 do j = 1, i - 1
-                    if (scene%chain(links(j))%name == c%parent) bodies(i)%parent = j
+                    if (scene%chain(links(j))%name == c%parent) parent = j
                 end do
                 select case (trim(c%joint))
-                case ('prismatic'); bodies(i)%joint = chain_joint_prismatic
-                case ('spherical'); bodies(i)%joint = chain_joint_spherical
-                case default; bodies(i)%joint = chain_joint_revolute
+                case ('prismatic'); joint = chain_joint_prismatic
+                case ('spherical'); joint = chain_joint_spherical
+                case default; joint = chain_joint_revolute
                 end select
-                bodies(i)%joint_position = c%joint_position
-                bodies(i)%axis = c%joint_axis / norm2(c%joint_axis)
-                bodies(i)%centre = c%centre
-                bodies(i)%mass = c%mass
-                bodies(i)%inertia = inertia_tensor(c%inertia, c%inertia_products)
-                defect = inertia_defect(bodies(i)%inertia)
+                inertia = inertia_tensor(c%inertia, c%inertia_products)
+                bodies(i) = new_chain_body(parent, joint, c%joint_position, &
+                    c%joint_axis / norm2(c%joint_axis), c%centre, c%mass, inertia)
+                defect = inertia_defect(inertia)
                 if (len(defect) > 0) then
                     call status%set(status_bad_input, scene%path // ': &rigid_chain ''' // &
                         trim(c%name) // ''': inertia, inertia_products: ' // defect // &
                         ' (line ' // int_text(c%line) // ')')
                     return
                 end if
-                if (bodies(i)%joint == chain_joint_spherical) then
+                if (joint == chain_joint_spherical) then
                     q0 = [q0, quat_from_axis_angle(c%rotation_axis / norm2(c%rotation_axis), &
                                                    c%rotation_angle)]
                     v0 = [v0, c%angular_rate]

@@ -15,6 +15,7 @@ module flexmbs_run_flexible_output
     use flexmbs_core_status, only: status_t
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_fe_flexible_body, only: flexible_body_t
+    use flexmbs_fe_mesh, only: mesh_t
     use flexmbs_mbs_modal_body, only: modal_body_t
     use flexmbs_io_record_values, only: record_values_t
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
@@ -113,7 +114,7 @@ contains
         integer :: n3
         base = 'flexible/' // path_name(name) // '/'
         call write_mesh(h5, body%fe, base, status)
-        if (status%ok()) call h5%write_vector(base // 'frequencies', sqrt(body%stiffness), &
+        if (status%ok()) call h5%write_vector(base // 'frequencies', body%frequencies(), &
                                               status)
         if (status%ok()) call h5%annotate(base // 'frequencies', 'unit', 'rad/s', status)
         if (status%ok()) call h5%annotate(base // 'frequencies', 'description', 'the modal &
@@ -142,33 +143,28 @@ contains
         type(flexible_body_t), intent(in) :: body
         character(len=*), intent(in) :: base
         type(status_t), intent(out) :: status
+        type(mesh_t) :: mesh
         integer :: k
-        call h5%write_matrix(base // 'reference_nodes', body%mesh%x, status)
+        mesh = body%reference_mesh()
+        call h5%write_matrix(base // 'reference_nodes', mesh%reference_positions(), status)
         if (status%ok()) call h5%annotate(base // 'reference_nodes', 'unit', 'm', status)
         if (status%ok()) call h5%write_integers(base // 'connectivity', &
-                                                body%mesh%connectivity, status)
+                                                mesh%element_nodes(), status)
         if (status%ok()) call h5%annotate(base // 'connectivity', 'description', 'the nodes &
             &of each element (numbered from 1, as in the mesh file)', status)
         if (status%ok()) call h5%annotate(base // 'connectivity', 'element_type', &
-            element_type(body%mesh%nnode_element), status)
-        if (allocated(body%mesh%node_sets)) then
-            do k = 1, size(body%mesh%node_sets)
-                if (.not. status%ok()) exit
-                associate (set => body%mesh%node_sets(k))
-                    call h5%write_integers(base // 'node_sets/' // path_name(set%name), &
-                                           set%nodes, status)
-                end associate
-            end do
-        end if
-        if (allocated(body%mesh%element_sets)) then
-            do k = 1, size(body%mesh%element_sets)
-                if (.not. status%ok()) exit
-                associate (set => body%mesh%element_sets(k))
-                    call h5%write_integers(base // 'element_sets/' // path_name(set%name), &
-                                           set%elements, status)
-                end associate
-            end do
-        end if
+            element_type(mesh%nodes_per_element()), status)
+        do k = 1, mesh%node_set_count()
+            if (.not. status%ok()) exit
+            call h5%write_integers(base // 'node_sets/' // path_name(mesh%node_set_name(k)), &
+                                   mesh%node_set_nodes(k), status)
+        end do
+        do k = 1, mesh%element_set_count()
+            if (.not. status%ok()) exit
+            call h5%write_integers(base // 'element_sets/' // &
+                                   path_name(mesh%element_set_name(k)), &
+                                   mesh%element_set_elements(k), status)
+        end do
     end subroutine write_mesh
 
     !> The per-record series of a body (its evaluators' bodies set).
@@ -256,7 +252,6 @@ contains
         real(wp), intent(in) :: t, y(:)
         real(wp), intent(out) :: values(:)
         type(status_t), intent(inout) :: status
-        integer :: i, j, d
         if (associated(self%modal)) then
             associate (m => self%modal)
                 if (self%velocity) then
@@ -264,25 +259,16 @@ contains
                                            y(self%ov + 1:self%ov + m%nv), values)
                 else
                     call m%node_positions(y(self%oq + 1:self%oq + m%nq), self%x)
-                    values = self%x - reshape(self%body%mesh%x, [size(values)])
+                    call self%body%displacements_of(self%x, values)
                 end if
             end associate
             return
         end if
-        associate (dof => self%body%dof)
-            do i = 1, size(dof, 2)
-                do j = 1, 3
-                    d = dof(j, i)
-                    if (d == 0) then
-                        values(3 * (i - 1) + j) = 0.0_wp
-                    else if (self%velocity) then
-                        values(3 * (i - 1) + j) = y(self%ov + d)
-                    else
-                        values(3 * (i - 1) + j) = y(self%oq + d) - self%body%mesh%x(j, i)
-                    end if
-                end do
-            end do
-        end associate
+        if (self%velocity) then
+            call self%body%nodal_values(y(self%ov + 1:self%ov + self%body%nv), .false., values)
+        else
+            call self%body%nodal_values(y(self%oq + 1:self%oq + self%body%nq), .true., values)
+        end if
     end subroutine node_evaluate
 
     subroutine energy_evaluate(self, t, y, values, status)
@@ -321,11 +307,13 @@ contains
         type(flexible_body_t), intent(in) :: body
         character(len=*), intent(in) :: name
         type(xdmf_body_t) :: xdmf
+        type(mesh_t) :: mesh
         xdmf%name = trim(name)
         xdmf%group = 'flexible/' // path_name(name)
-        xdmf%nodes = body%mesh%node_count()
-        xdmf%elements = body%mesh%element_count()
-        xdmf%element_nodes = body%mesh%nnode_element
+        mesh = body%reference_mesh()
+        xdmf%nodes = mesh%node_count()
+        xdmf%elements = mesh%element_count()
+        xdmf%element_nodes = mesh%nodes_per_element()
     end function xdmf_body
 
     pure function element_type(nodes) result(name)

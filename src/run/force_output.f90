@@ -42,10 +42,10 @@ contains
         values%system => sys
         values%oq = oq
         values%ov = ov
-        do k = 1, min(size(groups), size(sys%elements))
+        do k = 1, min(size(groups), sys%element_count())
             values%element = k
             base = trim(groups(k))
-            do side = 1, merge(1, 2, sys%elements(k)%marker_j == 0)
+            do side = 1, sys%element_bodies(k)
                 values%side = side
                 values%torque = .false.
                 call h5%add_series(base // merge('force_i', 'force_j', side == 1), 3, 'N', &

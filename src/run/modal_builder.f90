@@ -7,14 +7,13 @@
 !> centre of mass with the mesh's axes, η = 0, the body's rigid initial
 !> velocity field as ṙ and ω′.
 module flexmbs_run_modal_builder
-    use flexmbs_core_kinds, only: wp, i8
+    use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t, status_bad_input
     use flexmbs_core_text, only: int_text
-    use flexmbs_core_sha256, only: sha256_hex
     use flexmbs_fe_mesh, only: node_set_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
-    use flexmbs_fe_modal_basis, only: modal_basis_t, craig_bampton
-    use flexmbs_fe_modal_invariants, only: modal_invariants_t, modal_invariants
+    use flexmbs_fe_modal_basis, only: modal_basis_t, craig_bampton, basis_fingerprint
+    use flexmbs_fe_modal_invariants, only: modal_invariants
     use flexmbs_mbs_rotation, only: cross
     use flexmbs_mbs_modal_body, only: modal_body_t, new_modal_body
     use flexmbs_io_namelist, only: scene_input_t
@@ -25,10 +24,6 @@ module flexmbs_run_modal_builder
     private
 
     public :: build_modal_body, modal_interfaces, interface_number
-
-    !> The version of the basis the fingerprint covers: a change of the
-    !> algorithm that changes the shapes changes it, so old caches are redone.
-    character(len=*), parameter :: basis_version = 'craig-bampton 1'
 
 contains
 
@@ -45,10 +40,10 @@ contains
         type(flexible_body_t) :: fe
         type(node_set_t), allocatable :: sets(:)
         type(modal_basis_t) :: basis
-        type(modal_invariants_t) :: inv
         real(wp), allocatable :: qf(:), vf(:)
         character(len=:), allocatable :: where, print
-        real(wp) :: centroid(3)
+        real(wp) :: centroid(3), centre(3)
+        integer, allocatable :: nodes(:)
         integer :: j
         logical :: found
 
@@ -64,15 +59,15 @@ contains
             end if
             allocate (sets(size(names)))
             do j = 1, size(names)
-                sets(j)%name = trim(names(j))
-                call fe%mesh%node_set(trim(names(j)), sets(j)%nodes, status)
+                call fe%node_set(trim(names(j)), nodes, status)
                 if (.not. status%ok()) then
                     call status%set(status_bad_input, where // 'interfaces: ''' // &
                         trim(names(j)) // ''': ' // status%text())
                     return
                 end if
+                sets(j) = node_set_t(trim(names(j)), nodes)
             end do
-            print = fingerprint(fe, sets, b%modes)
+            print = basis_fingerprint(fe, sets, b%modes)
             found = .false.
             if (len_trim(b%modes_cache) > 0) then
                 call read_modal_cache(trim(b%modes_cache), print, basis, found, status)
@@ -93,18 +88,19 @@ contains
                     if (.not. status%ok()) return
                 end if
             end if
-            inv = modal_invariants(fe%mass_matrix, fe%mesh%x, basis%shapes)
-            call new_modal_body(body, basis, inv, status, gravity=b%gravity, fe=fe)
+            call new_modal_body(body, basis, modal_invariants(fe, basis), status, &
+                                gravity=b%gravity, fe=fe)
             if (.not. status%ok()) then
                 call status%set(status_bad_input, where // status%text())
                 return
             end if
             ! the rigid initial field v₀ + ω × (X − X̄) of a nonlinear body
-            centroid = sum(fe%mesh%x, dim=2) / fe%mesh%node_count()
+            centroid = fe%centroid()
+            centre = body%reference_centre()
             allocate (q0(body%nq), v0(body%nv), source=0.0_wp)
-            q0(1:3) = inv%centre
+            q0(1:3) = centre
             q0(4) = 1.0_wp
-            v0(1:3) = b%initial_velocity + cross(b%initial_angular_velocity, inv%centre - centroid)
+            v0(1:3) = b%initial_velocity + cross(b%initial_angular_velocity, centre - centroid)
             v0(4:6) = b%initial_angular_velocity
         end associate
     end subroutine build_modal_body
@@ -141,65 +137,4 @@ contains
         end do
         j = 0
     end function interface_number
-
-    !> The SHA-256 of what the basis depends on: the basis version, k, the
-    !> element type, every node's position and element's nodes (bit for
-    !> bit), every element's material constants, the interfaces' names and
-    !> nodes. The text is filled in place (long meshes: no repeated
-    !> concatenation).
-    function fingerprint(fe, sets, modes) result(digest)
-        type(flexible_body_t), intent(in) :: fe
-        type(node_set_t), intent(in) :: sets(:)
-        integer, intent(in) :: modes
-        character(len=:), allocatable :: digest
-        character(len=:), allocatable :: text
-        integer :: i, j, n, at
-        n = 64 + 17 * (size(fe%mesh%x) + 4 * size(fe%materials)) + &
-            12 * (size(fe%mesh%connectivity) + size(fe%element_material))
-        do j = 1, size(sets)
-            n = n + len(sets(j)%name) + 12 * size(sets(j)%nodes) + 2
-        end do
-        allocate (character(len=n) :: text)
-        at = 0
-        call put(basis_version // ' k=' // int_text(modes) // ' nnode=' // &
-                 int_text(fe%mesh%nnode_element) // ';')
-        do j = 1, size(fe%mesh%x, 2)
-            do i = 1, 3
-                call put(hex(fe%mesh%x(i, j)))
-            end do
-        end do
-        call put(';')
-        do j = 1, size(fe%mesh%connectivity, 2)
-            do i = 1, size(fe%mesh%connectivity, 1)
-                call put(int_text(fe%mesh%connectivity(i, j)) // ',')
-            end do
-        end do
-        call put(';')
-        do j = 1, size(fe%element_material)
-            call put(int_text(fe%element_material(j)) // ',')
-        end do
-        do j = 1, size(fe%materials)
-            associate (m => fe%materials(j))
-                call put(';' // hex(m%mu) // hex(m%lambda) // hex(m%beta) // hex(m%density))
-            end associate
-        end do
-        do j = 1, size(sets)
-            call put(';' // sets(j)%name // ':')
-            do i = 1, size(sets(j)%nodes)
-                call put(int_text(sets(j)%nodes(i)) // ',')
-            end do
-        end do
-        digest = sha256_hex(text(1:at))
-    contains
-        subroutine put(part)
-            character(len=*), intent(in) :: part
-            text(at + 1:at + len(part)) = part
-            at = at + len(part)
-        end subroutine put
-        function hex(x) result(w)
-            real(wp), intent(in) :: x
-            character(len=17) :: w
-            write (w, '(z16.16,a)') transfer(x, 1_i8), ','
-        end function hex
-    end function fingerprint
 end module flexmbs_run_modal_builder

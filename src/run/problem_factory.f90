@@ -23,7 +23,7 @@ module flexmbs_run_problem_factory
         new_reaction_diffusion, reaction_diffusion_initial
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &
-        formulation_index2, formulation_index3, formulation_ggl
+        formulation_index2, formulation_index3, formulation_ggl, block_q, block_v, block_lambda
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
     use flexmbs_mbs_system, only: mbs_system_t
     use flexmbs_io_namelist, only: scene_input_t
@@ -173,9 +173,7 @@ contains
                 status%message = scene%path // ': &multibody: ' // status%message
                 return
             end if
-            allocate (y0(formulation%n), yp0(formulation%n), source=0.0_wp)
-            y0(formulation%oq + 1:formulation%oq + formulation%nq) = q0
-            y0(formulation%ov + 1:formulation%ov + formulation%nv) = v0
+            call start_state(formulation, q0, v0, y0, yp0)
             call formulation%consistent_initial(scene%t_start, y0, yp0, status)
             if (.not. status%ok()) then
                 call status%set(status_bad_input, scene%path // ': no consistent initial &
@@ -186,14 +184,11 @@ contains
             select type (sys => mechanical)
             type is (mbs_system_t)
                 call check_assembly(scene, sys, labels, scene%t_start, q0, &
-                    y0(formulation%oq + 1:formulation%oq + formulation%nq), moves, status)
+                    y0(formulation%offset(block_q) + 1:formulation%last(block_q)), moves, status)
                 if (present(assembly)) assembly = moves
             end select
             if (.not. status%ok()) return
-            call append_block(blocks, 'q', formulation%oq + 1, formulation%oq + formulation%nq)
-            call append_block(blocks, 'v', formulation%ov + 1, formulation%ov + formulation%nv)
-            if (formulation%nc > 0) call append_block(blocks, 'lambda', formulation%ol + 1, &
-                formulation%ol + formulation%nc)
+            call append_layout(blocks, formulation)
             allocate (problem, source=formulation)
         case (problem_rigid_chain)
             allocate (rigid_chain_t :: mechanical)
@@ -211,15 +206,12 @@ contains
                 status%message = scene%path // ': &rigid_chain: ' // status%message
                 return
             end if
-            allocate (y0(formulation%n), yp0(formulation%n), source=0.0_wp)
-            y0(formulation%oq + 1:formulation%oq + formulation%nq) = q0
-            y0(formulation%ov + 1:formulation%ov + formulation%nv) = v0
+            call start_state(formulation, q0, v0, y0, yp0)
             if (.not. mech_core) then
                 call formulation%consistent_initial(scene%t_start, y0, yp0, status)
                 if (.not. status%ok()) return
             end if
-            call append_block(blocks, 'q', formulation%oq + 1, formulation%oq + formulation%nq)
-            call append_block(blocks, 'v', formulation%ov + 1, formulation%ov + formulation%nv)
+            call append_layout(blocks, formulation) ! nc = 0: q and v
             allocate (problem, source=formulation)
         case (problem_brusselator_1d, problem_brusselator_2d)
             bruss = new_reaction_diffusion(merge(1, 2, problem_id(scene%problem) == problem_brusselator_1d), &
@@ -236,6 +228,27 @@ contains
                 trim(scene%problem) // ''': not available in this build')
         end select
     end subroutine build_problem
+
+    !> y0 = (q0, v0, 0...) in the layout of `formulation`, yp0 = 0.
+    subroutine start_state(formulation, q0, v0, y0, yp0)
+        type(formulation_t), intent(in) :: formulation
+        real(wp), intent(in) :: q0(:), v0(:)
+        real(wp), allocatable, intent(out) :: y0(:), yp0(:)
+        allocate (y0(formulation%n), yp0(formulation%n), source=0.0_wp)
+        y0(formulation%offset(block_q) + 1:formulation%last(block_q)) = q0
+        y0(formulation%offset(block_v) + 1:formulation%last(block_v)) = v0
+    end subroutine start_state
+
+    !> The blocks q, v and (when there are constraints) lambda of
+    !> `formulation`'s y, appended to `blocks`.
+    subroutine append_layout(blocks, formulation)
+        type(block_spec_t), allocatable, intent(inout) :: blocks(:)
+        type(formulation_t), intent(in) :: formulation
+        call append_block(blocks, 'q', formulation%offset(block_q) + 1, formulation%last(block_q))
+        call append_block(blocks, 'v', formulation%offset(block_v) + 1, formulation%last(block_v))
+        if (formulation%block_size(block_lambda) > 0) call append_block(blocks, 'lambda', &
+            formulation%offset(block_lambda) + 1, formulation%last(block_lambda))
+    end subroutine append_layout
 
     !> With linear_solver = 'dense' the formulation and the solvers hold a
     !> few n x n matrices (the Jacobian, the mass matrix, the iteration
