@@ -137,7 +137,9 @@ if not pchoices or re.sub(r"&\s*&", '', pchoices.group(1)).split('|') != pnames:
 report('catalogue-names-are-the-solvers-names', problems)
 
 # Reach-ins from run/ and io/ into the components of mbs/ and fe/ types.
-REACH_IN_BOUND = 166
+# 51: named_output asks the formulation's blocks and the system's, chains',
+# bodies' bindings (issue 35, part 3)
+REACH_IN_BOUND = 51
 
 
 def type_parts(folders):

@@ -96,6 +96,7 @@ module flexmbs_fe_flexible_body
         procedure :: node_set => body_node_set
         procedure :: centroid => body_centroid
         procedure :: node_dofs => body_node_dofs
+        procedure :: node_count => body_node_count
         procedure :: applied_work => body_applied_work
         procedure :: nodal_values => body_nodal_values
         procedure :: displacements_of => body_displacements_of
@@ -611,6 +612,12 @@ contains
         integer :: dofs(3)
         dofs = self%dof(:, node)
     end function body_node_dofs
+
+    !> The number of nodes (of the mesh, held ones counted).
+    pure integer function body_node_count(self) result(n)
+        class(flexible_body_t), intent(in) :: self
+        n = size(self%dof, 2)
+    end function body_node_count
 
     !> The work f·(q − q_ref) of the constant applied forces (gravity, loads).
     real(wp) function body_applied_work(self, q, q_ref) result(w)

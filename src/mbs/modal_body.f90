@@ -91,6 +91,7 @@ module flexmbs_mbs_modal_body
         procedure :: node_velocities => modal_node_velocities
         procedure :: frequencies => modal_frequencies
         procedure :: reference_centre => modal_reference_centre
+        procedure :: mode_count => modal_mode_count
     end type modal_body_t
 
 contains
@@ -190,6 +191,12 @@ contains
         real(wp) :: centre(3)
         centre = self%centre
     end function modal_reference_centre
+
+    !> The number n of elastic coordinates η.
+    pure integer function modal_mode_count(self) result(n)
+        class(modal_body_t), intent(in) :: self
+        n = self%modes
+    end function modal_mode_count
 
     !> (a₂₃ − a₃₂, a₃₁ − a₁₃, a₁₂ − a₂₁): ∫ρ a × b for a = ∫ρ a bᵀ.
     pure function axial(a) result(w)

@@ -286,9 +286,22 @@ module flexmbs_mbs_system
         procedure :: joint_rows => system_joint_rows
         procedure :: element_count => system_element_count
         procedure :: element_bodies => system_element_bodies
+        procedure :: part_count => system_part_count
+        procedure :: part_offsets => system_part_offsets
+        procedure :: chain_of => system_chain_of
+        procedure :: flexible_of => system_flexible_of
+        procedure :: modal_of => system_modal_of
+        procedure :: joint_kind => system_joint_kind
+        procedure :: joint_primitive_count => system_joint_primitive_count
+        procedure :: joint_primitive => system_joint_primitive
     end type mbs_system_t
 
     public :: new_mbs_system, driver_t, driver_values, node_frame_t, force_element_t
+
+    !> The kinds of parts, for mbs_system_t's part_count and part_offsets:
+    !> rigid bodies, rigid chains, flexible bodies, modal bodies, node frames.
+    integer, parameter, public :: part_rigid = 1, part_chain = 2, part_flexible = 3, &
+        part_modal = 4, part_frame = 5
 
 
     interface
@@ -819,6 +832,53 @@ module flexmbs_mbs_system
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: k
         end function system_element_bodies
+        !> The number of parts of kind `part` (part_rigid: the rigid bodies,
+        !> node frames' massless bodies counted; part_chain, part_flexible,
+        !> part_modal; part_frame: the node frames); 0 for another number.
+        pure integer module function system_part_count(self, part) result(n)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: part
+        end function system_part_count
+        !> Where part i of kind `part` (part_chain, part_flexible, part_modal)
+        !> starts in q and v: q(oq + 1 ...), v(ov + 1 ...); -1 for another kind.
+        pure module subroutine system_part_offsets(self, part, i, oq, ov)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: part, i
+            integer, intent(out) :: oq, ov
+        end subroutine system_part_offsets
+        !> Chain c itself (the system, and so the pointer's target, must be a target).
+        module function system_chain_of(self, c) result(chain)
+            class(mbs_system_t), intent(in), target :: self
+            integer, intent(in) :: c
+            type(rigid_chain_t), pointer :: chain
+        end function system_chain_of
+        !> Flexible body i itself (the system must be a target).
+        module function system_flexible_of(self, i) result(body)
+            class(mbs_system_t), intent(in), target :: self
+            integer, intent(in) :: i
+            type(flexible_body_t), pointer :: body
+        end function system_flexible_of
+        !> Modal body i itself (the system must be a target).
+        module function system_modal_of(self, i) result(body)
+            class(mbs_system_t), intent(in), target :: self
+            integer, intent(in) :: i
+            type(modal_body_t), pointer :: body
+        end function system_modal_of
+        !> The kind of joint j (joint_spherical ... joint_primitive of the joint table).
+        pure integer module function system_joint_kind(self, j) result(kind)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: j
+        end function system_joint_kind
+        !> The number of constraint primitives joint j is made of.
+        pure integer module function system_joint_primitive_count(self, j) result(n)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: j
+        end function system_joint_primitive_count
+        !> The kind (primitive_*) of joint j's primitive p, in the order of its rows.
+        pure integer module function system_joint_primitive(self, j, p) result(kind)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: j, p
+        end function system_joint_primitive
     end interface
 
 contains
