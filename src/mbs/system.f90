@@ -135,6 +135,9 @@ module flexmbs_mbs_system
         integer :: chain = 0    !! rigid chain number (chain markers; position, axes
         integer :: link = 0     !! in the frame of this body of the chain)
         integer, allocatable :: nodes(:) !! set markers: the set's mesh nodes
+    contains
+        procedure :: on_node_set => marker_on_node_set
+        procedure :: attached_to => marker_attached_to
     end type marker_t
 
     !> Workspace of one marker side of a joint or force element, sized by the
@@ -292,6 +295,7 @@ module flexmbs_mbs_system
         procedure :: flexible_of => system_flexible_of
         procedure :: modal_of => system_modal_of
         procedure :: joint_kind => system_joint_kind
+        procedure :: joint_markers => system_joint_markers
         procedure :: joint_primitive_count => system_joint_primitive_count
         procedure :: joint_primitive => system_joint_primitive
     end type mbs_system_t
@@ -869,6 +873,12 @@ module flexmbs_mbs_system
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: j
         end function system_joint_kind
+        !> Joint j's markers i and j (for marker_pose).
+        pure module function system_joint_markers(self, j) result(markers)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: j
+            integer :: markers(2)
+        end function system_joint_markers
         !> The number of constraint primitives joint j is made of.
         pure integer module function system_joint_primitive_count(self, j) result(n)
             class(mbs_system_t), intent(in) :: self
@@ -894,4 +904,24 @@ contains
             row = self%joints(k)%row0 + 1
         end if
     end function system_joint_first_row
+
+    !> Makes the marker a set marker: on the nodes `nodes` of flexible body
+    !> `flexible` (component by component: a structure constructor with an
+    !> allocatable component leaks its temporary in gfortran 12).
+    pure subroutine marker_on_node_set(self, flexible, nodes)
+        class(marker_t), intent(inout) :: self
+        integer, intent(in) :: flexible, nodes(:)
+        self%flexible = flexible
+        self%nodes = nodes
+    end subroutine marker_on_node_set
+
+    !> What carries the marker: its body (0: the ground or none), its chain
+    !> and the chain's link (0: none).
+    pure subroutine marker_attached_to(self, body, chain, link)
+        class(marker_t), intent(in) :: self
+        integer, intent(out) :: body, chain, link
+        body = self%body
+        chain = self%chain
+        link = self%link
+    end subroutine marker_attached_to
 end module flexmbs_mbs_system

@@ -98,6 +98,10 @@ contains
         kind = self%joints(j)%joint%kind
     end procedure system_joint_kind
 
+    module procedure system_joint_markers
+        markers = [self%joints(j)%marker_i, self%joints(j)%marker_j]
+    end procedure system_joint_markers
+
     module procedure system_joint_primitive_count
         n = self%joints(j)%joint%nprimitives
     end procedure system_joint_primitive_count

@@ -612,11 +612,12 @@ contains
         real(wp), intent(out) :: values(:)
         type(status_t), intent(inout) :: status
         real(wp) :: xi(3), xj(3), ai(3, 3), aj(3, 3), angle
-        integer :: k
+        integer :: k, markers(2)
         real(wp), parameter :: two_pi = 8.0_wp * atan(1.0_wp)
-        associate (sys => self%system, jt => self%system%joints(self%joint))
-            call sys%marker_pose(jt%marker_i, y(self%oq + 1:self%oq + sys%nq), xi, ai)
-            call sys%marker_pose(jt%marker_j, y(self%oq + 1:self%oq + sys%nq), xj, aj)
+        associate (sys => self%system)
+            markers = sys%joint_markers(self%joint)
+            call sys%marker_pose(markers(1), y(self%oq + 1:self%oq + sys%nq), xi, ai)
+            call sys%marker_pose(markers(2), y(self%oq + 1:self%oq + sys%nq), xj, aj)
         end associate
         if (self%angle) then
             ! continued past ±π from the record before
