@@ -13,6 +13,7 @@ module flexmbs_run_summary
         chain_joint_spherical
     use flexmbs_mbs_system, only: mbs_system_t
     use flexmbs_mbs_joint_types, only: joint_has_angle, joint_displaced_axes
+    use flexmbs_mbs_formulation, only: block_q, block_v
     use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_io_namelist, only: scene_input_t
@@ -37,44 +38,46 @@ contains
         type(scene_input_t), intent(in) :: scene
         real(wp), intent(in) :: y(:)
         character(len=:), allocatable :: text
-        integer :: i, k
+        integer :: i, k, oq, ov
         text = ''
         if (.not. allocated(plan%mechanical)) return
         select type (f => plan%problem)
         type is (formulation_t)
+            oq = f%offset(block_q)
+            ov = f%offset(block_v)
             select type (m => plan%mechanical)
             type is (mbs_system_t)
                 do i = 1, size(scene%rigid_bodies)
                     text = text // body_line(trim(scene%rigid_bodies(i)%name), &
-                        y(f%oq + rigid_body_nq * (i - 1) + 1:f%oq + rigid_body_nq * i))
+                        y(oq + rigid_body_nq * (i - 1) + 1:oq + rigid_body_nq * i))
                 end do
                 do i = 1, size(m%chains)
-                    text = text // chain_lines(m%chains(i), y(f%oq + m%chain_q(i) + 1: &
-                        f%oq + m%chain_q(i) + m%chains(i)%nq), link_names(scene, i))
+                    text = text // chain_lines(m%chains(i), y(oq + m%chain_q(i) + 1: &
+                        oq + m%chain_q(i) + m%chains(i)%nq), link_names(scene, i))
                 end do
                 if (allocated(plan%joint_names)) then
                     do k = 1, min(size(plan%joint_names), size(m%joints))
                         text = text // joint_line(m, k, plan%joint_names(k), &
-                                                  y(f%oq + 1:f%oq + m%nq))
+                                                  y(oq + 1:oq + m%nq))
                     end do
                 end if
                 do i = 1, size(m%flex)
                     text = text // flexible_line(m%flex(i), &
                         trim(scene%bodies(nonlinear_body(scene, i))%name), &
-                        y(f%oq + m%flex_q(i) + 1:f%oq + m%flex_q(i) + m%flex(i)%nq), &
-                        y(f%ov + m%flex_v(i) + 1:f%ov + m%flex_v(i) + m%flex(i)%nv))
+                        y(oq + m%flex_q(i) + 1:oq + m%flex_q(i) + m%flex(i)%nq), &
+                        y(ov + m%flex_v(i) + 1:ov + m%flex_v(i) + m%flex(i)%nv))
                 end do
                 do i = 1, size(m%modal)
                     text = text // modal_line(m%modal(i), &
                         trim(scene%bodies(modal_body(scene, i))%name), &
-                        y(f%oq + m%modal_q(i) + 1:f%oq + m%modal_q(i) + m%modal(i)%nq), &
-                        y(f%ov + m%modal_v(i) + 1:f%ov + m%modal_v(i) + m%modal(i)%nv))
+                        y(oq + m%modal_q(i) + 1:oq + m%modal_q(i) + m%modal(i)%nq), &
+                        y(ov + m%modal_v(i) + 1:ov + m%modal_v(i) + m%modal(i)%nv))
                 end do
             type is (rigid_chain_t)
-                text = chain_lines(m, y(f%oq + 1:f%oq + m%nq), link_names(scene, 0))
+                text = chain_lines(m, y(oq + 1:oq + m%nq), link_names(scene, 0))
             type is (flexible_body_t)
-                text = flexible_line(m, trim(scene%bodies(1)%name), y(f%oq + 1:f%oq + m%nq), &
-                                     y(f%ov + 1:f%ov + m%nv))
+                text = flexible_line(m, trim(scene%bodies(1)%name), y(oq + 1:oq + m%nq), &
+                                     y(ov + 1:ov + m%nv))
             end select
         end select
 
