@@ -20,6 +20,7 @@ module test_chain_coupling
     use flexmbs_mbs_force_element, only: force_spring_damper, force_bushing
     use flexmbs_dae_mechanical_problem, only: mechanical_patterns_t
     use test_force_elements, only: compare_derivatives, compare_with_ad
+    use flexmbs_mbs_formulation, only: block_v
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_ggl, &
         formulation_index1, formulation_index2, formulation_index3
     use flexmbs_linalg_csc, only: csc_matrix_t
@@ -239,16 +240,17 @@ contains
                    'Jacobian differs from differences')
         y = 0.0_wp
         y(1:12) = q0
-        y(gen%ov + 8:gen%ov + 10) = [1.0_wp, -0.5_wp, 0.8_wp]   ! the ball joint's spin
+        ! the ball joint's spin
+        y(gen%offset(block_v) + 8:gen%offset(block_v) + 10) = [1.0_wp, -0.5_wp, 0.8_wp]
         call gen%consistent_initial(0.0_wp, y, yp, status)
-        e0 = hand%energy(y(1:12), y(gen%ov + 1:gen%ov + 10))
+        e0 = hand%energy(y(1:12), y(gen%offset(block_v) + 1:gen%offset(block_v) + 10))
         options%rtol = 1.0e-8_wp
         options%atol = 1.0e-8_wp
         t = 0.0_wp
         call solver%integrate(gen, t, y, 0.5_wp, options, stats, status)
         call check(error, status%ok(), 'run: ' // status%text())
         if (allocated(error)) return
-        e1 = hand%energy(y(1:12), y(gen%ov + 1:gen%ov + 10))
+        e1 = hand%energy(y(1:12), y(gen%offset(block_v) + 1:gen%offset(block_v) + 10))
         print '(4x,a,es9.2)', 'spherical chain coupling: relative energy drift ', &
             abs(e1 - e0) / abs(e0)
         call check(error, abs(e1 - e0) <= 1.0e-5_wp * abs(e0), 'energy drift')
@@ -755,14 +757,14 @@ contains
             allocate (y(gen%n), yp(gen%n), source=0.0_wp)
             y(1:n) = q0
             call gen%consistent_initial(0.0_wp, y, yp, status)
-            e0 = sys%energy(y(1:n), y(gen%ov + 1:gen%ov + n))
+            e0 = sys%energy(y(1:n), y(gen%offset(block_v) + 1:gen%offset(block_v) + n))
             options%rtol = tolerances(k)
             options%atol = tolerances(k)
             t = 0.0_wp
             call solver%integrate(gen, t, y, 1.0_wp, options, stats, status)
             call check(error, status%ok(), 'run: ' // status%text())
             if (allocated(error)) return
-            e1 = sys%energy(y(1:n), y(gen%ov + 1:gen%ov + n))
+            e1 = sys%energy(y(1:n), y(gen%offset(block_v) + 1:gen%offset(block_v) + n))
             drift(k) = abs(e1 - e0) / scale
             call sys%constraint(t, y(1:n), c, status)
             print '(4x,a,es8.1,a,i0,a,es9.2,a,es9.2)', 'long chain loop: rtol ', &

@@ -17,6 +17,7 @@ module test_condensed_newton
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    use flexmbs_mbs_formulation, only: block_q, block_v
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &
         formulation_index2, formulation_index3, formulation_ggl
     use flexmbs_mbs_condensed_newton, only: condensed_solver_t
@@ -82,8 +83,8 @@ contains
             if (allocated(error)) return
             select type (built)
             type is (formulation_t)
-                q0 = y0(built%oq + 1:built%oq + built%nq)
-                v0 = y0(built%ov + 1:built%ov + built%nv)
+                q0 = y0(built%offset(block_q) + 1:built%last(block_q))
+                v0 = y0(built%offset(block_v) + 1:built%last(block_v))
                 constant_mass = .not. built%accelerations
             class default
                 call check(error, .false., trim(scenes(s)) // ': not a formulation')
@@ -134,8 +135,8 @@ contains
         n = f%n
         allocate (y(n), b(n), xf(n), xc(n), zb(n), zf(n), zx(n))
         y = 0.0_wp
-        y(f%oq + 1:f%oq + f%nq) = q0
-        y(f%ov + 1:f%ov + f%nv) = v0
+        y(f%offset(block_q) + 1:f%last(block_q)) = q0
+        y(f%offset(block_v) + 1:f%last(block_v)) = v0
         do i = 1, n
             b(i) = sin(1.3_wp * i) + 0.5_wp * cos(0.37_wp * i * i)
             zb(i) = cmplx(b(i), cos(2.1_wp * i), kind=wp)

@@ -16,6 +16,7 @@ module test_formulation
     use flexmbs_problems_pendulum, only: pendulum_t, new_pendulum, pendulum_initial, &
         pendulum_reference, pendulum_mechanical_t, new_pendulum_mechanical, &
         pendulum_mechanical_initial
+    use flexmbs_mbs_formulation, only: block_a, block_lambda, block_v
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &
         formulation_index2, formulation_index3, formulation_ggl
     use testing, only: test_case_t, new_test, error_t, check
@@ -216,10 +217,10 @@ contains
         call pendulum_mechanical_initial(mech, phi0, q, v, lam)
         y = 0.0_wp
         y(1:2) = q
-        y(gen%ov + 1:gen%ov + 2) = v
-        if (gen%accelerations) y(gen%oa + 1:gen%oa + 2) = -q * lam(1) / mech%point_mass &
-            - [0.0_wp, mech%gravity]
-        y(gen%ol + 1) = lam(1)
+        y(gen%offset(block_v) + 1:gen%offset(block_v) + 2) = v
+        if (gen%accelerations) y(gen%offset(block_a) + 1:gen%offset(block_a) + 2) = &
+            -q * lam(1) / mech%point_mass - [0.0_wp, mech%gravity]
+        y(gen%offset(block_lambda) + 1) = lam(1)
     end subroutine initial_state
 
     !> RADAU5 runs every formulation in the acceleration layout (and index 2

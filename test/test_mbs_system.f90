@@ -19,6 +19,7 @@ module test_mbs_system
         joint_prismatic, joint_universal, joint_fixed, joint_primitive, joint_planar
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t
     use flexmbs_mbs_primitive_kinds, only: primitive_distance, primitive_dot1
+    use flexmbs_mbs_formulation, only: block_lambda, block_v
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &
         formulation_index2, formulation_ggl
     use test_formulation, only: difference_jacobian
@@ -328,7 +329,8 @@ contains
             call gen%consistent_initial(0.0_wp, y, yp, status)
             call check(error, status%ok(), status%text())
             if (allocated(error)) return
-            call sys%joint_reaction(1, 0.0_wp, y(1:7), y(gen%ol + 1:gen%ol + 3), force, torque)
+            call sys%joint_reaction(1, 0.0_wp, y(1:7), &
+                y(gen%offset(block_lambda) + 1:gen%offset(block_lambda) + 3), force, torque)
             side = merge(2, 1, order == 1)
             write (msg, '(a,i0,a,3es11.3,a,es10.3,a,3es11.3,a,es10.3)') 'order ', order, &
                 ': force on body ', force(:, side), ', |torque| ', norm2(torque(:, side)), &
@@ -618,7 +620,8 @@ contains
         fsum = 0.0_wp
         nsum = 0.0_wp
         do k = 1, 2
-            call sys%joint_reaction(k, 0.0_wp, y(1:14), y(gen%ol + 1:gen%ol + 10), force, torque)
+            call sys%joint_reaction(k, 0.0_wp, y(1:14), &
+                y(gen%offset(block_lambda) + 1:gen%offset(block_lambda) + 10), force, torque)
             do side = 1, 2
                 mk = merge(2 * k - 1, 2 * k, side == 1)
                 b = sys%markers(mk)%body
@@ -633,7 +636,7 @@ contains
         res_n = 0.0_wp
         do b = 1, 2
             iq = 7 * (b - 1)
-            iv = gen%ov + 6 * (b - 1)
+            iv = gen%offset(block_v) + 6 * (b - 1)
             associate (body => sys%rigid%bodies(b), w => y(iv + 4:iv + 6))
                 res_f = max(res_f, maxval(abs(body%mass * yp(iv + 1:iv + 3) - body%mass * &
                             [0.0_wp, -g_earth, 0.0_wp] - fsum(:, b))))

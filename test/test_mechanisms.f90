@@ -17,6 +17,7 @@ module test_mechanisms
         primitive_translation_driver, primitive_distance
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
         driver_t, driver_values
+    use flexmbs_mbs_formulation, only: block_lambda
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_ggl, &
         formulation_index1, formulation_index2, formulation_index3
     use flexmbs_dae_solver, only: dae_solver_t
@@ -251,7 +252,8 @@ contains
                 t = time(k)
                 call dae%consistent_multipliers(t, y(:, k), lambda, status)
                 call sys%joint_reaction(2, t, y(1:21, k), lambda, force, torque)
-                dev_lambda = max(dev_lambda, maxval(abs(lambda - y(dae%ol + 1:dae%ol + 18, k))) &
+                dev_lambda = max(dev_lambda, maxval(abs(lambda - &
+                    y(dae%offset(block_lambda) + 1:dae%offset(block_lambda) + 18, k))) &
                                  / maxval(abs(lambda)))
                 ! on the crank (marker j) and, the opposite, on the ground
                 drive = four_bar_torque(t, [1.0_wp, 0.5_wp, 1.0_wp / 3.0_wp], &

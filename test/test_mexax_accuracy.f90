@@ -24,6 +24,7 @@ module test_mexax_accuracy
     use flexmbs_dae_mexax, only: mexax_t, mexax_base_euler, mexax_base_midpoint, &
         mexax_control_hairer, mexax_control_deuflhard
     use flexmbs_dae_radau5, only: radau5_t
+    use flexmbs_mbs_formulation, only: block_q, block_v
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index2
     use flexmbs_dae_error_measure, only: paper_error
     use flexmbs_problems_pendulum_chain, only: pendulum_chain_t, new_pendulum_chain, &
@@ -116,8 +117,8 @@ contains
         gen = new_formulation(chain, formulation_index2, q, constant_mass=.true., status=status)
         if (.not. status%ok()) return
         allocate (y(gen%n), yp(gen%n), source=0.0_wp)
-        y(gen%oq + 1:gen%oq + gen%nq) = q
-        y(gen%ov + 1:gen%ov + gen%nv) = v
+        y(gen%offset(block_q) + 1:gen%last(block_q)) = q
+        y(gen%offset(block_v) + 1:gen%last(block_v)) = v
         call gen%consistent_initial(0.0_wp, y, yp, status)
         if (.not. status%ok()) return
         options%rtol = tol
@@ -127,7 +128,7 @@ contains
         solver%thet = 0.1_wp
         t = 0.0_wp
         call solver%integrate(gen, t, y, 1.0_wp, options, stats, status)
-        q = y(gen%oq + 1:gen%oq + gen%nq)
+        q = y(gen%offset(block_q) + 1:gen%last(block_q))
     end subroutine radau5_run
 
     !> The reference of chain b (computed and checked on first use).

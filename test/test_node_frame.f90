@@ -25,6 +25,7 @@ module test_node_frame
     use flexmbs_mbs_flexible_marker, only: flexible_marker_t, new_flexible_marker
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
         node_frame_t
+    use flexmbs_mbs_formulation, only: block_v
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_ggl, &
         formulation_index2
     use test_problems, only: fill_random
@@ -346,18 +347,18 @@ contains
             if (allocated(error)) return
             allocate (y(gen%n), yp(gen%n), source=0.0_wp)
             y(1:sys%nq) = q0
-            y(gen%ov + 6) = 2.0_wp   ! the link's spin about z (body frame)
+            y(gen%offset(block_v) + 6) = 2.0_wp   ! the link's spin about z (body frame)
             call gen%consistent_initial(0.0_wp, y, yp, status)
             call check(error, status%ok(), 'initial: ' // status%text())
             if (allocated(error)) return
-            e0 = sys%energy(y(1:sys%nq), y(gen%ov + 1:gen%ov + sys%nv))
+            e0 = sys%energy(y(1:sys%nq), y(gen%offset(block_v) + 1:gen%last(block_v)))
             options%rtol = tol(k)
             options%atol = tol(k)
             t = 0.0_wp
             call solver%integrate(gen, t, y, 0.2_wp, options, stats, status)
             call check(error, status%ok(), 'run: ' // status%text())
             if (allocated(error)) return
-            e1 = sys%energy(y(1:sys%nq), y(gen%ov + 1:gen%ov + sys%nv))
+            e1 = sys%energy(y(1:sys%nq), y(gen%offset(block_v) + 1:gen%last(block_v)))
             drift(k) = abs(e1 - e0)
             if (k < 2) deallocate (y, yp)
         end do
@@ -379,12 +380,13 @@ contains
         gen = new_formulation(sys, formulation_index2, q0, status=status)
         allocate (y(gen%n), yp(gen%n), source=0.0_wp)
         y(1:sys%nq) = q0
-        y(gen%ov + 6) = 2.0_wp
+        y(gen%offset(block_v) + 6) = 2.0_wp
         call gen%consistent_initial(0.0_wp, y, yp, status)
         options%rtol = 1.0e-7_wp
         options%atol = 1.0e-7_wp
         t = 0.0_wp
-        call mexax%integrate_mechanical(sys, t, y(1:sys%nq), y(gen%ov + 1:gen%ov + sys%nv), &
+        call mexax%integrate_mechanical(sys, t, y(1:sys%nq), &
+                                        y(gen%offset(block_v) + 1:gen%last(block_v)), &
                                         0.2_wp, options, stats, status)
         call check(error, status%ok(), 'mexax: ' // status%text())
         if (allocated(error)) return

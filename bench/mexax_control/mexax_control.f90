@@ -32,6 +32,7 @@ program flexmbs_bench_mexax_control
     use flexmbs_dae_solver, only: dae_solver_t
     use flexmbs_run_catalogue, only: solvers, solver_radau5
     use flexmbs_run_solver_factory, only: new_solver
+    use flexmbs_mbs_formulation, only: block_q, block_v
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index2
     use flexmbs_problems_pendulum_chain, only: pendulum_chain_t, new_pendulum_chain, &
         pendulum_chain_initial
@@ -269,8 +270,8 @@ contains
         gen = new_formulation(chain, formulation_index2, q, constant_mass=.true., status=status)
         if (.not. status%ok()) return
         allocate (y(gen%n), yp(gen%n), source=0.0_wp)
-        y(gen%oq + 1:gen%oq + gen%nq) = q
-        y(gen%ov + 1:gen%ov + gen%nv) = v
+        y(gen%offset(block_q) + 1:gen%last(block_q)) = q
+        y(gen%offset(block_v) + 1:gen%last(block_v)) = v
         call gen%consistent_initial(0.0_wp, y, yp, status)
         if (.not. status%ok()) return
         options%rtol = 1.0e-12_wp
@@ -279,6 +280,6 @@ contains
         if (.not. status%ok()) return
         t = 0.0_wp
         call solver%integrate_system(chain, gen, t, y, 1.0_wp, options, stats, status)
-        q = y(gen%oq + 1:gen%oq + gen%nq)
+        q = y(gen%offset(block_q) + 1:gen%last(block_q))
     end subroutine radau5_reference
 end program flexmbs_bench_mexax_control

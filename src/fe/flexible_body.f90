@@ -96,6 +96,12 @@ module flexmbs_fe_flexible_body
         procedure :: node_set => body_node_set
         procedure :: centroid => body_centroid
         procedure :: node_dofs => body_node_dofs
+        procedure :: node_count => body_node_count
+        procedure :: element_count => body_element_count
+        procedure :: nodes_per_element => body_nodes_per_element
+        procedure :: element_nodes => body_element_nodes
+        procedure :: reference_nodes => body_reference_nodes
+        procedure :: reference_node => body_reference_node
         procedure :: applied_work => body_applied_work
         procedure :: nodal_values => body_nodal_values
         procedure :: displacements_of => body_displacements_of
@@ -597,11 +603,16 @@ contains
         call self%mesh%node_set(name, nodes, status)
     end subroutine body_node_set
 
-    !> The mean of the mesh's reference positions.
-    pure function body_centroid(self) result(c)
+    !> The mean of the mesh's reference positions, or of those of `nodes`.
+    pure function body_centroid(self, nodes) result(c)
         class(flexible_body_t), intent(in) :: self
+        integer, intent(in), optional :: nodes(:)
         real(wp) :: c(3)
-        c = self%mesh%centroid()
+        if (present(nodes)) then
+            c = sum(self%mesh%x(:, nodes), dim=2) / size(nodes)
+        else
+            c = self%mesh%centroid()
+        end if
     end function body_centroid
 
     !> The free dofs (numbers in q and v) of node `node`'s x, y, z; 0 where held.
@@ -611,6 +622,47 @@ contains
         integer :: dofs(3)
         dofs = self%dof(:, node)
     end function body_node_dofs
+
+    !> The number of nodes (of the mesh, held ones counted).
+    pure integer function body_node_count(self) result(n)
+        class(flexible_body_t), intent(in) :: self
+        n = size(self%dof, 2)
+    end function body_node_count
+
+    !> The number of elements of the mesh.
+    pure integer function body_element_count(self) result(n)
+        class(flexible_body_t), intent(in) :: self
+        n = self%mesh%element_count()
+    end function body_element_count
+
+    !> The number of nodes of an element (8 or 27).
+    pure integer function body_nodes_per_element(self) result(n)
+        class(flexible_body_t), intent(in) :: self
+        n = self%mesh%nodes_per_element()
+    end function body_nodes_per_element
+
+    !> The nodes of element k, in the mesh's order.
+    pure function body_element_nodes(self, k) result(nodes)
+        class(flexible_body_t), intent(in) :: self
+        integer, intent(in) :: k
+        integer :: nodes(self%mesh%nodes_per_element())
+        nodes = self%mesh%connectivity(:, k)
+    end function body_element_nodes
+
+    !> Every node's reference position X into x (3, nodes): no allocation.
+    pure subroutine body_reference_nodes(self, x)
+        class(flexible_body_t), intent(in) :: self
+        real(wp), intent(out) :: x(:, :)
+        x = self%mesh%x
+    end subroutine body_reference_nodes
+
+    !> Node `node`'s reference position X.
+    pure function body_reference_node(self, node) result(x)
+        class(flexible_body_t), intent(in) :: self
+        integer, intent(in) :: node
+        real(wp) :: x(3)
+        x = self%mesh%reference_position(node)
+    end function body_reference_node
 
     !> The work f·(q − q_ref) of the constant applied forces (gravity, loads).
     real(wp) function body_applied_work(self, q, q_ref) result(w)

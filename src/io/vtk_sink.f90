@@ -194,10 +194,10 @@ contains
         ne = 0
         nc = 0
         do b = 1, size(self%flexible)
-            associate (mesh => self%flexible(b)%body%mesh)
-                n = n + mesh%node_count()
-                ne = ne + mesh%element_count()
-                nc = nc + size(mesh%connectivity)
+            associate (body => self%flexible(b)%body)
+                n = n + body%node_count()
+                ne = ne + body%element_count()
+                nc = nc + body%nodes_per_element() * body%element_count()
             end associate
         end do
         allocate (x(3, n), v(3, n), sigma(6, ne), mises(ne), points(nc), ends(ne), &
@@ -245,13 +245,12 @@ contains
             integer, intent(in) :: id
             real(wp), intent(in) :: y(:)
             type(status_t) :: stress_status
-            integer :: i, j, k, nn, m, me
-            associate (body => flexible%body, mesh => flexible%body%mesh, &
-                       oq => flexible%oq, ov => flexible%ov)
-                m = mesh%node_count()
-                me = mesh%element_count()
-                nn = size(mesh%connectivity, 1)
-                x(:, n + 1:n + m) = mesh%x
+            integer :: i, j, k, nn, m, me, dofs(3)
+            associate (body => flexible%body, oq => flexible%oq, ov => flexible%ov)
+                m = body%node_count()
+                me = body%element_count()
+                nn = body%nodes_per_element()
+                call body%reference_nodes(x(:, n + 1:n + m))
                 v(:, n + 1:n + m) = 0.0_wp
                 if (associated(flexible%modal)) then
                     call modal_fields(flexible%modal, y(oq + 1:oq + flexible%modal%nq), &
@@ -259,10 +258,11 @@ contains
                         stress_status)
                 else
                     do i = 1, m
+                        dofs = body%node_dofs(i)
                         do j = 1, 3
-                            if (body%dof(j, i) == 0) cycle
-                            x(j, n + i) = y(oq + body%dof(j, i))
-                            v(j, n + i) = y(ov + body%dof(j, i))
+                            if (dofs(j) == 0) cycle
+                            x(j, n + i) = y(oq + dofs(j))
+                            v(j, n + i) = y(ov + dofs(j))
                         end do
                     end do
                     call body%element_stress(y(oq + 1:oq + body%nq), y(ov + 1:ov + body%nv), &
@@ -273,7 +273,7 @@ contains
                     mises(ne + 1:ne + me) = 0.0_wp
                 end if
                 do k = 1, me
-                    points(nc + 1:nc + nn) = mesh%connectivity(:, k) + n
+                    points(nc + 1:nc + nn) = body%element_nodes(k) + n
                     nc = nc + nn
                     ends(ne + k) = nc
                 end do
@@ -290,19 +290,21 @@ contains
         !> A modal body's nodes and element stresses (into sigma, mises at
         !> ne + 1 ...) from its coordinates.
         subroutine modal_fields(modal, qm, vm, xb, vb, stress_status)
-            type(modal_body_t), intent(inout) :: modal
+            type(modal_body_t), intent(inout), target :: modal
             real(wp), intent(in) :: qm(:), vm(:)
             real(wp), intent(out) :: xb(:, :), vb(:, :)
             type(status_t), intent(out) :: stress_status
             real(wp) :: xf(size(xb)), vf(size(vb))
+            type(flexible_body_t), pointer :: fe
             integer :: me
-            me = modal%fe%mesh%element_count()
+            fe => modal%fe_body()
+            me = fe%element_count()
             call modal%node_positions(qm, xf)
             call modal%node_velocities(qm, vm, vf)
             xb = reshape(xf, shape(xb))
             vb = reshape(vf, shape(vb))
-            call modal%fe%element_stress(xf, vf, sigma(:, ne + 1:ne + me), &
-                                         mises(ne + 1:ne + me), stress_status)
+            call fe%element_stress(xf, vf, sigma(:, ne + 1:ne + me), mises(ne + 1:ne + me), &
+                                   stress_status)
         end subroutine modal_fields
 
         !> The bodies' reference positions, as x.
@@ -311,9 +313,9 @@ contains
             integer :: b, m
             m = 0
             do b = 1, size(self%flexible)
-                associate (mesh => self%flexible(b)%body%mesh)
-                    x0(:, m + 1:m + mesh%node_count()) = mesh%x
-                    m = m + mesh%node_count()
+                associate (body => self%flexible(b)%body)
+                    call body%reference_nodes(x0(:, m + 1:m + body%node_count()))
+                    m = m + body%node_count()
                 end associate
             end do
         end function reference

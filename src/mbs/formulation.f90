@@ -96,8 +96,8 @@ module flexmbs_mbs_formulation
         real(wp) :: projection_atol = 1.0e-6_wp
         integer, private :: projection_calls = 0
         integer :: nq = 0, nv = 0, nc = 0
-        !> offsets of the blocks in y (for the outer layers: offset, block_size, last)
-        integer :: oq = 0, ov = 0, oa = 0, ol = 0, om = 0
+        !> offsets of the blocks in y (outside the module: offset, block_size, last)
+        integer, private :: oq = 0, ov = 0, oa = 0, ol = 0, om = 0
         real(wp), allocatable, private :: q_mass(:)   !! where the constant M is evaluated
         ! workspaces, allocated once by the constructor
         real(wp), allocatable, private :: m(:, :), gmat(:, :), force(:), w(:), b(:), c(:), &

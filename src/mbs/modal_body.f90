@@ -91,6 +91,10 @@ module flexmbs_mbs_modal_body
         procedure :: node_velocities => modal_node_velocities
         procedure :: frequencies => modal_frequencies
         procedure :: reference_centre => modal_reference_centre
+        procedure :: mode_count => modal_mode_count
+        procedure :: fe_body => modal_fe_body
+        procedure :: centroid => modal_centroid
+        procedure :: interface_position => modal_interface_position
     end type modal_body_t
 
 contains
@@ -190,6 +194,35 @@ contains
         real(wp) :: centre(3)
         centre = self%centre
     end function modal_reference_centre
+
+    !> The number n of elastic coordinates η.
+    pure integer function modal_mode_count(self) result(n)
+        class(modal_body_t), intent(in) :: self
+        n = self%modes
+    end function modal_mode_count
+
+    !> The FE body the modes were computed on (its mesh, its stresses at the
+    !> reconstructed nodes); the modal body must be a target.
+    function modal_fe_body(self) result(fe)
+        class(modal_body_t), intent(in), target :: self
+        type(flexible_body_t), pointer :: fe
+        fe => self%fe
+    end function modal_fe_body
+
+    !> The mean of the mesh's reference positions (the FE body's centroid).
+    pure function modal_centroid(self) result(c)
+        class(modal_body_t), intent(in) :: self
+        real(wp) :: c(3)
+        c = self%fe%centroid()
+    end function modal_centroid
+
+    !> Interface j's centroid from the centre of mass, in the body's axes.
+    pure function modal_interface_position(self, j) result(position)
+        class(modal_body_t), intent(in) :: self
+        integer, intent(in) :: j
+        real(wp) :: position(3)
+        position = self%interface_offset(:, j)
+    end function modal_interface_position
 
     !> (a₂₃ − a₃₂, a₃₁ − a₁₃, a₁₂ − a₂₁): ∫ρ a × b for a = ∫ρ a bᵀ.
     pure function axial(a) result(w)

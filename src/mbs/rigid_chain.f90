@@ -109,6 +109,10 @@ module flexmbs_mbs_rigid_chain
         procedure :: body_velocity => chain_body_velocity
         procedure :: mass_derivative => chain_mass_derivative
         procedure :: force_derivatives => chain_force_derivatives
+        procedure :: link_count => chain_link_count
+        procedure :: link_joint => chain_link_joint
+        procedure :: link_centre => chain_link_centre
+        procedure :: link_coordinates => chain_link_coordinates
     end type rigid_chain_t
 
     public :: new_rigid_chain, new_chain_body
@@ -525,4 +529,38 @@ contains
         call self%energy(q, v, kinetic, potential)
         e = kinetic + potential
     end function chain_total_energy
+
+    !> The number of links (bodies) of the chain.
+    pure integer function chain_link_count(self) result(n)
+        class(rigid_chain_t), intent(in) :: self
+        n = 0
+        if (allocated(self%bodies)) n = size(self%bodies)
+    end function chain_link_count
+
+    !> The kind of link i's joint to its parent (chain_joint_revolute, _prismatic, _spherical).
+    pure integer function chain_link_joint(self, i) result(kind)
+        class(rigid_chain_t), intent(in) :: self
+        integer, intent(in) :: i
+        kind = self%bodies(i)%joint
+    end function chain_link_joint
+
+    !> Link i's centre of mass in its own frame (s_i).
+    pure function chain_link_centre(self, i) result(centre)
+        class(rigid_chain_t), intent(in) :: self
+        integer, intent(in) :: i
+        real(wp) :: centre(3)
+        centre = self%bodies(i)%centre
+    end function chain_link_centre
+
+    !> Where link i's joint sits in the chain's q and v: its coordinates
+    !> q(oq + 1:oq + nq), its rates v(ov + 1:ov + nv).
+    pure subroutine chain_link_coordinates(self, i, oq, nq, ov, nv)
+        class(rigid_chain_t), intent(in) :: self
+        integer, intent(in) :: i
+        integer, intent(out) :: oq, nq, ov, nv
+        oq = self%iq(i)
+        nq = self%iq(i + 1) - self%iq(i)
+        ov = self%iv(i)
+        nv = self%iv(i + 1) - self%iv(i)
+    end subroutine chain_link_coordinates
 end module flexmbs_mbs_rigid_chain

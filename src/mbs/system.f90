@@ -135,6 +135,9 @@ module flexmbs_mbs_system
         integer :: chain = 0    !! rigid chain number (chain markers; position, axes
         integer :: link = 0     !! in the frame of this body of the chain)
         integer, allocatable :: nodes(:) !! set markers: the set's mesh nodes
+    contains
+        procedure :: on_node_set => marker_on_node_set
+        procedure :: attached_to => marker_attached_to
     end type marker_t
 
     !> Workspace of one marker side of a joint or force element, sized by the
@@ -286,9 +289,23 @@ module flexmbs_mbs_system
         procedure :: joint_rows => system_joint_rows
         procedure :: element_count => system_element_count
         procedure :: element_bodies => system_element_bodies
+        procedure :: part_count => system_part_count
+        procedure :: part_offsets => system_part_offsets
+        procedure :: chain_of => system_chain_of
+        procedure :: flexible_of => system_flexible_of
+        procedure :: modal_of => system_modal_of
+        procedure :: joint_kind => system_joint_kind
+        procedure :: joint_markers => system_joint_markers
+        procedure :: joint_primitive_count => system_joint_primitive_count
+        procedure :: joint_primitive => system_joint_primitive
     end type mbs_system_t
 
     public :: new_mbs_system, driver_t, driver_values, node_frame_t, force_element_t
+
+    !> The kinds of parts, for mbs_system_t's part_count and part_offsets:
+    !> rigid bodies, rigid chains, flexible bodies, modal bodies, node frames.
+    integer, parameter, public :: part_rigid = 1, part_chain = 2, part_flexible = 3, &
+        part_modal = 4, part_frame = 5
 
 
     interface
@@ -819,6 +836,59 @@ module flexmbs_mbs_system
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: k
         end function system_element_bodies
+        !> The number of parts of kind `part` (part_rigid: the rigid bodies,
+        !> node frames' massless bodies counted; part_chain, part_flexible,
+        !> part_modal; part_frame: the node frames); 0 for another number.
+        pure integer module function system_part_count(self, part) result(n)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: part
+        end function system_part_count
+        !> Where part i of kind `part` (part_chain, part_flexible, part_modal)
+        !> starts in q and v: q(oq + 1 ...), v(ov + 1 ...); -1 for another kind.
+        pure module subroutine system_part_offsets(self, part, i, oq, ov)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: part, i
+            integer, intent(out) :: oq, ov
+        end subroutine system_part_offsets
+        !> Chain c itself (the system, and so the pointer's target, must be a target).
+        module function system_chain_of(self, c) result(chain)
+            class(mbs_system_t), intent(in), target :: self
+            integer, intent(in) :: c
+            type(rigid_chain_t), pointer :: chain
+        end function system_chain_of
+        !> Flexible body i itself (the system must be a target).
+        module function system_flexible_of(self, i) result(body)
+            class(mbs_system_t), intent(in), target :: self
+            integer, intent(in) :: i
+            type(flexible_body_t), pointer :: body
+        end function system_flexible_of
+        !> Modal body i itself (the system must be a target).
+        module function system_modal_of(self, i) result(body)
+            class(mbs_system_t), intent(in), target :: self
+            integer, intent(in) :: i
+            type(modal_body_t), pointer :: body
+        end function system_modal_of
+        !> The kind of joint j (joint_spherical ... joint_primitive of the joint table).
+        pure integer module function system_joint_kind(self, j) result(kind)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: j
+        end function system_joint_kind
+        !> Joint j's markers i and j (for marker_pose).
+        pure module function system_joint_markers(self, j) result(markers)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: j
+            integer :: markers(2)
+        end function system_joint_markers
+        !> The number of constraint primitives joint j is made of.
+        pure integer module function system_joint_primitive_count(self, j) result(n)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: j
+        end function system_joint_primitive_count
+        !> The kind (primitive_*) of joint j's primitive p, in the order of its rows.
+        pure integer module function system_joint_primitive(self, j, p) result(kind)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: j, p
+        end function system_joint_primitive
     end interface
 
 contains
@@ -834,4 +904,24 @@ contains
             row = self%joints(k)%row0 + 1
         end if
     end function system_joint_first_row
+
+    !> Makes the marker a set marker: on the nodes `nodes` of flexible body
+    !> `flexible` (component by component: a structure constructor with an
+    !> allocatable component leaks its temporary in gfortran 12).
+    pure subroutine marker_on_node_set(self, flexible, nodes)
+        class(marker_t), intent(inout) :: self
+        integer, intent(in) :: flexible, nodes(:)
+        self%flexible = flexible
+        self%nodes = nodes
+    end subroutine marker_on_node_set
+
+    !> What carries the marker: its body (0: the ground or none), its chain
+    !> and the chain's link (0: none).
+    pure subroutine marker_attached_to(self, body, chain, link)
+        class(marker_t), intent(in) :: self
+        integer, intent(out) :: body, chain, link
+        body = self%body
+        chain = self%chain
+        link = self%link
+    end subroutine marker_attached_to
 end module flexmbs_mbs_system

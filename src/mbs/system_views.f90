@@ -6,8 +6,7 @@ submodule (flexmbs_mbs_system) flexmbs_mbs_system_views
 contains
 
     module procedure system_chain_count
-        n = 0
-        if (allocated(self%chains)) n = size(self%chains)
+        n = self%part_count(part_chain)
     end procedure system_chain_count
 
     module procedure system_link_count
@@ -20,8 +19,7 @@ contains
     end procedure system_link_coordinates
 
     module procedure system_flexible_count
-        n = 0
-        if (allocated(self%flex)) n = size(self%flex)
+        n = self%part_count(part_flexible)
     end procedure system_flexible_count
 
     module procedure system_flexible_coordinates
@@ -51,4 +49,64 @@ contains
     module procedure system_element_bodies
         n = merge(1, 2, self%elements(k)%marker_j == 0)
     end procedure system_element_bodies
+
+    module procedure system_part_count
+        n = 0
+        select case (part)
+        case (part_rigid)
+            if (allocated(self%rigid%bodies)) n = size(self%rigid%bodies)
+        case (part_chain)
+            if (allocated(self%chains)) n = size(self%chains)
+        case (part_flexible)
+            if (allocated(self%flex)) n = size(self%flex)
+        case (part_modal)
+            if (allocated(self%modal)) n = size(self%modal)
+        case (part_frame)
+            if (allocated(self%frames)) n = size(self%frames)
+        end select
+    end procedure system_part_count
+
+    module procedure system_part_offsets
+        oq = -1
+        ov = -1
+        select case (part)
+        case (part_chain)
+            oq = self%chain_q(i)
+            ov = self%chain_v(i)
+        case (part_flexible)
+            oq = self%flex_q(i)
+            ov = self%flex_v(i)
+        case (part_modal)
+            oq = self%modal_q(i)
+            ov = self%modal_v(i)
+        end select
+    end procedure system_part_offsets
+
+    module procedure system_chain_of
+        chain => self%chains(c)
+    end procedure system_chain_of
+
+    module procedure system_flexible_of
+        body => self%flex(i)
+    end procedure system_flexible_of
+
+    module procedure system_modal_of
+        body => self%modal(i)
+    end procedure system_modal_of
+
+    module procedure system_joint_kind
+        kind = self%joints(j)%joint%kind
+    end procedure system_joint_kind
+
+    module procedure system_joint_markers
+        markers = [self%joints(j)%marker_i, self%joints(j)%marker_j]
+    end procedure system_joint_markers
+
+    module procedure system_joint_primitive_count
+        n = self%joints(j)%joint%nprimitives
+    end procedure system_joint_primitive_count
+
+    module procedure system_joint_primitive
+        kind = self%joints(j)%joint%primitive(p)
+    end procedure system_joint_primitive
 end submodule flexmbs_mbs_system_views

@@ -19,6 +19,7 @@ module flexmbs_run_monitor_sink
     use flexmbs_core_status, only: status_t
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
+    use flexmbs_mbs_formulation, only: block_q, block_v
     use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_mbs_system, only: mbs_system_t
     implicit none
@@ -98,8 +99,8 @@ contains
         call self%formulation%drift(t, y, position, velocity, st)
         self%records = self%records + 1
         self%table(:, self%records) = [t, position, velocity, &
-            energy(self, y(self%formulation%oq + 1:self%formulation%oq + self%formulation%nq), &
-                   y(self%formulation%ov + 1:self%formulation%ov + self%formulation%nv))]
+            energy(self, y(self%formulation%offset(block_q) + 1:self%formulation%last(block_q)), &
+                   y(self%formulation%offset(block_v) + 1:self%formulation%last(block_v)))]
         select type (m => self%mechanical)
         type is (mbs_system_t)
             associate (f => self%formulation)
@@ -108,7 +109,8 @@ contains
                 call f%consistent_multipliers(t, y, lambda, status)
                 if (.not. status%ok()) return
                 do k = 1, nj
-                    call m%joint_reaction(k, t, y(f%oq + 1:f%oq + f%nq), lambda, force, torque)
+                    call m%joint_reaction(k, t, y(f%offset(block_q) + 1:f%last(block_q)), lambda, &
+                                          force, torque)
                     self%reactions(12 * k - 11:12 * k, self%records) = [force(:, 1), &
                         torque(:, 1), force(:, 2), torque(:, 2)]
                 end do

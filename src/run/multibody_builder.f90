@@ -69,8 +69,8 @@ contains
             modal_q0(:)
         logical :: centroid(size(scene%markers))
         character(len=:), allocatable :: labels(:), frame_labels(:), defect, names(:)
-        real(wp) :: p(4), r(3, 3), anchor(3), origin(3)
-        integer :: i, nb, k, n, b, mi, fb, c
+        real(wp) :: p(4), r(3, 3), anchor(3), origin(3), inertia(3, 3), position(3)
+        integer :: i, nb, k, n, b, mi, fb, c, link
         ! node-set markers that a joint other than 'attach' or a driver uses
         ! get a node frame (a massless body after the scene's rigid bodies),
         ! unless spherical joints to points alone use them (centroid_markers)
@@ -94,9 +94,9 @@ contains
         allocate (q0(7 * nb), v0(6 * nb), source=0.0_wp)
         do i = 1, size(scene%rigid_bodies)
             associate (b => scene%rigid_bodies(i))
-                bodies(i)%mass = b%mass
-                bodies(i)%inertia = inertia_tensor(b%inertia, b%inertia_products)
-                defect = inertia_defect(bodies(i)%inertia)
+                inertia = inertia_tensor(b%inertia, b%inertia_products)
+                bodies(i) = rigid_body_t(mass=b%mass, inertia=inertia)
+                defect = inertia_defect(inertia)
                 if (len(defect) > 0) then
                     call status%set(status_bad_input, scene%path // ': &rigid_body ''' // &
                         trim(b%name) // ''': inertia, inertia_products: ' // defect // &
@@ -152,16 +152,16 @@ contains
                 if (.not. status%ok()) return
                 cycle
             end if
-            call flex(flex_of(fb))%mesh%node_set(trim(scene%markers(i)%node_set), nodes, status)
+            call flex(flex_of(fb))%node_set(trim(scene%markers(i)%node_set), nodes, status)
             if (.not. status%ok()) then
                 call status%set(status_bad_input, scene%path // ': &marker ''' // &
                     trim(scene%markers(i)%name) // ''': ' // status%text())
                 return
             end if
-            bodies(b)%frame = .true.
+            bodies(b) = rigid_body_t(frame=.true.)
             frames(k) = node_frame_t(flexible=flex_of(fb), body=b, nodes=nodes)
             frame_labels(k) = '&marker ''' // trim(scene%markers(i)%name) // ''' (node frame)'
-            anchor = sum(flex(flex_of(fb))%mesh%x(:, nodes), dim=2) / size(nodes)
+            anchor = flex(flex_of(fb))%centroid(nodes)
             q0(7 * b - 6:7 * b) = [anchor, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
             v0(6 * b - 5:6 * b) = [mean_velocity(fb, nodes), &
                                    scene%bodies(fb)%initial_angular_velocity]
@@ -171,41 +171,38 @@ contains
         allocate (markers(size(scene%markers)))
         do i = 1, size(markers)
             associate (m => scene%markers(i))
-                markers(i)%body = 0
                 if (frame_of(i) > 0) then
                     ! on the frame: the origin relative to the centroid, the
                     ! reference axes (the frame's at the start)
                     b = size(scene%rigid_bodies) + frame_of(i)
-                    markers(i)%body = b
-                    markers(i)%position = 0.0_wp
-                    if (m%position_given) markers(i)%position = m%position - &
-                        q0(7 * b - 6:7 * b - 4)
+                    position = 0.0_wp
+                    if (m%position_given) position = m%position - q0(7 * b - 6:7 * b - 4)
                     ! a position at the centroid (to round-off) is the centroid
-                    if (norm2(markers(i)%position) <= 1.0e-12_wp * max(1.0_wp, &
-                        norm2(m%position))) markers(i)%position = 0.0_wp
-                    markers(i)%axes = axes_from(m%z_axis, m%x_axis)
+                    if (norm2(position) <= 1.0e-12_wp * max(1.0_wp, norm2(m%position))) &
+                        position = 0.0_wp
+                    markers(i) = marker_t(body=b, position=position, &
+                                          axes=axes_from(m%z_axis, m%x_axis))
                     cycle
                 end if
                 if (centroid(i)) then
                     fb = flex_of(flexible_index(scene, m%body))
-                    call flex(fb)%mesh%node_set(trim(m%node_set), nodes, status)
+                    call flex(fb)%node_set(trim(m%node_set), nodes, status)
                     if (.not. status%ok()) then
                         call status%set(status_bad_input, scene%path // ': &marker ''' // &
                             trim(m%name) // ''': ' // status%text())
                         return
                     end if
-                    ! component by component: a structure constructor with an
-                    ! allocatable component leaks its temporary (gfortran 12)
-                    markers(i)%flexible = fb
-                    markers(i)%nodes = nodes
+                    call markers(i)%on_node_set(fb, nodes)
                     cycle
                 end if
+                b = 0
+                c = 0
+                link = 0
                 if (m%body /= 'ground' .and. len_trim(m%node_set) == 0) &
-                    markers(i)%body = body_index(scene, m%body)
-                if (markers(i)%body == 0 .and. m%body /= 'ground') &
-                    call chain_link(scene, m%body, markers(i)%chain, markers(i)%link)
-                markers(i)%position = m%position
-                markers(i)%axes = axes_from(m%z_axis, m%x_axis)
+                    b = body_index(scene, m%body)
+                if (b == 0 .and. m%body /= 'ground') call chain_link(scene, m%body, c, link)
+                markers(i) = marker_t(body=b, position=m%position, &
+                                      axes=axes_from(m%z_axis, m%x_axis), chain=c, link=link)
             end associate
         end do
         allocate (joints(0))
@@ -238,7 +235,7 @@ contains
                             &''fixed'' joint on its interface')
                         return
                     end if
-                    call flex(fb)%mesh%node_set(trim(mj%node_set), nodes, status)
+                    call flex(fb)%node_set(trim(mj%node_set), nodes, status)
                 end associate
                 if (.not. status%ok()) then
                     call status%set(status_bad_input, scene%path // ': &joint ''' // &
@@ -246,18 +243,17 @@ contains
                         status%text())
                     return
                 end if
-                b = markers(mi)%body
-                c = markers(mi)%chain
-                if (c > 0) call link_frame(c, markers(mi)%link, origin, r)
+                call markers(mi)%attached_to(b, c, link)
+                if (c > 0) call link_frame(c, link, origin, r)
                 do n = 1, size(nodes)
-                    anchor = flex(fb)%mesh%x(:, nodes(n))
+                    anchor = flex(fb)%reference_node(nodes(n))
                     if (c > 0) then
                         anchor = matmul(transpose(r), anchor - origin)
                     else if (b > 0) then
                         r = rotation_matrix(q0(7 * b - 3:7 * b))
                         anchor = matmul(transpose(r), anchor - q0(7 * b - 6:7 * b - 4))
                     end if
-                    markers = [markers, marker_t(b, anchor, chain=c, link=markers(mi)%link), &
+                    markers = [markers, marker_t(b, anchor, chain=c, link=link), &
                                marker_t(0, flexible=fb, node=nodes(n))]
                     joints = [joints, mbs_joint_t(joint_spherical, size(markers) - 1, &
                                                   size(markers))]
@@ -335,17 +331,17 @@ contains
                     int_text(scene%markers(i)%line) // ')')
                 return
             end if
-            bodies(b)%frame = .true.
+            bodies(b) = rigid_body_t(frame=.true.)
             frames(k) = node_frame_t(body=b, modal=mb, modal_interface=j)
             frame_labels(k) = '&marker ''' // trim(scene%markers(i)%name) // &
                 ''' (interface frame)'
-            d = modal(mb)%interface_offset(:, j)
+            d = modal(mb)%interface_position(j)
             c = q0(modal_q0(fm) + 1:modal_q0(fm) + 3)
             q0(7 * b - 6:7 * b) = [c + d, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
             associate (bd => scene%bodies(fm))
                 ! the rigid field v₀ + ω × (X − X̄) at the interface's centroid
                 v0(6 * b - 5:6 * b) = [bd%initial_velocity + cross(bd%initial_angular_velocity, &
-                    c + d - sum(modal(mb)%fe%mesh%x, dim=2) / modal(mb)%fe%mesh%node_count()), &
+                    c + d - modal(mb)%centroid()), &
                     bd%initial_angular_velocity]
             end associate
         end subroutine modal_frame
@@ -354,13 +350,12 @@ contains
         function mean_velocity(fb, set) result(u)
             integer, intent(in) :: fb, set(:)
             real(wp) :: u(3)
-            integer :: a, l
+            integer :: a, l, dofs(3)
             u = 0.0_wp
             do a = 1, size(set)
+                dofs = flex(flex_of(fb))%node_dofs(set(a))
                 do l = 1, 3
-                    associate (d => flex(flex_of(fb))%dof(l, set(a)))
-                        if (d > 0) u(l) = u(l) + v0(flex_v0(fb) + d)
-                    end associate
+                    if (dofs(l) > 0) u(l) = u(l) + v0(flex_v0(fb) + dofs(l))
                 end do
             end do
             u = u / size(set)

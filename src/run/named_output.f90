@@ -42,7 +42,8 @@ module flexmbs_run_named_output
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_mbs_rigid_body, only: rigid_body_nq, rigid_body_nv
-    use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_mbs_system, only: mbs_system_t, part_rigid, part_chain, part_flexible, &
+        part_modal, part_frame
     use flexmbs_mbs_joint_types, only: joint_has_angle, joint_displaced_axes
     use flexmbs_mbs_primitive_kinds, only: primitive_rows, primitive_dot1, &
         primitive_angle_driver, primitive_distance
@@ -50,7 +51,9 @@ module flexmbs_run_named_output
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, chain_joint_prismatic, &
         chain_joint_spherical
-    use flexmbs_mbs_formulation, only: formulation_t
+    use flexmbs_mbs_formulation, only: formulation_t, block_q, block_v, block_a, &
+        block_lambda, block_mu
+    use flexmbs_mbs_modal_body, only: modal_body_t
     use flexmbs_io_namelist, only: scene_input_t
     use flexmbs_io_record_values, only: record_values_t
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
@@ -131,7 +134,7 @@ contains
         type(reaction_values_t) :: reaction
         type(coordinate_values_t) :: coordinate
         character(len=:), allocatable :: base, groups(:)
-        integer :: i, k
+        integer :: i, k, oq, ov
         call add_labels(h5, plan, scene, status)
         if (.not. status%ok()) return
         if (.not. allocated(plan%mechanical)) return
@@ -142,7 +145,8 @@ contains
         type is (rigid_chain_t)
             select type (f => plan%problem)
             type is (formulation_t)
-                call add_chain(h5, sys, link_names(scene, 0), f%oq, f%ov, status)
+                call add_chain(h5, sys, link_names(scene, 0), f%offset(block_q), &
+                               f%offset(block_v), status)
             end select
             return
         type is (mbs_system_t)
@@ -150,8 +154,8 @@ contains
             type is (formulation_t)
                 do i = 1, size(scene%rigid_bodies)
                     base = 'bodies/' // path_name(scene%rigid_bodies(i)%name) // '/'
-                    body%iq = f%oq + rigid_body_nq * (i - 1)
-                    body%iv = f%ov + rigid_body_nv * (i - 1)
+                    body%iq = f%offset(block_q) + rigid_body_nq * (i - 1)
+                    body%iv = f%offset(block_v) + rigid_body_nv * (i - 1)
                     call add_body(body_position, 'position', 3, 'm', 'the body''s &
                         &reference point (its centre of mass)')
                     call add_body(body_orientation, 'orientation', 4, '1', 'unit quaternion &
@@ -163,32 +167,38 @@ contains
                         'in the world frame')
                     if (.not. status%ok()) return
                 end do
-                do i = 1, size(sys%chains)
-                    call add_chain(h5, sys%chains(i), link_names(scene, i), f%oq + sys%chain_q(i), &
-                                   f%ov + sys%chain_v(i), status)
+                do i = 1, sys%chain_count()
+                    call sys%part_offsets(part_chain, i, oq, ov)
+                    call add_chain(h5, sys%chain_of(i), link_names(scene, i), &
+                                   f%offset(block_q) + oq, f%offset(block_v) + ov, status)
                     if (.not. status%ok()) return
                 end do
-                do i = 1, size(sys%flex)
-                    call add_flexible(h5, sys%flex(i), scene%bodies(nonlinear_body(scene, i))%name, &
-                                      f%oq + sys%flex_q(i), f%ov + sys%flex_v(i), status)
+                do i = 1, sys%flexible_count()
+                    call sys%part_offsets(part_flexible, i, oq, ov)
+                    call add_flexible(h5, sys%flexible_of(i), &
+                                      scene%bodies(nonlinear_body(scene, i))%name, &
+                                      f%offset(block_q) + oq, f%offset(block_v) + ov, status)
                     if (.not. status%ok()) return
                 end do
-                do i = 1, size(sys%modal)
-                    call add_modal(h5, sys%modal(i), scene%bodies(modal_body(scene, i))%name, &
-                                   f%oq + sys%modal_q(i), f%ov + sys%modal_v(i), status)
+                do i = 1, sys%part_count(part_modal)
+                    call sys%part_offsets(part_modal, i, oq, ov)
+                    call add_modal(h5, sys%modal_of(i), scene%bodies(modal_body(scene, i))%name, &
+                                   f%offset(block_q) + oq, f%offset(block_v) + ov, status)
                     if (.not. status%ok()) return
                 end do
                 allocate (character(len=80) :: groups(size(scene%forces)))
                 do i = 1, size(scene%forces)
                     groups(i) = 'forces/' // path_name(scene%forces(i)%name) // '/'
                 end do
-                call add_force_output(h5, sys, groups, f%oq, f%ov, status)
+                call add_force_output(h5, sys, groups, f%offset(block_q), f%offset(block_v), &
+                                      status)
                 if (.not. status%ok()) return
-                if (.not. allocated(plan%joint_names) .or. f%nc == 0) return
+                if (.not. allocated(plan%joint_names) .or. f%block_size(block_lambda) == 0) &
+                    return
                 reaction%system => sys
                 reaction%formulation => f
-                reaction%oq = f%oq
-                do k = 1, min(size(plan%joint_names), size(sys%joints))
+                reaction%oq = f%offset(block_q)
+                do k = 1, min(size(plan%joint_names), sys%joint_count())
                     reaction%joint = k
                     base = group_path(plan%joint_names(k)) // '/'
                     call add_reaction(1, .false., 'reaction_force', 'N', 'marker i')
@@ -196,7 +206,7 @@ contains
                     call add_reaction(2, .false., 'reaction_force_j', 'N', 'marker j')
                     call add_reaction(2, .true., 'reaction_torque_j', 'N m', 'marker j')
                     if (.not. status%ok()) return
-                    call add_coordinates(sys%joints(k)%joint%kind)
+                    call add_coordinates(sys%joint_kind(k))
                 end do
             end select
         end select
@@ -208,7 +218,8 @@ contains
             type(flexible_body_t), intent(in), target :: b
             select type (f => plan%problem)
             type is (formulation_t)
-                call add_flexible(h5, b, scene%bodies(1)%name, f%oq, f%ov, status)
+                call add_flexible(h5, b, scene%bodies(1)%name, f%offset(block_q), &
+                                  f%offset(block_v), status)
             end select
         end subroutine add_standalone
 
@@ -283,14 +294,17 @@ contains
                 type is (mbs_system_t)
                     call system_labels(m, f)
                 type is (rigid_chain_t)
-                    call chain_labels(m, link_names(scene, 0), f%oq, f%ov, accelerations(f))
+                    call chain_labels(m, link_names(scene, 0), f%offset(block_q), &
+                                      f%offset(block_v), accelerations(f))
                 type is (flexible_body_t)
-                    call flexible_labels(m, trim(scene%bodies(1)%name), f%oq, f%ov, accelerations(f))
+                    call flexible_labels(m, trim(scene%bodies(1)%name), f%offset(block_q), &
+                                         f%offset(block_v), accelerations(f))
                 end select
-                if (f%nc > 0 .and. f%n > f%om) then   ! GGL: μ after λ
-                    do k = 1, f%nc
-                        labels(f%om + k) = trim(labels(f%ol + k)) // ' (mu)'
-                        units(f%om + k) = '-'
+                if (f%block_size(block_mu) > 0) then   ! GGL: μ after λ
+                    do k = 1, f%block_size(block_lambda)
+                        labels(f%offset(block_mu) + k) = trim(labels(f%offset(block_lambda) + k)) &
+                            // ' (mu)'
+                        units(f%offset(block_mu) + k) = '-'
                     end do
                 end if
             end select
@@ -301,68 +315,77 @@ contains
     contains
 
         subroutine system_labels(sys, f)
-            type(mbs_system_t), intent(in) :: sys
+            type(mbs_system_t), intent(in), target :: sys
             type(formulation_t), intent(in) :: f
             character(len=:), allocatable :: name
-            integer :: i, j, r, row
-            do i = 1, size(sys%rigid%bodies)
+            integer :: i, j, r, row, row0, oq, ov, oa, ol, nc, bq, bv
+            logical :: with_a
+            oq = f%offset(block_q)
+            ov = f%offset(block_v)
+            oa = f%offset(block_a)
+            ol = f%offset(block_lambda)
+            nc = f%block_size(block_lambda)
+            with_a = f%block_size(block_a) > 0
+            do i = 1, sys%part_count(part_rigid)
                 if (i <= size(scene%rigid_bodies)) then
                     name = trim(scene%rigid_bodies(i)%name)
                 else
                     name = 'node frame ' // int_text(i - size(scene%rigid_bodies))
                 end if
-                call put3(f%oq + 7 * (i - 1), name // '/position', 'm')
+                call put3(oq + 7 * (i - 1), name // '/position', 'm')
                 do j = 1, 4
-                    labels(f%oq + 7 * (i - 1) + 3 + j) = name // '/orientation/p' // &
+                    labels(oq + 7 * (i - 1) + 3 + j) = name // '/orientation/p' // &
                         int_text(j - 1)
-                    units(f%oq + 7 * (i - 1) + 3 + j) = '1'
+                    units(oq + 7 * (i - 1) + 3 + j) = '1'
                 end do
-                call put3(f%ov + 6 * (i - 1), name // '/velocity', 'm/s')
-                call put3(f%ov + 6 * (i - 1) + 3, name // '/angular_velocity (body)', 'rad/s')
-                if (f%accelerations) then
-                    call put3(f%oa + 6 * (i - 1), name // '/acceleration', 'm/s^2')
-                    call put3(f%oa + 6 * (i - 1) + 3, name // '/angular_acceleration (body)', &
+                call put3(ov + 6 * (i - 1), name // '/velocity', 'm/s')
+                call put3(ov + 6 * (i - 1) + 3, name // '/angular_velocity (body)', 'rad/s')
+                if (with_a) then
+                    call put3(oa + 6 * (i - 1), name // '/acceleration', 'm/s^2')
+                    call put3(oa + 6 * (i - 1) + 3, name // '/angular_acceleration (body)', &
                               'rad/s^2')
                 end if
             end do
-            do i = 1, size(sys%chains)
-                call chain_labels(sys%chains(i), link_names(scene, i), f%oq + sys%chain_q(i), &
-                    f%ov + sys%chain_v(i), &
-                    merge(f%oa + sys%chain_v(i), -1, f%accelerations))
+            do i = 1, sys%chain_count()
+                call sys%part_offsets(part_chain, i, bq, bv)
+                call chain_labels(sys%chain_of(i), link_names(scene, i), oq + bq, ov + bv, &
+                    merge(oa + bv, -1, with_a))
             end do
-            do i = 1, size(sys%flex)
-                call flexible_labels(sys%flex(i), trim(scene%bodies(nonlinear_body(scene, i))%name), &
-                    f%oq + sys%flex_q(i), f%ov + sys%flex_v(i), &
-                    merge(f%oa + sys%flex_v(i), -1, f%accelerations))
+            do i = 1, sys%flexible_count()
+                call sys%part_offsets(part_flexible, i, bq, bv)
+                call flexible_labels(sys%flexible_of(i), &
+                    trim(scene%bodies(nonlinear_body(scene, i))%name), oq + bq, ov + bv, &
+                    merge(oa + bv, -1, with_a))
             end do
-            do i = 1, size(sys%modal)
-                call modal_labels(sys%modal(i)%modes, trim(scene%bodies(modal_body(scene, i))%name), &
-                    f%oq + sys%modal_q(i), f%ov + sys%modal_v(i), &
-                    merge(f%oa + sys%modal_v(i), -1, f%accelerations))
+            do i = 1, sys%part_count(part_modal)
+                call sys%part_offsets(part_modal, i, bq, bv)
+                call modal_labels(sys%modal_of(i), trim(scene%bodies(modal_body(scene, i))%name), &
+                    oq + bq, ov + bv, merge(oa + bv, -1, with_a))
             end do
             ! multipliers: a row's unit is the force its constraint exerts
-            do i = 1, size(sys%joints)
+            do i = 1, sys%joint_count()
                 name = 'joint ' // int_text(i)
                 if (allocated(plan%joint_names)) then
                     if (i <= size(plan%joint_names)) name = trim(plan%joint_names(i))
                 end if
-                row = sys%joints(i)%row0
-                do j = 1, sys%joints(i)%joint%nprimitives
-                    do r = 1, primitive_rows(sys%joints(i)%joint%primitive(j))
+                row0 = sys%joint_first_row(i) - 1
+                row = row0
+                do j = 1, sys%joint_primitive_count(i)
+                    do r = 1, primitive_rows(sys%joint_primitive(i, j))
                         row = row + 1
-                        if (row > f%nc) exit
-                        labels(f%ol + row) = name // '/lambda ' // int_text(row - &
-                                                                          sys%joints(i)%row0)
-                        units(f%ol + row) = multiplier_unit(sys%joints(i)%joint%primitive(j))
+                        if (row > nc) exit
+                        labels(ol + row) = name // '/lambda ' // int_text(row - row0)
+                        units(ol + row) = multiplier_unit(sys%joint_primitive(i, j))
                     end do
                 end do
             end do
-            do i = 1, size(sys%frames)
+            do i = 1, sys%part_count(part_frame)
+                row0 = sys%joint_first_row(sys%joint_count() + i) - 1
                 do r = 1, 6
-                    row = sys%frames(i)%row0 + r
-                    if (row > f%nc) exit
-                    labels(f%ol + row) = 'node frame ' // int_text(i) // '/lambda ' // int_text(r)
-                    units(f%ol + row) = merge('N  ', 'N m', r <= 3)
+                    row = row0 + r
+                    if (row > nc) exit
+                    labels(ol + row) = 'node frame ' // int_text(i) // '/lambda ' // int_text(r)
+                    units(ol + row) = merge('N  ', 'N m', r <= 3)
                 end do
             end do
         end subroutine system_labels
@@ -372,23 +395,24 @@ contains
             character(len=*), intent(in) :: names(:) !! the chain's links'
             integer, intent(in) :: oq, ov, oa   !! oa < 0: no accelerations in y
             character(len=:), allocatable :: name, unit
-            integer :: i, j
-            do i = 1, size(chain%bodies)
+            integer :: i, j, lq, nq, lv, nv
+            do i = 1, chain%link_count()
                 name = 'link ' // int_text(i)
                 if (i <= size(names)) name = trim(names(i))
                 unit = 'rad'
-                if (chain%bodies(i)%joint == chain_joint_prismatic) unit = 'm'
-                if (chain%bodies(i)%joint == chain_joint_spherical) unit = '1'
-                do j = chain%iq(i) + 1, chain%iq(i + 1)
-                    labels(oq + j) = name // '/coordinate ' // int_text(j - chain%iq(i))
+                if (chain%link_joint(i) == chain_joint_prismatic) unit = 'm'
+                if (chain%link_joint(i) == chain_joint_spherical) unit = '1'
+                call chain%link_coordinates(i, lq, nq, lv, nv)
+                do j = lq + 1, lq + nq
+                    labels(oq + j) = name // '/coordinate ' // int_text(j - lq)
                     units(oq + j) = unit
                 end do
                 if (unit == '1') unit = 'rad'
-                do j = chain%iv(i) + 1, chain%iv(i + 1)
-                    labels(ov + j) = name // '/rate ' // int_text(j - chain%iv(i))
+                do j = lv + 1, lv + nv
+                    labels(ov + j) = name // '/rate ' // int_text(j - lv)
                     units(ov + j) = unit // '/s'
                     if (oa >= 0) then
-                        labels(oa + j) = name // '/rate derivative ' // int_text(j - chain%iv(i))
+                        labels(oa + j) = name // '/rate derivative ' // int_text(j - lv)
                         units(oa + j) = unit // '/s^2'
                     end if
                 end do
@@ -400,10 +424,11 @@ contains
             character(len=*), intent(in) :: name
             integer, intent(in) :: oq, ov, oa   !! oa < 0: no accelerations in y
             character(len=1), parameter :: xyz(3) = ['x', 'y', 'z']
-            integer :: i, j, d
-            do i = 1, size(body%dof, 2)
+            integer :: i, j, d, dofs(3)
+            do i = 1, body%node_count()
+                dofs = body%node_dofs(i)
                 do j = 1, 3
-                    d = body%dof(j, i)
+                    d = dofs(j)
                     if (d == 0) cycle
                     labels(oq + d) = name // '/node ' // int_text(i) // '/' // xyz(j)
                     units(oq + d) = 'm'
@@ -419,8 +444,8 @@ contains
         end subroutine flexible_labels
 
         !> (r, p, η), (ṙ, ω′, η̇) and their rates of a modal body.
-        subroutine modal_labels(modes, name, oq, ov, oa)
-            integer, intent(in) :: modes
+        subroutine modal_labels(body, name, oq, ov, oa)
+            type(modal_body_t), intent(in) :: body
             character(len=*), intent(in) :: name
             integer, intent(in) :: oq, ov, oa   !! oa < 0: no accelerations in y
             integer :: j
@@ -435,7 +460,7 @@ contains
                 call put3(oa, name // '/frame/acceleration', 'm/s^2')
                 call put3(oa + 3, name // '/frame/angular_acceleration (body)', 'rad/s^2')
             end if
-            do j = 1, modes
+            do j = 1, body%mode_count()
                 labels(oq + 7 + j) = name // '/eta ' // int_text(j)
                 units(oq + 7 + j) = 'sqrt(kg) m'
                 labels(ov + 6 + j) = name // '/eta ' // int_text(j) // '/rate'
@@ -473,7 +498,7 @@ contains
     pure integer function accelerations(f) result(oa)
         type(formulation_t), intent(in) :: f
         oa = -1
-        if (f%accelerations) oa = f%oa
+        if (f%block_size(block_a) > 0) oa = f%offset(block_a)
     end function accelerations
 
     !> The unit of the multiplier of a constraint row of primitive `kind`:
@@ -502,11 +527,11 @@ contains
         type(status_t), intent(out) :: status
         type(link_values_t) :: link
         character(len=:), allocatable :: base, unit, rate_unit
-        integer :: i, nc
+        integer :: i, nc, o, nv, ov_link
         link%chain => chain
         link%oq = oq
         link%ov = ov
-        do i = 1, min(size(names), size(chain%bodies))
+        do i = 1, min(size(names), chain%link_count())
             base = 'chains/' // path_name(names(i)) // '/'
             link%link = i
             call add_link(link_position, 'position', 3, 'm', 'its centre of mass')
@@ -515,8 +540,8 @@ contains
             call add_link(link_velocity, 'velocity', 3, 'm/s', 'of its centre of mass')
             call add_link(link_angular_velocity, 'angular_velocity', 3, 'rad/s', &
                 'in the world frame')
-            nc = chain%iq(i + 1) - chain%iq(i)
-            select case (chain%bodies(i)%joint)
+            call chain%link_coordinates(i, o, nc, ov_link, nv)
+            select case (chain%link_joint(i))
             case (chain_joint_prismatic)
                 unit = 'm'
                 rate_unit = 'm/s'
@@ -529,7 +554,7 @@ contains
             end select
             call add_link(link_coordinate, 'coordinate', nc, unit, 'of the joint to its &
                 &parent (angle, displacement, or quaternion of a spherical joint)')
-            call add_link(link_rate, 'rate', chain%iv(i + 1) - chain%iv(i), rate_unit, &
+            call add_link(link_rate, 'rate', nv, rate_unit, &
                 'of the joint to its parent')
             if (.not. status%ok()) return
         end do
@@ -550,14 +575,16 @@ contains
         real(wp), intent(in) :: t, y(:)
         real(wp), intent(out) :: values(:)
         type(status_t), intent(inout) :: status
-        real(wp) :: o(3), r(3, 3), vc(3), omega(3)
+        real(wp) :: o(3), r(3, 3), vc(3), omega(3), centre(3)
+        integer :: oq, nq, ov, nv
         associate (chain => self%chain, i => self%link)
             associate (q => y(self%oq + 1:self%oq + chain%nq), &
                        v => y(self%ov + 1:self%ov + chain%nv))
                 select case (self%what)
                 case (link_position)
                     call chain%body_frame(q, i, o, r)
-                    values = o + matmul(r, chain%bodies(i)%centre)
+                    centre = chain%link_centre(i)
+                    values = o + matmul(r, centre)
                 case (link_rotation)
                     call chain%body_frame(q, i, o, r)
                     values = reshape(r, [9])
@@ -569,9 +596,11 @@ contains
                         values = omega
                     end if
                 case (link_coordinate)
-                    values = q(chain%iq(i) + 1:chain%iq(i + 1))
+                    call chain%link_coordinates(i, oq, nq, ov, nv)
+                    values = q(oq + 1:oq + nq)
                 case (link_rate)
-                    values = v(chain%iv(i) + 1:chain%iv(i + 1))
+                    call chain%link_coordinates(i, oq, nq, ov, nv)
+                    values = v(ov + 1:ov + nv)
                 end select
             end associate
         end associate
@@ -583,11 +612,12 @@ contains
         real(wp), intent(out) :: values(:)
         type(status_t), intent(inout) :: status
         real(wp) :: xi(3), xj(3), ai(3, 3), aj(3, 3), angle
-        integer :: k
+        integer :: k, markers(2)
         real(wp), parameter :: two_pi = 8.0_wp * atan(1.0_wp)
-        associate (sys => self%system, jt => self%system%joints(self%joint))
-            call sys%marker_pose(jt%marker_i, y(self%oq + 1:self%oq + sys%nq), xi, ai)
-            call sys%marker_pose(jt%marker_j, y(self%oq + 1:self%oq + sys%nq), xj, aj)
+        associate (sys => self%system)
+            markers = sys%joint_markers(self%joint)
+            call sys%marker_pose(markers(1), y(self%oq + 1:self%oq + sys%nq), xi, ai)
+            call sys%marker_pose(markers(2), y(self%oq + 1:self%oq + sys%nq), xj, aj)
         end associate
         if (self%angle) then
             ! continued past ±π from the record before

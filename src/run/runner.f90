@@ -13,6 +13,7 @@ module flexmbs_run_runner
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_sink, only: sink_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
+    use flexmbs_mbs_formulation, only: block_q, block_v
     use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_mbs_system, only: mbs_system_t
     use flexmbs_io_namelist, only: scene_input_t
@@ -181,7 +182,7 @@ contains
                 monitor%formulation => p
                 monitor%mechanical => plan%mechanical
                 monitor%every_step = scene%every_step
-                monitor%q_start = result%y(p%oq + 1:p%oq + p%nq)
+                monitor%q_start = result%y(p%offset(block_q) + 1:p%last(block_q))
                 call sinks%attach(monitor)
                 result%constraints = p%nc
             end if
@@ -374,8 +375,8 @@ contains
                 vtk%flexible(k)%ov = m%nq + m%flex_v(k)
                 select type (p => plan%problem)
                 type is (formulation_t)
-                    vtk%flexible(k)%oq = p%oq + m%flex_q(k)
-                    vtk%flexible(k)%ov = p%ov + m%flex_v(k)
+                    vtk%flexible(k)%oq = p%offset(block_q) + m%flex_q(k)
+                    vtk%flexible(k)%ov = p%offset(block_v) + m%flex_v(k)
                 end select
             end do
             do k = 1, size(m%modal)
@@ -387,8 +388,8 @@ contains
                     vf%ov = m%nq + m%modal_v(k)
                     select type (p => plan%problem)
                     type is (formulation_t)
-                        vf%oq = p%oq + m%modal_q(k)
-                        vf%ov = p%ov + m%modal_v(k)
+                        vf%oq = p%offset(block_q) + m%modal_q(k)
+                        vf%ov = p%offset(block_v) + m%modal_v(k)
                     end select
                 end associate
             end do
@@ -398,7 +399,7 @@ contains
                 ! the reactions need a formulation's multipliers (consistent with q, v)
                 select type (p => plan%problem)
                 type is (formulation_t)
-                    vtk%system_q = p%oq
+                    vtk%system_q = p%offset(block_q)
                     if (p%nc > 0) vtk%formulation => p
                 end select
             end if

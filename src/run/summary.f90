@@ -13,6 +13,7 @@ module flexmbs_run_summary
         chain_joint_spherical
     use flexmbs_mbs_system, only: mbs_system_t
     use flexmbs_mbs_joint_types, only: joint_has_angle, joint_displaced_axes
+    use flexmbs_mbs_formulation, only: block_q, block_v
     use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_io_namelist, only: scene_input_t
@@ -37,44 +38,46 @@ contains
         type(scene_input_t), intent(in) :: scene
         real(wp), intent(in) :: y(:)
         character(len=:), allocatable :: text
-        integer :: i, k
+        integer :: i, k, oq, ov
         text = ''
         if (.not. allocated(plan%mechanical)) return
         select type (f => plan%problem)
         type is (formulation_t)
+            oq = f%offset(block_q)
+            ov = f%offset(block_v)
             select type (m => plan%mechanical)
             type is (mbs_system_t)
                 do i = 1, size(scene%rigid_bodies)
                     text = text // body_line(trim(scene%rigid_bodies(i)%name), &
-                        y(f%oq + rigid_body_nq * (i - 1) + 1:f%oq + rigid_body_nq * i))
+                        y(oq + rigid_body_nq * (i - 1) + 1:oq + rigid_body_nq * i))
                 end do
                 do i = 1, size(m%chains)
-                    text = text // chain_lines(m%chains(i), y(f%oq + m%chain_q(i) + 1: &
-                        f%oq + m%chain_q(i) + m%chains(i)%nq), link_names(scene, i))
+                    text = text // chain_lines(m%chains(i), y(oq + m%chain_q(i) + 1: &
+                        oq + m%chain_q(i) + m%chains(i)%nq), link_names(scene, i))
                 end do
                 if (allocated(plan%joint_names)) then
                     do k = 1, min(size(plan%joint_names), size(m%joints))
                         text = text // joint_line(m, k, plan%joint_names(k), &
-                                                  y(f%oq + 1:f%oq + m%nq))
+                                                  y(oq + 1:oq + m%nq))
                     end do
                 end if
                 do i = 1, size(m%flex)
                     text = text // flexible_line(m%flex(i), &
                         trim(scene%bodies(nonlinear_body(scene, i))%name), &
-                        y(f%oq + m%flex_q(i) + 1:f%oq + m%flex_q(i) + m%flex(i)%nq), &
-                        y(f%ov + m%flex_v(i) + 1:f%ov + m%flex_v(i) + m%flex(i)%nv))
+                        y(oq + m%flex_q(i) + 1:oq + m%flex_q(i) + m%flex(i)%nq), &
+                        y(ov + m%flex_v(i) + 1:ov + m%flex_v(i) + m%flex(i)%nv))
                 end do
                 do i = 1, size(m%modal)
                     text = text // modal_line(m%modal(i), &
                         trim(scene%bodies(modal_body(scene, i))%name), &
-                        y(f%oq + m%modal_q(i) + 1:f%oq + m%modal_q(i) + m%modal(i)%nq), &
-                        y(f%ov + m%modal_v(i) + 1:f%ov + m%modal_v(i) + m%modal(i)%nv))
+                        y(oq + m%modal_q(i) + 1:oq + m%modal_q(i) + m%modal(i)%nq), &
+                        y(ov + m%modal_v(i) + 1:ov + m%modal_v(i) + m%modal(i)%nv))
                 end do
             type is (rigid_chain_t)
-                text = chain_lines(m, y(f%oq + 1:f%oq + m%nq), link_names(scene, 0))
+                text = chain_lines(m, y(oq + 1:oq + m%nq), link_names(scene, 0))
             type is (flexible_body_t)
-                text = flexible_line(m, trim(scene%bodies(1)%name), y(f%oq + 1:f%oq + m%nq), &
-                                     y(f%ov + 1:f%ov + m%nv))
+                text = flexible_line(m, trim(scene%bodies(1)%name), y(oq + 1:oq + m%nq), &
+                                     y(ov + 1:ov + m%nv))
             end select
         end select
 
@@ -87,13 +90,14 @@ contains
             character(len=*), intent(in) :: names(:)
             character(len=:), allocatable :: lines
             character(len=:), allocatable :: name
-            integer :: j
+            integer :: j, lq, nq, lv, nv
             lines = ''
-            do j = 1, size(chain%bodies)
+            do j = 1, chain%link_count()
                 name = 'link ' // int_text(j)
                 if (j <= size(names)) name = trim(names(j))
-                associate (c => q(chain%iq(j) + 1:chain%iq(j + 1)))
-                    select case (chain%bodies(j)%joint)
+                call chain%link_coordinates(j, lq, nq, lv, nv)
+                associate (c => q(lq + 1:lq + nq))
+                    select case (chain%link_joint(j))
                     case (chain_joint_prismatic)
                         lines = lines // '  ' // name // ': joint displacement ' // &
                             fixed(c(1), 4) // ' m' // nl
@@ -132,16 +136,15 @@ contains
         real(wp) :: xi(3), xj(3), ai(3, 3), aj(3, 3)
         logical :: angle, displaced(3)
         character(len=:), allocatable :: name, values
-        integer :: a
+        integer :: a, markers(2)
         line = ''
         name = trim(group_name(index(group_name, '/') + 1:))
-        associate (jt => sys%joints(k))
-            angle = joint_has_angle(jt%joint%kind)
-            displaced = joint_displaced_axes(jt%joint%kind)
-            if (.not. (angle .or. any(displaced))) return
-            call sys%marker_pose(jt%marker_i, q, xi, ai)
-            call sys%marker_pose(jt%marker_j, q, xj, aj)
-        end associate
+        angle = joint_has_angle(sys%joint_kind(k))
+        displaced = joint_displaced_axes(sys%joint_kind(k))
+        if (.not. (angle .or. any(displaced))) return
+        markers = sys%joint_markers(k)
+        call sys%marker_pose(markers(1), q, xi, ai)
+        call sys%marker_pose(markers(2), q, xj, aj)
         if (angle) line = '  ' // name // ': angle ' // &
             fixed(joint_angle(ai, aj) * degrees, 2) // ' deg' // nl
         if (.not. any(displaced)) return
@@ -158,14 +161,17 @@ contains
     !> 'coupler: largest displacement D m (node N), largest von Mises stress S Pa'
     !> flexible_line of a modal body's reconstructed nodes.
     function modal_line(body, name, q, v) result(line)
-        type(modal_body_t), intent(inout) :: body
+        type(modal_body_t), intent(inout), target :: body
         character(len=*), intent(in) :: name
         real(wp), intent(in) :: q(:), v(:)
         character(len=:), allocatable :: line
-        real(wp) :: x(3 * body%fe%mesh%node_count()), xd(3 * body%fe%mesh%node_count())
+        type(flexible_body_t), pointer :: fe
+        real(wp), allocatable :: x(:), xd(:)
+        fe => body%fe_body()
+        allocate (x(3 * fe%node_count()), xd(3 * fe%node_count()))
         call body%node_positions(q, x)
         call body%node_velocities(q, v, xd)
-        line = flexible_line(body%fe, name // ' (modal)', x, xd)
+        line = flexible_line(fe, name // ' (modal)', x, xd)
     end function modal_line
 
     function flexible_line(body, name, q, v) result(line)
@@ -174,16 +180,14 @@ contains
         real(wp), intent(in) :: q(:), v(:)
         character(len=:), allocatable :: line
         real(wp), allocatable :: sigma(:, :), mises(:)
-        real(wp) :: u(3), largest
+        real(wp) :: u(3), largest, displacements(3 * body%node_count())
         type(status_t) :: status
-        integer :: i, j, at
+        integer :: i, at
         largest = 0.0_wp
         at = 0
-        do i = 1, size(body%dof, 2)
-            u = 0.0_wp
-            do j = 1, 3
-                if (body%dof(j, i) > 0) u(j) = q(body%dof(j, i)) - body%mesh%x(j, i)
-            end do
+        call body%nodal_values(q, .true., displacements)
+        do i = 1, body%node_count()
+            u = displacements(3 * i - 2:3 * i)
             if (norm2(u) > largest .or. at == 0) then
                 largest = norm2(u)
                 at = i
@@ -191,7 +195,7 @@ contains
         end do
         line = '  ' // name // ': largest displacement ' // real_text(largest) // ' m (node ' &
             // int_text(at) // ')'
-        allocate (sigma(6, body%mesh%element_count()), mises(body%mesh%element_count()))
+        allocate (sigma(6, body%element_count()), mises(body%element_count()))
         call body%element_stress(q, v, sigma, mises, status)
         if (status%ok() .and. size(mises) > 0) line = line // ', largest von Mises stress ' // &
             real_text(maxval(mises)) // ' Pa (element ' // &
