@@ -160,6 +160,7 @@ contains
         type(csc_matrix_t) :: union
         integer, allocatable :: rows(:), cols(:), mrows(:), mcols(:)
         integer :: i, j, nj, nm, k, n, stat
+        integer(i8) :: filled !! positions listed so far
         n = w%n
         associate (data => w%data)
             select case (data%mass%storage)
@@ -201,9 +202,9 @@ contains
                 call out_of_memory(st, 'ida iteration pattern positions', 2_i8 * (nj + nm), 4)
                 return
             end if
-            k = 0
-            call append_pattern(data%jac, rows, cols, k)
-            call append_pattern(data%mass_csc, rows, cols, k)
+            filled = 0
+            call data%jac%append_positions(rows, cols, filled)
+            call data%mass_csc%append_positions(rows, cols, filled)
             call union%build(n, n, rows, cols, st)
             if (.not. st%ok()) return
             data%nnz = union%nnz
@@ -213,22 +214,6 @@ contains
             data%mass_slot = union%triplet_map(nj + 1:nj + nm)
         end associate
     end subroutine build_iteration_pattern
-
-    !> Append the 1-based positions of a's entries to (rows, cols) after k.
-    pure subroutine append_pattern(a, rows, cols, k)
-        type(csc_matrix_t), intent(in) :: a
-        integer, intent(inout) :: rows(:), cols(:)
-        integer, intent(inout) :: k
-        integer :: j
-        integer(i8) :: p
-        do j = 1, a%ncol
-            do p = a%colptr(j) + 1, a%colptr(j + 1)
-                k = k + 1
-                rows(k) = int(a%rowind(p)) + 1
-                cols(k) = j
-            end do
-        end do
-    end subroutine append_pattern
 
     !> y'0: given, F (M = I), guessed for IDACalcIC, or the problem's.
     subroutine initial_derivative(self, w, problem, st, yp)

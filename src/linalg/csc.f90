@@ -29,9 +29,28 @@ module flexmbs_linalg_csc
         procedure :: to_dense => csc_to_dense
         procedure :: find => csc_find
         procedure :: is_built => csc_is_built
+        procedure :: append_positions => csc_append_positions
     end type csc_matrix_t
 
 contains
+
+    !> Append the 1-based (row, column) of every slot, in slot order, to
+    !> (rows, cols) after their first k entries; k becomes the last filled
+    !> (the triplets of a union pattern: dae/ida_setup, linalg/shifted_pattern).
+    pure subroutine csc_append_positions(self, rows, cols, k)
+        class(csc_matrix_t), intent(in) :: self
+        integer, intent(inout) :: rows(:), cols(:)
+        integer(i8), intent(inout) :: k
+        integer :: j
+        integer(i8) :: p
+        do j = 1, self%ncol
+            do p = self%colptr(j) + 1, self%colptr(j + 1)
+                k = k + 1
+                rows(k) = int(self%rowind(p)) + 1
+                cols(k) = j
+            end do
+        end do
+    end subroutine csc_append_positions
 
     !> Build the pattern from triplets (1-based rows and columns). Duplicate
     !> positions share one slot. Values are zeroed.

@@ -211,8 +211,8 @@ contains
             cols(i) = i
         end do
         k = n
-        call list_slots(jac%csc, n, rows, cols, k)
-        if (mass%storage == storage_sparse) call list_slots(mass%csc, n, rows, cols, k)
+        call jac%csc%append_positions(rows, cols, k)
+        if (mass%storage == storage_sparse) call mass%csc%append_positions(rows, cols, k)
         call union%build(n, n, rows, cols, status)
         if (.not. status%ok()) return
         self%diag_slot = union%triplet_map(1:n)
@@ -221,23 +221,6 @@ contains
         call move_alloc(union%colptr, self%colptr)
         call move_alloc(union%rowind, self%rowind)
     end subroutine sparse_union
-
-    !> Append the (row, column) of every CSC slot of a, in slot order.
-    subroutine list_slots(a, n, rows, cols, k)
-        type(csc_matrix_t), intent(in) :: a
-        integer, intent(in) :: n
-        integer, intent(inout) :: rows(:), cols(:)
-        integer(i8), intent(inout) :: k !! last filled triplet
-        integer :: j
-        integer(i8) :: p
-        do j = 1, n
-            do p = a%colptr(j) + 1, a%colptr(j + 1)
-                k = k + 1
-                rows(k) = int(a%rowind(p)) + 1
-                cols(k) = j
-            end do
-        end do
-    end subroutine list_slots
 
     !> True when M and J keep the storages and CSC sizes they had at build
     !> (the slot maps were built for those); otherwise a message in status.
