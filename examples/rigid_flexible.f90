@@ -145,7 +145,7 @@ program rigid_flexible
     formulation = new_formulation(sys, form, q0, constant_mass=.true., status=status)
     call check(status)
     allocate (y(formulation%n), yp(formulation%n), source=0.0_wp)
-    y(formulation%oq + 1:formulation%oq + sys%nq) = q0
+    y(formulation%offset(block_q) + 1:formulation%offset(block_q) + sys%nq) = q0
     call formulation%consistent_initial(0.0_wp, y, yp, status)
     call check(status)
 
@@ -153,8 +153,8 @@ program rigid_flexible
     options%atol = tol
     options%output_times = [(0.1_wp * i, i = 0, 5)]
     sink%sys => sys
-    sink%oq = formulation%oq
-    sink%ov = formulation%ov
+    sink%oq = formulation%offset(block_q)
+    sink%ov = formulation%offset(block_v)
     sink%hub = 2
     sink%tip = size(markers)
     write (*, '(a,i0,a,i0,a,i0,a)') 'rigid link + soft block: ', sys%nq, ' coordinates, ', &
@@ -164,7 +164,8 @@ program rigid_flexible
     call check(status)
 
     allocate (c(sys%nc))
-    call sys%constraint(t, y(formulation%oq + 1:formulation%oq + sys%nq), c, status)
+    call sys%constraint(t, y(formulation%offset(block_q) + 1:formulation%last(block_q)), c, &
+        status)
     call check(status)
     closure = maxval(abs(c))
     weight = (link(1)%mass + density * product(block)) * norm2(g)

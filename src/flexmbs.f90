@@ -34,7 +34,8 @@ module flexmbs
     use flexmbs_fe_flexible_body, only: flexible_body_t, new_flexible_body
     use flexmbs_fe_statics, only: solve_static, static_options_t, static_report_t
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &
-        formulation_index2, formulation_index3, formulation_ggl
+        formulation_index2, formulation_index3, formulation_ggl, block_q, block_v, block_a, &
+        block_lambda, block_mu
     use flexmbs_mbs_rigid_body, only: rigid_bodies_t, rigid_body_t, new_rigid_bodies, &
         rigid_body_energy, rigid_body_momenta
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
