@@ -41,7 +41,7 @@ contains
         type(node_set_t), allocatable :: sets(:)
         type(modal_basis_t) :: basis
         real(wp), allocatable :: qf(:), vf(:)
-        character(len=:), allocatable :: where, print
+        character(len=:), allocatable :: where, print, set_name
         real(wp) :: centroid(3), centre(3)
         integer, allocatable :: nodes(:)
         integer :: j
@@ -65,7 +65,10 @@ contains
                         trim(names(j)) // ''': ' // status%text())
                     return
                 end if
-                sets(j) = node_set_t(trim(names(j)), nodes)
+                ! through a named variable: gfortran 12 leaks a trimmed temporary
+                ! given to the allocatable name of a structure constructor
+                set_name = trim(names(j))
+                sets(j) = node_set_t(set_name, nodes)
             end do
             print = basis_fingerprint(fe, sets, b%modes)
             found = .false.
