@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Behaviour unchanged? Every scene of inputs/ cut short, with each solver, and
 # variants (every step to the sink; finite-difference Jacobians, dense and
-# KLU, tight, loose and capped runs, MEXAX's Euler base, ...): 264 runs, a
+# KLU, tight, loose and capped runs, MEXAX's Euler base, ...): 272 runs, a
 # few minutes on one core.
 #
 #   bash bench/identity/grid.sh FLEXMBS OUTDIR     (EXTRA="key = value" adds
@@ -33,6 +33,9 @@ for s in $solvers; do
     for n in $small; do run A_${n}_$s $n 0.1 $s; done
     run A_van_der_pol_$s van_der_pol 0.5 $s
     for n in five_body five_body_undamped; do run A_${n}_$s $n 0.05 $s; done
+    # scenes added later, default settings only: modal bodies, the planar joint
+    run A_five_body_modal_$s five_body_modal 0.05 $s
+    run A_planar_slider_$s planar_slider 0.1 $s
     for n in five_body_fine five_body_fine_undamped; do
         if [ $s = mexax ]; then run A_${n}_$s $n 0.003 $s max_steps=25
         else run A_${n}_$s $n 0.003 $s; fi
