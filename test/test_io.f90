@@ -19,7 +19,7 @@ module test_io
     use flexmbs_io_progress, only: progress_t, new_progress
     use flexmbs_dae_radau5, only: radau5_t, radau5_controller_classical
     use flexmbs_dae_solver, only: dae_solver_t
-    use flexmbs_io_scene_input, only: setting_given, given_setting
+    use flexmbs_io_scene_input, only: given_setting
     use flexmbs_dae_solver_setting, only: solver_setting_t
     use flexmbs_run_solver_factory, only: build_solver, new_solver
     use flexmbs_run_catalogue, only: solvers
@@ -137,7 +137,10 @@ contains
         call check(error, index(scene%text, '&SOLVER') > 0, 'text kept')
         if (allocated(error)) return
         ! given settings reach the solver; the others keep its type's defaults
-        call check(error, setting_given(scene, 'thet') .and. .not. setting_given(scene, 'nit'), &
+        setting = given_setting(scene, 'nit')
+        call check(error, len_trim(setting%name) == 0, 'nit not given')
+        setting = given_setting(scene, 'thet')
+        call check(error, setting%name == 'thet', &
                    'settings given')
         call build_solver(scene, solver, status)
         call check(error, status%ok(), 'build_solver: ' // status%text())

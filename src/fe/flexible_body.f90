@@ -21,6 +21,7 @@ module flexmbs_fe_flexible_body
     use flexmbs_fe_neo_hooke, only: neo_hooke_t
     use flexmbs_fe_element, only: element_mass, element_forces
     use flexmbs_fe_mesh, only: mesh_t
+    use flexmbs_fe_element_colouring, only: colour_elements
     implicit none
     private
 
@@ -202,7 +203,8 @@ contains
         nthreads = 1
         !$ nthreads = omp_get_max_threads()
         call allocate_workspace(body, nthreads)
-        call colour_elements(body)
+        call colour_elements(mesh%connectivity, mesh%node_count(), body%colour_start, &
+                             body%colour_elements)
         call build_patterns(body, status)
     end subroutine new_flexible_body
 
@@ -430,51 +432,6 @@ contains
         call status%set(code, 'flexible body: element ' // int_text(e) // ': ' // &
                         status%text(), reason)
     end subroutine name_element
-
-    !> Greedy colouring: each element takes the lowest colour not used by an
-    !> element sharing one of its nodes (colours as bits per node, 64 per
-    !> word); the elements are then listed colour by colour, in element order.
-    subroutine colour_elements(body)
-        class(flexible_body_t), intent(inout) :: body
-        integer(i8), allocatable :: used(:, :)
-        integer, allocatable :: colour(:)
-        integer(i8) :: mask
-        integer :: e, a, w, b, nwords, ncolour, ne, node
-        ne = body%mesh%element_count()
-        nwords = 1
-        allocate (colour(ne))
-        do
-            allocate (used(nwords, body%mesh%node_count()), source=0_i8)
-            ncolour = 0
-            elements: do e = 1, ne
-                do w = 1, nwords
-                    mask = 0_i8
-                    do a = 1, body%hex%nnode
-                        mask = ior(mask, used(w, body%mesh%connectivity(a, e)))
-                    end do
-                    if (mask == not(0_i8)) cycle
-                    b = trailz(not(mask))
-                    colour(e) = 64 * (w - 1) + b + 1
-                    ncolour = max(ncolour, colour(e))
-                    do a = 1, body%hex%nnode
-                        node = body%mesh%connectivity(a, e)
-                        used(w, node) = ibset(used(w, node), b)
-                    end do
-                    cycle elements
-                end do
-                exit
-            end do elements
-            if (e > ne) exit
-            deallocate (used)
-            nwords = 2 * nwords
-        end do
-        allocate (body%colour_start(ncolour + 1), body%colour_elements(ne))
-        body%colour_start(1) = 1
-        do a = 1, ncolour
-            body%colour_start(a + 1) = body%colour_start(a) + count(colour == a)
-        end do
-        body%colour_elements = [(pack([(e, e = 1, ne)], colour == a), a = 1, ncolour)]
-    end subroutine colour_elements
 
     !> Element workspaces for n threads (gathers and element results).
     subroutine allocate_workspace(body, n)

@@ -91,22 +91,13 @@ module flexmbs_io_scene_input
         procedure :: has_body => scene_has_body
     end type scene_input_t
 
-    public :: setting_given, given_setting, marker_index, flexible_index, material_of, nonlinear_body, &
+    public :: given_setting, marker_index, flexible_index, material_of, nonlinear_body, &
         modal_body
 
 contains
 
-    !> Whether the scene gives the solver setting `name` (&solver).
-    pure logical function setting_given(scene, name)
-        type(scene_input_t), intent(in) :: scene
-        character(len=*), intent(in) :: name
-        setting_given = .false.
-        if (allocated(scene%solver_settings)) &
-            setting_given = any(scene%solver_settings%name == name)
-    end function setting_given
-
-    !> The solver setting `name` the scene gives (setting_given), or one
-    !> without a name.
+    !> The solver setting `name` the scene gives, or one without a name when
+    !> it gives none.
     pure function given_setting(scene, name) result(setting)
         type(scene_input_t), intent(in) :: scene
         character(len=*), intent(in) :: name
