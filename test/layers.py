@@ -12,10 +12,10 @@
 - bench/ and the command line build solvers through the catalogue's
   factories: bench/ uses no solver module's type.
 - The types of src/mbs/ and src/fe/ keep their parts: src/run/ and src/io/
-  reach into their data components (`var%component`, `var` declared of such
-  a type, the component not a type-bound procedure) at most REACH_IN_BOUND
-  times; the bound only comes down, towards 10, each with a comment saying
-  why (issue 35).
+  reach into their data components (a reference chain that steps into a
+  component, not a type-bound procedure, of such a type: test/reach_ins.py
+  follows declarations, components, associate and select type names) at
+  most REACH_IN_BOUND times, each with a comment saying why (issue 35).
 - The scene schema's joint types (joint_choices) are those of the table
   of joint types (src/mbs/joint_types.f90).
 
@@ -25,6 +25,10 @@ Prints `pass layers/...` or `FAIL layers/...: why` lines and
 import os
 import re
 import sys
+import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from reach_ins import reach_ins, sources  # noqa: E402
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..')
 SOLVERS = ('radau5', 'ddassl', 'ida', 'mexax')
@@ -48,15 +52,6 @@ def report(name, problems):
     else:
         passed += 1
         print('pass layers/%s' % name)
-
-
-def sources(*folders):
-    for folder in folders:
-        for base, _, files in os.walk(os.path.join(ROOT, folder)):
-            for f in sorted(files):
-                if f.endswith(('.f90', '.F90', '.inc')):
-                    path = os.path.join(base, f)
-                    yield os.path.relpath(path, ROOT), path
 
 
 def strings(line):
@@ -136,65 +131,44 @@ if not pchoices or re.sub(r"&\s*&", '', pchoices.group(1)).split('|') != pnames:
     problems.append('problem_choices differs from the table %s' % pnames)
 report('catalogue-names-are-the-solvers-names', problems)
 
-# Reach-ins from run/ and io/ into the components of mbs/ and fe/ types.
-# 0: named_output, summary, vtk_sink and multibody_builder ask the
-# formulation's blocks and the system's, chains', markers' and bodies'
-# bindings (issue 35, part 3); a new reach-in fails
+# Reach-ins from run/ and io/ into the components of mbs/ and fe/ types,
+# following chains through components, associate and select type names
+# (test/reach_ins.py). 0: the outer layers ask the formulation's blocks and
+# the system's, chains', markers' and bodies' bindings (issue 35, part 3);
+# a new reach-in fails
 REACH_IN_BOUND = 0
 
+# the counter's own check: a sample with each kind of chain it follows
+SAMPLE = """subroutine sample(plan, sys)
+    type(run_plan_t), intent(in) :: plan
+    type(mbs_system_t), pointer :: sys
+    select type (m => plan%mechanical)
+    type is (mbs_system_t)
+        n = size(m%chains)
+        associate (c => m%chains(1))
+            k = c%nq + c%link_count()
+            x = c%bodies(1)%centre
+        end associate
+    end select
+    n = sys%joint_count() + sys%joints(1)%joint%kind
+end subroutine sample
+"""
+EXPECTED = ['mbs_system_t%chains', 'mbs_system_t%chains', 'rigid_chain_t%bodies',
+            'chain_body_t%centre', 'mbs_system_t%joints', 'assembled_joint_t%joint',
+            'joint_t%kind']
+with tempfile.TemporaryDirectory() as folder:
+    with open(os.path.join(folder, 'sample.f90'), 'w', encoding='utf-8') as f:
+        f.write(SAMPLE)
+    seen = [r.split()[1] for r in reach_ins(outer=(folder,))]
+report('reach-in-counter-follows-chains',
+       [] if seen == EXPECTED else ['found %s, expected %s' % (seen, EXPECTED)])
 
-def type_parts(folders):
-    """{type name: (data components, bindings)} of the derived types defined
-    in `folders`."""
-    parts = {}
-    start = re.compile(r'type\s*(?:,\s*[^:]*)?::\s*(\w+)\s*$', re.I)
-    for rel, path in sources(*folders):
-        current, bound = None, False
-        for line in open(path, encoding='utf-8'):
-            code = line.split('!')[0].strip()
-            m = start.match(code)
-            if m:
-                current, bound = m.group(1).lower(), False
-                parts[current] = (set(), set())
-                continue
-            if current is None:
-                continue
-            if re.match(r'end\s*type\b', code, re.I):
-                current = None
-            elif code.lower() == 'contains':
-                bound = True
-            elif '::' in code:
-                names = [re.match(r'\s*(\w+)', part) for part in
-                         re.split(r',(?![^()]*\))', code.split('::', 1)[1])]
-                target = parts[current][1] if bound else parts[current][0]
-                target.update(n.group(1).lower() for n in names if n)
-    return parts
-
-
-parts = type_parts(('src/mbs', 'src/fe'))
-declared = re.compile(r'(?:type|class)\s*\(\s*(\w+)\s*\)[^:\n]*::\s*([^\n!]*)', re.I)
-reference = re.compile(r'\b(\w+)\s*(?:\([^()]*(?:\([^()]*\)[^()]*)*\))?\s*%\s*(\w+)')
-reach_ins = []
-for rel, path in sources('src/run', 'src/io'):
-    text = open(path, encoding='utf-8').read()
-    kinds = {}
-    for m in declared.finditer(text):
-        if m.group(1).lower() in parts:
-            for part in re.split(r',(?![^()]*\))', m.group(2)):
-                n = re.match(r'\s*(\w+)', part)
-                if n:
-                    kinds[n.group(1).lower()] = m.group(1).lower()
-    for k, line in enumerate(text.split('\n'), 1):
-        for m in reference.finditer(line.split('!')[0]):
-            var, component = m.group(1).lower(), m.group(2).lower()
-            if var in kinds and component in parts[kinds[var]][0]:
-                reach_ins.append('%s:%d %s%%%s (%s)' % (rel, k, var, component, kinds[var]))
+found = reach_ins()
 print('    %d reach-ins from run/ and io/ into mbs/ and fe/ components (bound %d)'
-      % (len(reach_ins), REACH_IN_BOUND))
+      % (len(found), REACH_IN_BOUND))
 report('run-and-io-keep-out-of-mbs-and-fe-components',
-       [] if len(reach_ins) <= REACH_IN_BOUND else
-       ['%d reach-ins, more than %d: %s' % (len(reach_ins), REACH_IN_BOUND, r)
-        for r in reach_ins])
+       [] if len(found) <= REACH_IN_BOUND else
+       ['%d reach-ins, more than %d: %s' % (len(found), REACH_IN_BOUND, r) for r in found])
 
 # The scene's joint types are the table's: joint_choices lists, in order,
 # the entries of flexmbs_mbs_joint_types that have primitives of their own.

@@ -44,7 +44,7 @@ module flexmbs_io_vtk_sink
     use flexmbs_mbs_modal_body, only: modal_body_t
     use flexmbs_mbs_rotation, only: rotation_matrix
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
-    use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_mbs_system, only: mbs_system_t, part_chain
     use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_mbs_joint_types, only: joint_primitive, joint_name
     use flexmbs_mbs_primitive_kinds, only: primitive_name, primitive_angle_driver, &
@@ -68,16 +68,13 @@ module flexmbs_io_vtk_sink
         character(len=:), allocatable :: prefix
         type(vtk_flexible_t), allocatable :: flexible(:) !! none: no mesh files
         integer :: bodies = 0         !! rigid bodies: (r, p) at y(7 b − 6 : 7 b)
-        !> chains (substructures), their links after them, chain c's
-        !> coordinates after y(chain_q(c))
-        type(rigid_chain_t), pointer :: chains(:) => null()
-        integer, allocatable :: chain_q(:)
         !> the names of the rigid bodies, then of the chains' links (a point
         !> each in the bodies' files: field data body_names, point data body_id)
         character(len=32), allocatable :: names(:)
-        !> a multibody system's joints and drivers (a point each in the
-        !> joints' files): its q after y(system_q); the reactions from its
-        !> formulation's consistent multipliers (none: no reactions)
+        !> a multibody system: its chains' links (after the rigid bodies) and
+        !> its joints and drivers (a point each in the joints' files), its q
+        !> after y(system_q); the reactions from its formulation's consistent
+        !> multipliers (none: no reactions)
         type(mbs_system_t), pointer :: system => null()
         type(formulation_t), pointer :: formulation => null()
         integer :: system_q = 0
@@ -329,20 +326,23 @@ contains
         real(wp) :: a(3, 3), centre(3, self%bodies + links(self)), &
             axes(3, 3, self%bodies + links(self))
         type(vtu_file_t) :: file
-        integer :: b, k, n, f
+        type(rigid_chain_t), pointer :: chain
+        integer :: b, k, n, f, oq, ov
         n = self%bodies + links(self)
         do b = 1, self%bodies
             centre(:, b) = y(7 * b - 6:7 * b - 4)
             axes(:, :, b) = rotation_matrix(y(7 * b - 3:7 * b))
         end do
         n = self%bodies
-        if (associated(self%chains)) then
-            do f = 1, size(self%chains)
-                do b = 1, size(self%chains(f)%bodies)
+        if (associated(self%system)) then
+            do f = 1, self%system%chain_count()
+                chain => self%system%chain_of(f)
+                call self%system%part_offsets(part_chain, f, oq, ov)
+                do b = 1, chain%link_count()
                     n = n + 1
-                    associate (ch => self%chains(f), c => centre(:, n), oq => self%chain_q(f))
-                        call ch%body_frame(y(oq + 1:oq + ch%nq), b, c, a)
-                        c = c + matmul(a, ch%bodies(b)%centre)
+                    associate (c => centre(:, n))
+                        call chain%body_frame(y(oq + 1:oq + chain%nq), b, c, a)
+                        c = c + matmul(a, chain%link_centre(b))
                         axes(:, :, n) = a
                     end associate
                 end do
@@ -382,7 +382,7 @@ contains
         character(len=32) :: types(joints(self))
         character(len=80) :: names(joints(self))
         type(vtu_file_t) :: file
-        integer :: k, n
+        integer :: k, n, kind_k, first, markers(2)
         logical :: reactions
         n = joints(self)
         reactions = associated(self%formulation)
@@ -392,18 +392,18 @@ contains
         end if
         associate (sys => self%system, q => y(self%system_q + 1:self%system_q + self%system%nq))
             do k = 1, n
-                associate (jt => sys%joints(k))
-                    call sys%marker_pose(jt%marker_i, q, xi(:, k), ai)
-                    call sys%marker_pose(jt%marker_j, q, xj, aj)
-                    offset(:, k) = xj - xi(:, k)
-                    axis(:, k) = ai(:, joint_axis(jt%joint%kind, jt%joint%primitive(1), &
-                                                  jt%joint%axis_i(1)))
-                    types(k) = joint_name(jt%joint%kind)
-                    if (jt%joint%kind == joint_primitive) types(k) = &
-                        primitive_name(jt%joint%primitive(1))
-                    if (reactions) call sys%joint_reaction(k, t, q, lambda, force(:, :, k), &
-                                                           torque(:, :, k))
-                end associate
+                markers = sys%joint_markers(k)
+                call sys%marker_pose(markers(1), q, xi(:, k), ai)
+                call sys%marker_pose(markers(2), q, xj, aj)
+                offset(:, k) = xj - xi(:, k)
+                kind_k = sys%joint_kind(k)
+                first = 0
+                if (sys%joint_primitive_count(k) > 0) first = sys%joint_primitive(k, 1)
+                axis(:, k) = ai(:, joint_axis(kind_k, first, sys%joint_axis(k)))
+                types(k) = joint_name(kind_k)
+                if (kind_k == joint_primitive) types(k) = primitive_name(first)
+                if (reactions) call sys%joint_reaction(k, t, q, lambda, force(:, :, k), &
+                                                       torque(:, :, k))
                 names(k) = 'joint ' // int_text(k)
                 if (allocated(self%joint_names)) then
                     if (k <= size(self%joint_names)) names(k) = self%joint_names(k)
@@ -421,7 +421,7 @@ contains
         call file%cells([(k, k=1, n)], [(k, k=1, n)], [(1, k=1, n)])
         call file%line('<PointData Vectors="axis">')
         call file%integers('joint_id', [(k, k=1, n)])
-        call file%integers('joint_type', [(self%system%joints(k)%joint%kind, k=1, n)])
+        call file%integers('joint_type', [(self%system%joint_kind(k), k=1, n)])
         call file%reals('axis', axis)
         call file%reals('marker_j_offset', offset)
         if (reactions) then
@@ -452,7 +452,7 @@ contains
     pure integer function joints(self)
         class(vtk_sink_t), intent(in) :: self
         joints = 0
-        if (associated(self%system)) joints = size(self%system%joints)
+        if (associated(self%system)) joints = self%system%joint_count()
     end function joints
 
     !> Whether there are flexible bodies to draw.
@@ -467,9 +467,9 @@ contains
         class(vtk_sink_t), intent(in) :: self
         integer :: f
         links = 0
-        if (.not. associated(self%chains)) return
-        do f = 1, size(self%chains)
-            links = links + size(self%chains(f)%bodies)
+        if (.not. associated(self%system)) return
+        do f = 1, self%system%chain_count()
+            links = links + self%system%link_count(f)
         end do
     end function links
 

@@ -85,7 +85,7 @@ module flexmbs_mbs_formulation
     !> A mechanical problem in one formulation, as a `dae_problem_t`.
     type, extends(dae_problem_t), public :: formulation_t
         class(mechanical_problem_t), pointer :: mechanical => null()
-        integer :: form = formulation_index2
+        integer, private :: form = formulation_index2 !! outside the module: form_kind
         logical :: accelerations = .true.  !! layout (q, v, a, λ[, μ]) or (q, v, λ[, μ])
         real(wp), private :: baumgarte_zeta = 0.0_wp  !! index 1: damping ratio ζ
         !> index 1: frequency ω (0: no Baumgarte)
@@ -95,7 +95,8 @@ module flexmbs_mbs_formulation
         real(wp) :: projection_rtol = 1.0e-6_wp !! weights rtol |q| + atol of §6
         real(wp) :: projection_atol = 1.0e-6_wp
         integer, private :: projection_calls = 0
-        integer :: nq = 0, nv = 0, nc = 0
+        !> outside the module: block_size of block_q, block_v, block_lambda
+        integer, private :: nq = 0, nv = 0, nc = 0
         !> offsets of the blocks in y (outside the module: offset, block_size, last)
         integer, private :: oq = 0, ov = 0, oa = 0, ol = 0, om = 0
         real(wp), allocatable, private :: q_mass(:)   !! where the constant M is evaluated
@@ -137,6 +138,7 @@ module flexmbs_mbs_formulation
         procedure :: has_projection => formulation_has_projection
         procedure :: offset => formulation_offset
         procedure :: block_size => formulation_block_size
+        procedure :: form_kind => formulation_form_kind
         procedure :: last => formulation_last
         procedure :: project => formulation_project
         procedure :: consistent_initial => formulation_consistent_initial
@@ -688,6 +690,12 @@ contains
             offset = -1
         end select
     end function formulation_offset
+
+    !> The formulation (formulation_index1, _index2, _index3, formulation_ggl).
+    pure integer function formulation_form_kind(self) result(form)
+        class(formulation_t), intent(in) :: self
+        form = self%form
+    end function formulation_form_kind
 
     !> The length of block `block` in y: 0 for a block the layout has not
     !> (a without accelerations, μ outside GGL) and for another number.

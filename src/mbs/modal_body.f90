@@ -84,6 +84,7 @@ module flexmbs_mbs_modal_body
         procedure :: mass_derivative => modal_mass_derivative
         procedure :: force_derivatives => modal_force_derivatives
         procedure :: energy => modal_energy
+        procedure :: elastic_energy => modal_elastic_energy
         procedure :: total_energy => modal_total_energy
         procedure :: momenta => modal_momenta
         procedure :: interface_pose => modal_interface_pose
@@ -439,6 +440,13 @@ contains
         end associate
     end subroutine modal_force_derivatives
 
+    !> The elastic energy ½ Σ ω_l² η_l² of the reduced model at q = (r, p, η).
+    pure real(wp) function modal_elastic_energy(self, q) result(e)
+        class(modal_body_t), intent(in) :: self
+        real(wp), intent(in) :: q(:)
+        e = 0.5_wp * dot_product(self%stiffness, q(8:)**2)
+    end function modal_elastic_energy
+
     !> Kinetic energy ½ vᵀ M v, elastic ½ Σ ω_l² η_l², gravity −m g·r.
     subroutine modal_energy(self, q, v, kinetic, potential)
         class(modal_body_t), intent(inout) :: self
@@ -447,7 +455,7 @@ contains
         real(wp) :: m(self%nv, self%nv)
         call self%mass_matrix(q, m)
         kinetic = 0.5_wp * dot_product(v, matmul(m, v))
-        potential = 0.5_wp * dot_product(self%stiffness, q(8:)**2) &
+        potential = self%elastic_energy(q) &
             - self%total_mass * dot_product(self%gravity, q(1:3))
     end subroutine modal_energy
 

@@ -298,6 +298,7 @@ module flexmbs_mbs_system
         procedure :: joint_markers => system_joint_markers
         procedure :: joint_primitive_count => system_joint_primitive_count
         procedure :: joint_primitive => system_joint_primitive
+        procedure :: joint_axis => system_joint_axis
     end type mbs_system_t
 
     public :: new_mbs_system, driver_t, driver_values, node_frame_t, force_element_t
@@ -889,6 +890,11 @@ module flexmbs_mbs_system
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: j, p
         end function system_joint_primitive
+        !> The axis (1, 2, 3 of marker i's frame) of joint j's first primitive.
+        pure integer module function system_joint_axis(self, j) result(axis)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: j
+        end function system_joint_axis
     end interface
 
 contains

@@ -109,4 +109,8 @@ contains
     module procedure system_joint_primitive
         kind = self%joints(j)%joint%primitive(p)
     end procedure system_joint_primitive
+
+    module procedure system_joint_axis
+        axis = self%joints(j)%joint%axis_i(1)
+    end procedure system_joint_axis
 end submodule flexmbs_mbs_system_views

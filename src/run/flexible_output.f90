@@ -110,29 +110,31 @@ contains
         type(stress_values_t) :: stress
         type(energy_values_t) :: energy
         type(modal_values_t) :: eta
+        type(flexible_body_t), pointer :: fe
         character(len=:), allocatable :: base
         integer :: n3
         base = 'flexible/' // path_name(name) // '/'
-        call write_mesh(h5, body%fe, base, status)
+        fe => body%fe_body()
+        call write_mesh(h5, fe, base, status)
         if (status%ok()) call h5%write_vector(base // 'frequencies', body%frequencies(), &
                                               status)
         if (status%ok()) call h5%annotate(base // 'frequencies', 'unit', 'rad/s', status)
         if (status%ok()) call h5%annotate(base // 'frequencies', 'description', 'the modal &
             &body''s own frequencies (its reduced K and M), one per modal coordinate', status)
         if (.not. status%ok()) return
-        n3 = 3 * body%fe%mesh%node_count()
-        nodes%body => body%fe
+        n3 = 3 * fe%node_count()
+        nodes%body => fe
         nodes%modal => body
         allocate (nodes%x(n3), stress%x(n3), stress%xd(n3))
-        stress%body => body%fe
+        stress%body => fe
         stress%modal => body
-        energy%body => body%fe
+        energy%body => fe
         energy%modal => body
         call add_body_series(h5, base, oq, ov, nodes, stress, energy, status)
-        if (.not. status%ok() .or. body%modes == 0) return
+        if (.not. status%ok() .or. body%mode_count() == 0) return
         eta%oq = oq
-        eta%n = body%modes
-        call h5%add_series(base // 'modal_coordinates', body%modes, '1', eta, status, &
+        eta%n = body%mode_count()
+        call h5%add_series(base // 'modal_coordinates', body%mode_count(), '1', eta, status, &
             'eta of every mode (shapes M-orthonormal: eta in sqrt(kg) m)')
     end subroutine add_modal
 
@@ -177,7 +179,7 @@ contains
         type(energy_values_t), intent(inout) :: energy
         type(status_t), intent(out) :: status
         integer :: nn, ne, stat
-        nn = nodes%body%mesh%node_count()
+        nn = nodes%body%node_count()
         nodes%oq = oq
         nodes%ov = ov
         nodes%velocity = .false.
@@ -188,7 +190,7 @@ contains
         call h5%add_series(base // 'velocity', 3, 'm/s', nodes, status, 'of every node', &
             columns=nn)
         if (.not. status%ok()) return
-        ne = nodes%body%mesh%element_count()
+        ne = nodes%body%element_count()
         allocate (stress%sigma(6, ne), stress%mises(ne), stat=stat)
         if (stat /= 0) then
             call out_of_memory(status, 'the elements'' stress for the HDF5 file', &
@@ -282,7 +284,7 @@ contains
                 ! the energy of the reduced model: ½ Σ ω² η² and ½ vᵀ M v
                 call m%energy(y(self%oq + 1:self%oq + m%nq), y(self%ov + 1:self%ov + m%nv), &
                               kinetic, potential)
-                values(1) = 0.5_wp * dot_product(m%stiffness, y(self%oq + 8:self%oq + m%nq)**2)
+                values(1) = m%elastic_energy(y(self%oq + 1:self%oq + m%nq))
                 values(2) = kinetic
             end associate
             return

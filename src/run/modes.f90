@@ -34,7 +34,8 @@ module flexmbs_run_modes
     use flexmbs_dae_linearisation, only: linearise
     use flexmbs_dae_bdf_stability, only: bdf_stability_angle, sector_angle
     use flexmbs_problems_pendulum, only: pendulum_t, pendulum_index1, pendulum_index2
-    use flexmbs_mbs_formulation, only: formulation_t, formulation_index1, formulation_index2
+    use flexmbs_mbs_formulation, only: formulation_t, formulation_index1, formulation_index2, &
+        block_q, block_v, block_lambda
     use flexmbs_io_namelist, only: scene_input_t
     use flexmbs_run_catalogue, only: pmax_grid_solver
     use flexmbs_run_plan, only: run_plan_t, make_plan, scene_stab
@@ -241,10 +242,10 @@ contains
         integer :: nq, nv, nc, form
         select type (p => plan%problem)
         type is (formulation_t)
-            nq = p%nq
-            nv = p%nv
-            nc = p%nc
-            form = p%form
+            nq = p%block_size(block_q)
+            nv = p%block_size(block_v)
+            nc = p%block_size(block_lambda)
+            form = p%form_kind()
             result%constraint_values = merge(nc, 0, form == formulation_index2) + &
                 merge(2 * nc, 0, form == formulation_index1)
         type is (pendulum_t)

@@ -19,7 +19,7 @@ module flexmbs_run_monitor_sink
     use flexmbs_core_status, only: status_t
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
-    use flexmbs_mbs_formulation, only: block_q, block_v
+    use flexmbs_mbs_formulation, only: block_q, block_v, block_lambda
     use flexmbs_mbs_formulation, only: formulation_t
     use flexmbs_mbs_system, only: mbs_system_t
     implicit none
@@ -80,7 +80,7 @@ contains
         nj = 0
         select type (m => self%mechanical)
         type is (mbs_system_t)
-            nj = size(m%joints)
+            nj = m%joint_count()
         end select
         if (.not. allocated(self%table)) allocate (self%table(4, 64), &
                                                    self%reactions(12 * nj, 64))
@@ -105,7 +105,7 @@ contains
         type is (mbs_system_t)
             associate (f => self%formulation)
                 if (nj == 0) return
-                allocate (lambda(f%nc))
+                allocate (lambda(f%block_size(block_lambda)))
                 call f%consistent_multipliers(t, y, lambda, status)
                 if (.not. status%ok()) return
                 do k = 1, nj

@@ -25,7 +25,7 @@ module flexmbs_run_problem_factory
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index1, &
         formulation_index2, formulation_index3, formulation_ggl, block_q, block_v, block_lambda
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t
-    use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_mbs_system, only: mbs_system_t, part_frame
     use flexmbs_io_namelist, only: scene_input_t
     use flexmbs_run_catalogue, only: problem_id, problem_van_der_pol, problem_pendulum, &
         problem_robertson, problem_brusselator_1d, problem_brusselator_2d, &
@@ -153,7 +153,7 @@ contains
             type is (mbs_system_t)
                 call build_multibody(scene, sys, q0, v0, status, labels, names)
                 if (present(joint_names) .and. allocated(names)) joint_names = names
-                massless = size(sys%frames) > 0
+                massless = sys%part_count(part_frame) > 0
             end select
             if (.not. status%ok()) return
             call check_dense_size(scene, mechanical, status)

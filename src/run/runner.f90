@@ -13,9 +13,10 @@ module flexmbs_run_runner
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_sink, only: sink_t
     use flexmbs_fe_flexible_body, only: flexible_body_t
-    use flexmbs_mbs_formulation, only: block_q, block_v
+    use flexmbs_mbs_modal_body, only: modal_body_t
+    use flexmbs_mbs_formulation, only: block_q, block_v, block_lambda
     use flexmbs_mbs_formulation, only: formulation_t
-    use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_mbs_system, only: mbs_system_t, part_rigid, part_flexible, part_modal
     use flexmbs_io_namelist, only: scene_input_t
     use flexmbs_io_scene_input, only: nonlinear_body, modal_body
     use flexmbs_io_scene_schema, only: len_name
@@ -184,7 +185,7 @@ contains
                 monitor%every_step = scene%every_step
                 monitor%q_start = result%y(p%offset(block_q) + 1:p%last(block_q))
                 call sinks%attach(monitor)
-                result%constraints = p%nc
+                result%constraints = p%block_size(block_lambda)
             end if
         end select
 
@@ -203,7 +204,7 @@ contains
         result%has_energy = result%has_energy .and. status%ok()
 
         if (monitor%records > 0) then
-            result%has_drift = monitor%formulation%nc > 0
+            result%has_drift = monitor%formulation%block_size(block_lambda) > 0
             result%drift_end = monitor%table(2:3, monitor%records)
             result%monitor_energy = [monitor%table(4, 1), monitor%table(4, monitor%records)]
             result%has_monitor_energy = .not. any(ieee_is_nan(result%monitor_energy))
@@ -317,7 +318,7 @@ contains
         if (io_status%ok()) call h5%annotate('energy', 'unit', 'J', io_status)
         if (io_status%ok()) call h5%annotate('energy', 'description', 'kinetic plus &
             &potential energy at each record of /time', io_status)
-        if (monitor%formulation%nc == 0) then
+        if (monitor%formulation%block_size(block_lambda) == 0) then
             ! nothing to drift: said, not written as zeros
             if (io_status%ok()) call h5%write_text('drift_note', 'no /drift: the &
                 &scene has no constraints (its /monitor drift columns are 0)', io_status)
@@ -346,7 +347,7 @@ contains
         type(run_plan_t), intent(in), target :: plan
         type(scene_input_t), intent(in) :: scene
         type(status_t), intent(inout) :: status
-        integer :: k
+        integer :: k, nf, ob, ov, oq, ovk
         vtk%prefix = trim(scene%vtk)
         vtk%binary = scene%vtk_format /= 'ascii'
         if (.not. allocated(plan%mechanical)) then
@@ -361,48 +362,42 @@ contains
             vtk%flexible(1)%ov = m%nq
             vtk%flexible(1)%name = scene%bodies(1)%name
         type is (mbs_system_t)
-            vtk%bodies = size(m%rigid%bodies)
-            vtk%names = body_names(scene, size(m%rigid%bodies))
-            if (size(m%chains) > 0) then
-                vtk%chains => m%chains
-                vtk%chain_q = m%chain_q
-            end if
-            allocate (vtk%flexible(size(m%flex) + size(m%modal)))
-            do k = 1, size(m%flex)
-                vtk%flexible(k)%body => m%flex(k)
+            nf = m%part_count(part_flexible)
+            vtk%bodies = m%part_count(part_rigid)
+            vtk%names = body_names(scene, vtk%bodies)
+            vtk%system => m
+            ! y's q block starts at the formulation's offset (0 without one)
+            select type (p => plan%problem)
+            type is (formulation_t)
+                ob = p%offset(block_q)
+                ov = p%offset(block_v)
+                vtk%system_q = ob
+                ! the reactions need a formulation's multipliers (consistent with q, v)
+                if (m%joint_count() > 0 .and. p%block_size(block_lambda) > 0) vtk%formulation => p
+            class default
+                ob = 0
+                ov = m%nq
+            end select
+            allocate (vtk%flexible(nf + m%part_count(part_modal)))
+            do k = 1, nf
+                call m%part_offsets(part_flexible, k, oq, ovk)
+                vtk%flexible(k)%body => m%flexible_of(k)
                 vtk%flexible(k)%name = scene%bodies(nonlinear_body(scene, k))%name
-                vtk%flexible(k)%oq = m%flex_q(k)
-                vtk%flexible(k)%ov = m%nq + m%flex_v(k)
-                select type (p => plan%problem)
-                type is (formulation_t)
-                    vtk%flexible(k)%oq = p%offset(block_q) + m%flex_q(k)
-                    vtk%flexible(k)%ov = p%offset(block_v) + m%flex_v(k)
-                end select
+                vtk%flexible(k)%oq = ob + oq
+                vtk%flexible(k)%ov = ov + ovk
             end do
-            do k = 1, size(m%modal)
-                associate (vf => vtk%flexible(size(m%flex) + k))
-                    vf%body => m%modal(k)%fe
-                    vf%modal => m%modal(k)
+            do k = 1, m%part_count(part_modal)
+                call m%part_offsets(part_modal, k, oq, ovk)
+                associate (vf => vtk%flexible(nf + k))
+                    vf%modal => m%modal_of(k)
+                    vf%body => vf%modal%fe_body()
                     vf%name = scene%bodies(modal_body(scene, k))%name
-                    vf%oq = m%modal_q(k)
-                    vf%ov = m%nq + m%modal_v(k)
-                    select type (p => plan%problem)
-                    type is (formulation_t)
-                        vf%oq = p%offset(block_q) + m%modal_q(k)
-                        vf%ov = p%offset(block_v) + m%modal_v(k)
-                    end select
+                    vf%oq = ob + oq
+                    vf%ov = ov + ovk
                 end associate
             end do
-            if (size(m%joints) > 0) then
-                vtk%system => m
-                if (allocated(plan%joint_names)) vtk%joint_names = plan%joint_names
-                ! the reactions need a formulation's multipliers (consistent with q, v)
-                select type (p => plan%problem)
-                type is (formulation_t)
-                    vtk%system_q = p%offset(block_q)
-                    if (p%nc > 0) vtk%formulation => p
-                end select
-            end if
+            if (m%joint_count() > 0 .and. allocated(plan%joint_names)) &
+                vtk%joint_names = plan%joint_names
         class default
             call status%set(status_bad_input, scene%path // ': &output: vtk: problem = ''' &
                 // trim(scene%problem) // ''' has no bodies to draw')
@@ -419,7 +414,8 @@ contains
         type(run_result_t), intent(inout) :: result
         type(status_t), intent(inout) :: io_status
         type(xdmf_body_t), allocatable :: bodies(:)
-        integer :: k
+        type(modal_body_t), pointer :: modal
+        integer :: k, nf
         call io_status%clear()
         if (.not. allocated(plan%mechanical)) return
         select type (m => plan%mechanical)
@@ -427,13 +423,16 @@ contains
             allocate (bodies(1))
             bodies(1) = xdmf_body(m, scene%bodies(1)%name)
         type is (mbs_system_t)
-            allocate (bodies(size(m%flex) + size(m%modal)))
-            do k = 1, size(m%flex)
-                bodies(k) = xdmf_body(m%flex(k), scene%bodies(nonlinear_body(scene, k))%name)
+            nf = m%part_count(part_flexible)
+            allocate (bodies(nf + m%part_count(part_modal)))
+            do k = 1, nf
+                bodies(k) = xdmf_body(m%flexible_of(k), &
+                                      scene%bodies(nonlinear_body(scene, k))%name)
             end do
-            do k = 1, size(m%modal)
-                bodies(size(m%flex) + k) = xdmf_body(m%modal(k)%fe, &
-                    scene%bodies(modal_body(scene, k))%name)
+            do k = 1, m%part_count(part_modal)
+                modal => m%modal_of(k)
+                bodies(nf + k) = xdmf_body(modal%fe_body(), &
+                                           scene%bodies(modal_body(scene, k))%name)
             end do
         class default
             return

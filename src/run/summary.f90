@@ -11,7 +11,7 @@ module flexmbs_run_summary
     use flexmbs_mbs_rigid_body, only: rigid_body_nq
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, chain_joint_prismatic, &
         chain_joint_spherical
-    use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_mbs_system, only: mbs_system_t, part_chain, part_flexible, part_modal
     use flexmbs_mbs_joint_types, only: joint_has_angle, joint_displaced_axes
     use flexmbs_mbs_formulation, only: block_q, block_v
     use flexmbs_mbs_formulation, only: formulation_t
@@ -38,7 +38,10 @@ contains
         type(scene_input_t), intent(in) :: scene
         real(wp), intent(in) :: y(:)
         character(len=:), allocatable :: text
-        integer :: i, k, oq, ov
+        integer :: i, k, oq, ov, pq, pv
+        type(rigid_chain_t), pointer :: chain
+        type(flexible_body_t), pointer :: body
+        type(modal_body_t), pointer :: modal
         text = ''
         if (.not. allocated(plan%mechanical)) return
         select type (f => plan%problem)
@@ -51,27 +54,31 @@ contains
                     text = text // body_line(trim(scene%rigid_bodies(i)%name), &
                         y(oq + rigid_body_nq * (i - 1) + 1:oq + rigid_body_nq * i))
                 end do
-                do i = 1, size(m%chains)
-                    text = text // chain_lines(m%chains(i), y(oq + m%chain_q(i) + 1: &
-                        oq + m%chain_q(i) + m%chains(i)%nq), link_names(scene, i))
+                do i = 1, m%part_count(part_chain)
+                    chain => m%chain_of(i)
+                    call m%part_offsets(part_chain, i, pq, pv)
+                    text = text // chain_lines(chain, y(oq + pq + 1:oq + pq + chain%nq), &
+                                               link_names(scene, i))
                 end do
                 if (allocated(plan%joint_names)) then
-                    do k = 1, min(size(plan%joint_names), size(m%joints))
+                    do k = 1, min(size(plan%joint_names), m%joint_count())
                         text = text // joint_line(m, k, plan%joint_names(k), &
                                                   y(oq + 1:oq + m%nq))
                     end do
                 end if
-                do i = 1, size(m%flex)
-                    text = text // flexible_line(m%flex(i), &
+                do i = 1, m%part_count(part_flexible)
+                    body => m%flexible_of(i)
+                    call m%part_offsets(part_flexible, i, pq, pv)
+                    text = text // flexible_line(body, &
                         trim(scene%bodies(nonlinear_body(scene, i))%name), &
-                        y(oq + m%flex_q(i) + 1:oq + m%flex_q(i) + m%flex(i)%nq), &
-                        y(ov + m%flex_v(i) + 1:ov + m%flex_v(i) + m%flex(i)%nv))
+                        y(oq + pq + 1:oq + pq + body%nq), y(ov + pv + 1:ov + pv + body%nv))
                 end do
-                do i = 1, size(m%modal)
-                    text = text // modal_line(m%modal(i), &
+                do i = 1, m%part_count(part_modal)
+                    modal => m%modal_of(i)
+                    call m%part_offsets(part_modal, i, pq, pv)
+                    text = text // modal_line(modal, &
                         trim(scene%bodies(modal_body(scene, i))%name), &
-                        y(oq + m%modal_q(i) + 1:oq + m%modal_q(i) + m%modal(i)%nq), &
-                        y(ov + m%modal_v(i) + 1:ov + m%modal_v(i) + m%modal(i)%nv))
+                        y(oq + pq + 1:oq + pq + modal%nq), y(ov + pv + 1:ov + pv + modal%nv))
                 end do
             type is (rigid_chain_t)
                 text = chain_lines(m, y(oq + 1:oq + m%nq), link_names(scene, 0))
