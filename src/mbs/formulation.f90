@@ -42,6 +42,11 @@
 !> the positions, the mechanical problem's `normalize` restores invariants of
 !> the kinematics that are not constraints (unit quaternions): with projection
 !> on, the formulation keeps them; without it they drift at tolerance level.
+!>
+!> Submodules: formulation_products (G(t, q) once, then G x, Gᵀ x, M x and
+!> G v + g_I, shared by F, ∂F/∂y and the projection) and
+!> formulation_projection (the projection, the consistent initial values and
+!> multipliers, the drift).
 module flexmbs_mbs_formulation
     use, intrinsic :: ieee_exceptions, only: ieee_status_type, ieee_get_status, ieee_set_status
     use flexmbs_core_kinds, only: wp, i8
@@ -147,6 +152,82 @@ module flexmbs_mbs_formulation
         procedure :: admissible => formulation_admissible
         procedure :: iteration_solver => formulation_iteration_solver
     end type formulation_t
+
+    ! the G and M products (submodule formulation_products) and the
+    ! projection and consistent values (submodule formulation_projection)
+    interface
+        !> G v + g_I with G(t, q) already evaluated (eval_g).
+        module subroutine velocity_constraint(self, t, q, v, c, status)
+            class(formulation_t), intent(inout) :: self
+            real(wp), intent(in) :: t, q(:), v(:)
+            real(wp), intent(out) :: c(:)
+            type(status_t), intent(inout) :: status
+        end subroutine velocity_constraint
+        !> G(t, q), dense (self%gmat) or sparse (self%sp).
+        module subroutine eval_g(self, t, q, status)
+            class(formulation_t), intent(inout) :: self
+            real(wp), intent(in) :: t, q(:)
+            type(status_t), intent(inout) :: status
+        end subroutine eval_g
+        !> y = G x with the G of the last eval_g.
+        module subroutine g_times(self, x, y)
+            class(formulation_t), intent(in) :: self
+            real(wp), intent(in) :: x(:)
+            real(wp), intent(out) :: y(:)
+        end subroutine g_times
+        !> y = Gᵀ x with the G of the last eval_g.
+        module subroutine gt_times(self, x, y)
+            class(formulation_t), intent(in) :: self
+            real(wp), intent(in) :: x(:)
+            real(wp), intent(out) :: y(:)
+        end subroutine gt_times
+        !> y = M(t, q) x.
+        module subroutine mass_times(self, t, q, x, y, status)
+            class(formulation_t), intent(inout) :: self
+            real(wp), intent(in) :: t, q(:), x(:)
+            real(wp), intent(out) :: y(:)
+            type(status_t), intent(inout) :: status
+        end subroutine mass_times
+        !> Eqs. (11)-(12) after an accepted step (module header).
+        module subroutine formulation_project(self, t, y, status)
+            class(formulation_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(inout) :: y(:)
+            type(status_t), intent(inout) :: status
+        end subroutine formulation_project
+        !> Consistent (y, y'): q and v projected onto g = 0 and G v + g_I = 0
+        !> (iterated to round-off), a and λ from [M Gᵀ; G 0] [a; λ] = [f; -γ],
+        !> μ = 0; y' = (T v, a, 0, ...) (v' = a in both layouts).
+        module subroutine formulation_consistent_initial(self, t, y, yp, status)
+            class(formulation_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(inout) :: y(:), yp(:)
+            type(status_t), intent(inout) :: status
+        end subroutine formulation_consistent_initial
+        !> The multipliers λ consistent with the positions and velocities in y:
+        !> [M Gᵀ; G 0] [a; λ] = [f; -γ] at y's (q, v), as λ of index 1. In the
+        !> index-2, index-3 and GGL forms the integrator's λ is an index-2/3
+        !> variable, less accurate than q and v (RADAU5: order 3 against 5, its
+        !> error weighted by the step), so reactions are computed from these
+        !> (docs/multibody.md). The last state's λ is kept: asked again for the
+        !> same (t, q, v), as every reaction series of one output record asks,
+        !> nothing is solved. K is not refactored at every record: the solve
+        !> is refined with the factorization held (of a nearby q), and K is
+        !> factored afresh only when that converges slowly.
+        module subroutine formulation_consistent_multipliers(self, t, y, lambda, status)
+            class(formulation_t), intent(inout) :: self
+            real(wp), intent(in) :: t, y(:)
+            real(wp), intent(out) :: lambda(:)  !! size nc
+            type(status_t), intent(inout) :: status
+        end subroutine formulation_consistent_multipliers
+        !> Drift of a state: max-norms of g(t, q) and G v + g_I.
+        module subroutine formulation_drift(self, t, y, position, velocity, status)
+            class(formulation_t), intent(inout) :: self
+            real(wp), intent(in) :: t, y(:)
+            real(wp), intent(out) :: position, velocity
+            type(status_t), intent(inout) :: status
+        end subroutine formulation_drift
+    end interface
 
     public :: new_formulation
 
@@ -354,66 +435,6 @@ contains
         end associate
     end subroutine formulation_rhs
 
-    !> G v + g_I with G(t, q) already evaluated (eval_g).
-    subroutine velocity_constraint(self, t, q, v, c, status)
-        class(formulation_t), intent(inout) :: self
-        real(wp), intent(in) :: t, q(:), v(:)
-        real(wp), intent(out) :: c(:)
-        type(status_t), intent(inout) :: status
-        call self%mechanical%constraint_time_derivative(t, q, self%ct, status)
-        call g_times(self, v, c)
-        c = c + self%ct
-    end subroutine velocity_constraint
-
-    !> G(t, q), dense (self%gmat) or sparse (self%sp).
-    subroutine eval_g(self, t, q, status)
-        class(formulation_t), intent(inout) :: self
-        real(wp), intent(in) :: t, q(:)
-        type(status_t), intent(inout) :: status
-        if (self%sparse) then
-            call self%sp%constraint_jacobian(self%mechanical, t, q, status)
-        else
-            call self%mechanical%constraint_jacobian(t, q, self%gmat, status)
-        end if
-    end subroutine eval_g
-
-    !> y = G x with the G of the last eval_g.
-    subroutine g_times(self, x, y)
-        class(formulation_t), intent(in) :: self
-        real(wp), intent(in) :: x(:)
-        real(wp), intent(out) :: y(:)
-        if (self%sparse) then
-            call self%sp%g_times(x, y)
-        else
-            y = matmul(self%gmat, x)
-        end if
-    end subroutine g_times
-
-    !> y = Gᵀ x with the G of the last eval_g.
-    subroutine gt_times(self, x, y)
-        class(formulation_t), intent(in) :: self
-        real(wp), intent(in) :: x(:)
-        real(wp), intent(out) :: y(:)
-        if (self%sparse) then
-            call self%sp%gt_times(x, y)
-        else
-            y = matmul(x, self%gmat)
-        end if
-    end subroutine gt_times
-
-    !> y = M(t, q) x.
-    subroutine mass_times(self, t, q, x, y, status)
-        class(formulation_t), intent(inout) :: self
-        real(wp), intent(in) :: t, q(:), x(:)
-        real(wp), intent(out) :: y(:)
-        type(status_t), intent(inout) :: status
-        if (self%sparse) then
-            call self%sp%m_times(self%mechanical, t, q, x, y, status)
-        else
-            call self%mechanical%mass(t, q, self%m, status)
-            y = matmul(self%m, x)
-        end if
-    end subroutine mass_times
 
     integer function formulation_jacobian_storage(self)
         class(formulation_t), intent(in) :: self
@@ -724,279 +745,6 @@ contains
         last = self%offset(block) + self%block_size(block)
     end function formulation_last
 
-    !> Eqs. (11)-(12) after an accepted step (module header).
-    subroutine formulation_project(self, t, y, status)
-        class(formulation_t), intent(inout) :: self
-        real(wp), intent(in) :: t
-        real(wp), intent(inout) :: y(:)
-        type(status_t), intent(inout) :: status
-        self%projection_calls = self%projection_calls + 1
-        call self%mechanical%normalize(y(self%oq + 1:self%oq + self%nq))
-        call project_positions(self, t, y(self%oq + 1:self%oq + self%nq), projection_epsreq, &
-                               status)
-        if (.not. status%ok()) return
-        if (mod(self%projection_calls, max(1, self%velocity_interval)) == 0) &
-            call project_velocities(self, t, y(self%oq + 1:self%oq + self%nq), &
-                                    y(self%ov + 1:self%ov + self%nv), status)
-    end subroutine formulation_project
-
-    !> Factor K = [M Gᵀ; G 0] at q into self%kkt (or the sparse one).
-    subroutine factor_kkt(self, t, q, status)
-        class(formulation_t), intent(inout) :: self
-        real(wp), intent(in) :: t, q(:)
-        type(status_t), intent(inout) :: status
-        type(status_t) :: local
-        if (self%sparse) then
-            call self%sp%factor_kkt(self%mechanical, t, q, status)
-            self%kkt_factored = status%ok()
-            return
-        end if
-        call self%mechanical%mass(t, q, self%m, status)
-        call self%mechanical%constraint_jacobian(t, q, self%gmat, status)
-        call self%kkt%assemble(self%m, self%gmat)
-        call self%kkt%factor(local)
-        self%kkt_factored = local%ok()
-        if (.not. local%ok()) call status%set(status_solver_failure, &
-            'formulation: projection matrix [M Gᵀ; G 0] is singular (redundant constraints?)', &
-            reason_singular_matrix)
-    end subroutine factor_kkt
-
-    !> self%kkt_rhs ← K⁻¹ self%kkt_rhs.
-    subroutine solve_kkt(self)
-        class(formulation_t), intent(inout) :: self
-        type(status_t) :: status
-        if (self%sparse) then
-            call self%sp%solve_kkt(self%kkt_rhs, status)
-        else
-            call self%kkt%solve(self%kkt_rhs, status)
-        end if
-    end subroutine solve_kkt
-
-    !> Simplified Newton for g(t, q) = 0 with K at the starting q̃ (§3.6 step 1).
-    subroutine project_positions(self, t, q, epsreq, status)
-        class(formulation_t), intent(inout) :: self
-        real(wp), intent(in) :: t, epsreq
-        real(wp), intent(inout) :: q(:)
-        type(status_t), intent(inout) :: status
-        real(wp) :: eps, eps_old
-        integer :: it
-        character(len=120) :: msg
-        if (self%nc == 0) return
-        self%q0 = q
-        call factor_kkt(self, t, q, status)
-        if (.not. status%ok()) return
-        eps_old = huge(1.0_wp)
-        do it = 0, projection_itmax - 1
-            call self%mechanical%constraint(t, q, self%c, status)
-            if (.not. status%ok()) return
-            self%kkt_rhs(1:self%nv) = 0.0_wp
-            self%kkt_rhs(self%nv + 1:) = -self%c
-            call solve_kkt(self)
-            call self%mechanical%kinematics(t, self%q0, self%kkt_rhs(1:self%nv), self%tq, status)
-            q = q + self%tq
-            eps = sqrt(sum((self%tq / (self%projection_rtol * abs(self%q0) &
-                + self%projection_atol))**2) / self%nq)
-            if (eps <= epsreq) return
-            if ((it >= 1 .and. eps > 2.0_wp * eps_old) .or. .not. (eps == eps)) exit
-            eps_old = eps
-        end do
-        write (msg, '(a,es10.3,a,es10.3)') 'formulation: position projection did not &
-            &converge at t = ', t, ', last correction norm ', eps
-        call status%set(status_solver_failure, trim(msg), reason_projection)
-    end subroutine project_positions
-
-    !> Eq. (12): v ← v + Δv with K [Δv; μ] = [0; -(G v + g_I)] at q.
-    subroutine project_velocities(self, t, q, v, status)
-        class(formulation_t), intent(inout) :: self
-        real(wp), intent(in) :: t, q(:)
-        real(wp), intent(inout) :: v(:)
-        type(status_t), intent(inout) :: status
-        if (self%nc == 0) return
-        call factor_kkt(self, t, q, status)
-        if (.not. status%ok()) return
-        call velocity_constraint(self, t, q, v, self%c, status)
-        self%kkt_rhs(1:self%nv) = 0.0_wp
-        self%kkt_rhs(self%nv + 1:) = -self%c
-        call solve_kkt(self)
-        v = v + self%kkt_rhs(1:self%nv)
-    end subroutine project_velocities
-
-    !> Consistent (y, y'): q and v projected onto g = 0 and G v + g_I = 0
-    !> (iterated to round-off), a and λ from [M Gᵀ; G 0] [a; λ] = [f; -γ],
-    !> μ = 0; y' = (T v, a, 0, ...) (v' = a in both layouts).
-    subroutine formulation_consistent_initial(self, t, y, yp, status)
-        class(formulation_t), intent(inout) :: self
-        real(wp), intent(in) :: t
-        real(wp), intent(inout) :: y(:), yp(:)
-        type(status_t), intent(inout) :: status
-        ! Three simplified-Newton projections, each with K refactored at its
-        ! start (an outer Newton iteration), reach round-off from any start
-        ! the iteration converges from.
-        integer, parameter :: restarts = 3
-        integer :: nv, nc, k
-        nv = self%nv
-        nc = self%nc
-        associate (q => y(self%oq + 1:self%oq + self%nq), v => y(self%ov + 1:self%ov + nv))
-            call self%mechanical%normalize(q)
-            do k = 1, restarts
-                call project_positions(self, t, q, projection_epsreq, status)
-                if (.not. status%ok()) return
-            end do
-            call project_velocities(self, t, q, v, status)
-            if (.not. status%ok()) return
-            call solve_accelerations(self, t, q, v, status)
-            if (.not. status%ok()) return
-            yp = 0.0_wp
-            call self%mechanical%kinematics(t, q, v, yp(self%oq + 1:self%oq + self%nq), status)
-            yp(self%ov + 1:self%ov + nv) = self%kkt_rhs(1:nv)
-            if (self%accelerations) y(self%oa + 1:self%oa + nv) = self%kkt_rhs(1:nv)
-            y(self%ol + 1:self%ol + nc) = self%kkt_rhs(nv + 1:)
-            if (self%form == formulation_ggl) y(self%om + 1:self%om + nc) = 0.0_wp
-        end associate
-    end subroutine formulation_consistent_initial
-
-    !> [M Gᵀ; G 0] [a; λ] = [f; -γ] at (t, q, v): a and λ in self%kkt_rhs.
-    subroutine solve_accelerations(self, t, q, v, status)
-        class(formulation_t), intent(inout) :: self
-        real(wp), intent(in) :: t, q(:), v(:)
-        type(status_t), intent(inout) :: status
-        call self%mechanical%forces(t, q, v, self%force, status)
-        self%kkt_rhs(1:self%nv) = self%force
-        if (self%nc > 0) then
-            call self%mechanical%constraint_curvature(t, q, v, self%c, status)
-            self%kkt_rhs(self%nv + 1:) = -self%c
-        end if
-        if (.not. status%ok()) return
-        call factor_kkt(self, t, q, status)
-        if (.not. status%ok()) return
-        call solve_kkt(self)
-    end subroutine solve_accelerations
-
-    !> The multipliers λ consistent with the positions and velocities in y:
-    !> [M Gᵀ; G 0] [a; λ] = [f; -γ] at y's (q, v), as λ of index 1. In the
-    !> index-2, index-3 and GGL forms the integrator's λ is an index-2/3
-    !> variable, less accurate than q and v (RADAU5: order 3 against 5, its
-    !> error weighted by the step), so reactions are computed from these
-    !> (docs/multibody.md). The last state's λ is kept: asked again for the
-    !> same (t, q, v), as every reaction series of one output record asks,
-    !> nothing is solved. K is not refactored at every record: the solve
-    !> is refined with the factorization held (of a nearby q), and K is
-    !> factored afresh only when that converges slowly.
-    subroutine formulation_consistent_multipliers(self, t, y, lambda, status)
-        class(formulation_t), intent(inout) :: self
-        real(wp), intent(in) :: t, y(:)
-        real(wp), intent(out) :: lambda(:)  !! size nc
-        type(status_t), intent(inout) :: status
-        type(ieee_status_type) :: flags
-        integer :: stat
-        if (self%nc == 0) return
-        associate (state => y(self%oq + 1:self%ov + self%nv), &
-                   q => y(self%oq + 1:self%oq + self%nq), v => y(self%ov + 1:self%ov + self%nv))
-            if (allocated(self%multipliers)) then
-                if (t == self%multipliers_t .and. all(state == self%multipliers_state)) then
-                    lambda = self%multipliers
-                    return
-                end if
-            else
-                allocate (self%multipliers_state(self%nq + self%nv), self%multipliers(self%nc), &
-                          self%kkt_b(self%nv + self%nc), self%kkt_x(self%nv + self%nc), stat=stat)
-                if (stat /= 0) then
-                    call out_of_memory(status, 'formulation multipliers', &
-                                       int(self%nq + 3 * self%nv + 3 * self%nc, i8), 8)
-                    return
-                end if
-            end if
-            self%multipliers_t = huge(1.0_wp)
-            call self%mechanical%forces(t, q, v, self%force, status)
-            call self%mechanical%constraint_curvature(t, q, v, self%c, status)
-            if (.not. status%ok()) return
-            self%kkt_b = [self%force, -self%c]
-            call ieee_get_status(flags)
-            if (.not. refined(self, t, q, status)) then
-                if (.not. status%ok()) return
-                ! a refinement given up may have overflowed on its way (a huge
-                ! mass): its flags must not outlive it
-                call ieee_set_status(flags)
-                call factor_kkt(self, t, q, status)
-                if (.not. status%ok()) return
-                self%kkt_rhs = self%kkt_b
-                call solve_kkt(self)
-                self%kkt_x = self%kkt_rhs
-            end if
-            lambda = self%kkt_x(self%nv + 1:)
-            self%multipliers = lambda
-            self%multipliers_state = state
-            self%multipliers_t = t
-        end associate
-    end subroutine formulation_consistent_multipliers
-
-    !> Iterative refinement of K(t, q) x = self%kkt_b into self%kkt_x with
-    !> the factorization of K held: x ← x + K₀⁻¹ (b − K x). False when there
-    !> is none or the corrections do not shrink fast enough to reach
-    !> round-off in a few solves (then factoring K costs less).
-    logical function refined(self, t, q, status) result(converged)
-        class(formulation_t), intent(inout) :: self
-        real(wp), intent(in) :: t, q(:)
-        type(status_t), intent(inout) :: status
-        ! correction relative to the solution that counts as round-off, the
-        ! most solves, and the least shrinking per solve that is worth them
-        real(wp), parameter :: converged_below = 1.0e-13_wp, slowest = 0.25_wp
-        integer, parameter :: max_solves = 8
-        real(wp) :: size_x, correction, previous
-        integer :: k
-        converged = .false.
-        if (.not. self%kkt_factored) return
-        associate (nv => self%nv, x => self%kkt_x, r => self%kkt_rhs)
-            self%kkt_rhs = self%kkt_b
-            call solve_kkt(self)
-            x = self%kkt_rhs
-            call eval_g(self, t, q, status)
-            if (.not. status%ok()) return
-            previous = huge(1.0_wp)
-            do k = 2, max_solves
-                ! r = b − K x, K = [M Gᵀ; G 0] at (t, q)
-                call mass_times(self, t, q, x(1:nv), r(1:nv), status)
-                if (.not. status%ok()) return
-                call gt_times(self, x(nv + 1:), self%b)
-                r(1:nv) = self%kkt_b(1:nv) - r(1:nv) - self%b
-                call g_times(self, x(1:nv), self%c)
-                r(nv + 1:) = self%kkt_b(nv + 1:) - self%c
-                call solve_kkt(self)
-                x = x + r
-                size_x = maxval(abs(x))
-                correction = maxval(abs(r))
-                ! overflow (a huge mass) or NaN: not for refinement
-                if (.not. (size_x <= huge(1.0_wp))) return
-                if (correction <= converged_below * size_x) then
-                    converged = .true.
-                    return
-                end if
-                if (.not. (correction < slowest * previous)) return
-                ! too slow to reach round-off within max_solves at this rate
-                if (k > 2 .and. real(k, wp) + log(converged_below * size_x / correction) &
-                    / log(correction / previous) > max_solves) return
-                previous = correction
-            end do
-        end associate
-    end function refined
-
-    !> Drift of a state: max-norms of g(t, q) and G v + g_I.
-    subroutine formulation_drift(self, t, y, position, velocity, status)
-        class(formulation_t), intent(inout) :: self
-        real(wp), intent(in) :: t, y(:)
-        real(wp), intent(out) :: position, velocity
-        type(status_t), intent(inout) :: status
-        position = 0.0_wp
-        velocity = 0.0_wp
-        if (self%nc == 0) return
-        associate (q => y(self%oq + 1:self%oq + self%nq), v => y(self%ov + 1:self%ov + self%nv))
-            call self%mechanical%constraint(t, q, self%c, status)
-            position = maxval(abs(self%c))
-            call eval_g(self, t, q, status)
-            call velocity_constraint(self, t, q, v, self%c, status)
-            velocity = maxval(abs(self%c))
-        end associate
-    end subroutine formulation_drift
 
     !> The condensed Newton systems (docs/theory.md §3.7) on the sparse path
     !> with newton_system = 'condensed' and a sparse LU ('auto', 'klu',
