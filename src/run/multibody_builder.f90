@@ -42,6 +42,29 @@ module flexmbs_run_multibody_builder
     !> Relative singular-value threshold for independent constraint rows.
     real(wp), parameter :: rank_tolerance = 1.0e-10_wp
 
+    !> What build_multibody assembles, phase by phase, for new_mbs_system:
+    !> the parts, the initial state, and what each node-set marker became.
+    type :: parts_t
+        type(rigid_body_t), allocatable :: bodies(:)  !! the rigid bodies, then the frames
+        type(marker_t), allocatable :: markers(:)
+        type(mbs_joint_t), allocatable :: joints(:)
+        type(flexible_body_t), allocatable :: flex(:)
+        type(rigid_chain_t), allocatable :: chains(:)
+        type(node_frame_t), allocatable :: frames(:)
+        type(modal_body_t), allocatable :: modal(:)
+        integer :: nb = 0                             !! rigid bodies and frames
+        real(wp), allocatable :: q0(:), v0(:)
+        !> per scene marker: its node frame (0: none), whether it is a
+        !> set's centroid for spherical joints alone
+        integer, allocatable :: frame_of(:)
+        logical, allocatable :: centroid(:)
+        !> per &flexible_body: its number among the nonlinear (flex_of) or
+        !> modal (modal_of) bodies, where its v (flex_v0) or q (modal_q0) start
+        integer, allocatable :: flex_of(:), modal_of(:), flex_v0(:), modal_q0(:)
+        !> per joint: the scene's label and the output's name; per frame its label
+        character(len=80), allocatable :: labels(:), names(:), frame_labels(:)
+    end type parts_t
+
     public :: build_multibody
 
 contains
@@ -57,25 +80,47 @@ contains
         !> per joint of the system (not the node frames): 'joints/NAME' or
         !> 'drivers/NAME' ('joints/NAME (node N)' for the joints of an attach)
         character(len=:), allocatable, intent(out), optional :: joint_names(:)
-        type(rigid_body_t), allocatable :: bodies(:)
-        type(marker_t), allocatable :: markers(:)
-        type(mbs_joint_t), allocatable :: joints(:)
-        type(flexible_body_t), allocatable :: flex(:)
-        type(rigid_chain_t), allocatable :: chains(:)
-        type(node_frame_t), allocatable :: frames(:)
-        type(modal_body_t), allocatable :: modal(:)
-        real(wp), allocatable :: qf(:), vf(:), qc(:), vc(:)
-        integer, allocatable :: nodes(:), frame_of(:), flex_v0(:), flex_of(:), modal_of(:), &
-            modal_q0(:)
-        logical :: centroid(size(scene%markers))
-        character(len=:), allocatable :: labels(:), frame_labels(:), defect, names(:)
-        real(wp) :: p(4), r(3, 3), anchor(3), origin(3), inertia(3, 3), position(3)
-        integer :: i, nb, k, n, b, mi, fb, c, link
-        ! node-set markers that a joint other than 'attach' or a driver uses
-        ! get a node frame (a massless body after the scene's rigid bodies),
-        ! unless spherical joints to points alone use them (centroid_markers)
-        centroid = centroid_markers(scene)
-        allocate (frame_of(size(scene%markers)), source=0)
+        type(parts_t) :: parts
+        call choose_frames(scene, parts)
+        call place_rigid_bodies(scene, parts, status)
+        if (.not. status%ok()) return
+        call add_bodies(scene, parts, status)
+        if (.not. status%ok()) return
+        call place_frames(scene, parts, status)
+        if (.not. status%ok()) return
+        call place_markers(scene, parts, status)
+        if (.not. status%ok()) return
+        call add_joints(scene, parts, status)
+        if (.not. status%ok()) return
+        call add_drivers(scene, parts)
+        sys = new_mbs_system(parts%bodies, parts%markers, parts%joints, &
+            gravity=scene%multibody%gravity, &
+            constraint_derivatives=trim(scene%multibody%constraint_derivatives), status=status, &
+            flexible=parts%flex, chains=parts%chains, frames=parts%frames, &
+            elements=scene_forces(scene), modal=parts%modal)
+        call move_alloc(parts%q0, q0)
+        call move_alloc(parts%v0, v0)
+        if (.not. status%ok()) then
+            call status%set(status_bad_input, scene%path // ': ' // status%text())
+            return
+        end if
+        call check_rank(scene, sys, q0, [character(len=80) :: parts%labels, parts%frame_labels], &
+                        status)
+        if (present(joint_labels)) &
+            joint_labels = [character(len=80) :: parts%labels, parts%frame_labels]
+        if (present(joint_names)) joint_names = parts%names
+    end subroutine build_multibody
+
+    !> Node-set markers that a joint other than 'attach', a driver or a force
+    !> uses get a node frame (a massless body after the scene's rigid
+    !> bodies), unless spherical joints to points alone use them
+    !> (centroid_markers): parts%frame_of, parts%centroid.
+    subroutine choose_frames(scene, parts)
+        type(scene_input_t), intent(in) :: scene
+        type(parts_t), intent(inout) :: parts
+        integer :: i
+        parts%centroid = centroid_markers(scene)
+        allocate (parts%frame_of(size(scene%markers)), source=0)
         do i = 1, size(scene%joints)
             if (scene%joints(i)%type == 'attach') cycle
             call use_frame(scene%joints(i)%marker_i)
@@ -89,13 +134,38 @@ contains
             call use_frame(scene%forces(i)%marker_i)
             call use_frame(scene%forces(i)%marker_j)
         end do
-        nb = size(scene%rigid_bodies) + count(frame_of > 0)
-        allocate (bodies(nb))
-        allocate (q0(7 * nb), v0(6 * nb), source=0.0_wp)
+
+    contains
+
+        !> Marker `name` gets a node frame if it is a node-set marker.
+        subroutine use_frame(name)
+            character(len=*), intent(in) :: name
+            integer :: k
+            k = marker_index(scene, name)
+            if (k == 0) return
+            if (len_trim(scene%markers(k)%node_set) == 0 .or. parts%frame_of(k) > 0 .or. &
+                parts%centroid(k)) return
+            parts%frame_of(k) = maxval(parts%frame_of) + 1
+        end subroutine use_frame
+    end subroutine choose_frames
+
+    !> The scene's rigid bodies, and room for the node frames after them:
+    !> their masses and inertias, q0 and v0.
+    subroutine place_rigid_bodies(scene, parts, status)
+        type(scene_input_t), intent(in) :: scene
+        type(parts_t), intent(inout) :: parts
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: defect
+        real(wp) :: p(4), r(3, 3), inertia(3, 3)
+        integer :: i, nb
+        nb = size(scene%rigid_bodies) + count(parts%frame_of > 0)
+        parts%nb = nb
+        allocate (parts%bodies(nb))
+        allocate (parts%q0(7 * nb), parts%v0(6 * nb), source=0.0_wp)
         do i = 1, size(scene%rigid_bodies)
             associate (b => scene%rigid_bodies(i))
                 inertia = inertia_tensor(b%inertia, b%inertia_products)
-                bodies(i) = rigid_body_t(mass=b%mass, inertia=inertia)
+                parts%bodies(i) = rigid_body_t(mass=b%mass, inertia=inertia)
                 defect = inertia_defect(inertia)
                 if (len(defect) > 0) then
                     call status%set(status_bad_input, scene%path // ': &rigid_body ''' // &
@@ -106,93 +176,177 @@ contains
                 p = quat_from_axis_angle(b%rotation_axis / norm2(b%rotation_axis), &
                                          b%rotation_angle)
                 r = rotation_matrix(p)
-                q0(7 * i - 6:7 * i) = [b%position, p]
-                v0(6 * i - 5:6 * i) = [b%velocity, matmul(transpose(r), b%angular_velocity)]
+                parts%q0(7 * i - 6:7 * i) = [b%position, p]
+                parts%v0(6 * i - 5:6 * i) = [b%velocity, matmul(transpose(r), b%angular_velocity)]
             end associate
         end do
-        ! rigid chains (one per &rigid_chain tree), after the rigid bodies
-        call build_rigid_chains(scene, chains, qc, vc, status)
+    end subroutine place_rigid_bodies
+
+    !> The rigid chains (one per &rigid_chain tree) after the rigid bodies,
+    !> then the flexible bodies (body fb's velocities after v0(flex_v0(fb))),
+    !> then the modal bodies (their q after q0(modal_q0(fb))).
+    subroutine add_bodies(scene, parts, status)
+        type(scene_input_t), intent(in) :: scene
+        type(parts_t), intent(inout) :: parts
+        type(status_t), intent(inout) :: status
+        real(wp), allocatable :: qf(:), vf(:), qc(:), vc(:)
+        integer :: fb
+        call build_rigid_chains(scene, parts%chains, qc, vc, status)
         if (.not. status%ok()) return
-        q0 = [q0, qc]
-        v0 = [v0, vc]
-        ! the flexible bodies, after them (body fb's velocities after
-        ! v0(flex_v0(fb))), then the modal bodies (their q after q0(modal_q0))
-        call number_bodies(scene, flex_of, modal_of)
-        allocate (flex(count(flex_of > 0)), flex_v0(size(scene%bodies)), &
-                  modal(count(modal_of > 0)), modal_q0(size(scene%bodies)))
+        parts%q0 = [parts%q0, qc]
+        parts%v0 = [parts%v0, vc]
+        call number_bodies(scene, parts%flex_of, parts%modal_of)
+        allocate (parts%flex(count(parts%flex_of > 0)), parts%flex_v0(size(scene%bodies)), &
+                  parts%modal(count(parts%modal_of > 0)), parts%modal_q0(size(scene%bodies)))
         do fb = 1, size(scene%bodies)
-            if (flex_of(fb) == 0) cycle
-            call build_flexible_body(scene, fb, flex(flex_of(fb)), qf, vf, status)
+            if (parts%flex_of(fb) == 0) cycle
+            call build_flexible_body(scene, fb, parts%flex(parts%flex_of(fb)), qf, vf, status)
             if (.not. status%ok()) return
-            flex_v0(fb) = size(v0)
-            q0 = [q0, qf]
-            v0 = [v0, vf]
+            parts%flex_v0(fb) = size(parts%v0)
+            parts%q0 = [parts%q0, qf]
+            parts%v0 = [parts%v0, vf]
         end do
         do fb = 1, size(scene%bodies)
-            if (modal_of(fb) == 0) cycle
+            if (parts%modal_of(fb) == 0) cycle
             call build_modal_body(scene, fb, modal_interfaces(scene, fb), &
-                                  modal(modal_of(fb)), qf, vf, status)
+                                  parts%modal(parts%modal_of(fb)), qf, vf, status)
             if (.not. status%ok()) return
-            modal_q0(fb) = size(q0)
-            q0 = [q0, qf]
-            v0 = [v0, vf]
+            parts%modal_q0(fb) = size(parts%q0)
+            parts%q0 = [parts%q0, qf]
+            parts%v0 = [parts%v0, vf]
         end do
-        ! node frames: at the set's centroid with the reference axes (a
-        ! flexible body starts in its reference configuration), moving with
-        ! the mean velocity of the set and the body's initial spin
-        allocate (frames(count(frame_of > 0)))
-        allocate (character(len=80) :: frame_labels(size(frames)))
+    end subroutine add_bodies
+
+    !> The node frames: at the set's centroid with the reference axes (a
+    !> flexible body starts in its reference configuration), moving with
+    !> the mean velocity of the set and the body's initial spin; on a modal
+    !> body, at its interface (modal_frame).
+    subroutine place_frames(scene, parts, status)
+        type(scene_input_t), intent(in) :: scene
+        type(parts_t), intent(inout) :: parts
+        type(status_t), intent(inout) :: status
+        integer, allocatable :: nodes(:)
+        real(wp) :: anchor(3)
+        integer :: i, k, b, fb
+        allocate (parts%frames(count(parts%frame_of > 0)))
+        allocate (parts%frame_labels(size(parts%frames)))
         do i = 1, size(scene%markers)
-            k = frame_of(i)
+            k = parts%frame_of(i)
             if (k == 0) cycle
             fb = flexible_index(scene, scene%markers(i)%body)
             b = size(scene%rigid_bodies) + k
-            if (modal_of(fb) > 0) then
-                call modal_frame(i, k, b)
+            if (parts%modal_of(fb) > 0) then
+                call modal_frame(scene, parts, i, k, b, status)
                 if (.not. status%ok()) return
                 cycle
             end if
-            call flex(flex_of(fb))%node_set(trim(scene%markers(i)%node_set), nodes, status)
-            if (.not. status%ok()) then
-                call status%set(status_bad_input, scene%path // ': &marker ''' // &
-                    trim(scene%markers(i)%name) // ''': ' // status%text())
-                return
-            end if
-            bodies(b) = rigid_body_t(frame=.true.)
-            frames(k) = node_frame_t(flexible=flex_of(fb), body=b, nodes=nodes)
-            frame_labels(k) = '&marker ''' // trim(scene%markers(i)%name) // ''' (node frame)'
-            anchor = flex(flex_of(fb))%centroid(nodes)
-            q0(7 * b - 6:7 * b) = [anchor, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
-            v0(6 * b - 5:6 * b) = [mean_velocity(fb, nodes), &
-                                   scene%bodies(fb)%initial_angular_velocity]
+            associate (body => parts%flex(parts%flex_of(fb)))
+                call body%node_set(trim(scene%markers(i)%node_set), nodes, status)
+                if (.not. status%ok()) then
+                    call status%set(status_bad_input, scene%path // ': &marker ''' // &
+                        trim(scene%markers(i)%name) // ''': ' // status%text())
+                    return
+                end if
+                parts%bodies(b) = rigid_body_t(frame=.true.)
+                parts%frames(k) = node_frame_t(flexible=parts%flex_of(fb), body=b, nodes=nodes)
+                parts%frame_labels(k) = '&marker ''' // trim(scene%markers(i)%name) // &
+                    ''' (node frame)'
+                anchor = body%centroid(nodes)
+                parts%q0(7 * b - 6:7 * b) = [anchor, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+                parts%v0(6 * b - 5:6 * b) = [mean_velocity(body, parts%v0(parts%flex_v0(fb) + 1:), &
+                    nodes), scene%bodies(fb)%initial_angular_velocity]
+            end associate
         end do
-        ! scene markers first (node-set markers of 'attach' joints are
-        ! placeholders: the joint expands into node markers, appended below)
-        allocate (markers(size(scene%markers)))
-        do i = 1, size(markers)
+    end subroutine place_frames
+
+    !> The interface frame of node-set marker i on a modal body: frame k,
+    !> rigid body b, at the interface's centroid with the mesh's axes,
+    !> moving with the body's initial rigid field.
+    subroutine modal_frame(scene, parts, i, k, b, status)
+        type(scene_input_t), intent(in) :: scene
+        type(parts_t), intent(inout) :: parts
+        integer, intent(in) :: i, k, b
+        type(status_t), intent(inout) :: status
+        integer :: j, mb, fm
+        real(wp) :: d(3), c(3)
+        fm = flexible_index(scene, scene%markers(i)%body)
+        mb = parts%modal_of(fm)
+        j = interface_number(scene, fm, scene%markers(i)%node_set)
+        if (j == 0) then
+            call status%set(status_bad_input, scene%path // ': &marker ''' // &
+                trim(scene%markers(i)%name) // ''': node_set = ''' // &
+                trim(scene%markers(i)%node_set) // ''': not an interface of the modal &
+                &body ''' // trim(scene%bodies(fm)%name) // ''' (line ' // &
+                int_text(scene%markers(i)%line) // ')')
+            return
+        end if
+        parts%bodies(b) = rigid_body_t(frame=.true.)
+        parts%frames(k) = node_frame_t(body=b, modal=mb, modal_interface=j)
+        parts%frame_labels(k) = '&marker ''' // trim(scene%markers(i)%name) // &
+            ''' (interface frame)'
+        d = parts%modal(mb)%interface_position(j)
+        c = parts%q0(parts%modal_q0(fm) + 1:parts%modal_q0(fm) + 3)
+        parts%q0(7 * b - 6:7 * b) = [c + d, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+        associate (bd => scene%bodies(fm))
+            ! the rigid field v₀ + ω × (X − X̄) at the interface's centroid
+            parts%v0(6 * b - 5:6 * b) = [bd%initial_velocity + &
+                cross(bd%initial_angular_velocity, c + d - parts%modal(mb)%centroid()), &
+                bd%initial_angular_velocity]
+        end associate
+    end subroutine modal_frame
+
+    !> Mean initial velocity of the nodes `set` of a flexible body whose free
+    !> velocities are v (fixed nodes at rest).
+    function mean_velocity(body, v, set) result(u)
+        type(flexible_body_t), intent(in) :: body
+        real(wp), intent(in) :: v(:)
+        integer, intent(in) :: set(:)
+        real(wp) :: u(3)
+        integer :: a, l, dofs(3)
+        u = 0.0_wp
+        do a = 1, size(set)
+            dofs = body%node_dofs(set(a))
+            do l = 1, 3
+                if (dofs(l) > 0) u(l) = u(l) + v(dofs(l))
+            end do
+        end do
+        u = u / size(set)
+    end function mean_velocity
+
+    !> The scene's markers first (node-set markers of 'attach' joints are
+    !> placeholders: the joint expands into node markers, add_joints).
+    subroutine place_markers(scene, parts, status)
+        type(scene_input_t), intent(in) :: scene
+        type(parts_t), intent(inout) :: parts
+        type(status_t), intent(inout) :: status
+        integer, allocatable :: nodes(:)
+        real(wp) :: position(3)
+        integer :: i, b, c, link, fb
+        allocate (parts%markers(size(scene%markers)))
+        do i = 1, size(parts%markers)
             associate (m => scene%markers(i))
-                if (frame_of(i) > 0) then
+                if (parts%frame_of(i) > 0) then
                     ! on the frame: the origin relative to the centroid, the
                     ! reference axes (the frame's at the start)
-                    b = size(scene%rigid_bodies) + frame_of(i)
+                    b = size(scene%rigid_bodies) + parts%frame_of(i)
                     position = 0.0_wp
-                    if (m%position_given) position = m%position - q0(7 * b - 6:7 * b - 4)
+                    if (m%position_given) position = m%position - parts%q0(7 * b - 6:7 * b - 4)
                     ! a position at the centroid (to round-off) is the centroid
                     if (norm2(position) <= 1.0e-12_wp * max(1.0_wp, norm2(m%position))) &
                         position = 0.0_wp
-                    markers(i) = marker_t(body=b, position=position, &
-                                          axes=axes_from(m%z_axis, m%x_axis))
+                    parts%markers(i) = marker_t(body=b, position=position, &
+                                                axes=axes_from(m%z_axis, m%x_axis))
                     cycle
                 end if
-                if (centroid(i)) then
-                    fb = flex_of(flexible_index(scene, m%body))
-                    call flex(fb)%node_set(trim(m%node_set), nodes, status)
+                if (parts%centroid(i)) then
+                    fb = parts%flex_of(flexible_index(scene, m%body))
+                    call parts%flex(fb)%node_set(trim(m%node_set), nodes, status)
                     if (.not. status%ok()) then
                         call status%set(status_bad_input, scene%path // ': &marker ''' // &
                             trim(m%name) // ''': ' // status%text())
                         return
                     end if
-                    call markers(i)%on_node_set(fb, nodes)
+                    call parts%markers(i)%on_node_set(fb, nodes)
                     cycle
                 end if
                 b = 0
@@ -201,166 +355,128 @@ contains
                 if (m%body /= 'ground' .and. len_trim(m%node_set) == 0) &
                     b = body_index(scene, m%body)
                 if (b == 0 .and. m%body /= 'ground') call chain_link(scene, m%body, c, link)
-                markers(i) = marker_t(body=b, position=m%position, &
-                                      axes=axes_from(m%z_axis, m%x_axis), chain=c, link=link)
+                parts%markers(i) = marker_t(body=b, position=m%position, &
+                                            axes=axes_from(m%z_axis, m%x_axis), chain=c, &
+                                            link=link)
             end associate
         end do
-        allocate (joints(0))
-        allocate (character(len=80) :: labels(0), names(0))
+    end subroutine place_markers
+
+    !> The scene's joints: one of the table's types each, or for 'attach' a
+    !> spherical joint per node of the set, the rigid side's marker at the
+    !> node's reference position in that body's (or chain link's) frame.
+    subroutine add_joints(scene, parts, status)
+        type(scene_input_t), intent(in) :: scene
+        type(parts_t), intent(inout) :: parts
+        type(status_t), intent(inout) :: status
+        integer :: i
+        allocate (parts%joints(0), parts%labels(0), parts%names(0))
         do i = 1, size(scene%joints)
             associate (jt => scene%joints(i))
-                if (jt%type /= 'attach') then
-                    if (joint_kind(jt%type) == 0) then
-                        call status%set(status_bad_input, scene%path // ': &joint ''' // &
-                            trim(jt%name) // ''': type = ''' // trim(jt%type) // ''': no joint &
-                            &type of that name; use one of ' // joint_choices // '|attach')
-                        return
-                    end if
-                    joints = [joints, mbs_joint_t(joint_kind(jt%type), &
-                        marker_index(scene, jt%marker_i), marker_index(scene, jt%marker_j))]
-                    labels = [character(len=80) :: labels, '&joint ''' // trim(jt%name) // '''']
-                    names = [character(len=80) :: names, 'joints/' // trim(jt%name)]
+                if (jt%type == 'attach') then
+                    call attach(scene, parts, i, status)
+                    if (.not. status%ok()) return
                     cycle
                 end if
-                ! 'attach': a spherical joint per node of the set, the rigid side's
-                ! marker at the node's reference position in that body's (or chain
-                ! link's) frame
-                mi = marker_index(scene, jt%marker_i)
-                associate (mj => scene%markers(marker_index(scene, jt%marker_j)))
-                    fb = flex_of(flexible_index(scene, mj%body))
-                    if (fb == 0) then
-                        call status%set(status_bad_input, scene%path // ': &joint ''' // &
-                            trim(jt%name) // ''': type = ''attach'' ties nodes of a nonlinear &
-                            &body; on the modal body ''' // trim(mj%body) // ''' use a &
-                            &''fixed'' joint on its interface')
-                        return
-                    end if
-                    call flex(fb)%node_set(trim(mj%node_set), nodes, status)
-                end associate
-                if (.not. status%ok()) then
+                if (joint_kind(jt%type) == 0) then
                     call status%set(status_bad_input, scene%path // ': &joint ''' // &
-                        trim(jt%name) // ''': marker_j ''' // trim(jt%marker_j) // ''': ' // &
-                        status%text())
+                        trim(jt%name) // ''': type = ''' // trim(jt%type) // ''': no joint &
+                        &type of that name; use one of ' // joint_choices // '|attach')
                     return
                 end if
-                call markers(mi)%attached_to(b, c, link)
-                if (c > 0) call link_frame(c, link, origin, r)
-                do n = 1, size(nodes)
-                    anchor = flex(fb)%reference_node(nodes(n))
-                    if (c > 0) then
-                        anchor = matmul(transpose(r), anchor - origin)
-                    else if (b > 0) then
-                        r = rotation_matrix(q0(7 * b - 3:7 * b))
-                        anchor = matmul(transpose(r), anchor - q0(7 * b - 6:7 * b - 4))
-                    end if
-                    markers = [markers, marker_t(b, anchor, chain=c, link=link), &
-                               marker_t(0, flexible=fb, node=nodes(n))]
-                    joints = [joints, mbs_joint_t(joint_spherical, size(markers) - 1, &
-                                                  size(markers))]
-                    labels = [character(len=80) :: labels, '&joint ''' // trim(jt%name) // &
-                              ''' (node ' // int_text(nodes(n)) // ')']
-                    names = [character(len=80) :: names, 'joints/' // trim(jt%name) // &
-                             ' (node ' // int_text(nodes(n)) // ')']
-                end do
+                parts%joints = [parts%joints, mbs_joint_t(joint_kind(jt%type), &
+                    marker_index(scene, jt%marker_i), marker_index(scene, jt%marker_j))]
+                parts%labels = [character(len=80) :: parts%labels, &
+                                '&joint ''' // trim(jt%name) // '''']
+                parts%names = [character(len=80) :: parts%names, 'joints/' // trim(jt%name)]
             end associate
         end do
+    end subroutine add_joints
+
+    !> Joint i, an 'attach': its spherical joints, one per node of marker
+    !> j's set, and their markers.
+    subroutine attach(scene, parts, i, status)
+        type(scene_input_t), intent(in) :: scene
+        type(parts_t), intent(inout) :: parts
+        integer, intent(in) :: i
+        type(status_t), intent(inout) :: status
+        integer, allocatable :: nodes(:)
+        real(wp) :: anchor(3), origin(3), r(3, 3)
+        integer :: mi, fb, b, c, link, n
+        associate (jt => scene%joints(i))
+            mi = marker_index(scene, jt%marker_i)
+            associate (mj => scene%markers(marker_index(scene, jt%marker_j)))
+                fb = parts%flex_of(flexible_index(scene, mj%body))
+                if (fb == 0) then
+                    call status%set(status_bad_input, scene%path // ': &joint ''' // &
+                        trim(jt%name) // ''': type = ''attach'' ties nodes of a nonlinear &
+                        &body; on the modal body ''' // trim(mj%body) // ''' use a &
+                        &''fixed'' joint on its interface')
+                    return
+                end if
+                call parts%flex(fb)%node_set(trim(mj%node_set), nodes, status)
+            end associate
+            if (.not. status%ok()) then
+                call status%set(status_bad_input, scene%path // ': &joint ''' // &
+                    trim(jt%name) // ''': marker_j ''' // trim(jt%marker_j) // ''': ' // &
+                    status%text())
+                return
+            end if
+            call parts%markers(mi)%attached_to(b, c, link)
+            if (c > 0) call link_frame(parts, c, link, origin, r)
+            do n = 1, size(nodes)
+                anchor = parts%flex(fb)%reference_node(nodes(n))
+                if (c > 0) then
+                    anchor = matmul(transpose(r), anchor - origin)
+                else if (b > 0) then
+                    r = rotation_matrix(parts%q0(7 * b - 3:7 * b))
+                    anchor = matmul(transpose(r), anchor - parts%q0(7 * b - 6:7 * b - 4))
+                end if
+                parts%markers = [parts%markers, marker_t(b, anchor, chain=c, link=link), &
+                                 marker_t(0, flexible=fb, node=nodes(n))]
+                parts%joints = [parts%joints, mbs_joint_t(joint_spherical, &
+                    size(parts%markers) - 1, size(parts%markers))]
+                parts%labels = [character(len=80) :: parts%labels, '&joint ''' // &
+                    trim(jt%name) // ''' (node ' // int_text(nodes(n)) // ')']
+                parts%names = [character(len=80) :: parts%names, 'joints/' // trim(jt%name) // &
+                               ' (node ' // int_text(nodes(n)) // ')']
+            end do
+        end associate
+    end subroutine attach
+
+    !> Origin and axes of link `link` of chain c at q0 (the chains' q
+    !> follow the rigid bodies', chain by chain).
+    subroutine link_frame(parts, c, link, origin, axes)
+        type(parts_t), intent(inout) :: parts
+        integer, intent(in) :: c, link
+        real(wp), intent(out) :: origin(3), axes(3, 3)
+        integer :: first, k
+        first = 7 * parts%nb
+        do k = 1, c - 1
+            first = first + parts%chains(k)%nq
+        end do
+        call parts%chains(c)%body_frame(parts%q0(first + 1:first + parts%chains(c)%nq), link, &
+                                        origin, axes)
+    end subroutine link_frame
+
+    !> The scene's drivers, after the joints: a driven primitive each.
+    subroutine add_drivers(scene, parts)
+        type(scene_input_t), intent(in) :: scene
+        type(parts_t), intent(inout) :: parts
+        integer :: i
         do i = 1, size(scene%drivers)
             associate (d => scene%drivers(i))
-                joints = [joints, mbs_joint_t(joint_primitive, marker_index(scene, d%marker_i), &
-                    marker_index(scene, d%marker_j), &
+                parts%joints = [parts%joints, mbs_joint_t(joint_primitive, &
+                    marker_index(scene, d%marker_i), marker_index(scene, d%marker_j), &
                     driver_kind(d%type), d%axis_i, d%axis_j, &
                     driver_t(d%coefficients, d%amplitude, d%frequency, d%phase, d%ramp_rate, &
                              d%ramp_time))]
-                labels = [character(len=80) :: labels, '&driver ''' // trim(d%name) // '''']
-                names = [character(len=80) :: names, 'drivers/' // trim(d%name)]
+                parts%labels = [character(len=80) :: parts%labels, &
+                                '&driver ''' // trim(d%name) // '''']
+                parts%names = [character(len=80) :: parts%names, 'drivers/' // trim(d%name)]
             end associate
         end do
-        sys = new_mbs_system(bodies, markers, joints, gravity=scene%multibody%gravity, &
-            constraint_derivatives=trim(scene%multibody%constraint_derivatives), status=status, &
-            flexible=flex, chains=chains, frames=frames, elements=scene_forces(scene), &
-            modal=modal)
-        if (.not. status%ok()) then
-            call status%set(status_bad_input, scene%path // ': ' // status%text())
-            return
-        end if
-        call check_rank(scene, sys, q0, [character(len=80) :: labels, frame_labels], status)
-        if (present(joint_labels)) joint_labels = [character(len=80) :: labels, frame_labels]
-        if (present(joint_names)) joint_names = names
-
-    contains
-
-        !> Origin and axes of link `link` of chain c at q0 (the chains' q
-        !> follow the rigid bodies', chain by chain).
-        subroutine link_frame(c, link, origin, axes)
-            integer, intent(in) :: c, link
-            real(wp), intent(out) :: origin(3), axes(3, 3)
-            integer :: first, k
-            first = 7 * nb
-            do k = 1, c - 1
-                first = first + chains(k)%nq
-            end do
-            call chains(c)%body_frame(q0(first + 1:first + chains(c)%nq), link, origin, axes)
-        end subroutine link_frame
-
-        !> Marker `name` gets a node frame if it is a node-set marker.
-        subroutine use_frame(name)
-            character(len=*), intent(in) :: name
-            integer :: k
-            k = marker_index(scene, name)
-            if (k == 0) return
-            if (len_trim(scene%markers(k)%node_set) == 0 .or. frame_of(k) > 0 .or. &
-                centroid(k)) return
-            frame_of(k) = maxval(frame_of) + 1
-        end subroutine use_frame
-
-        !> The interface frame of node-set marker i on a modal body: frame k,
-        !> rigid body b, at the interface's centroid with the mesh's axes,
-        !> moving with the body's initial rigid field.
-        subroutine modal_frame(i, k, b)
-            integer, intent(in) :: i, k, b
-            integer :: j, mb, fm
-            real(wp) :: d(3), c(3)
-            fm = flexible_index(scene, scene%markers(i)%body)
-            mb = modal_of(fm)
-            j = interface_number(scene, fm, scene%markers(i)%node_set)
-            if (j == 0) then
-                call status%set(status_bad_input, scene%path // ': &marker ''' // &
-                    trim(scene%markers(i)%name) // ''': node_set = ''' // &
-                    trim(scene%markers(i)%node_set) // ''': not an interface of the modal &
-                    &body ''' // trim(scene%bodies(fm)%name) // ''' (line ' // &
-                    int_text(scene%markers(i)%line) // ')')
-                return
-            end if
-            bodies(b) = rigid_body_t(frame=.true.)
-            frames(k) = node_frame_t(body=b, modal=mb, modal_interface=j)
-            frame_labels(k) = '&marker ''' // trim(scene%markers(i)%name) // &
-                ''' (interface frame)'
-            d = modal(mb)%interface_position(j)
-            c = q0(modal_q0(fm) + 1:modal_q0(fm) + 3)
-            q0(7 * b - 6:7 * b) = [c + d, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
-            associate (bd => scene%bodies(fm))
-                ! the rigid field v₀ + ω × (X − X̄) at the interface's centroid
-                v0(6 * b - 5:6 * b) = [bd%initial_velocity + cross(bd%initial_angular_velocity, &
-                    c + d - modal(mb)%centroid()), &
-                    bd%initial_angular_velocity]
-            end associate
-        end subroutine modal_frame
-
-        !> Mean initial velocity of nodes of flexible body fb (fixed nodes at rest).
-        function mean_velocity(fb, set) result(u)
-            integer, intent(in) :: fb, set(:)
-            real(wp) :: u(3)
-            integer :: a, l, dofs(3)
-            u = 0.0_wp
-            do a = 1, size(set)
-                dofs = flex(flex_of(fb))%node_dofs(set(a))
-                do l = 1, 3
-                    if (dofs(l) > 0) u(l) = u(l) + v0(flex_v0(fb) + dofs(l))
-                end do
-            end do
-            u = u / size(set)
-        end function mean_velocity
-    end subroutine build_multibody
+    end subroutine add_drivers
 
     !> Each &flexible_body's number among the nonlinear ones (flex_of) or
     !> the modal ones (modal_of), 0 in the other.
