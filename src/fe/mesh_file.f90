@@ -24,7 +24,7 @@ module flexmbs_fe_mesh_file
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input, status_io_error
     use flexmbs_core_text, only: int_text, lower, excerpt
-    use flexmbs_core_files, only: read_text_file
+    use flexmbs_fe_mesh_tokens, only: token_cursor_t, open_tokens
     use flexmbs_fe_hexahedron, only: shape_functions
     use flexmbs_fe_tensor, only: det3
     use flexmbs_fe_mesh, only: mesh_t, node_set_t, element_set_t
@@ -35,12 +35,6 @@ module flexmbs_fe_mesh_file
 
     character(len=*), parameter :: magic = 'flexmbs-mesh'
 
-    !> The file as tokens: start and end offsets and the line of each.
-    type :: tokens_t
-        integer, allocatable :: first(:), last(:), line(:)
-        integer :: n = 0
-    end type tokens_t
-
 contains
 
     !> Read a mesh in the flexmbs text format (the module's grammar) from `path`;
@@ -49,57 +43,85 @@ contains
         character(len=*), intent(in) :: path
         type(mesh_t), intent(out) :: mesh
         type(status_t), intent(out) :: status
-        character(len=:), allocatable :: text
-        type(tokens_t) :: tok
+        type(token_cursor_t) :: cur
         type(mesh_t) :: work
-        integer :: pos, nnode, nelem, i, a, k, id, nset, stat
-        character(len=:), allocatable :: word, name
-        real(wp) :: x(3)
-        call read_text_file(path, text, status)
+        integer :: k
+        call open_tokens(path, cur, status)
         if (.not. status%ok()) return
-        call tokenise(text, tok, status)
+        call cur%expect_word(magic, status)
         if (.not. status%ok()) return
-        pos = 0
-        call expect_word(magic)
-        if (.not. status%ok()) return
-        call next_int(k, 'format version')
+        call cur%next_int(k, 'format version', status)
         if (.not. status%ok()) return
         if (k /= 1) then
-            call fail('format version ' // int_text(k) // ' is not supported (1 is)')
+            call cur%fail('format version ' // int_text(k) // ' is not supported (1 is)', status)
             return
         end if
-        call expect_word('nodes')
+        call read_nodes(cur, path, work, status)
         if (.not. status%ok()) return
-        call next_int(nnode, 'node count')
+        call read_elements(cur, path, work, status)
+        if (.not. status%ok()) return
+        call read_sets(cur, path, work, status)
+        if (.not. status%ok()) return
+        call work%check(status)
+        if (.not. status%ok()) then
+            call status%set(status_bad_input, path // ': ' // status%text())
+            return
+        end if
+        mesh = work
+    end subroutine read_mesh
+
+    !> 'nodes N' and the N nodes, ids 1..N in order, into work%x.
+    subroutine read_nodes(cur, path, work, status)
+        type(token_cursor_t), intent(inout) :: cur
+        character(len=*), intent(in) :: path
+        type(mesh_t), intent(inout) :: work
+        type(status_t), intent(inout) :: status
+        integer :: nnode, i, k, id, stat
+        real(wp) :: x(3)
+        call cur%expect_word('nodes', status)
+        if (.not. status%ok()) return
+        call cur%next_int(nnode, 'node count', status)
         if (.not. status%ok()) return
         if (nnode < 1) then
-            call fail('node count must be positive')
+            call cur%fail('node count must be positive', status)
             return
         end if
         ! counts beyond what the text can hold are refused before allocating
-        if (.not. fits(nnode, 4, 'nodes')) return
+        if (.not. cur%fits(nnode, 4, 'nodes', status)) return
         allocate (work%x(3, nnode), stat=stat)
         if (stat /= 0) then
             call out_of_memory(status, path // ': node coordinates', 3_i8 * nnode, 8)
             return
         end if
         do i = 1, nnode
-            call next_int(id, 'node id')
+            call cur%next_int(id, 'node id', status)
             if (.not. status%ok()) return
             if (id /= i) then
-                call fail('node id ' // int_text(id) // ' where ' // int_text(i) // &
-                          ' is expected (ids run 1..N in order)')
+                call cur%fail('node id ' // int_text(id) // ' where ' // int_text(i) // &
+                              ' is expected (ids run 1..N in order)', status)
                 return
             end if
             do k = 1, 3
-                call next_real(x(k), 'node coordinate')
+                call cur%next_real(x(k), 'node coordinate', status)
                 if (.not. status%ok()) return
             end do
             work%x(:, i) = x
         end do
-        call expect_word('elements')
+    end subroutine read_nodes
+
+    !> 'elements hex8|hex27 E' and the E elements, ids 1..E in order, into
+    !> work%connectivity; an inverted element is bad input.
+    subroutine read_elements(cur, path, work, status)
+        type(token_cursor_t), intent(inout) :: cur
+        character(len=*), intent(in) :: path
+        type(mesh_t), intent(inout) :: work
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: word
+        integer :: nnode, nelem, i, a, k, id, stat
+        nnode = size(work%x, 2)
+        call cur%expect_word('elements', status)
         if (.not. status%ok()) return
-        call next_word(word, 'element type')
+        call cur%next_word(word, 'element type', status)
         if (.not. status%ok()) return
         select case (lower(word))
         case ('hex8')
@@ -107,211 +129,153 @@ contains
         case ('hex27')
             work%nnode_element = 27
         case default
-            call fail('element type ''' // excerpt(word) // ''': hex8 or hex27 expected')
+            call cur%fail('element type ''' // excerpt(word) // ''': hex8 or hex27 expected', &
+                          status)
             return
         end select
-        call next_int(nelem, 'element count')
+        call cur%next_int(nelem, 'element count', status)
         if (.not. status%ok()) return
         if (nelem < 1) then
-            call fail('element count must be positive')
+            call cur%fail('element count must be positive', status)
             return
         end if
-        if (.not. fits(nelem, work%nnode_element + 1, 'elements')) return
+        if (.not. cur%fits(nelem, work%nnode_element + 1, 'elements', status)) return
         allocate (work%connectivity(work%nnode_element, nelem), stat=stat)
         if (stat /= 0) then
             call out_of_memory(status, path // ': connectivity', &
                 int(work%nnode_element, i8) * nelem, 4)
             return
         end if
-        allocate (work%node_sets(0), work%element_sets(0))
         do i = 1, nelem
-            call next_int(id, 'element id')
+            call cur%next_int(id, 'element id', status)
             if (.not. status%ok()) return
             if (id /= i) then
-                call fail('element id ' // int_text(id) // ' where ' // int_text(i) // &
-                          ' is expected (ids run 1..E in order)')
+                call cur%fail('element id ' // int_text(id) // ' where ' // int_text(i) // &
+                              ' is expected (ids run 1..E in order)', status)
                 return
             end if
             do a = 1, work%nnode_element
-                call next_int(k, 'element node')
+                call cur%next_int(k, 'element node', status)
                 if (.not. status%ok()) return
                 if (k < 1 .or. k > nnode) then
-                    call fail('element ' // int_text(i) // ' names node ' // int_text(k) // &
-                              ', outside 1..' // int_text(nnode))
+                    call cur%fail('element ' // int_text(i) // ' names node ' // int_text(k) // &
+                                  ', outside 1..' // int_text(nnode), status)
                     return
                 end if
                 work%connectivity(a, i) = k
             end do
             if (.not. positive_centre_jacobian(work, i)) then
-                call fail('element ' // int_text(i) // ' is inverted or degenerate ' // &
-                          '(det J <= 0 at its centre; check the VTK node order)')
+                call cur%fail('element ' // int_text(i) // ' is inverted or degenerate ' // &
+                              '(det J <= 0 at its centre; check the VTK node order)', status)
                 return
             end if
         end do
-        do while (pos < tok%n)
-            call next_word(word, 'set keyword')
+    end subroutine read_elements
+
+    !> The node and element sets, to the end of the file.
+    subroutine read_sets(cur, path, work, status)
+        type(token_cursor_t), intent(inout) :: cur
+        character(len=*), intent(in) :: path
+        type(mesh_t), intent(inout) :: work
+        type(status_t), intent(inout) :: status
+        character(len=:), allocatable :: word, name
+        integer :: nset
+        allocate (work%node_sets(0), work%element_sets(0))
+        do while (.not. cur%at_end())
+            call cur%next_word(word, 'set keyword', status)
             if (.not. status%ok()) return
             select case (lower(word))
             case ('node_set', 'element_set')
-                call next_word(name, 'set name')
+                call cur%next_word(name, 'set name', status)
                 if (.not. status%ok()) return
-                call next_int(nset, 'set size')
+                call cur%next_int(nset, 'set size', status)
                 if (.not. status%ok()) return
                 if (nset < 0) then
-                    call fail('set ''' // excerpt(name) // ''': negative size')
+                    call cur%fail('set ''' // excerpt(name) // ''': negative size', status)
                     return
                 end if
                 if (lower(word) == 'node_set') then
-                    call read_node_set(name, nset)
+                    call read_node_set(cur, path, work, name, nset, status)
                 else
-                    call read_element_set(name, nset)
+                    call read_element_set(cur, path, work, name, nset, status)
                 end if
                 if (.not. status%ok()) return
             case default
-                call fail('''' // excerpt(word) // ''': node_set or element_set expected')
+                call cur%fail('''' // excerpt(word) // ''': node_set or element_set expected', &
+                              status)
                 return
             end select
         end do
-        call work%check(status)
-        if (.not. status%ok()) then
-            call status%set(status_bad_input, path // ': ' // status%text())
+    end subroutine read_sets
+
+    !> Node set `name` of nset members, appended to work's.
+    subroutine read_node_set(cur, path, work, name, nset, status)
+        type(token_cursor_t), intent(inout) :: cur
+        character(len=*), intent(in) :: path, name
+        type(mesh_t), intent(inout) :: work
+        integer, intent(in) :: nset
+        type(status_t), intent(inout) :: status
+        type(node_set_t) :: set
+        integer :: j, nnode, stat
+        nnode = size(work%x, 2)
+        if (any([(work%node_sets(j)%name == name, j = 1, size(work%node_sets))])) then
+            call cur%fail('a second node set named ''' // excerpt(name) // '''', status)
             return
         end if
-        mesh = work
-
-    contains
-
-        subroutine read_node_set(name, nset)
-            character(len=*), intent(in) :: name
-            integer, intent(in) :: nset
-            type(node_set_t) :: set
-            integer :: j
-            if (any([(work%node_sets(j)%name == name, j = 1, size(work%node_sets))])) then
-                call fail('a second node set named ''' // excerpt(name) // '''')
-                return
-            end if
-            set%name = name
-            if (.not. fits(nset, 1, 'set members')) return
-            allocate (set%nodes(nset), stat=stat)
-            if (stat /= 0) then
-                call out_of_memory(status, path // ': node set', int(nset, i8), 4)
-                return
-            end if
-            do j = 1, nset
-                call next_int(set%nodes(j), 'node id of set ''' // excerpt(name) // '''')
-                if (.not. status%ok()) return
-                if (set%nodes(j) < 1 .or. set%nodes(j) > nnode) then
-                    call fail('node set ''' // excerpt(name) // ''' names node ' // &
-                              int_text(set%nodes(j)) // ', outside 1..' // int_text(nnode))
-                    return
-                end if
-            end do
-            work%node_sets = [work%node_sets, set]
-        end subroutine read_node_set
-
-        subroutine read_element_set(name, nset)
-            character(len=*), intent(in) :: name
-            integer, intent(in) :: nset
-            type(element_set_t) :: set
-            integer :: j
-            if (any([(work%element_sets(j)%name == name, j = 1, size(work%element_sets))])) then
-                call fail('a second element set named ''' // excerpt(name) // '''')
-                return
-            end if
-            set%name = name
-            if (.not. fits(nset, 1, 'set members')) return
-            allocate (set%elements(nset), stat=stat)
-            if (stat /= 0) then
-                call out_of_memory(status, path // ': element set', int(nset, i8), 4)
-                return
-            end if
-            do j = 1, nset
-                call next_int(set%elements(j), 'element id of set ''' // excerpt(name) // '''')
-                if (.not. status%ok()) return
-                if (set%elements(j) < 1 .or. set%elements(j) > nelem) then
-                    call fail('element set ''' // excerpt(name) // ''' names element ' // &
-                              int_text(set%elements(j)) // ', outside 1..' // int_text(nelem))
-                    return
-                end if
-            end do
-            work%element_sets = [work%element_sets, set]
-        end subroutine read_element_set
-
-        !> Whether `count` items of `per_item` values each fit in the values
-        !> the file has left; bad input (before any allocation) if not, so
-        !> that a declared count of 2e9 cannot exhaust the memory.
-        logical function fits(count, per_item, what)
-            integer, intent(in) :: count, per_item
-            character(len=*), intent(in) :: what
-            fits = count <= (tok%n - pos) / per_item
-            if (.not. fits) call fail(int_text(count) // ' ' // what // ' declared, but the &
-                &file holds only ' // int_text(tok%n - pos) // ' more values (' // &
-                int_text(per_item) // ' per item)')
-        end function fits
-
-        !> Bad input at the current token's line (the last line at the end).
-        subroutine fail(reason)
-            character(len=*), intent(in) :: reason
-            integer :: line
-            line = 1
-            if (tok%n > 0) line = tok%line(max(1, min(pos, tok%n)))
-            call status%set(status_bad_input, path // ':' // int_text(line) // ': ' // reason)
-        end subroutine fail
-
-        subroutine next_word(word, what)
-            character(len=:), allocatable, intent(out) :: word
-            character(len=*), intent(in) :: what
-            if (pos >= tok%n) then
-                pos = tok%n
-                word = ''
-                call fail('file ends where a ' // what // ' is expected')
-                return
-            end if
-            pos = pos + 1
-            word = text(tok%first(pos):tok%last(pos))
-        end subroutine next_word
-
-        subroutine expect_word(keyword)
-            character(len=*), intent(in) :: keyword
-            character(len=:), allocatable :: word
-            call next_word(word, '''' // keyword // '''')
+        set%name = name
+        if (.not. cur%fits(nset, 1, 'set members', status)) return
+        allocate (set%nodes(nset), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, path // ': node set', int(nset, i8), 4)
+            return
+        end if
+        do j = 1, nset
+            call cur%next_int(set%nodes(j), 'node id of set ''' // excerpt(name) // '''', status)
             if (.not. status%ok()) return
-            if (lower(word) /= keyword) call fail('''' // excerpt(word) // ''' where ''' // keyword // &
-                                                  ''' is expected')
-        end subroutine expect_word
-
-        subroutine next_int(value, what)
-            integer, intent(out) :: value
-            character(len=*), intent(in) :: what
-            character(len=:), allocatable :: word
-            integer :: ios
-            value = 0
-            call next_word(word, what)
-            if (.not. status%ok()) return
-            if (verify(word, '+-0123456789') /= 0) then
-                ios = 1
-            else
-                read (word, *, iostat=ios) value
+            if (set%nodes(j) < 1 .or. set%nodes(j) > nnode) then
+                call cur%fail('node set ''' // excerpt(name) // ''' names node ' // &
+                              int_text(set%nodes(j)) // ', outside 1..' // int_text(nnode), &
+                              status)
+                return
             end if
-            if (ios /= 0) call fail('''' // excerpt(word) // ''' is not an integer (' // what // ')')
-        end subroutine next_int
+        end do
+        work%node_sets = [work%node_sets, set]
+    end subroutine read_node_set
 
-        subroutine next_real(value, what)
-            real(wp), intent(out) :: value
-            character(len=*), intent(in) :: what
-            character(len=:), allocatable :: word
-            integer :: ios
-            value = 0.0_wp
-            call next_word(word, what)
+    !> Element set `name` of nset members, appended to work's.
+    subroutine read_element_set(cur, path, work, name, nset, status)
+        type(token_cursor_t), intent(inout) :: cur
+        character(len=*), intent(in) :: path, name
+        type(mesh_t), intent(inout) :: work
+        integer, intent(in) :: nset
+        type(status_t), intent(inout) :: status
+        type(element_set_t) :: set
+        integer :: j, nelem, stat
+        nelem = size(work%connectivity, 2)
+        if (any([(work%element_sets(j)%name == name, j = 1, size(work%element_sets))])) then
+            call cur%fail('a second element set named ''' // excerpt(name) // '''', status)
+            return
+        end if
+        set%name = name
+        if (.not. cur%fits(nset, 1, 'set members', status)) return
+        allocate (set%elements(nset), stat=stat)
+        if (stat /= 0) then
+            call out_of_memory(status, path // ': element set', int(nset, i8), 4)
+            return
+        end if
+        do j = 1, nset
+            call cur%next_int(set%elements(j), 'element id of set ''' // excerpt(name) // '''', &
+                              status)
             if (.not. status%ok()) return
-            if (verify(word, '+-.0123456789eEdD') /= 0) then
-                ios = 1
-            else
-                read (word, *, iostat=ios) value
+            if (set%elements(j) < 1 .or. set%elements(j) > nelem) then
+                call cur%fail('element set ''' // excerpt(name) // ''' names element ' // &
+                              int_text(set%elements(j)) // ', outside 1..' // int_text(nelem), &
+                              status)
+                return
             end if
-            if (ios /= 0) call fail('''' // excerpt(word) // ''' is not a number (' // what // ')')
-        end subroutine next_real
-    end subroutine read_mesh
+        end do
+        work%element_sets = [work%element_sets, set]
+    end subroutine read_element_set
 
     !> Write `mesh` in the format above; an I/O error names the file.
     subroutine write_mesh(path, mesh, status)
@@ -368,68 +332,6 @@ contains
         end subroutine write_ids
     end subroutine write_mesh
 
-    !> Split text into whitespace-separated tokens, dropping # comments.
-    subroutine tokenise(text, tok, status)
-        character(len=*), intent(in) :: text
-        type(tokens_t), intent(out) :: tok
-        type(status_t), intent(inout) :: status
-        integer :: i, line, start, capacity
-        logical :: comment
-        character :: c
-        capacity = 1024
-        allocate (tok%first(capacity), tok%last(capacity), tok%line(capacity))
-        line = 1
-        start = 0
-        comment = .false.
-        do i = 1, len(text) + 1
-            if (i <= len(text)) then
-                c = text(i:i)
-            else
-                c = new_line('a')
-            end if
-            if (c == new_line('a') .or. c == char(13) .or. c == ' ' .or. c == char(9) &
-                .or. (c == '#' .and. .not. comment)) then
-                if (start > 0) call push(start, i - 1)
-                if (.not. status%ok()) return
-                start = 0
-                if (c == '#') comment = .true.
-                if (c == new_line('a')) then
-                    line = line + 1
-                    comment = .false.
-                end if
-            else if (.not. comment .and. start == 0) then
-                start = i
-            end if
-        end do
-
-    contains
-
-        subroutine push(first, last)
-            integer, intent(in) :: first, last
-            integer, allocatable :: tmp_first(:), tmp_last(:), tmp_line(:)
-            integer :: stat
-            if (tok%n == capacity) then
-                ! a token takes at least 2 characters: len(text) bounds the count
-                capacity = int(min(2_i8 * capacity, len(text, i8) / 2 + 1, int(huge(1), i8)))
-                allocate (tmp_first(capacity), tmp_last(capacity), tmp_line(capacity), &
-                    stat=stat)
-                if (stat /= 0) then
-                    call out_of_memory(status, 'mesh file tokens', 3_i8 * capacity, 4)
-                    return
-                end if
-                tmp_first(1:tok%n) = tok%first(1:tok%n)
-                call move_alloc(tmp_first, tok%first)
-                tmp_last(1:tok%n) = tok%last(1:tok%n)
-                call move_alloc(tmp_last, tok%last)
-                tmp_line(1:tok%n) = tok%line(1:tok%n)
-                call move_alloc(tmp_line, tok%line)
-            end if
-            tok%n = tok%n + 1
-            tok%first(tok%n) = first
-            tok%last(tok%n) = last
-            tok%line(tok%n) = line
-        end subroutine push
-    end subroutine tokenise
 
     !> det J at the natural centre of element e is positive.
     logical function positive_centre_jacobian(mesh, e) result(ok)
