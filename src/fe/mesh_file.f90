@@ -179,7 +179,9 @@ contains
         type(mesh_t), intent(inout) :: work
         type(status_t), intent(inout) :: status
         character(len=:), allocatable :: word, name
-        integer :: nset
+        type(node_set_t) :: node_set
+        type(element_set_t) :: element_set
+        integer :: nset, j
         allocate (work%node_sets(0), work%element_sets(0))
         do while (.not. cur%at_end())
             call cur%next_word(word, 'set keyword', status)
@@ -195,11 +197,29 @@ contains
                     return
                 end if
                 if (lower(word) == 'node_set') then
-                    call read_node_set(cur, path, work, name, nset, status)
+                    if (any([(work%node_sets(j)%name == name, j = 1, size(work%node_sets))])) then
+                        call cur%fail('a second node set named ''' // excerpt(name) // '''', &
+                                      status)
+                        return
+                    end if
+                    node_set%name = name
+                    call read_set_ids(cur, path, 'node', name, nset, size(work%x, 2), &
+                                      node_set%nodes, status)
+                    if (.not. status%ok()) return
+                    work%node_sets = [work%node_sets, node_set]
                 else
-                    call read_element_set(cur, path, work, name, nset, status)
+                    if (any([(work%element_sets(j)%name == name, &
+                              j = 1, size(work%element_sets))])) then
+                        call cur%fail('a second element set named ''' // excerpt(name) // '''', &
+                                      status)
+                        return
+                    end if
+                    element_set%name = name
+                    call read_set_ids(cur, path, 'element', name, nset, &
+                                      size(work%connectivity, 2), element_set%elements, status)
+                    if (.not. status%ok()) return
+                    work%element_sets = [work%element_sets, element_set]
                 end if
-                if (.not. status%ok()) return
             case default
                 call cur%fail('''' // excerpt(word) // ''': node_set or element_set expected', &
                               status)
@@ -208,74 +228,31 @@ contains
         end do
     end subroutine read_sets
 
-    !> Node set `name` of nset members, appended to work's.
-    subroutine read_node_set(cur, path, work, name, nset, status)
+    !> The nset ids of set `name` of `kind` ('node' or 'element'), each in
+    !> 1..bound.
+    subroutine read_set_ids(cur, path, kind, name, nset, bound, ids, status)
         type(token_cursor_t), intent(inout) :: cur
-        character(len=*), intent(in) :: path, name
-        type(mesh_t), intent(inout) :: work
-        integer, intent(in) :: nset
+        character(len=*), intent(in) :: path, kind, name
+        integer, intent(in) :: nset, bound
+        integer, allocatable, intent(out) :: ids(:)
         type(status_t), intent(inout) :: status
-        type(node_set_t) :: set
-        integer :: j, nnode, stat
-        nnode = size(work%x, 2)
-        if (any([(work%node_sets(j)%name == name, j = 1, size(work%node_sets))])) then
-            call cur%fail('a second node set named ''' // excerpt(name) // '''', status)
-            return
-        end if
-        set%name = name
+        integer :: j, stat
         if (.not. cur%fits(nset, 1, 'set members', status)) return
-        allocate (set%nodes(nset), stat=stat)
+        allocate (ids(nset), stat=stat)
         if (stat /= 0) then
-            call out_of_memory(status, path // ': node set', int(nset, i8), 4)
+            call out_of_memory(status, path // ': ' // kind // ' set', int(nset, i8), 4)
             return
         end if
         do j = 1, nset
-            call cur%next_int(set%nodes(j), 'node id of set ''' // excerpt(name) // '''', status)
+            call cur%next_int(ids(j), kind // ' id of set ''' // excerpt(name) // '''', status)
             if (.not. status%ok()) return
-            if (set%nodes(j) < 1 .or. set%nodes(j) > nnode) then
-                call cur%fail('node set ''' // excerpt(name) // ''' names node ' // &
-                              int_text(set%nodes(j)) // ', outside 1..' // int_text(nnode), &
-                              status)
+            if (ids(j) < 1 .or. ids(j) > bound) then
+                call cur%fail(kind // ' set ''' // excerpt(name) // ''' names ' // kind // ' ' &
+                              // int_text(ids(j)) // ', outside 1..' // int_text(bound), status)
                 return
             end if
         end do
-        work%node_sets = [work%node_sets, set]
-    end subroutine read_node_set
-
-    !> Element set `name` of nset members, appended to work's.
-    subroutine read_element_set(cur, path, work, name, nset, status)
-        type(token_cursor_t), intent(inout) :: cur
-        character(len=*), intent(in) :: path, name
-        type(mesh_t), intent(inout) :: work
-        integer, intent(in) :: nset
-        type(status_t), intent(inout) :: status
-        type(element_set_t) :: set
-        integer :: j, nelem, stat
-        nelem = size(work%connectivity, 2)
-        if (any([(work%element_sets(j)%name == name, j = 1, size(work%element_sets))])) then
-            call cur%fail('a second element set named ''' // excerpt(name) // '''', status)
-            return
-        end if
-        set%name = name
-        if (.not. cur%fits(nset, 1, 'set members', status)) return
-        allocate (set%elements(nset), stat=stat)
-        if (stat /= 0) then
-            call out_of_memory(status, path // ': element set', int(nset, i8), 4)
-            return
-        end if
-        do j = 1, nset
-            call cur%next_int(set%elements(j), 'element id of set ''' // excerpt(name) // '''', &
-                              status)
-            if (.not. status%ok()) return
-            if (set%elements(j) < 1 .or. set%elements(j) > nelem) then
-                call cur%fail('element set ''' // excerpt(name) // ''' names element ' // &
-                              int_text(set%elements(j)) // ', outside 1..' // int_text(nelem), &
-                              status)
-                return
-            end if
-        end do
-        work%element_sets = [work%element_sets, set]
-    end subroutine read_element_set
+    end subroutine read_set_ids
 
     !> Write `mesh` in the format above; an I/O error names the file.
     subroutine write_mesh(path, mesh, status)
