@@ -63,6 +63,21 @@ module flexmbs_fe_statics
         real(wp), allocatable :: decrement_history(:)
     end type static_report_t
 
+    !> A solve's workspace and the scales of its tests: the last two
+    !> equilibria, the Newton iterate and its base, the residual r, the
+    !> increment dq, the tangent values k, one load step's histories.
+    type :: static_work_t
+        type(static_options_t) :: opt
+        type(static_report_t) :: rep
+        type(klu_factor_t) :: klu
+        real(wp), allocatable :: zero_v(:), q_last(:), q_prev(:), q_trial(:), q_base(:), &
+            r(:), dq(:), k(:), history(:), decrements(:)
+        real(wp) :: gnorm = 0.0_wp      !! ‖g‖∞
+        real(wp) :: size_scale = 1.0_wp !! the body's extent
+        real(wp) :: floor = 0.0_wp      !! round-off level of k
+        integer :: nhist = 0            !! entries of history in this load step
+    end type static_work_t
+
     public :: solve_static
 
 contains
@@ -76,247 +91,275 @@ contains
         type(status_t), intent(out) :: status
         type(static_options_t), intent(in), optional :: options
         type(static_report_t), intent(out), optional :: report
-        type(static_options_t) :: opt
-        type(static_report_t) :: rep
-        type(klu_factor_t) :: klu
-        real(wp), allocatable :: zero_v(:), q_last(:), q_prev(:), q_trial(:), q_base(:), r(:), &
-            dq(:), k(:), history(:), decrements(:)
-        real(wp) :: lambda_last, lambda_prev, dlambda, lambda, gnorm, size_scale, floor
-        integer :: e, stat
-        logical :: converged
-        integer :: nhist
-        character(len=:), allocatable :: why
+        type(static_work_t) :: w
+        if (present(options)) w%opt = options
+        call check_input(body, q, w%opt, status)
+        if (status%ok()) call prepare(w, body, q, status)
+        if (.not. status%ok()) then
+            if (present(report)) report = w%rep
+            return
+        end if
+        if (body%nq == 0) then
+            w%rep%load_factor = 1.0_wp
+            if (present(report)) report = w%rep
+            return
+        end if
+        call w%klu%analyse(body%nv, body%stiffness%colptr, body%stiffness%rowind, status)
+        if (status%ok()) then
+            call follow_load(w, body, status)
+            q = w%q_last
+        end if
+        if (present(report)) report = w%rep
+    end subroutine solve_static
 
-        if (present(options)) opt = options
+    !> Bad input: q not of the body's size, options out of range, a guess
+    !> or applied force that is not finite.
+    subroutine check_input(body, q, opt, status)
+        class(flexible_body_t), intent(in) :: body
+        real(wp), intent(in) :: q(:)
+        type(static_options_t), intent(in) :: opt
+        type(status_t), intent(inout) :: status
         if (size(q) /= body%nq) then
             call status%set(status_bad_input, 'static equilibrium: q has ' // &
                             int_text(size(q)) // ' entries, the body ' // int_text(body%nq))
-            if (present(report)) report = rep
-            return
-        end if
-        if (.not. (opt%min_increment > 0.0_wp .and. opt%initial_increment >= opt%min_increment &
-                   .and. opt%residual_tolerance > 0.0_wp .and. opt%max_iterations > 0)) then
+        else if (.not. (opt%min_increment > 0.0_wp .and. &
+                        opt%initial_increment >= opt%min_increment .and. &
+                        opt%residual_tolerance > 0.0_wp .and. opt%max_iterations > 0)) then
             call status%set(status_bad_input, 'static equilibrium: options need 0 < ' // &
                 'min_increment <= initial_increment, residual_tolerance > 0, max_iterations > 0')
-            if (present(report)) report = rep
-            return
-        end if
-        if (.not. (all(ieee_is_finite(q)) .and. all(ieee_is_finite(body%applied_force)))) then
+        else if (.not. (all(ieee_is_finite(q)) .and. all(ieee_is_finite(body%applied_force)))) then
             call status%set(status_bad_input, 'static equilibrium: the initial guess or ' // &
                             'the applied force is not finite')
-            if (present(report)) report = rep
-            return
         end if
-        allocate (zero_v(body%nv), history(opt%max_iterations + 1), &
-            decrements(opt%max_iterations), stat=stat)
-        if (stat == 0) allocate (q_last, q_prev, q_trial, q_base, r, dq, k, source=q, stat=stat)
+    end subroutine check_input
+
+    !> The workspace, and the scales of the convergence tests: ‖g‖∞, the
+    !> body's size and the round-off level of k.
+    subroutine prepare(w, body, q, status)
+        type(static_work_t), intent(inout) :: w
+        class(flexible_body_t), intent(in) :: body
+        real(wp), intent(in) :: q(:)
+        type(status_t), intent(inout) :: status
+        integer :: e, stat
+        allocate (w%zero_v(body%nv), w%history(w%opt%max_iterations + 1), &
+            w%decrements(w%opt%max_iterations), stat=stat)
+        if (stat == 0) allocate (w%q_last, w%q_prev, w%q_trial, w%q_base, w%r, w%dq, w%k, &
+                                 source=q, stat=stat)
         if (stat /= 0) then
             call out_of_memory(status, 'static equilibrium workspace', &
-                body%nv + 2_i8 * opt%max_iterations + 1 + 7_i8 * size(q), 8)
-            if (present(report)) report = rep
+                body%nv + 2_i8 * w%opt%max_iterations + 1 + 7_i8 * size(q), 8)
             return
         end if
-        zero_v = 0.0_wp
-        gnorm = 0.0_wp
-        if (body%nv > 0) gnorm = maxval(abs(body%applied_force))
-        size_scale = maxval(body%mesh%x) - minval(body%mesh%x)
-        if (size_scale <= 0.0_wp) size_scale = 1.0_wp
+        w%zero_v = 0.0_wp
+        w%gnorm = 0.0_wp
+        if (body%nv > 0) w%gnorm = maxval(abs(body%applied_force))
+        w%size_scale = maxval(body%mesh%x) - minval(body%mesh%x)
+        if (w%size_scale <= 0.0_wp) w%size_scale = 1.0_wp
         ! Round-off level of k: the stresses carry absolute errors of about
         ! ε (2μ + λ) (from I − C⁻¹ and J − 1), times an element's area.
-        floor = 0.0_wp
+        w%floor = 0.0_wp
         do e = 1, body%mesh%element_count()
             associate (mat => body%materials(body%element_material(e)))
-                floor = max(floor, (2.0_wp * mat%mu + mat%lambda) &
-                                   * sum(body%wdv(:, e))**(2.0_wp / 3))
+                w%floor = max(w%floor, (2.0_wp * mat%mu + mat%lambda) &
+                                       * sum(body%wdv(:, e))**(2.0_wp / 3))
             end associate
         end do
-        floor = 1.0e2_wp * epsilon(1.0_wp) * floor
+        w%floor = 1.0e2_wp * epsilon(1.0_wp) * w%floor
+    end subroutine prepare
 
-        if (body%nq == 0) then
-            rep%load_factor = 1.0_wp
-            call finish()
-            return
-        end if
-        call klu%analyse(body%nv, body%stiffness%colptr, body%stiffness%rowind, status)
-        if (.not. status%ok()) then
-            call finish()
-            return
-        end if
-
+    !> The load factor from 0 to 1 in increments (module header): the last
+    !> equilibrium in w%q_last, its load factor in the report.
+    subroutine follow_load(w, body, status)
+        type(static_work_t), intent(inout) :: w
+        class(flexible_body_t), intent(inout) :: body
+        type(status_t), intent(inout) :: status
+        real(wp) :: lambda_last, lambda_prev, dlambda, lambda
+        logical :: converged
+        character(len=:), allocatable :: why
         lambda_last = 0.0_wp
         lambda_prev = 0.0_wp
-        dlambda = min(1.0_wp, opt%initial_increment)
+        dlambda = min(1.0_wp, w%opt%initial_increment)
         do while (lambda_last < 1.0_wp)
-            if (rep%load_steps + rep%failed_steps >= opt%max_load_steps) then
+            if (w%rep%load_steps + w%rep%failed_steps >= w%opt%max_load_steps) then
                 call status%set(status_solver_failure, 'static equilibrium: ' // &
-                    int_text(opt%max_load_steps) // ' load steps reached at load factor ' // &
+                    int_text(w%opt%max_load_steps) // ' load steps reached at load factor ' // &
                     real_text(lambda_last), reason_step_too_small)
                 exit
             end if
             lambda = min(1.0_wp, lambda_last + dlambda)
             ! Secant predictor through the last two equilibria.
             if (lambda_last > lambda_prev) then
-                q_trial = q_last + (lambda - lambda_last) / (lambda_last - lambda_prev) &
-                          * (q_last - q_prev)
+                w%q_trial = w%q_last + (lambda - lambda_last) / (lambda_last - lambda_prev) &
+                            * (w%q_last - w%q_prev)
             else
-                q_trial = q_last
+                w%q_trial = w%q_last
             end if
-            call newton(lambda, converged, why)
-            if (.not. status%ok()) exit
+            call newton(w, body, lambda, converged, why)
             if (.not. converged) then
                 ! The predictor may be what failed: retry from the last state.
                 if (lambda_last > lambda_prev) then
-                    q_trial = q_last
-                    call newton(lambda, converged, why)
-                    if (.not. status%ok()) exit
+                    w%q_trial = w%q_last
+                    call newton(w, body, lambda, converged, why)
                 end if
             end if
             if (converged) then
-                rep%load_steps = rep%load_steps + 1
-                q_prev = q_last
+                w%rep%load_steps = w%rep%load_steps + 1
+                w%q_prev = w%q_last
                 lambda_prev = lambda_last
-                q_last = q_trial
+                w%q_last = w%q_trial
                 lambda_last = lambda
-                rep%residual_history = history(1:nhist)
-                rep%decrement_history = decrements(1:nhist - 1)
-                if (nhist <= 5) dlambda = min(1.0_wp, 2.0_wp * dlambda)
+                w%rep%residual_history = w%history(1:w%nhist)
+                w%rep%decrement_history = w%decrements(1:w%nhist - 1)
+                if (w%nhist <= 5) dlambda = min(1.0_wp, 2.0_wp * dlambda)
             else
-                rep%failed_steps = rep%failed_steps + 1
+                w%rep%failed_steps = w%rep%failed_steps + 1
                 dlambda = 0.5_wp * dlambda
-                if (dlambda < opt%min_increment) then
+                if (dlambda < w%opt%min_increment) then
                     call status%set(status_solver_failure, 'static equilibrium: load ' // &
-                        'increment below ' // real_text(opt%min_increment) // &
+                        'increment below ' // real_text(w%opt%min_increment) // &
                         ' at load factor ' // real_text(lambda_last) // ' (the step to ' // &
                         real_text(lambda) // ' failed: ' // why // ')', reason_newton_failure)
                     exit
                 end if
             end if
         end do
-        q = q_last
-        rep%load_factor = lambda_last
-        call finish()
+        w%rep%load_factor = lambda_last
+    end subroutine follow_load
 
-    contains
-
-        !> Newton from q_trial for load factor lam; q_trial is the solution
-        !> when converged. Hard errors (bad input, KLU misuse) go to status.
-        subroutine newton(lam, converged, why)
-            real(wp), intent(in) :: lam
-            logical, intent(out) :: converged
-            character(len=:), allocatable, intent(out) :: why
-            type(status_t) :: st
-            real(wp) :: rnorm, rtrial, alpha, dqnorm, slope, pi0, pi
-            logical :: have_pi0
-            integer :: it, ib
-            converged = .false.
-            nhist = 0
-            call residual(q_trial, lam, rnorm, st)
+    !> Newton from w%q_trial for load factor lam; w%q_trial is the solution
+    !> when converged, else why says what failed.
+    subroutine newton(w, body, lam, converged, why)
+        type(static_work_t), intent(inout) :: w
+        class(flexible_body_t), intent(inout) :: body
+        real(wp), intent(in) :: lam
+        logical, intent(out) :: converged
+        character(len=:), allocatable, intent(out) :: why
+        type(status_t) :: st
+        real(wp) :: rnorm, rtrial, alpha, dqnorm, slope
+        integer :: it
+        converged = .false.
+        w%nhist = 0
+        call residual(body, w%q_trial, lam, w%zero_v, w%r, rnorm, st)
+        if (.not. st%ok()) then
+            why = st%text()
+            return
+        end if
+        do it = 1, w%opt%max_iterations
+            w%nhist = w%nhist + 1
+            w%history(w%nhist) = rnorm
+            w%rep%newton_iterations = w%rep%newton_iterations + 1
+            call body%tangents(w%q_trial, w%zero_v, w%k, st)
             if (.not. st%ok()) then
                 why = st%text()
                 return
             end if
-            do it = 1, opt%max_iterations
-                nhist = nhist + 1
-                history(nhist) = rnorm
-                rep%newton_iterations = rep%newton_iterations + 1
-                call body%tangents(q_trial, zero_v, k, st)
-                if (.not. st%ok()) then
-                    why = st%text()
-                    return
-                end if
-                call klu%factor(body%stiffness%values, st)
-                rep%factorizations = rep%factorizations + 1
-                if (.not. st%ok()) then
-                    why = 'tangent stiffness: ' // st%text()
-                    return
-                end if
-                dq = -r
-                call klu%solve(dq, st)
-                if (.not. st%ok()) then
-                    why = 'tangent stiffness solve: ' // st%text()
-                    return
-                end if
-                dqnorm = maxval(abs(dq))
-                ! Backtracking (Armijo, small slope factor) on ‖r‖∞, or else on
-                ! the potential Π when dq descends it (see the module header).
-                q_base = q_trial
-                slope = dot_product(dq, r)
-                decrements(nhist) = sqrt(abs(slope))
-                have_pi0 = .false.
-                alpha = 1.0_wp
-                do ib = 0, opt%max_backtracks
-                    q_trial = q_base + alpha * dq
-                    call residual(q_trial, lam, rtrial, st)
-                    if (st%ok()) then
-                        if (rtrial <= (1.0_wp - 1.0e-4_wp * alpha) * rnorm) exit
-                        if (slope < 0.0_wp) then
-                            if (.not. have_pi0) then
-                                pi0 = potential(q_base, lam, st)
-                                have_pi0 = st%ok()
-                            end if
-                            if (have_pi0) then
-                                pi = potential(q_trial, lam, st)
-                                if (st%ok() .and. pi <= pi0 + 1.0e-4_wp * alpha * slope) exit
-                            end if
-                        end if
-                    else
-                        why = st%text()
-                    end if
-                    alpha = 0.5_wp * alpha
-                end do
-                if (ib > opt%max_backtracks) then
-                    q_trial = q_base
-                    ! No descent: converged if r is at round-off level or the
-                    ! Newton correction itself is negligible.
-                    if (rnorm <= max(opt%residual_tolerance * lam * gnorm, floor) .or. &
-                        dqnorm <= opt%increment_tolerance * size_scale) then
-                        call residual(q_trial, lam, rnorm, st)
-                        converged = st%ok()
-                        nhist = nhist + 1
-                        history(nhist) = rnorm
-                        rep%residual = rnorm
-                        return
-                    end if
-                    if (.not. allocated(why)) why = 'no descent along the Newton direction'
-                    call residual(q_trial, lam, rnorm, st)
-                    return
-                end if
-                rnorm = rtrial
-                if ((rnorm <= opt%residual_tolerance * lam * gnorm .or. rnorm <= floor) .and. &
-                    alpha * dqnorm <= opt%increment_tolerance * size_scale) then
-                    converged = .true.
-                    nhist = nhist + 1
-                    history(nhist) = rnorm
-                    rep%residual = rnorm
-                    return
-                end if
-            end do
-            why = 'no convergence in ' // int_text(opt%max_iterations) // ' iterations'
-        end subroutine newton
-
-        !> Total potential Π = W(q) − lam g·q of the dead loads.
-        real(wp) function potential(qq, lam, st)
-            real(wp), intent(in) :: qq(:), lam
-            type(status_t), intent(out) :: st
-            potential = body%strain_energy(qq, st) - lam * dot_product(body%applied_force, qq)
-        end function potential
-
-        !> r = k(q, 0) − lam g and its ∞-norm; st fails on det F ≤ 0.
-        subroutine residual(qq, lam, rnorm, st)
-            real(wp), intent(in) :: qq(:), lam
-            real(wp), intent(out) :: rnorm
-            type(status_t), intent(out) :: st
-            call body%internal_forces(qq, zero_v, r, st)
+            call w%klu%factor(body%stiffness%values, st)
+            w%rep%factorizations = w%rep%factorizations + 1
             if (.not. st%ok()) then
-                rnorm = huge(1.0_wp)
+                why = 'tangent stiffness: ' // st%text()
                 return
             end if
-            r = r - lam * body%applied_force
-            rnorm = maxval(abs(r))
-        end subroutine residual
+            w%dq = -w%r
+            call w%klu%solve(w%dq, st)
+            if (.not. st%ok()) then
+                why = 'tangent stiffness solve: ' // st%text()
+                return
+            end if
+            dqnorm = maxval(abs(w%dq))
+            w%q_base = w%q_trial
+            slope = dot_product(w%dq, w%r)
+            w%decrements(w%nhist) = sqrt(abs(slope))
+            call line_search(w, body, lam, rnorm, slope, alpha, rtrial, why)
+            if (alpha == 0.0_wp) then
+                w%q_trial = w%q_base
+                ! No descent: converged if r is at round-off level or the
+                ! Newton correction itself is negligible.
+                if (rnorm <= max(w%opt%residual_tolerance * lam * w%gnorm, w%floor) .or. &
+                    dqnorm <= w%opt%increment_tolerance * w%size_scale) then
+                    call residual(body, w%q_trial, lam, w%zero_v, w%r, rnorm, st)
+                    converged = st%ok()
+                    w%nhist = w%nhist + 1
+                    w%history(w%nhist) = rnorm
+                    w%rep%residual = rnorm
+                    return
+                end if
+                if (.not. allocated(why)) why = 'no descent along the Newton direction'
+                call residual(body, w%q_trial, lam, w%zero_v, w%r, rnorm, st)
+                return
+            end if
+            rnorm = rtrial
+            if ((rnorm <= w%opt%residual_tolerance * lam * w%gnorm .or. rnorm <= w%floor) .and. &
+                alpha * dqnorm <= w%opt%increment_tolerance * w%size_scale) then
+                converged = .true.
+                w%nhist = w%nhist + 1
+                w%history(w%nhist) = rnorm
+                w%rep%residual = rnorm
+                return
+            end if
+        end do
+        why = 'no convergence in ' // int_text(w%opt%max_iterations) // ' iterations'
+    end subroutine newton
 
-        subroutine finish()
-            if (present(report)) report = rep
-        end subroutine finish
-    end subroutine solve_static
+    !> Backtracking along w%dq from w%q_base (Armijo, small slope factor) on
+    !> ‖r‖∞, or else on the potential Π when dq descends it (module header):
+    !> the step alpha taken (w%q_trial, its ‖r‖∞ rtrial), 0 when no step of
+    !> max_backtracks halvings descends (why: a failed evaluation's reason).
+    subroutine line_search(w, body, lam, rnorm, slope, alpha, rtrial, why)
+        type(static_work_t), intent(inout) :: w
+        class(flexible_body_t), intent(inout) :: body
+        real(wp), intent(in) :: lam, rnorm, slope
+        real(wp), intent(out) :: alpha, rtrial
+        character(len=:), allocatable, intent(inout) :: why
+        type(status_t) :: st
+        real(wp) :: pi0, pi
+        logical :: have_pi0
+        integer :: ib
+        have_pi0 = .false.
+        alpha = 1.0_wp
+        do ib = 0, w%opt%max_backtracks
+            w%q_trial = w%q_base + alpha * w%dq
+            call residual(body, w%q_trial, lam, w%zero_v, w%r, rtrial, st)
+            if (st%ok()) then
+                if (rtrial <= (1.0_wp - 1.0e-4_wp * alpha) * rnorm) return
+                if (slope < 0.0_wp) then
+                    if (.not. have_pi0) then
+                        pi0 = potential(body, w%q_base, lam, st)
+                        have_pi0 = st%ok()
+                    end if
+                    if (have_pi0) then
+                        pi = potential(body, w%q_trial, lam, st)
+                        if (st%ok() .and. pi <= pi0 + 1.0e-4_wp * alpha * slope) return
+                    end if
+                end if
+            else
+                why = st%text()
+            end if
+            alpha = 0.5_wp * alpha
+        end do
+        alpha = 0.0_wp
+    end subroutine line_search
+
+    !> Total potential Π = W(q) − lam g·q of the dead loads.
+    real(wp) function potential(body, qq, lam, st)
+        class(flexible_body_t), intent(inout) :: body
+        real(wp), intent(in) :: qq(:), lam
+        type(status_t), intent(out) :: st
+        potential = body%strain_energy(qq, st) - lam * dot_product(body%applied_force, qq)
+    end function potential
+
+    !> r = k(q, 0) − lam g and its ∞-norm; st fails on det F ≤ 0.
+    subroutine residual(body, qq, lam, zero_v, r, rnorm, st)
+        class(flexible_body_t), intent(inout) :: body
+        real(wp), intent(in) :: qq(:), lam, zero_v(:)
+        real(wp), intent(inout) :: r(:)
+        real(wp), intent(out) :: rnorm
+        type(status_t), intent(out) :: st
+        call body%internal_forces(qq, zero_v, r, st)
+        if (.not. st%ok()) then
+            rnorm = huge(1.0_wp)
+            return
+        end if
+        r = r - lam * body%applied_force
+        rnorm = maxval(abs(r))
+    end subroutine residual
 end module flexmbs_fe_statics
