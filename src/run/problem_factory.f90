@@ -67,14 +67,10 @@ contains
         !> a multibody scene: per joint of the system, its group and name
         !> ('joints/NAME', 'drivers/NAME'; run/multibody_builder)
         character(len=:), allocatable, intent(out), optional :: joint_names(:)
-        character(len=:), allocatable :: labels(:), moves, names(:)
         type(robertson_t) :: robertson
-        type(pendulum_t) :: pendulum
         type(reaction_diffusion_t) :: bruss
-        type(formulation_t) :: formulation
-        real(wp), allocatable :: q0(:), v0(:), yp0(:)
-        integer :: nq
-        logical :: klu, massless, mech_core
+        character(len=:), allocatable :: moves, names(:)
+        logical :: klu, mech_core
         ! the solver integrates the mechanical form itself (MEXAX)
         mech_core = solver_mechanical_only(scene%solver_name)
         klu = scene%linear_solver == 'klu' .or. scene%linear_solver == 'mumps'
@@ -100,119 +96,18 @@ contains
             call robertson_initial(robertson, y0)
             allocate (problem, source=robertson)
         case (problem_pendulum)
-            ! A mechanical core takes the mechanical form; its state y = (q, v, λ) has the
-            ! layout and initial values of the index-2 formulation.
-            pendulum = new_pendulum(merge(pendulum_index2, &
-                formulation_code(scene%pendulum_formulation), mech_core), &
-                scene%pendulum_angle, mass=scene%pendulum_mass, length=scene%pendulum_length, &
-                gravity=scene%gravity, sparse=klu, sparse_mass=klu, &
-                projection=scene%pendulum_projection, status=status)
-            if (.not. status%ok()) then
-                status%message = scene%path // ': &simulation: ' // status%message
-                return
-            end if
-            allocate (y0(pendulum%n))
-            call pendulum_initial(pendulum, y0)
-            ! y = (x, y, u, v, λ[, μ])
-            call append_block(blocks, 'q', 1, 2)
-            call append_block(blocks, 'v', 3, 4)
-            call append_block(blocks, 'lambda', 5, 5)
-            allocate (problem, source=pendulum)
-            if (mech_core .and. present(mechanical)) then
-                allocate (mechanical, source=new_pendulum_mechanical(mass=scene%pendulum_mass, &
-                    length=scene%pendulum_length, gravity=scene%gravity, status=status))
-            end if
+            call build_pendulum(scene, mech_core, klu, problem, y0, blocks, status, mechanical)
         case (problem_flexible_body)
-            allocate (flexible_body_t :: mechanical)
-            select type (body => mechanical)
-            type is (flexible_body_t)
-                call build_flexible_body(scene, 1, body, q0, v0, status)
-            end select
-            if (.not. status%ok()) return
-            call check_dense_size(scene, mechanical, status)
-            if (.not. status%ok()) return
-            ! M is constant in absolute nodal coordinates: y = (q, v[, λ]).
-            formulation = new_formulation(mechanical, &
-                mechanical_formulation(scene%bodies(1)%formulation), q0, constant_mass=.true., &
-                status=status, sparse=scene%linear_solver /= 'dense')
-            if (.not. status%ok()) then
-                status%message = scene%path // ': &flexible_body: ' // status%message
-                return
-            end if
-            nq = size(q0)
-            allocate (y0(formulation%n), source=0.0_wp)
-            y0(1:nq) = q0
-            y0(nq + 1:2 * nq) = v0
-            call append_block(blocks, 'q', 1, nq)
-            call append_block(blocks, 'v', nq + 1, 2 * nq)
-            allocate (problem, source=formulation)
+            call build_flexible_problem(scene, problem, y0, blocks, mechanical, status)
         case (problem_multibody)
-            allocate (mbs_system_t :: mechanical)
-            massless = .false.
-            select type (sys => mechanical)
-            type is (mbs_system_t)
-                call build_multibody(scene, sys, q0, v0, status, labels, names)
-                if (present(joint_names) .and. allocated(names)) joint_names = names
-                massless = sys%part_count(part_frame) > 0
-            end select
-            if (.not. status%ok()) return
-            call check_dense_size(scene, mechanical, status)
-            if (.not. status%ok()) return
-            ! Rigid and flexible bodies have a constant M (body-fixed ω'):
-            ! y = (q, v, λ[, μ]); a chain's M(q) and the zero M of node frames
-            ! need the acceleration layout y = (q, v, a, λ[, μ]), where the
-            ! constraints determine a through [M Gᵀ; G 0]. A mechanical core integrates
-            ! y = (q, v, λ) (index 2).
-            formulation = new_formulation(mechanical, merge(formulation_index2, &
-                mechanical_formulation(scene%multibody%formulation), &
-                mech_core), q0, constant_mass=(size(scene%chain) == 0 &
-                .and. .not. massless) .or. mech_core, &
-                projection=scene%multibody%projection, status=status, &
-                sparse=scene%linear_solver /= 'dense')
-            if (.not. status%ok()) then
-                status%message = scene%path // ': &multibody: ' // status%message
-                return
-            end if
-            call start_state(formulation, q0, v0, y0, yp0)
-            call formulation%consistent_initial(scene%t_start, y0, yp0, status)
-            if (.not. status%ok()) then
-                call status%set(status_bad_input, scene%path // ': no consistent initial &
-                    &state (the joints cannot be assembled from the given positions and &
-                    &velocities): ' // status%text())
-                return
-            end if
-            select type (sys => mechanical)
-            type is (mbs_system_t)
-                call check_assembly(scene, sys, labels, scene%t_start, q0, &
-                    y0(formulation%offset(block_q) + 1:formulation%last(block_q)), moves, status)
-                if (present(assembly)) assembly = moves
-            end select
-            if (.not. status%ok()) return
-            call append_layout(blocks, formulation)
-            allocate (problem, source=formulation)
+            call build_multibody_problem(scene, mech_core, problem, y0, blocks, mechanical, &
+                                         status, moves, names)
+            ! (gfortran 12 loses a deferred length passed on through two
+            ! optional dummies: the results come back in locals)
+            if (present(assembly) .and. allocated(moves)) assembly = moves
+            if (present(joint_names) .and. allocated(names)) joint_names = names
         case (problem_rigid_chain)
-            allocate (rigid_chain_t :: mechanical)
-            select type (chain => mechanical)
-            type is (rigid_chain_t)
-                call build_rigid_chain(scene, chain, q0, v0, status)
-            end select
-            if (.not. status%ok()) return
-            ! M(q) varies: the acceleration layout y = (q, v, a) (nc = 0). MEXAX
-            ! integrates y = (q, v); its formulation only gives that layout.
-            formulation = new_formulation(mechanical, merge(formulation_index2, &
-                mechanical_formulation(scene%multibody%formulation), &
-                mech_core), q0, constant_mass=mech_core, status=status)
-            if (.not. status%ok()) then
-                status%message = scene%path // ': &rigid_chain: ' // status%message
-                return
-            end if
-            call start_state(formulation, q0, v0, y0, yp0)
-            if (.not. mech_core) then
-                call formulation%consistent_initial(scene%t_start, y0, yp0, status)
-                if (.not. status%ok()) return
-            end if
-            call append_layout(blocks, formulation) ! nc = 0: q and v
-            allocate (problem, source=formulation)
+            call build_chain_problem(scene, mech_core, problem, y0, blocks, mechanical, status)
         case (problem_brusselator_1d, problem_brusselator_2d)
             bruss = new_reaction_diffusion(merge(1, 2, problem_id(scene%problem) == problem_brusselator_1d), &
                 scene%npoints, sparse=scene%linear_solver /= 'dense', status=status)
@@ -228,6 +123,171 @@ contains
                 trim(scene%problem) // ''': not available in this build')
         end select
     end subroutine build_problem
+
+    !> The pendulum in the scene's formulation; a mechanical core takes the
+    !> mechanical form, its state y = (q, v, λ) with the layout and initial
+    !> values of the index-2 formulation.
+    subroutine build_pendulum(scene, mech_core, klu, problem, y0, blocks, status, mechanical)
+        type(scene_input_t), intent(in) :: scene
+        logical, intent(in) :: mech_core, klu
+        class(dae_problem_t), allocatable, intent(inout) :: problem
+        real(wp), allocatable, intent(inout) :: y0(:)
+        type(block_spec_t), allocatable, intent(inout) :: blocks(:)
+        type(status_t), intent(inout) :: status
+        class(mechanical_problem_t), allocatable, intent(inout), optional :: mechanical
+        type(pendulum_t) :: pendulum
+        pendulum = new_pendulum(merge(pendulum_index2, &
+            formulation_code(scene%pendulum_formulation), mech_core), &
+            scene%pendulum_angle, mass=scene%pendulum_mass, length=scene%pendulum_length, &
+            gravity=scene%gravity, sparse=klu, sparse_mass=klu, &
+            projection=scene%pendulum_projection, status=status)
+        if (.not. status%ok()) then
+            status%message = scene%path // ': &simulation: ' // status%message
+            return
+        end if
+        allocate (y0(pendulum%n))
+        call pendulum_initial(pendulum, y0)
+        ! y = (x, y, u, v, λ[, μ])
+        call append_block(blocks, 'q', 1, 2)
+        call append_block(blocks, 'v', 3, 4)
+        call append_block(blocks, 'lambda', 5, 5)
+        allocate (problem, source=pendulum)
+        if (mech_core .and. present(mechanical)) then
+            allocate (mechanical, source=new_pendulum_mechanical(mass=scene%pendulum_mass, &
+                length=scene%pendulum_length, gravity=scene%gravity, status=status))
+        end if
+    end subroutine build_pendulum
+
+    !> One flexible body: M is constant in absolute nodal coordinates, so
+    !> y = (q, v[, λ]).
+    subroutine build_flexible_problem(scene, problem, y0, blocks, mechanical, status)
+        type(scene_input_t), intent(in) :: scene
+        class(dae_problem_t), allocatable, intent(inout) :: problem
+        real(wp), allocatable, intent(inout) :: y0(:)
+        type(block_spec_t), allocatable, intent(inout) :: blocks(:)
+        class(mechanical_problem_t), allocatable, target, intent(inout) :: mechanical
+        type(status_t), intent(inout) :: status
+        type(formulation_t) :: formulation
+        real(wp), allocatable :: q0(:), v0(:)
+        integer :: nq
+        allocate (flexible_body_t :: mechanical)
+        select type (body => mechanical)
+        type is (flexible_body_t)
+            call build_flexible_body(scene, 1, body, q0, v0, status)
+        end select
+        if (.not. status%ok()) return
+        call check_dense_size(scene, mechanical, status)
+        if (.not. status%ok()) return
+        formulation = new_formulation(mechanical, &
+            mechanical_formulation(scene%bodies(1)%formulation), q0, constant_mass=.true., &
+            status=status, sparse=scene%linear_solver /= 'dense')
+        if (.not. status%ok()) then
+            status%message = scene%path // ': &flexible_body: ' // status%message
+            return
+        end if
+        nq = size(q0)
+        allocate (y0(formulation%n), source=0.0_wp)
+        y0(1:nq) = q0
+        y0(nq + 1:2 * nq) = v0
+        call append_block(blocks, 'q', 1, nq)
+        call append_block(blocks, 'v', nq + 1, 2 * nq)
+        allocate (problem, source=formulation)
+    end subroutine build_flexible_problem
+
+    !> A multibody system in its formulation, from consistent initial values
+    !> (the initial assembly checked and reported).
+    subroutine build_multibody_problem(scene, mech_core, problem, y0, blocks, mechanical, &
+                                       status, moves, names)
+        type(scene_input_t), intent(in) :: scene
+        logical, intent(in) :: mech_core
+        class(dae_problem_t), allocatable, intent(inout) :: problem
+        real(wp), allocatable, intent(inout) :: y0(:)
+        type(block_spec_t), allocatable, intent(inout) :: blocks(:)
+        class(mechanical_problem_t), allocatable, target, intent(inout) :: mechanical
+        type(status_t), intent(inout) :: status
+        !> how far the initial assembly moved each body; per joint its group and name
+        character(len=:), allocatable, intent(out) :: moves, names(:)
+        character(len=:), allocatable :: labels(:)
+        type(formulation_t) :: formulation
+        real(wp), allocatable :: q0(:), v0(:), yp0(:)
+        logical :: massless
+        allocate (mbs_system_t :: mechanical)
+        massless = .false.
+        select type (sys => mechanical)
+        type is (mbs_system_t)
+            call build_multibody(scene, sys, q0, v0, status, labels, names)
+            massless = sys%part_count(part_frame) > 0
+        end select
+        if (.not. status%ok()) return
+        call check_dense_size(scene, mechanical, status)
+        if (.not. status%ok()) return
+        ! Rigid and flexible bodies have a constant M (body-fixed ω'):
+        ! y = (q, v, λ[, μ]); a chain's M(q) and the zero M of node frames
+        ! need the acceleration layout y = (q, v, a, λ[, μ]), where the
+        ! constraints determine a through [M Gᵀ; G 0]. A mechanical core integrates
+        ! y = (q, v, λ) (index 2).
+        formulation = new_formulation(mechanical, merge(formulation_index2, &
+            mechanical_formulation(scene%multibody%formulation), &
+            mech_core), q0, constant_mass=(size(scene%chain) == 0 &
+            .and. .not. massless) .or. mech_core, &
+            projection=scene%multibody%projection, status=status, &
+            sparse=scene%linear_solver /= 'dense')
+        if (.not. status%ok()) then
+            status%message = scene%path // ': &multibody: ' // status%message
+            return
+        end if
+        call start_state(formulation, q0, v0, y0, yp0)
+        call formulation%consistent_initial(scene%t_start, y0, yp0, status)
+        if (.not. status%ok()) then
+            call status%set(status_bad_input, scene%path // ': no consistent initial &
+                &state (the joints cannot be assembled from the given positions and &
+                &velocities): ' // status%text())
+            return
+        end if
+        select type (sys => mechanical)
+        type is (mbs_system_t)
+            call check_assembly(scene, sys, labels, scene%t_start, q0, &
+                y0(formulation%offset(block_q) + 1:formulation%last(block_q)), moves, status)
+        end select
+        if (.not. status%ok()) return
+        call append_layout(blocks, formulation)
+        allocate (problem, source=formulation)
+    end subroutine build_multibody_problem
+
+    !> A rigid chain alone: M(q) varies, so the acceleration layout
+    !> y = (q, v, a) (nc = 0). MEXAX integrates y = (q, v); its formulation
+    !> only gives that layout.
+    subroutine build_chain_problem(scene, mech_core, problem, y0, blocks, mechanical, status)
+        type(scene_input_t), intent(in) :: scene
+        logical, intent(in) :: mech_core
+        class(dae_problem_t), allocatable, intent(inout) :: problem
+        real(wp), allocatable, intent(inout) :: y0(:)
+        type(block_spec_t), allocatable, intent(inout) :: blocks(:)
+        class(mechanical_problem_t), allocatable, target, intent(inout) :: mechanical
+        type(status_t), intent(inout) :: status
+        type(formulation_t) :: formulation
+        real(wp), allocatable :: q0(:), v0(:), yp0(:)
+        allocate (rigid_chain_t :: mechanical)
+        select type (chain => mechanical)
+        type is (rigid_chain_t)
+            call build_rigid_chain(scene, chain, q0, v0, status)
+        end select
+        if (.not. status%ok()) return
+        formulation = new_formulation(mechanical, merge(formulation_index2, &
+            mechanical_formulation(scene%multibody%formulation), &
+            mech_core), q0, constant_mass=mech_core, status=status)
+        if (.not. status%ok()) then
+            status%message = scene%path // ': &rigid_chain: ' // status%message
+            return
+        end if
+        call start_state(formulation, q0, v0, y0, yp0)
+        if (.not. mech_core) then
+            call formulation%consistent_initial(scene%t_start, y0, yp0, status)
+            if (.not. status%ok()) return
+        end if
+        call append_layout(blocks, formulation) ! nc = 0: q and v
+        allocate (problem, source=formulation)
+    end subroutine build_chain_problem
 
     !> y0 = (q0, v0, 0...) in the layout of `formulation`, yp0 = 0.
     subroutine start_state(formulation, q0, v0, y0, yp0)
