@@ -128,12 +128,8 @@ contains
     !> mechanical form, its state y = (q, v, λ) with the layout and initial
     !> values of the index-2 formulation.
     subroutine build_pendulum(scene, mech_core, klu, problem, y0, blocks, status, mechanical)
-        type(scene_input_t), intent(in) :: scene
+        include 'problem_builder_arguments.inc'
         logical, intent(in) :: mech_core, klu
-        class(dae_problem_t), allocatable, intent(inout) :: problem
-        real(wp), allocatable, intent(inout) :: y0(:)
-        type(block_spec_t), allocatable, intent(inout) :: blocks(:)
-        type(status_t), intent(inout) :: status
         class(mechanical_problem_t), allocatable, intent(inout), optional :: mechanical
         type(pendulum_t) :: pendulum
         pendulum = new_pendulum(merge(pendulum_index2, &
@@ -161,12 +157,8 @@ contains
     !> One flexible body: M is constant in absolute nodal coordinates, so
     !> y = (q, v[, λ]).
     subroutine build_flexible_problem(scene, problem, y0, blocks, mechanical, status)
-        type(scene_input_t), intent(in) :: scene
-        class(dae_problem_t), allocatable, intent(inout) :: problem
-        real(wp), allocatable, intent(inout) :: y0(:)
-        type(block_spec_t), allocatable, intent(inout) :: blocks(:)
+        include 'problem_builder_arguments.inc'
         class(mechanical_problem_t), allocatable, target, intent(inout) :: mechanical
-        type(status_t), intent(inout) :: status
         type(formulation_t) :: formulation
         real(wp), allocatable :: q0(:), v0(:)
         integer :: nq
@@ -198,13 +190,9 @@ contains
     !> (the initial assembly checked and reported).
     subroutine build_multibody_problem(scene, mech_core, problem, y0, blocks, mechanical, &
                                        status, moves, names)
-        type(scene_input_t), intent(in) :: scene
+        include 'problem_builder_arguments.inc'
         logical, intent(in) :: mech_core
-        class(dae_problem_t), allocatable, intent(inout) :: problem
-        real(wp), allocatable, intent(inout) :: y0(:)
-        type(block_spec_t), allocatable, intent(inout) :: blocks(:)
         class(mechanical_problem_t), allocatable, target, intent(inout) :: mechanical
-        type(status_t), intent(inout) :: status
         !> how far the initial assembly moved each body; per joint its group and name
         character(len=:), allocatable, intent(out) :: moves, names(:)
         character(len=:), allocatable :: labels(:)
@@ -258,13 +246,9 @@ contains
     !> y = (q, v, a) (nc = 0). MEXAX integrates y = (q, v); its formulation
     !> only gives that layout.
     subroutine build_chain_problem(scene, mech_core, problem, y0, blocks, mechanical, status)
-        type(scene_input_t), intent(in) :: scene
+        include 'problem_builder_arguments.inc'
         logical, intent(in) :: mech_core
-        class(dae_problem_t), allocatable, intent(inout) :: problem
-        real(wp), allocatable, intent(inout) :: y0(:)
-        type(block_spec_t), allocatable, intent(inout) :: blocks(:)
         class(mechanical_problem_t), allocatable, target, intent(inout) :: mechanical
-        type(status_t), intent(inout) :: status
         type(formulation_t) :: formulation
         real(wp), allocatable :: q0(:), v0(:), yp0(:)
         allocate (rigid_chain_t :: mechanical)
