@@ -47,6 +47,8 @@ module flexmbs_dae_sink
         end subroutine output_i
     end interface
 
+    public :: finish_sink
+
 contains
 
     !> The order of the multistep formula the last step used (BDF: 1..5);
@@ -78,4 +80,16 @@ contains
         class(sink_t), intent(inout) :: self
         type(status_t), intent(inout) :: status
     end subroutine default_finish
+
+    !> The end of an integration for a solver's optional sink: `finish` once,
+    !> its error reported only when the integration itself succeeded (a
+    !> failed run's status says why it stopped).
+    subroutine finish_sink(sink, status)
+        class(sink_t), intent(inout), optional :: sink
+        type(status_t), intent(inout) :: status
+        type(status_t) :: sink_status
+        if (.not. present(sink)) return
+        call sink%finish(sink_status)
+        if (status%ok() .and. .not. sink_status%ok()) status = sink_status
+    end subroutine finish_sink
 end module flexmbs_dae_sink
