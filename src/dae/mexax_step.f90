@@ -38,14 +38,7 @@ contains
     !> for a restart, a rejection (the next call retries) or a stop
     !> (`r%done`, status set, or at t_end).
     subroutine macro_step(self, r, problem, t_end, options, stats, status, sink)
-        class(mexax_engine_t), intent(inout) :: self
-        type(mexax_run_t), intent(inout) :: r
-        class(mechanical_problem_t), intent(inout) :: problem
-        real(wp), intent(in) :: t_end
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(inout) :: stats
-        type(status_t), intent(inout) :: status
-        class(sink_t), intent(inout), optional :: sink
+        include 'mexax_step_arguments.inc'
         if (r%need_start) then
             call start_point(self%native, problem, r%w, r%t, status, accelerations=.false.)
             if (.not. status%ok()) then
@@ -75,6 +68,7 @@ contains
         end if
 
         ! ---- one attempt: ODEX's column sequence (§3.4) or Deuflhard's window ----
+        r%decision = undecided
         if (r%w%ctl%scheme == mexax_control_deuflhard) then
             call attempt_window(self, r, problem, status)
         else
@@ -136,14 +130,14 @@ contains
     end subroutine too_small
 
     !> One attempt from t with H and the planned column k: the columns in
-    !> the order of ODEX (§3.4); r%decision and r%kc say how it ended.
+    !> the order of ODEX (§3.4); r%decision (undecided on entry) and r%kc
+    !> say how it ended.
     subroutine attempt(self, r, problem, status)
         class(mexax_engine_t), intent(inout) :: self
         type(mexax_run_t), intent(inout) :: r
         class(mechanical_problem_t), intent(inout) :: problem
         type(status_t), intent(inout) :: status
         integer :: j
-        r%decision = undecided
         if (.not. r%basic_entry .and. (r%first .or. r%last)) then
             do j = 1, r%k
                 if (.not. column(self, r, problem, j, status)) exit
@@ -192,7 +186,6 @@ contains
         class(mechanical_problem_t), intent(inout) :: problem
         type(status_t), intent(inout) :: status
         integer :: j
-        r%decision = undecided
         do j = 1, r%w%ctl%qmax
             if (.not. column(self, r, problem, j, status)) return
             r%kc = j
@@ -326,14 +319,7 @@ contains
     !> The projected point accepted: the new point, the outputs, then the
     !> order and step size after acceptance (§3.4); at t_end the loop ends.
     subroutine accept_step(self, r, problem, t_end, options, stats, status, sink)
-        class(mexax_engine_t), intent(inout) :: self
-        type(mexax_run_t), intent(inout) :: r
-        class(mechanical_problem_t), intent(inout) :: problem
-        real(wp), intent(in) :: t_end
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(inout) :: stats
-        type(status_t), intent(inout) :: status
-        class(sink_t), intent(inout), optional :: sink
+        include 'mexax_step_arguments.inc'
         self%native%naccpt = self%native%naccpt + 1
         call r%refusal%clear()
         r%t_old = r%t

@@ -30,14 +30,7 @@ contains
     !> accepted (R4–R6), rejected (R7) or failed (R8), with the next block
     !> set, or it ends the integration (`done`, status set unless at t_end).
     subroutine attempt_block(self, w, problem, y, options, stats, status, sink)
-        class(radau5_engine_t), intent(inout) :: self
-        type(radau5_work_t), intent(inout) :: w
-        class(dae_problem_t), intent(inout) :: problem
-        real(wp), intent(inout) :: y(:)
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(inout) :: stats
-        type(status_t), intent(inout) :: status
-        class(sink_t), intent(inout), optional :: sink
+        include 'radau5_step_arguments.inc'
         type(status_t) :: fstatus
         real(wp) :: fac
         integer :: cause, nind1, nind2
@@ -167,14 +160,7 @@ contains
     !> Block R4, accept the step (projection and admissibility may still take it
     !> back), the dense output, the outputs; then R5/R6, or the end at t_end.
     subroutine accept_step(self, w, problem, y, options, stats, status, sink)
-        class(radau5_engine_t), intent(inout) :: self
-        type(radau5_work_t), intent(inout) :: w
-        class(dae_problem_t), intent(inout) :: problem
-        real(wp), intent(inout) :: y(:)
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(inout) :: stats
-        type(status_t), intent(inout) :: status
-        class(sink_t), intent(inout), optional :: sink
+        include 'radau5_step_arguments.inc'
         type(status_t) :: fstatus
         real(wp) :: facgus, ak
         integer :: i
