@@ -42,8 +42,7 @@ module flexmbs_dae_sink
         subroutine output_i(self, t, y, status)
             import :: sink_t, wp, status_t
             class(sink_t), intent(inout) :: self
-            real(wp), intent(in) :: t, y(:)
-            type(status_t), intent(inout) :: status
+            include 'sink_output_arguments.inc'
         end subroutine output_i
     end interface
 
@@ -68,11 +67,7 @@ contains
     !> t_old = t). Setting `stop` ends the integration (status interrupted).
     subroutine default_step(self, nr, t_old, t, y, dense, stop, status)
         class(sink_t), intent(inout) :: self
-        integer, intent(in) :: nr                  !! 1 at t0, then accepted steps + 1
-        real(wp), intent(in) :: t_old, t, y(:)
-        class(dense_output_t), intent(in) :: dense
-        logical, intent(inout) :: stop
-        type(status_t), intent(inout) :: status
+        include 'sink_step_arguments.inc'
     end subroutine default_step
 
     !> Called once at the end, successful or not.
