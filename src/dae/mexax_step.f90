@@ -16,7 +16,7 @@ module flexmbs_dae_mexax_step
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_rejections, only: cause_error_test, cause_singular_matrix, &
         cause_model_refused, cause_projection, cause_unstable
-    use flexmbs_dae_sink, only: sink_t
+    use flexmbs_dae_sink, only: sink_t, dense_outputs
     use flexmbs_dae_mexax_workspace, only: workspace_t, ev_ok, ev_restart, ev_stop, ev_refused, &
         user_failed
     use flexmbs_dae_mexax_tableau, only: start_point, base_column, extrapolate_column, &
@@ -412,13 +412,10 @@ contains
         type(dae_options_t), intent(in) :: options
         type(status_t), intent(inout) :: status
         class(sink_t), intent(inout) :: sink
-        do while (r%iout <= r%nout)
-            if ((options%output_times(r%iout) - r%t) * r%posneg > 0.0_wp) exit
-            call self%dense%evaluate(options%output_times(r%iout), r%yout)
-            call sink%output(options%output_times(r%iout), r%yout, status)
-            r%iout = r%iout + 1
-            if (.not. status%ok()) return
-        end do
+        logical :: failed
+        call dense_outputs(sink, self%dense, options, r%nout, r%t, r%posneg, r%iout, r%yout, &
+                           status, failed)
+        if (failed) return
         if (r%want_steps) call sink%step(self%native%naccpt + 1, r%t_old, r%t, self%dense%y1, &
             self%dense, r%stop_requested, status)
     end subroutine emit_outputs

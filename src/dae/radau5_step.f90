@@ -14,7 +14,7 @@ module flexmbs_dae_radau5_step
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_rejections, only: cause_error_test, cause_model_refused, cause_projection
-    use flexmbs_dae_sink, only: sink_t
+    use flexmbs_dae_sink, only: sink_t, dense_outputs
     use flexmbs_dae_radau5_state, only: radau5_engine_t, radau5_work_t, eval_f, compute_scal, &
         ieee_nan, c1, c2, c1m1, c2m1, c1mc2, dd1, dd2, dd3, err_floor, first_reject_factor, &
         end_factor, blk_jacobian, blk_factor, blk_attempt
@@ -315,13 +315,10 @@ contains
         type(dae_options_t), intent(in) :: options
         type(status_t), intent(inout) :: status
         class(sink_t), intent(inout) :: sink
-        do while (w%iout <= w%nout)
-            if ((options%output_times(w%iout) - w%x) * w%posneg > 0.0_wp) exit
-            call self%dense%evaluate(options%output_times(w%iout), w%ytmp)
-            call sink%output(options%output_times(w%iout), w%ytmp, status)
-            w%iout = w%iout + 1
-            if (.not. status%ok()) return
-        end do
+        logical :: failed
+        call dense_outputs(sink, self%dense, options, w%nout, w%x, w%posneg, w%iout, w%ytmp, &
+                           status, failed)
+        if (failed) return
         if (w%want_steps) call sink%step(self%native%naccpt + 1, w%xold, w%x, y, self%dense, &
             w%stop_requested, status)
     end subroutine emit_outputs

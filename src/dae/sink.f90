@@ -7,6 +7,7 @@
 module flexmbs_dae_sink
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t
+    use flexmbs_dae_options, only: dae_options_t
     implicit none
     private
 
@@ -46,7 +47,7 @@ module flexmbs_dae_sink
         end subroutine output_i
     end interface
 
-    public :: finish_sink
+    public :: finish_sink, dense_outputs
 
 contains
 
@@ -75,6 +76,31 @@ contains
         class(sink_t), intent(inout) :: self
         type(status_t), intent(inout) :: status
     end subroutine default_finish
+
+    !> The requested output times up to t (in the direction posneg) from a
+    !> step's dense output to the sink: options%output_times(iout) on, of
+    !> nout, iout moved past them; y holds one value. `failed`: an output
+    !> failed (status says why) and the rest were not given.
+    subroutine dense_outputs(sink, dense, options, nout, t, posneg, iout, y, status, failed)
+        class(sink_t), intent(inout) :: sink
+        class(dense_output_t), intent(in) :: dense
+        type(dae_options_t), intent(in) :: options
+        integer, intent(in) :: nout
+        real(wp), intent(in) :: t, posneg
+        integer, intent(inout) :: iout
+        real(wp), intent(inout) :: y(:)
+        type(status_t), intent(inout) :: status
+        logical, intent(out) :: failed
+        failed = .false.
+        do while (iout <= nout)
+            if ((options%output_times(iout) - t) * posneg > 0.0_wp) exit
+            call dense%evaluate(options%output_times(iout), y)
+            call sink%output(options%output_times(iout), y, status)
+            iout = iout + 1
+            failed = .not. status%ok()
+            if (failed) return
+        end do
+    end subroutine dense_outputs
 
     !> The end of an integration for a solver's optional sink: `finish` once,
     !> its error reported only when the integration itself succeeded (a
