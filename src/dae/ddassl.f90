@@ -25,7 +25,7 @@ module flexmbs_dae_ddassl
     use flexmbs_dae_residual_problem, only: residual_problem_t, dae_residual_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t, projection_refusal
-    use flexmbs_dae_sink, only: sink_t, dense_output_t
+    use flexmbs_dae_sink, only: sink_t, finish_sink, dense_output_t
     use flexmbs_dae_solver_setting, only: solver_setting_t
     use flexmbs_dae_ddassl_state, only: ddassl_engine_t, ddassl_work_t, ddassl_native_t, &
         ddassl_max_order, mx, hmin_factor, tstop_tol, ddassl_fail_none, &
@@ -378,7 +378,6 @@ contains
         type(dae_stats_t), intent(inout) :: stats
         type(status_t), intent(inout) :: status
         class(sink_t), intent(inout), optional :: sink
-        type(status_t) :: sink_status
         stats%nst = self%native%nst + self%native%netf + self%native%ncfn
         stats%nac = self%native%nst
         stats%nrj = self%native%netf + self%native%ncfn
@@ -397,10 +396,7 @@ contains
         self%h_next = self%work%h
         stats%cpu = timer%cpu()
         stats%wall = timer%wall()
-        if (present(sink)) then
-            call sink%finish(sink_status)
-            if (status%ok() .and. .not. sink_status%ok()) status = sink_status
-        end if
+        call finish_sink(sink, status)
     end subroutine finish
 
     subroutine copy_dense(self)

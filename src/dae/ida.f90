@@ -23,7 +23,7 @@ module flexmbs_dae_ida
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t, projection_refusal
-    use flexmbs_dae_sink, only: sink_t
+    use flexmbs_dae_sink, only: sink_t, finish_sink
     use flexmbs_dae_ida_state, only: ida_engine_t, ida_work_t, ida_native_t, collect_statistics
     use flexmbs_dae_ida_setup, only: prepare, setup_matrices, initial_derivative, &
         first_step_estimate
@@ -60,7 +60,6 @@ contains
         include 'integrate_arguments.inc'
         real(wp), intent(inout), optional :: yp(:)
         type(timer_t) :: timer
-        type(status_t) :: sink_status
 
         call timer%start()
         stats%t_reached = t
@@ -91,10 +90,7 @@ contains
         call solve(self, problem, t, y, t_end, options, stats, status, sink, yp)
         stats%cpu = timer%cpu()
         stats%wall = timer%wall()
-        if (present(sink)) then
-            call sink%finish(sink_status)
-            if (status%ok() .and. .not. sink_status%ok()) status = sink_status
-        end if
+        call finish_sink(sink, status)
     end subroutine ida_integrate
 
     !> The integration proper; `problem` is a target so that the callbacks

@@ -52,13 +52,7 @@ contains
 
     !> IDA_NORMAL to each output time, then to t_end (IDA interpolates).
     subroutine to_output_times(self, w, problem, t_end, options, stats, status, sink)
-        class(ida_engine_t), intent(inout) :: self
-        type(ida_work_t), intent(inout) :: w
-        class(dae_problem_t), intent(inout) :: problem
-        real(wp), intent(in) :: t_end
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(inout) :: stats
-        type(status_t), intent(inout) :: status
+        include 'ida_output_arguments.inc'
         class(sink_t), intent(inout), optional :: sink
         real(c_double) :: tret(1)
         real(wp) :: tout
@@ -99,13 +93,7 @@ contains
 
     !> IDA_ONE_STEP, so that the sink sees every accepted step.
     subroutine step_by_step(self, w, problem, t_end, options, stats, status, sink)
-        class(ida_engine_t), intent(inout) :: self
-        type(ida_work_t), intent(inout) :: w
-        class(dae_problem_t), intent(inout) :: problem
-        real(wp), intent(in) :: t_end
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(inout) :: stats
-        type(status_t), intent(inout) :: status
+        include 'ida_output_arguments.inc'
         class(sink_t), intent(inout) :: sink
         real(c_double) :: tret(1)
         real(wp) :: x_old

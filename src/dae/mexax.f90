@@ -35,7 +35,7 @@ module flexmbs_dae_mexax
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
-    use flexmbs_dae_sink, only: sink_t
+    use flexmbs_dae_sink, only: sink_t, finish_sink
     use flexmbs_dae_solver_setting, only: solver_setting_t
     use flexmbs_dae_mexax_control, only: mexax_base_midpoint, mexax_base_euler, &
         mexax_max_columns, mexax_control_hairer, mexax_control_deuflhard
@@ -201,7 +201,6 @@ contains
         type(dae_stats_t), intent(inout) :: stats
         type(status_t), intent(inout) :: status
         class(sink_t), intent(inout), optional :: sink
-        type(status_t) :: sink_status
         stats%nst = self%native%nstep
         stats%nac = self%native%naccpt
         stats%nrj = stats%nst - stats%nac
@@ -214,10 +213,7 @@ contains
         stats%cpu = r%timer%cpu()
         stats%wall = r%timer%wall()
         call stats%rejections%annotate(status)
-        if (present(sink)) then
-            call sink%finish(sink_status)
-            if (status%ok() .and. .not. sink_status%ok()) status = sink_status
-        end if
+        call finish_sink(sink, status)
     end subroutine finish
 
     !> One macro step of size big_h from (t, q, v) without projection or

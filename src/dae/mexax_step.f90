@@ -16,7 +16,7 @@ module flexmbs_dae_mexax_step
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_rejections, only: cause_error_test, cause_singular_matrix, &
         cause_model_refused, cause_projection, cause_unstable
-    use flexmbs_dae_sink, only: sink_t
+    use flexmbs_dae_sink, only: sink_t, dense_outputs
     use flexmbs_dae_mexax_workspace, only: workspace_t, ev_ok, ev_restart, ev_stop, ev_refused, &
         user_failed
     use flexmbs_dae_mexax_tableau, only: start_point, base_column, extrapolate_column, &
@@ -38,14 +38,7 @@ contains
     !> for a restart, a rejection (the next call retries) or a stop
     !> (`r%done`, status set, or at t_end).
     subroutine macro_step(self, r, problem, t_end, options, stats, status, sink)
-        class(mexax_engine_t), intent(inout) :: self
-        type(mexax_run_t), intent(inout) :: r
-        class(mechanical_problem_t), intent(inout) :: problem
-        real(wp), intent(in) :: t_end
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(inout) :: stats
-        type(status_t), intent(inout) :: status
-        class(sink_t), intent(inout), optional :: sink
+        include 'mexax_step_arguments.inc'
         if (r%need_start) then
             call start_point(self%native, problem, r%w, r%t, status, accelerations=.false.)
             if (.not. status%ok()) then
@@ -75,6 +68,7 @@ contains
         end if
 
         ! ---- one attempt: ODEX's column sequence (§3.4) or Deuflhard's window ----
+        r%decision = undecided
         if (r%w%ctl%scheme == mexax_control_deuflhard) then
             call attempt_window(self, r, problem, status)
         else
@@ -136,14 +130,14 @@ contains
     end subroutine too_small
 
     !> One attempt from t with H and the planned column k: the columns in
-    !> the order of ODEX (§3.4); r%decision and r%kc say how it ended.
+    !> the order of ODEX (§3.4); r%decision (undecided on entry) and r%kc
+    !> say how it ended.
     subroutine attempt(self, r, problem, status)
         class(mexax_engine_t), intent(inout) :: self
         type(mexax_run_t), intent(inout) :: r
         class(mechanical_problem_t), intent(inout) :: problem
         type(status_t), intent(inout) :: status
         integer :: j
-        r%decision = undecided
         if (.not. r%basic_entry .and. (r%first .or. r%last)) then
             do j = 1, r%k
                 if (.not. column(self, r, problem, j, status)) exit
@@ -192,7 +186,6 @@ contains
         class(mechanical_problem_t), intent(inout) :: problem
         type(status_t), intent(inout) :: status
         integer :: j
-        r%decision = undecided
         do j = 1, r%w%ctl%qmax
             if (.not. column(self, r, problem, j, status)) return
             r%kc = j
@@ -326,14 +319,7 @@ contains
     !> The projected point accepted: the new point, the outputs, then the
     !> order and step size after acceptance (§3.4); at t_end the loop ends.
     subroutine accept_step(self, r, problem, t_end, options, stats, status, sink)
-        class(mexax_engine_t), intent(inout) :: self
-        type(mexax_run_t), intent(inout) :: r
-        class(mechanical_problem_t), intent(inout) :: problem
-        real(wp), intent(in) :: t_end
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(inout) :: stats
-        type(status_t), intent(inout) :: status
-        class(sink_t), intent(inout), optional :: sink
+        include 'mexax_step_arguments.inc'
         self%native%naccpt = self%native%naccpt + 1
         call r%refusal%clear()
         r%t_old = r%t
@@ -426,13 +412,10 @@ contains
         type(dae_options_t), intent(in) :: options
         type(status_t), intent(inout) :: status
         class(sink_t), intent(inout) :: sink
-        do while (r%iout <= r%nout)
-            if ((options%output_times(r%iout) - r%t) * r%posneg > 0.0_wp) exit
-            call self%dense%evaluate(options%output_times(r%iout), r%yout)
-            call sink%output(options%output_times(r%iout), r%yout, status)
-            r%iout = r%iout + 1
-            if (.not. status%ok()) return
-        end do
+        logical :: failed
+        call dense_outputs(sink, self%dense, options, r%nout, r%t, r%posneg, r%iout, r%yout, &
+                           status, failed)
+        if (failed) return
         if (r%want_steps) call sink%step(self%native%naccpt + 1, r%t_old, r%t, self%dense%y1, &
             self%dense, r%stop_requested, status)
     end subroutine emit_outputs

@@ -107,17 +107,7 @@ contains
     !> (E), §3.2: p_{i+1} = p_i + h T v_i, then one augmented solve for
     !> (v_{i+1}, h λ_{i+1}) with the matrices at p_{i+1}.
     subroutine euler_substeps(native, problem, w, t, big_h, n, check_stability, ev, status)
-        type(mexax_native_t), intent(inout) :: native
-        class(mechanical_problem_t), intent(inout) :: problem
-        type(workspace_t), intent(inout) :: w
-        real(wp), intent(in) :: t, big_h
-        integer, intent(in) :: n
-        logical, intent(in) :: check_stability
-        integer, intent(out) :: ev
-        type(status_t), intent(inout) :: status
-        integer :: nv
-        integer :: i
-        real(wp) :: h, ti, tn
+        include 'mexax_substeps.inc'
         nv = w%nv
         h = big_h / n
         w%p = w%p0
@@ -165,17 +155,7 @@ contains
     !> (M), §3.2: an explicit start step, then q_{i+1} = q_{i−1} + 2h T v_i,
     !> v_{i+1} = v_{i−1} + 2h a_i with [M(q_i) G(q_i)ᵀ; G(q_{i+1}) 0].
     subroutine midpoint_substeps(native, problem, w, t, big_h, n, check_stability, ev, status)
-        type(mexax_native_t), intent(inout) :: native
-        class(mechanical_problem_t), intent(inout) :: problem
-        type(workspace_t), intent(inout) :: w
-        real(wp), intent(in) :: t, big_h
-        integer, intent(in) :: n
-        logical, intent(in) :: check_stability
-        integer, intent(out) :: ev
-        type(status_t), intent(inout) :: status
-        integer :: nv
-        integer :: i
-        real(wp) :: h, ti, tn
+        include 'mexax_substeps.inc'
         nv = w%nv
         h = big_h / n
         ev = ev_ok

@@ -22,7 +22,7 @@ module flexmbs_dae_radau5
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_rejections, only: cause_singular_matrix
-    use flexmbs_dae_sink, only: sink_t
+    use flexmbs_dae_sink, only: sink_t, finish_sink
     use flexmbs_dae_solver_setting, only: solver_setting_t
     use flexmbs_dae_radau5_state, only: radau5_engine_t, radau5_work_t, radau5_dense_t, &
         radau5_native_t, radau5_controller_predictive, radau5_controller_classical, &
@@ -144,7 +144,6 @@ contains
         type(dae_stats_t), intent(inout) :: stats
         type(status_t), intent(inout) :: status
         class(sink_t), intent(inout), optional :: sink
-        type(status_t) :: sink_status
         stats%nst = self%native%nstep + stats%rejections%count_of(cause_singular_matrix)
         if (w%abandoned) stats%nst = stats%nst - 1
         stats%nac = self%native%naccpt
@@ -159,9 +158,6 @@ contains
         stats%cpu = w%timer%cpu()
         stats%wall = w%timer%wall()
         call stats%rejections%annotate(status)
-        if (present(sink)) then
-            call sink%finish(sink_status)
-            if (status%ok() .and. .not. sink_status%ok()) status = sink_status
-        end if
+        call finish_sink(sink, status)
     end subroutine finish
 end module flexmbs_dae_radau5

@@ -14,7 +14,7 @@ module flexmbs_dae_radau5_step
     use flexmbs_dae_options, only: dae_options_t
     use flexmbs_dae_stats, only: dae_stats_t
     use flexmbs_dae_rejections, only: cause_error_test, cause_model_refused, cause_projection
-    use flexmbs_dae_sink, only: sink_t
+    use flexmbs_dae_sink, only: sink_t, dense_outputs
     use flexmbs_dae_radau5_state, only: radau5_engine_t, radau5_work_t, eval_f, compute_scal, &
         ieee_nan, c1, c2, c1m1, c2m1, c1mc2, dd1, dd2, dd3, err_floor, first_reject_factor, &
         end_factor, blk_jacobian, blk_factor, blk_attempt
@@ -30,14 +30,7 @@ contains
     !> accepted (R4–R6), rejected (R7) or failed (R8), with the next block
     !> set, or it ends the integration (`done`, status set unless at t_end).
     subroutine attempt_block(self, w, problem, y, options, stats, status, sink)
-        class(radau5_engine_t), intent(inout) :: self
-        type(radau5_work_t), intent(inout) :: w
-        class(dae_problem_t), intent(inout) :: problem
-        real(wp), intent(inout) :: y(:)
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(inout) :: stats
-        type(status_t), intent(inout) :: status
-        class(sink_t), intent(inout), optional :: sink
+        include 'radau5_step_arguments.inc'
         type(status_t) :: fstatus
         real(wp) :: fac
         integer :: cause, nind1, nind2
@@ -167,14 +160,7 @@ contains
     !> Block R4, accept the step (projection and admissibility may still take it
     !> back), the dense output, the outputs; then R5/R6, or the end at t_end.
     subroutine accept_step(self, w, problem, y, options, stats, status, sink)
-        class(radau5_engine_t), intent(inout) :: self
-        type(radau5_work_t), intent(inout) :: w
-        class(dae_problem_t), intent(inout) :: problem
-        real(wp), intent(inout) :: y(:)
-        type(dae_options_t), intent(in) :: options
-        type(dae_stats_t), intent(inout) :: stats
-        type(status_t), intent(inout) :: status
-        class(sink_t), intent(inout), optional :: sink
+        include 'radau5_step_arguments.inc'
         type(status_t) :: fstatus
         real(wp) :: facgus, ak
         integer :: i
@@ -329,13 +315,10 @@ contains
         type(dae_options_t), intent(in) :: options
         type(status_t), intent(inout) :: status
         class(sink_t), intent(inout) :: sink
-        do while (w%iout <= w%nout)
-            if ((options%output_times(w%iout) - w%x) * w%posneg > 0.0_wp) exit
-            call self%dense%evaluate(options%output_times(w%iout), w%ytmp)
-            call sink%output(options%output_times(w%iout), w%ytmp, status)
-            w%iout = w%iout + 1
-            if (.not. status%ok()) return
-        end do
+        logical :: failed
+        call dense_outputs(sink, self%dense, options, w%nout, w%x, w%posneg, w%iout, w%ytmp, &
+                           status, failed)
+        if (failed) return
         if (w%want_steps) call sink%step(self%native%naccpt + 1, w%xold, w%x, y, self%dense, &
             w%stop_requested, status)
     end subroutine emit_outputs

@@ -135,13 +135,7 @@ contains
     pure function rejections_summary(self) result(text)
         class(rejections_t), intent(in) :: self
         character(len=:), allocatable :: text
-        integer :: c
-        text = ''
-        do c = 1, cause_count
-            if (self%counts(c) == 0) cycle
-            if (len(text) > 0) text = text // ', '
-            text = text // trim(cause_labels(c)) // ' ' // int_text(self%counts(c))
-        end do
+        text = cause_list(self, failure=.false.)
     end function rejections_summary
 
     !> ' after 12 Newton divergences, 3 model refusals (det F ...)': the
@@ -149,21 +143,34 @@ contains
     pure function rejections_failure_text(self) result(text)
         class(rejections_t), intent(in) :: self
         character(len=:), allocatable :: text
+        text = cause_list(self, failure=.true.)
+    end function rejections_failure_text
+
+    !> The nonzero causes joined by ', ': labels and counts for the
+    !> statistics line, or counts and phrases after ' after ' for a failure.
+    pure function cause_list(self, failure) result(text)
+        type(rejections_t), intent(in) :: self
+        logical, intent(in) :: failure
+        character(len=:), allocatable :: text
         integer :: c
         text = ''
         do c = 1, cause_count
             if (self%counts(c) == 0) cycle
-            if (len(text) == 0) then
-                text = ' after '
-            else
+            if (len(text) > 0) then
                 text = text // ', '
+            else if (failure) then
+                text = ' after '
             end if
-            text = text // int_text(self%counts(c)) // ' ' // &
-                trim(merge(phrase_one(c), phrase_many(c), self%counts(c) == 1))
-            if (c == cause_model_refused .and. len_trim(self%refusal) > 0) &
-                text = text // ' (' // trim(self%refusal) // ')'
+            if (failure) then
+                text = text // int_text(self%counts(c)) // ' ' // &
+                    trim(merge(phrase_one(c), phrase_many(c), self%counts(c) == 1))
+                if (c == cause_model_refused .and. len_trim(self%refusal) > 0) &
+                    text = text // ' (' // trim(self%refusal) // ')'
+            else
+                text = text // trim(cause_labels(c)) // ' ' // int_text(self%counts(c))
+            end if
         end do
-    end function rejections_failure_text
+    end function cause_list
 
     !> Append the failure text to a solver failure's message.
     pure subroutine rejections_annotate(self, status)

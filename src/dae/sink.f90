@@ -7,6 +7,7 @@
 module flexmbs_dae_sink
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t
+    use flexmbs_dae_options, only: dae_options_t
     implicit none
     private
 
@@ -42,10 +43,11 @@ module flexmbs_dae_sink
         subroutine output_i(self, t, y, status)
             import :: sink_t, wp, status_t
             class(sink_t), intent(inout) :: self
-            real(wp), intent(in) :: t, y(:)
-            type(status_t), intent(inout) :: status
+            include 'sink_output_arguments.inc'
         end subroutine output_i
     end interface
+
+    public :: finish_sink, dense_outputs
 
 contains
 
@@ -66,11 +68,7 @@ contains
     !> t_old = t). Setting `stop` ends the integration (status interrupted).
     subroutine default_step(self, nr, t_old, t, y, dense, stop, status)
         class(sink_t), intent(inout) :: self
-        integer, intent(in) :: nr                  !! 1 at t0, then accepted steps + 1
-        real(wp), intent(in) :: t_old, t, y(:)
-        class(dense_output_t), intent(in) :: dense
-        logical, intent(inout) :: stop
-        type(status_t), intent(inout) :: status
+        include 'sink_step_arguments.inc'
     end subroutine default_step
 
     !> Called once at the end, successful or not.
@@ -78,4 +76,41 @@ contains
         class(sink_t), intent(inout) :: self
         type(status_t), intent(inout) :: status
     end subroutine default_finish
+
+    !> The requested output times up to t (in the direction posneg) from a
+    !> step's dense output to the sink: options%output_times(iout) on, of
+    !> nout, iout moved past them; y holds one value. `failed`: an output
+    !> failed (status says why) and the rest were not given.
+    subroutine dense_outputs(sink, dense, options, nout, t, posneg, iout, y, status, failed)
+        class(sink_t), intent(inout) :: sink
+        class(dense_output_t), intent(in) :: dense
+        type(dae_options_t), intent(in) :: options
+        integer, intent(in) :: nout
+        real(wp), intent(in) :: t, posneg
+        integer, intent(inout) :: iout
+        real(wp), intent(inout) :: y(:)
+        type(status_t), intent(inout) :: status
+        logical, intent(out) :: failed
+        failed = .false.
+        do while (iout <= nout)
+            if ((options%output_times(iout) - t) * posneg > 0.0_wp) exit
+            call dense%evaluate(options%output_times(iout), y)
+            call sink%output(options%output_times(iout), y, status)
+            iout = iout + 1
+            failed = .not. status%ok()
+            if (failed) return
+        end do
+    end subroutine dense_outputs
+
+    !> The end of an integration for a solver's optional sink: `finish` once,
+    !> its error reported only when the integration itself succeeded (a
+    !> failed run's status says why it stopped).
+    subroutine finish_sink(sink, status)
+        class(sink_t), intent(inout), optional :: sink
+        type(status_t), intent(inout) :: status
+        type(status_t) :: sink_status
+        if (.not. present(sink)) return
+        call sink%finish(sink_status)
+        if (status%ok() .and. .not. sink_status%ok()) status = sink_status
+    end subroutine finish_sink
 end module flexmbs_dae_sink

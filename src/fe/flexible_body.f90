@@ -506,6 +506,17 @@ contains
         end do
     end subroutine gather
 
+    !> F and det F at Gauss point g of element e, whose nodes gather put in
+    !> work(1); det F ≤ 0 fails.
+    subroutine point_gradient(self, e, g, f, detf, status)
+        class(flexible_body_t), intent(in) :: self
+        integer, intent(in) :: e, g
+        real(wp), intent(out) :: f(3, 3), detf
+        type(status_t), intent(inout) :: status
+        call deformation_gradient(self%hex%nnode, self%dndx(:, :, g, e), self%work(1)%xe, f, &
+                                  detf, status)
+    end subroutine point_gradient
+
     !> Strain energy Σ_e Σ_g W(E) w_g det J_g; det F ≤ 0 fails as in forces.
     function body_strain_energy(self, q, status) result(energy)
         class(flexible_body_t), intent(inout) :: self
@@ -519,9 +530,7 @@ contains
         do e = 1, self%mesh%element_count()
             call gather(self, e, 1)
             do g = 1, self%hex%ngauss
-                call deformation_gradient(self%hex%nnode, self%dndx(:, :, g, e), &
-                                          self%work(1)%xe, f, &
-                                          detf, status)
+                call point_gradient(self, e, g, f, detf, status)
                 if (.not. status%ok()) return
                 energy = energy + self%wdv(g, e) * self%materials(self%element_material(e)) &
                     %strain_energy(0.5_wp * (matmul(transpose(f), f) - identity3))
@@ -672,9 +681,7 @@ contains
         do e = 1, self%mesh%element_count()
             call gather(self, e, 1)
             do g = 1, self%hex%ngauss
-                call deformation_gradient(self%hex%nnode, self%dndx(:, :, g, e), &
-                                          self%work(1)%xe, f, &
-                                          detf, status)
+                call point_gradient(self, e, g, f, detf, status)
                 if (.not. status%ok()) then
                     call name_element(status, e)
                     return
@@ -701,8 +708,7 @@ contains
             acc = 0.0_wp
             volume = 0.0_wp
             do g = 1, self%hex%ngauss
-                call deformation_gradient(self%hex%nnode, self%dndx(:, :, g, el), &
-                                          self%work(1)%xe, f, detf, status)
+                call point_gradient(self, el, g, f, detf, status)
                 if (.not. status%ok()) then
                     call name_element(status, el)
                     return
@@ -810,17 +816,28 @@ contains
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: fq(:, :), fv(:, :)
         type(status_t), intent(inout) :: status
-        type(status_t) :: local
-        call self%assemble_tangents(q, v, local)
-        if (.not. local%ok()) then
-            status = local
-            return
-        end if
+        logical :: ok
+        call refresh_tangents(self, q, v, status, ok)
+        if (.not. ok) return
         call self%stiffness%to_dense(fq)
         call self%damping%to_dense(fv)
         fq = -fq
         fv = -fv
     end subroutine body_force_derivatives
+
+    !> The tangents at (q, v) assembled; when that fails, status takes its
+    !> status and ok is false (otherwise status, the caller's, is left as it
+    !> is).
+    subroutine refresh_tangents(self, q, v, status, ok)
+        class(flexible_body_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        type(status_t), intent(inout) :: status
+        logical, intent(out) :: ok
+        type(status_t) :: local
+        call self%assemble_tangents(q, v, local)
+        ok = local%ok()
+        if (.not. ok) status = local
+    end subroutine refresh_tangents
 
     !> T = I: ∂(T w)/∂q = 0.
     subroutine body_kinematics_derivative(self, t, q, w, dq, status)
@@ -960,12 +977,9 @@ contains
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: fq(:), fv(:)
         type(status_t), intent(inout) :: status
-        type(status_t) :: local
-        call self%assemble_tangents(q, v, local)
-        if (.not. local%ok()) then
-            status = local
-            return
-        end if
+        logical :: ok
+        call refresh_tangents(self, q, v, status, ok)
+        if (.not. ok) return
         fq = -self%stiffness%values
         fv = -self%damping%values
     end subroutine body_force_derivatives_sparse

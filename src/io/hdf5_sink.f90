@@ -286,8 +286,7 @@ contains
 
     subroutine sink_output(self, t, y, status)
         class(hdf5_sink_t), intent(inout) :: self
-        real(wp), intent(in) :: t, y(:)
-        type(status_t), intent(inout) :: status
+        include '../dae/sink_output_arguments.inc'
         if (self%every_step) return
         call append(self, t, y, status)
     end subroutine sink_output
@@ -299,11 +298,7 @@ contains
 
     subroutine sink_step(self, nr, t_old, t, y, dense, stop, status)
         class(hdf5_sink_t), intent(inout) :: self
-        integer, intent(in) :: nr
-        real(wp), intent(in) :: t_old, t, y(:)
-        class(dense_output_t), intent(in) :: dense
-        logical, intent(inout) :: stop
-        type(status_t), intent(inout) :: status
+        include '../dae/sink_step_arguments.inc'
         if (.not. self%every_step) return
         call append(self, t, y, status)
     end subroutine sink_step

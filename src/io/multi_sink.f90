@@ -34,8 +34,7 @@ contains
 
     subroutine multi_output(self, t, y, status)
         class(multi_sink_t), intent(inout) :: self
-        real(wp), intent(in) :: t, y(:)
-        type(status_t), intent(inout) :: status
+        include '../dae/sink_output_arguments.inc'
         integer :: i
         if (.not. allocated(self%sinks)) return
         do i = 1, size(self%sinks)
@@ -56,11 +55,7 @@ contains
 
     subroutine multi_step(self, nr, t_old, t, y, dense, stop, status)
         class(multi_sink_t), intent(inout) :: self
-        integer, intent(in) :: nr
-        real(wp), intent(in) :: t_old, t, y(:)
-        class(dense_output_t), intent(in) :: dense
-        logical, intent(inout) :: stop
-        type(status_t), intent(inout) :: status
+        include '../dae/sink_step_arguments.inc'
         integer :: i
         if (.not. allocated(self%sinks)) return
         do i = 1, size(self%sinks)

@@ -98,8 +98,7 @@ contains
 
     subroutine progress_output(self, t, y, status)
         class(progress_t), intent(inout) :: self
-        real(wp), intent(in) :: t, y(:)
-        type(status_t), intent(inout) :: status
+        include '../dae/sink_output_arguments.inc'
         if (.not. self%enabled) return
         self%t = t
         call draw(self, .false.)
@@ -112,11 +111,7 @@ contains
 
     subroutine progress_step(self, nr, t_old, t, y, dense, stop, status)
         class(progress_t), intent(inout) :: self
-        integer, intent(in) :: nr
-        real(wp), intent(in) :: t_old, t, y(:)
-        class(dense_output_t), intent(in) :: dense
-        logical, intent(inout) :: stop
-        type(status_t), intent(inout) :: status
+        include '../dae/sink_step_arguments.inc'
         if (.not. self%enabled) return
         self%t = t
         self%steps = nr - 1

@@ -23,8 +23,7 @@ contains
     !> Append (t, y), doubling the storage when full.
     subroutine record_output(self, t, y, status)
         class(record_sink_t), intent(inout) :: self
-        real(wp), intent(in) :: t, y(:)
-        type(status_t), intent(inout) :: status
+        include '../dae/sink_output_arguments.inc'
         real(wp), allocatable :: tt(:), yy(:, :)
         integer :: capacity, stat
         if (.not. allocated(self%t)) then

@@ -21,7 +21,7 @@ module flexmbs_io_result_columns
     character(len=*), parameter :: groups(5) = [character(len=8) :: 'bodies', 'chains', &
         'joints', 'drivers', 'flexible']
 
-    public :: read_column
+    public :: read_column, open_result
 
 contains
 
@@ -32,14 +32,10 @@ contains
         real(wp), allocatable, intent(out) :: values(:)
         type(status_t), intent(out) :: status
         integer(hid_t) :: file
-        integer :: err, k, ios, close_err
+        integer :: k, ios, close_err
         character(len=:), allocatable :: parts(:)
-        call h5open_f(err)
-        call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
-        if (err < 0) then
-            call status%set(status_io_error, path // ': not an HDF5 file')
-            return
-        end if
+        call open_result(path, file, status)
+        if (.not. status%ok()) return
         read (name, *, iostat=ios) k
         if (ios == 0 .and. verify(trim(adjustl(name)), '0123456789') == 0) then
             call read_row(file, 'y', k, values, status)
@@ -153,14 +149,10 @@ contains
         real(wp), allocatable, intent(out) :: values(:)
         type(status_t), intent(out) :: status
         integer(hsize_t) :: dims(2), maxdims(2), offset(2), count(2)
-        integer(hid_t) :: dset, space, memspace
+        integer(hid_t) :: dset, space
         integer :: err, rank, close_err, stat
-        call h5dopen_f(file, name, dset, err)
-        if (err < 0) then
-            call status%set(status_bad_input, 'no dataset /' // name)
-            return
-        end if
-        call h5dget_space_f(dset, space, err)
+        call open_dataset(file, name, dset, space, status)
+        if (.not. status%ok()) return
         call h5sget_simple_extent_ndims_f(space, rank, err)
         if (rank /= 2) then
             call status%set(status_bad_input, '/' // name // ' is not a series of rows')
@@ -176,12 +168,7 @@ contains
                 else
                     offset = [int(row - 1, hsize_t), 0_hsize_t]
                     count = [1_hsize_t, dims(2)]
-                    call h5sselect_hyperslab_f(space, H5S_SELECT_SET_F, offset, count, err)
-                    call h5screate_simple_f(2, count, memspace, err)
-                    call h5dread_f(dset, H5T_NATIVE_DOUBLE, values, count, err, &
-                                   mem_space_id=memspace, file_space_id=space)
-                    call h5sclose_f(memspace, close_err)
-                    if (err < 0) call status%set(status_io_error, 'cannot read /' // name)
+                    call read_slab(dset, space, offset, count, name, values, status)
                 end if
             end if
         end if
@@ -197,7 +184,7 @@ contains
         real(wp), allocatable, intent(out) :: values(:)
         type(status_t), intent(out) :: status
         integer(hsize_t) :: dims(3), maxdims(3), offset(3), count(3)
-        integer(hid_t) :: dset, space, memspace
+        integer(hid_t) :: dset, space
         integer :: err, rank, close_err, stat
         logical :: exists
         call link_exists(file, name, exists)
@@ -220,12 +207,7 @@ contains
                 else
                     offset = [int(c - 1, hsize_t), int(node - 1, hsize_t), 0_hsize_t]
                     count = [1_hsize_t, 1_hsize_t, dims(3)]
-                    call h5sselect_hyperslab_f(space, H5S_SELECT_SET_F, offset, count, err)
-                    call h5screate_simple_f(3, count, memspace, err)
-                    call h5dread_f(dset, H5T_NATIVE_DOUBLE, values, count, err, &
-                                   mem_space_id=memspace, file_space_id=space)
-                    call h5sclose_f(memspace, close_err)
-                    if (err < 0) call status%set(status_io_error, 'cannot read /' // name)
+                    call read_slab(dset, space, offset, count, name, values, status)
                 end if
             end if
         else
@@ -243,26 +225,63 @@ contains
         real(wp), allocatable, intent(out) :: value(:)
         type(status_t), intent(out) :: status
         integer(hsize_t) :: offset(2), count(2)
-        integer(hid_t) :: dset, space, memspace
-        integer :: err, close_err
+        integer(hid_t) :: dset, space
+        integer :: close_err
         allocate (value(1))
+        call open_dataset(file, name, dset, space, status)
+        if (.not. status%ok()) return
+        offset = [int(row - 1, hsize_t), int(column - 1, hsize_t)]
+        count = [1_hsize_t, 1_hsize_t]
+        call read_slab(dset, space, offset, count, name, value, status)
+        call h5sclose_f(space, close_err)
+        call h5dclose_f(dset, close_err)
+    end subroutine read_row_at
+
+    !> Open the result `path` for reading (the HDF5 library opened first); a
+    !> file that is not HDF5 is an I/O error naming the path.
+    subroutine open_result(path, file, status)
+        character(len=*), intent(in) :: path
+        integer(hid_t), intent(out) :: file
+        type(status_t), intent(inout) :: status
+        integer :: err
+        call h5open_f(err)
+        call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
+        if (err < 0) call status%set(status_io_error, path // ': not an HDF5 file')
+    end subroutine open_result
+
+    !> The dataset `name` of `file` and its dataspace, or bad input when
+    !> there is none.
+    subroutine open_dataset(file, name, dset, space, status)
+        integer(hid_t), intent(in) :: file
+        character(len=*), intent(in) :: name
+        integer(hid_t), intent(out) :: dset, space
+        type(status_t), intent(inout) :: status
+        integer :: err
         call h5dopen_f(file, name, dset, err)
         if (err < 0) then
             call status%set(status_bad_input, 'no dataset /' // name)
             return
         end if
         call h5dget_space_f(dset, space, err)
-        offset = [int(row - 1, hsize_t), int(column - 1, hsize_t)]
-        count = [1_hsize_t, 1_hsize_t]
+    end subroutine open_dataset
+
+    !> The hyperslab (offset, count) of the dataset `name` (dset, its
+    !> dataspace `space`) into values, of the slab's size.
+    subroutine read_slab(dset, space, offset, count, name, values, status)
+        integer(hid_t), intent(in) :: dset, space
+        integer(hsize_t), intent(in) :: offset(:), count(:)
+        character(len=*), intent(in) :: name
+        real(wp), intent(inout) :: values(:)
+        type(status_t), intent(inout) :: status
+        integer(hid_t) :: memspace
+        integer :: err, close_err
         call h5sselect_hyperslab_f(space, H5S_SELECT_SET_F, offset, count, err)
-        call h5screate_simple_f(2, count, memspace, err)
-        call h5dread_f(dset, H5T_NATIVE_DOUBLE, value, count, err, mem_space_id=memspace, &
+        call h5screate_simple_f(size(count), count, memspace, err)
+        call h5dread_f(dset, H5T_NATIVE_DOUBLE, values, count, err, mem_space_id=memspace, &
                        file_space_id=space)
-        if (err < 0) call status%set(status_io_error, 'cannot read /' // name)
         call h5sclose_f(memspace, close_err)
-        call h5sclose_f(space, close_err)
-        call h5dclose_f(dset, close_err)
-    end subroutine read_row_at
+        if (err < 0) call status%set(status_io_error, 'cannot read /' // name)
+    end subroutine read_slab
 
     !> x, y, z (or p0 .. p3) as 1, 2, 3 (1 .. 4), or a number from 1; 0 if neither.
     integer function component(text) result(c)

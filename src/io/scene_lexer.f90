@@ -414,14 +414,7 @@ contains
         character(len=*), intent(in) :: text
         integer, intent(inout) :: pos
         character(len=:), allocatable :: word
-        integer :: start
-        start = pos
-        do while (pos <= len(text))
-            if (.not. (is_letter(text(pos:pos)) .or. is_digit(text(pos:pos)) &
-                       .or. text(pos:pos) == '_')) exit
-            pos = pos + 1
-        end do
-        word = text(start:pos - 1)
+        word = word_at(text, pos, designator=.false.)
     end function name_word
 
     !> A variable designator: a name, possibly with a subscript or
@@ -430,15 +423,30 @@ contains
         character(len=*), intent(in) :: text
         integer, intent(inout) :: pos
         character(len=:), allocatable :: word
+        word = word_at(text, pos, designator=.true.)
+    end function variable_word
+
+    !> The word starting at pos, pos moved past it: a name's characters, or
+    !> with `designator` anything up to a blank, a newline or one of =,/&'".
+    function word_at(text, pos, designator) result(word)
+        character(len=*), intent(in) :: text
+        integer, intent(inout) :: pos
+        logical, intent(in) :: designator
+        character(len=:), allocatable :: word
         integer :: start
         start = pos
         do while (pos <= len(text))
-            if (is_space(text(pos:pos)) .or. text(pos:pos) == new_line('a')) exit
-            if (scan(text(pos:pos), '=,/&''"') > 0) exit
+            if (designator) then
+                if (is_space(text(pos:pos)) .or. text(pos:pos) == new_line('a')) exit
+                if (scan(text(pos:pos), '=,/&''"') > 0) exit
+            else if (.not. (is_letter(text(pos:pos)) .or. is_digit(text(pos:pos)) &
+                            .or. text(pos:pos) == '_')) then
+                exit
+            end if
             pos = pos + 1
         end do
         word = text(start:pos - 1)
-    end function variable_word
+    end function word_at
 
     !> Anything up to the next separator (for messages about stray text).
     function bare_word(text, pos) result(word)

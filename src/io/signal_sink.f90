@@ -25,8 +25,7 @@ contains
     !> Output times need nothing: every step is checked.
     subroutine signal_output(self, t, y, status)
         class(signal_sink_t), intent(inout) :: self
-        real(wp), intent(in) :: t, y(:)
-        type(status_t), intent(inout) :: status
+        include '../dae/sink_output_arguments.inc'
     end subroutine signal_output
 
     logical function signal_wants_steps(self)
@@ -36,11 +35,7 @@ contains
 
     subroutine signal_step(self, nr, t_old, t, y, dense, stop, status)
         class(signal_sink_t), intent(inout) :: self
-        integer, intent(in) :: nr
-        real(wp), intent(in) :: t_old, t, y(:)
-        class(dense_output_t), intent(in) :: dense
-        logical, intent(inout) :: stop
-        type(status_t), intent(inout) :: status
+        include '../dae/sink_step_arguments.inc'
         if (signal_pending()) stop = .true.
     end subroutine signal_step
 end module flexmbs_io_signal_sink

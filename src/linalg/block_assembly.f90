@@ -43,7 +43,7 @@ module flexmbs_linalg_block_assembly
         procedure :: scatter_full => assembly_scatter_full
     end type block_assembly_t
 
-    public :: product_pattern, product_values, transpose_pattern, transpose_values
+    public :: product_pattern, product_positions, product_values, transpose_pattern, transpose_values
 
 contains
 
@@ -242,8 +242,8 @@ contains
         type(csc_matrix_t), intent(inout) :: c
         type(status_t), intent(out) :: status
         integer, allocatable :: rows(:), cols(:), mark(:)
-        integer(i8) :: nt, p, q
-        integer :: j, k, i, pass, stat
+        integer(i8) :: nt
+        integer :: pass, stat
         if (a%ncol /= b%nrow) then
             call status%set(status_bad_input, 'sparse product: A is ' // int_text(a%nrow) // &
                 ' x ' // int_text(a%ncol) // ', B is ' // int_text(b%nrow) // ' x ' // &
@@ -270,24 +270,40 @@ contains
                 mark = 0
                 nt = 0
             end if
-            do j = 1, b%ncol
-                do p = b%colptr(j) + 1, b%colptr(j + 1)
-                    k = int(b%rowind(p)) + 1
-                    do q = a%colptr(k) + 1, a%colptr(k + 1)
-                        i = int(a%rowind(q)) + 1
-                        if (mark(i) == j) cycle
-                        mark(i) = j
-                        nt = nt + 1
-                        if (pass == 2) then
-                            rows(nt) = i
-                            cols(nt) = j
-                        end if
-                    end do
-                end do
-            end do
+            call product_positions(a, b, mark, nt, pass == 2, rows, cols)
         end do
         call c%build(a%nrow, b%ncol, rows, cols, status)
     end subroutine product_pattern
+
+    !> The positions of A B, column by column of B, each row once a column:
+    !> counted on in nt and, with `list`, stored at rows(nt), cols(nt) (pass
+    !> 2 of a two-pass listing, pass 1 counting). mark(i) == j says that row
+    !> i is in column j already; on entry mark (A's rows) holds no column of
+    !> B (0 does).
+    pure subroutine product_positions(a, b, mark, nt, list, rows, cols)
+        type(csc_matrix_t), intent(in) :: a, b
+        integer, intent(inout) :: mark(:)
+        integer(i8), intent(inout) :: nt
+        logical, intent(in) :: list
+        integer, intent(inout) :: rows(:), cols(:)
+        integer(i8) :: p, q
+        integer :: j, k, i
+        do j = 1, b%ncol
+            do p = b%colptr(j) + 1, b%colptr(j + 1)
+                k = int(b%rowind(p)) + 1
+                do q = a%colptr(k) + 1, a%colptr(k + 1)
+                i = int(a%rowind(q)) + 1
+                if (mark(i) == j) cycle
+                mark(i) = j
+                nt = nt + 1
+                if (list) then
+                    rows(nt) = i
+                    cols(nt) = j
+                end if
+                end do
+            end do
+        end do
+    end subroutine product_positions
 
     !> Values of C = A B on the pattern from product_pattern.
     pure subroutine product_values(a, b, c)

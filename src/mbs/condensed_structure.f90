@@ -29,6 +29,7 @@ module flexmbs_mbs_condensed_structure
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_text, only: int_text
     use flexmbs_linalg_csc, only: csc_matrix_t
+    use flexmbs_linalg_block_assembly, only: product_positions
     use flexmbs_linalg_sub_block, only: sub_block_t
     implicit none
     private
@@ -634,8 +635,8 @@ contains
         type(condensed_structure_t), intent(inout) :: self
         type(status_t), intent(inout) :: status
         integer, allocatable :: rows(:), cols(:), mark(:)
-        integer(i8) :: nt, p, q
-        integer :: j, e, r, pass, stat
+        integer(i8) :: nt
+        integer :: pass, stat
         allocate (mark(self%nk), stat=stat)
         if (stat /= 0) then
             call out_of_memory(status, who // ' S marks', int(self%nk, i8), 4)
@@ -658,21 +659,7 @@ contains
                 call add_block(self%jka%a, .true.)
             end if
             mark = 0
-            do j = 1, self%nk
-                do p = self%w%colptr(j) + 1, self%w%colptr(j + 1)
-                    e = int(self%w%rowind(p)) + 1
-                    do q = self%jke%a%colptr(e) + 1, self%jke%a%colptr(e + 1)
-                        r = int(self%jke%a%rowind(q)) + 1
-                        if (mark(r) == j) cycle
-                        mark(r) = j
-                        nt = nt + 1
-                        if (pass == 2) then
-                            rows(nt) = r
-                            cols(nt) = j
-                        end if
-                    end do
-                end do
-            end do
+            call product_positions(self%jke%a, self%w, mark, nt, pass == 2, rows, cols)
         end do
         call self%s%build(self%nk, self%nk, rows, cols, status)
         if (.not. status%ok()) return

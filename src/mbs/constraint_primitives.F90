@@ -6,16 +6,11 @@ module flexmbs_mbs_constraint_primitives
     use flexmbs_core_kinds, only: wp
     use flexmbs_mbs_rotation, only: rotation_matrix, rotated_vector_jacobian, skew, cross, &
         quat_from_axis_angle
-    use flexmbs_mbs_primitive_kinds, only: primitive_dot1, primitive_dot2, &
-        primitive_spherical, primitive_distance, primitive_angle_driver, &
-        primitive_translation_driver, primitive_rows
+    ! every primitive kind and its rows: the formulas select on them all
+    use flexmbs_mbs_primitive_kinds
     use flexmbs_mbs_joint, only: joint_t, joint_part_time_derivative, joint_part_convective
     implicit none
     private
-    public :: rigid_marker_state, rigid_marker_pose, ground_marker_state, rigid_marker_jacobian, &
-        rigid_marker_jacobian_q, primitive_value, primitive_jacobian, &
-        primitive_time_derivative, primitive_convective, primitive_time_terms, &
-        joint_value, joint_jacobian, joint_rows, chain_marker_state, chain_marker_jacobian
 
 #define SCALAR real(wp)
 #define SPECIFICATION

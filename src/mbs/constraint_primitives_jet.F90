@@ -7,13 +7,11 @@ module flexmbs_mbs_constraint_primitives_jet
         operator(**), assignment(=), sin, cos, matmul
     use flexmbs_mbs_rotation_jet, only: rotation_matrix, rotated_vector_jacobian, skew, &
         cross, quat_from_axis_angle
-    use flexmbs_mbs_primitive_kinds, only: primitive_dot1, primitive_dot2, &
-        primitive_spherical, primitive_distance, primitive_angle_driver, &
-        primitive_translation_driver, primitive_rows
+    ! every primitive kind and its rows: the formulas select on them all
+    use flexmbs_mbs_primitive_kinds
     use flexmbs_mbs_joint, only: joint_t, joint_part_time_derivative, joint_part_convective
     implicit none
     private
-    public :: marker_state_t, ground_marker_state, joint_value
 
 #define SCALAR type(jet_t)
 #define SPECIFICATION

@@ -84,16 +84,19 @@ contains
 
     ! ------------------------------------------------ AD passes
 
-    !> Dual positions with local columns lo..hi seeded: unit directions in
-    !> position space; in velocity space the directions T e_l (a
-    !> quaternion's tangents for ω_f′ and ω′).
-    pure subroutine seed_positions(z, lo, hi, position_space, zd)
+    !> Dual positions with the batch of local columns lo..hi seeded, hi =
+    !> min(n, lo + dual_size − 1) of n columns: unit directions in position
+    !> space; in velocity space the directions T e_l (a quaternion's tangents
+    !> for ω_f′ and ω′).
+    pure subroutine seed_positions(z, lo, n, position_space, zd, hi)
         real(wp), intent(in) :: z(:)
-        integer, intent(in) :: lo, hi
+        integer, intent(in) :: lo, n
         logical, intent(in) :: position_space
         type(dual_t), intent(out) :: zd(:)
+        integer, intent(out) :: hi
         real(wp) :: tf(4, 3), tm(4, 3)
         integer :: c, d
+        hi = min(n, lo + dual_size - 1)
         zd = z
         tf = quat_rate_matrix(z(4:7))
         tm = quat_rate_matrix(z(11:14))
@@ -138,8 +141,7 @@ contains
         integer :: lo, hi
         block = 0.0_wp
         do lo = 1, size(block, 2), dual_size
-            hi = min(size(block, 2), lo + dual_size - 1)
-            call seed_positions(z, lo, hi, position_space, zd)
+            call seed_positions(z, lo, size(block, 2), position_space, zd, hi)
             call scatter(rows_d(m, zd(1:3), zd(4:7), zd(8:10), zd(11:14), zd(15:)), lo, hi, &
                          block)
         end do
@@ -180,15 +182,7 @@ contains
         type(modal_interface_t), intent(in) :: m
         real(wp), intent(in) :: z(:), w(:)
         real(wp), intent(out) :: block(:, :)
-        type(dual_t) :: zd(size(z))
-        integer :: lo, hi
-        block = 0.0_wp
-        do lo = 1, frame_nq, dual_size
-            hi = min(frame_nq, lo + dual_size - 1)
-            call seed_positions(z, lo, hi, .true., zd)
-            call scatter(matmul(velocity_jacobian_d(m, zd(4:7), zd(11:14), zd(15:)), w), lo, &
-                         hi, block)
-        end do
+        call position_tangents(m, z, w, .false., block)
         call eta_columns(m, z, w, rate=block(:, frame_nq + 1:))
     end subroutine modal_frame_rate_q
 
@@ -197,17 +191,32 @@ contains
         type(modal_interface_t), intent(in) :: m
         real(wp), intent(in) :: z(:), lam(6)
         real(wp), intent(out) :: block(:, :)
+        call position_tangents(m, z, lam, .true., block)
+        call eta_columns(m, z, lam=lam, gtl=block(:, frame_nq + 1:))
+    end subroutine modal_frame_gtl_q
+
+    !> The frame_nq position columns of ∂(G x)/∂q, or of ∂(Gᵀx)/∂q when
+    !> `transposed`, by AD of G in batches of position seeds; the η columns
+    !> are left zero (eta_columns).
+    pure subroutine position_tangents(m, z, x, transposed, block)
+        type(modal_interface_t), intent(in) :: m
+        real(wp), intent(in) :: z(:), x(:)
+        logical, intent(in) :: transposed
+        real(wp), intent(out) :: block(:, :)
         type(dual_t) :: zd(size(z))
         integer :: lo, hi
         block = 0.0_wp
         do lo = 1, frame_nq, dual_size
-            hi = min(frame_nq, lo + dual_size - 1)
-            call seed_positions(z, lo, hi, .true., zd)
-            call scatter(matmul(transpose(velocity_jacobian_d(m, zd(4:7), zd(11:14), &
-                                                              zd(15:))), lam), lo, hi, block)
+            call seed_positions(z, lo, frame_nq, .true., zd, hi)
+            if (transposed) then
+                call scatter(matmul(transpose(velocity_jacobian_d(m, zd(4:7), zd(11:14), &
+                                                                  zd(15:))), x), lo, hi, block)
+            else
+                call scatter(matmul(velocity_jacobian_d(m, zd(4:7), zd(11:14), zd(15:)), x), &
+                             lo, hi, block)
+            end if
         end do
-        call eta_columns(m, z, lam=lam, gtl=block(:, frame_nq + 1:))
-    end subroutine modal_frame_gtl_q
+    end subroutine position_tangents
 
     !> ∂γ/∂q (6, 14 + n) and ∂γ/∂v (6, 12 + n).
     pure subroutine modal_frame_curvature_qv(m, z, w, gq, gv)
@@ -220,8 +229,7 @@ contains
         gv = 0.0_wp
         wd = w
         do lo = 1, frame_nq, dual_size
-            hi = min(frame_nq, lo + dual_size - 1)
-            call seed_positions(z, lo, hi, .true., zd)
+            call seed_positions(z, lo, frame_nq, .true., zd, hi)
             call scatter(curvature_d(m, zd(4:7), zd(11:14), zd(15:), wd(1:6), wd(7:)), lo, hi, &
                          gq)
         end do

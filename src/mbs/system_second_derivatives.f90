@@ -77,6 +77,16 @@ contains
                 end do
             end associate
         end do
+        call frame_jacobian_derivatives(self, q, w, lambda, gwq, gtlq)
+    end procedure jacobian_derivatives_into
+
+    !> The node frames' part of jacobian_derivatives_into: their blocks of
+    !> ∂(G w)/∂q and ∂(Gᵀλ)/∂q added into gwq, gtlq.
+    subroutine frame_jacobian_derivatives(self, q, w, lambda, gwq, gtlq)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), w(:), lambda(:)
+        type(accumulator_t), intent(inout) :: gwq, gtlq
+        integer :: k, l, r
         do k = 1, size(self%frames)
             associate (fr => self%frames(k))
                 block
@@ -95,7 +105,7 @@ contains
                 end block
             end associate
         end do
-    end procedure jacobian_derivatives_into
+    end subroutine frame_jacobian_derivatives
 
     !> out(row, q columns of body i and j) += tangents of s (directions 1..qi
     !> for body i at offset iqi, qi+1..qi+qj for body j at offset iqj).
@@ -217,6 +227,16 @@ contains
                 end do
             end associate
         end do
+        call frame_curvature_derivatives(self, q, v, gq, gv)
+    end procedure curvature_derivatives_into
+
+    !> The node frames' part of curvature_derivatives_into: their blocks of
+    !> ∂γ/∂q and ∂γ/∂v added into gq, gv.
+    subroutine frame_curvature_derivatives(self, q, v, gq, gv)
+        class(mbs_system_t), intent(inout) :: self
+        real(wp), intent(in) :: q(:), v(:)
+        type(accumulator_t), intent(inout) :: gq, gv
+        integer :: k
         do k = 1, size(self%frames)
             associate (fr => self%frames(k))
                 block
@@ -228,5 +248,5 @@ contains
                 end block
             end associate
         end do
-    end procedure curvature_derivatives_into
+    end subroutine frame_curvature_derivatives
 end submodule flexmbs_mbs_system_second_derivatives

@@ -13,12 +13,21 @@ module flexmbs_run_force_output
     implicit none
     private
 
-    !> One element's force or torque on one marker at each record.
-    type, extends(record_values_t) :: element_values_t
-        type(mbs_system_t), pointer :: system => null()
-        integer :: element = 0
+    !> The force (`torque` false) or the torque on the body of one marker of
+    !> a two-marker item, a force element or a joint (its reaction), at
+    !> each record; an extension's evaluate finds the item's two wrenches
+    !> and gives `part` of them.
+    type, abstract, extends(record_values_t), public :: wrench_values_t
         integer :: side = 1 !! marker i (1) or marker j (2)
         logical :: torque = .false.
+    contains
+        procedure :: part => wrench_part
+    end type wrench_values_t
+
+    !> One element's force or torque on one marker at each record.
+    type, extends(wrench_values_t) :: element_values_t
+        type(mbs_system_t), pointer :: system => null()
+        integer :: element = 0
         integer :: oq = 0, ov = 0 !! q and v in y
     contains
         procedure :: evaluate => element_evaluate
@@ -71,10 +80,19 @@ contains
             call sys%element_wrench(self%element, t, y(self%oq + 1:self%oq + sys%nq), &
                                     y(self%ov + 1:self%ov + sys%nv), force, torque, status)
         end associate
+        call self%part(force, torque, values)
+    end subroutine element_evaluate
+
+    !> The series' values of the item's forces and torques on the bodies of
+    !> its markers i and j (columns 1, 2).
+    pure subroutine wrench_part(self, force, torque, values)
+        class(wrench_values_t), intent(in) :: self
+        real(wp), intent(in) :: force(3, 2), torque(3, 2)
+        real(wp), intent(out) :: values(:)
         if (self%torque) then
             values = torque(:, self%side)
         else
             values = force(:, self%side)
         end if
-    end subroutine element_evaluate
+    end subroutine wrench_part
 end module flexmbs_run_force_output

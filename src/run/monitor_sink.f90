@@ -47,8 +47,7 @@ contains
 
     subroutine monitor_output(self, t, y, status)
         class(monitor_sink_t), intent(inout) :: self
-        real(wp), intent(in) :: t, y(:)
-        type(status_t), intent(inout) :: status
+        include '../dae/sink_output_arguments.inc'
         if (.not. self%every_step) call record(self, t, y, status)
     end subroutine monitor_output
 
@@ -59,11 +58,7 @@ contains
 
     subroutine monitor_step(self, nr, t_old, t, y, dense, stop, status)
         class(monitor_sink_t), intent(inout) :: self
-        integer, intent(in) :: nr
-        real(wp), intent(in) :: t_old, t, y(:)
-        class(dense_output_t), intent(in) :: dense
-        logical, intent(inout) :: stop
-        type(status_t), intent(inout) :: status
+        include '../dae/sink_step_arguments.inc'
         if (self%every_step) call record(self, t, y, status)
     end subroutine monitor_step
 

@@ -53,7 +53,7 @@ module flexmbs_run_named_output
     use flexmbs_io_record_values, only: record_values_t
     use flexmbs_io_hdf5_sink, only: hdf5_sink_t
     use flexmbs_run_plan, only: run_plan_t
-    use flexmbs_run_force_output, only: add_force_output
+    use flexmbs_run_force_output, only: add_force_output, wrench_values_t
     use flexmbs_run_flexible_output, only: add_flexible, add_modal
     use flexmbs_io_scene_input, only: nonlinear_body, modal_body
     use flexmbs_io_hdf5_text, only: path_name
@@ -76,11 +76,10 @@ module flexmbs_run_named_output
     !> (side 1) or j (side 2): force (torque = .false.) or torque, from the
     !> multipliers consistent with the record's q and v (the formulation's
     !> consistent_multipliers: more accurate than y's λ of index 2 or 3).
-    type, extends(record_values_t) :: reaction_values_t
+    type, extends(wrench_values_t) :: reaction_values_t
         type(mbs_system_t), pointer :: system => null()
         type(formulation_t), pointer :: formulation => null()
-        integer :: joint = 0, side = 1, oq = 0
-        logical :: torque = .false.
+        integer :: joint = 0, oq = 0
     contains
         procedure :: evaluate => reaction_evaluate
     end type reaction_values_t
@@ -442,11 +441,7 @@ contains
             call sys%joint_reaction(self%joint, t, y(self%oq + 1:self%oq + sys%nq), lambda, &
                                     force, torque)
         end associate
-        if (self%torque) then
-            values = torque(:, self%side)
-        else
-            values = force(:, self%side)
-        end if
+        call self%part(force, torque, values)
     end subroutine reaction_evaluate
 
 

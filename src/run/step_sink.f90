@@ -36,8 +36,7 @@ contains
 
     subroutine step_output(self, t, y, status)
         class(step_sink_t), intent(inout) :: self
-        real(wp), intent(in) :: t, y(:)
-        type(status_t), intent(inout) :: status
+        include '../dae/sink_output_arguments.inc'
     end subroutine step_output
 
     logical function step_wants_steps(self)
@@ -47,11 +46,7 @@ contains
 
     subroutine step_step(self, nr, t_old, t, y, dense, stop, status)
         class(step_sink_t), intent(inout) :: self
-        integer, intent(in) :: nr
-        real(wp), intent(in) :: t_old, t, y(:)
-        class(dense_output_t), intent(in) :: dense
-        logical, intent(inout) :: stop
-        type(status_t), intent(inout) :: status
+        include '../dae/sink_step_arguments.inc'
         if (self%wants_state .and. .not. self%has_state) then
             if (t == self%t_state) then
                 self%state = y

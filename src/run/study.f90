@@ -29,6 +29,7 @@
 !> run/study_merge assembles the table from the records there.
 module flexmbs_run_study
     use hdf5
+    use flexmbs_io_result_columns, only: open_result
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_resources, only: out_of_memory
     use flexmbs_core_status, only: status_t, status_bad_input, status_io_error, &
@@ -263,12 +264,8 @@ contains
                 '''flexmbs reference'' first)')
             return
         end if
-        call h5open_f(err)
-        call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
-        if (err < 0) then
-            call status%set(status_io_error, path // ': not an HDF5 file')
-            return
-        end if
+        call open_result(path, file, status)
+        if (.not. status%ok()) return
         call h5dopen_f(file, 'time', dset, err)
         if (err >= 0) then
             call h5dget_space_f(dset, space, err)
@@ -321,11 +318,9 @@ contains
         character(len=:), allocatable :: note, refused
         integer :: k
 
-        call prepare_sweep(study, base, t_ref, y_ref, points, note, status, force)
+        call prepare_sweep(study, base, t_ref, y_ref, points, note, status, force, &
+                           table=.true.)
         if (present(stale)) stale = note
-        if (.not. status%ok()) return
-        if (len(study%table) > 0) call check_study_output(study, base, 'table', study%table, &
-                                                          output_table, given(force), status)
         if (.not. status%ok()) return
         allocate (runs(size(points)))
         do k = 1, size(points)
@@ -358,14 +353,16 @@ contains
     !> limit (not the reference's), the reference, checked to be the one
     !> `flexmbs reference` would make of the study now (`stale` says why
     !> not, with `force`), at the scene's output times, and the grid's points.
-    subroutine prepare_sweep(study, base, t_ref, y_ref, points, stale, status, force)
+    !> With `table`, the path of the study's table (if it names one) is
+    !> checked too, as before a sweep's first run.
+    subroutine prepare_sweep(study, base, t_ref, y_ref, points, stale, status, force, table)
         type(study_input_t), intent(in) :: study
         type(scene_input_t), intent(out) :: base
         real(wp), allocatable, intent(out) :: t_ref(:), y_ref(:, :)
         type(sweep_point_t), allocatable, intent(out) :: points(:)
         character(len=:), allocatable, intent(out) :: stale
         type(status_t), intent(out) :: status
-        logical, intent(in), optional :: force
+        logical, intent(in), optional :: force, table
         type(reference_print_t) :: now
         stale = ''
         call read_study_scene(study, base, status)
@@ -376,6 +373,8 @@ contains
         if (.not. status%ok()) return
         if (study%max_steps > 0) base%max_steps = study%max_steps
         call sweep_points(study, base, points)
+        if (given(table) .and. len(study%table) > 0) call check_study_output(study, base, &
+            'table', study%table, output_table, given(force), status)
     end subroutine prepare_sweep
 
     !> What a sweep whose points run elsewhere checks first, as a serial
@@ -395,11 +394,9 @@ contains
         real(wp), allocatable :: t_ref(:), y_ref(:, :)
         character(len=:), allocatable :: note
         npoints = 0
-        call prepare_sweep(study, base, t_ref, y_ref, points, note, status, force)
+        call prepare_sweep(study, base, t_ref, y_ref, points, note, status, force, &
+                           table=.true.)
         if (present(stale)) stale = note
-        if (.not. status%ok()) return
-        if (len(study%table) > 0) call check_study_output(study, base, 'table', study%table, &
-                                                          output_table, given(force), status)
         if (.not. status%ok()) return
         npoints = size(points)
         call make_results_folder(study, folder, status)
