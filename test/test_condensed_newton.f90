@@ -142,10 +142,10 @@ contains
             zb(i) = cmplx(b(i), cos(2.1_wp * i), kind=wp)
         end do
         ! positions and velocities a little off the trajectory; a, λ, μ nonzero
-        do i = 1, f%nq + f%nv
+        do i = 1, f%block_size(block_q) + f%block_size(block_v)
             y(i) = y(i) + 1.0e-3_wp * sin(1.7_wp * i)
         end do
-        do i = f%nq + f%nv + 1, n
+        do i = f%block_size(block_q) + f%block_size(block_v) + 1, n
             y(i) = 3.0_wp * sin(0.9_wp * i) + 0.5_wp
         end do
         jac%n = n

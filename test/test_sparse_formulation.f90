@@ -15,7 +15,7 @@ module test_sparse_formulation
     use flexmbs_linalg_factory, only: new_linear_solver
     use flexmbs_dae_problem, only: dae_problem_t
     use flexmbs_dae_mechanical_problem, only: mechanical_problem_t
-    use flexmbs_mbs_formulation, only: formulation_t
+    use flexmbs_mbs_formulation, only: formulation_t, block_q
     use flexmbs_io_namelist, only: scene_input_t, read_scene
     use flexmbs_run_runner, only: run_result_t, run_scene
     use flexmbs_run_problem_factory, only: build_problem, block_spec_t
@@ -253,7 +253,7 @@ contains
         n = size(y)
         select type (ps)
         type is (formulation_t)
-            call check(error, ps%is_sparse() .and. ps%nq == 4 * 7 + 2 + 3 * 756, &
+            call check(error, ps%is_sparse() .and. ps%block_size(block_q) == 4 * 7 + 2 + 3 * 756, &
                        'fine five-body: sparse, 2268 FE coordinates')
         end select
         if (allocated(error)) return

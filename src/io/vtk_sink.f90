@@ -146,8 +146,7 @@ contains
 
     subroutine vtk_output(self, t, y, status)
         class(vtk_sink_t), intent(inout) :: self
-        real(wp), intent(in) :: t, y(:)
-        type(status_t), intent(inout) :: status
+        include '../dae/sink_output_arguments.inc'
         real(wp), allocatable :: tt(:)
         if (.not. status%ok()) return
         self%records = self%records + 1
