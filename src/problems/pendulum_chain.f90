@@ -42,17 +42,17 @@ module flexmbs_problems_pendulum_chain
         real(wp) :: half_length = 0.0_wp !! l = 0.5/NB
         real(wp) :: inertia = 0.0_wp     !! m l²/3
     contains
-        procedure :: kinematics => chain_kinematics
-        procedure :: mass => chain_mass
-        procedure :: forces => chain_forces
-        procedure :: constraint => chain_constraint
-        procedure :: constraint_jacobian => chain_constraint_jacobian
-        procedure :: constraint_curvature => chain_constraint_curvature
-        procedure :: has_sparse => chain_has_sparse
-        procedure :: mass_pattern => chain_mass_pattern
-        procedure :: mass_sparse => chain_mass_sparse
-        procedure :: constraint_jacobian_pattern => chain_constraint_jacobian_pattern
-        procedure :: constraint_jacobian_sparse => chain_constraint_jacobian_sparse
+        procedure :: kinematics => pendulum_chain_kinematics
+        procedure :: mass => pendulum_chain_mass
+        procedure :: forces => pendulum_chain_forces
+        procedure :: constraint => pendulum_chain_constraint
+        procedure :: constraint_jacobian => pendulum_chain_constraint_jacobian
+        procedure :: constraint_curvature => pendulum_chain_constraint_curvature
+        procedure :: has_sparse => pendulum_chain_has_sparse
+        procedure :: mass_pattern => pendulum_chain_mass_pattern
+        procedure :: mass_sparse => pendulum_chain_mass_sparse
+        procedure :: constraint_jacobian_pattern => pendulum_chain_constraint_jacobian_pattern
+        procedure :: constraint_jacobian_sparse => pendulum_chain_constraint_jacobian_sparse
     end type pendulum_chain_t
 
     public :: new_pendulum_chain, pendulum_chain_initial
@@ -96,16 +96,16 @@ contains
         lambda = 0.0_wp
     end subroutine pendulum_chain_initial
 
-    subroutine chain_kinematics(self, t, q, w, qdot, status)
+    subroutine pendulum_chain_kinematics(self, t, q, w, qdot, status)
         class(pendulum_chain_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:), w(:)
         real(wp), intent(out) :: qdot(:)
         type(status_t), intent(inout) :: status
         qdot = w
-    end subroutine chain_kinematics
+    end subroutine pendulum_chain_kinematics
 
     !> M = diag(m, m, m l²/3) per body.
-    subroutine chain_mass(self, t, q, m, status)
+    subroutine pendulum_chain_mass(self, t, q, m, status)
         class(pendulum_chain_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:)
         real(wp), intent(out) :: m(:, :)
@@ -117,9 +117,9 @@ contains
             m(3 * i - 1, 3 * i - 1) = self%body_mass
             m(3 * i, 3 * i) = self%inertia
         end do
-    end subroutine chain_mass
+    end subroutine pendulum_chain_mass
 
-    subroutine chain_forces(self, t, q, v, f, status)
+    subroutine pendulum_chain_forces(self, t, q, v, f, status)
         class(pendulum_chain_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: f(:)
@@ -129,9 +129,9 @@ contains
         do i = 1, self%bodies
             f(3 * i - 1) = -self%body_mass * chain_gravity
         end do
-    end subroutine chain_forces
+    end subroutine pendulum_chain_forces
 
-    subroutine chain_constraint(self, t, q, g, status)
+    subroutine pendulum_chain_constraint(self, t, q, g, status)
         class(pendulum_chain_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:)
         real(wp), intent(out) :: g(:)
@@ -145,10 +145,10 @@ contains
             g(2 * i - 1) = q(3 * i - 5) + l * sin(q(3 * i - 3)) - q(3 * i - 2) + l * sin(q(3 * i))
             g(2 * i) = q(3 * i - 4) - l * cos(q(3 * i - 3)) - q(3 * i - 1) - l * cos(q(3 * i))
         end do
-    end subroutine chain_constraint
+    end subroutine pendulum_chain_constraint
 
     !> G = g_q (T = I), 2 NB x 3 NB.
-    subroutine chain_constraint_jacobian(self, t, q, gmat, status)
+    subroutine pendulum_chain_constraint_jacobian(self, t, q, gmat, status)
         class(pendulum_chain_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:)
         real(wp), intent(out) :: gmat(:, :)
@@ -171,10 +171,10 @@ contains
             gmat(2 * i, 3 * i - 1) = -1.0_wp
             gmat(2 * i, 3 * i) = l * sin(q(3 * i))
         end do
-    end subroutine chain_constraint_jacobian
+    end subroutine pendulum_chain_constraint_jacobian
 
     !> γ = (G v)_q v: only the angle entries of G depend on q.
-    subroutine chain_constraint_curvature(self, t, q, v, gamma, status)
+    subroutine pendulum_chain_constraint_curvature(self, t, q, v, gamma, status)
         class(pendulum_chain_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:), v(:)
         real(wp), intent(out) :: gamma(:)
@@ -189,24 +189,24 @@ contains
                 + sin(q(3 * i)) * v(3 * i)**2)
             gamma(2 * i) = l * (cos(q(3 * i - 3)) * v(3 * i - 3)**2 + cos(q(3 * i)) * v(3 * i)**2)
         end do
-    end subroutine chain_constraint_curvature
+    end subroutine pendulum_chain_constraint_curvature
 
-    logical function chain_has_sparse(self)
+    logical function pendulum_chain_has_sparse(self)
         class(pendulum_chain_t), intent(in) :: self
-        chain_has_sparse = .true.
-    end function chain_has_sparse
+        pendulum_chain_has_sparse = .true.
+    end function pendulum_chain_has_sparse
 
     !> M is diagonal.
-    subroutine chain_mass_pattern(self, pattern, status)
+    subroutine pendulum_chain_mass_pattern(self, pattern, status)
         class(pendulum_chain_t), intent(inout) :: self
         type(csc_matrix_t), intent(inout) :: pattern
         type(status_t), intent(inout) :: status
         integer :: i
         call pattern%build(self%nv, self%nv, [(i, i=1, self%nv)], [(i, i=1, self%nv)], status)
-    end subroutine chain_mass_pattern
+    end subroutine pendulum_chain_mass_pattern
 
     !> diag(m, m, m l²/3) per body, in the slots of the diagonal pattern.
-    subroutine chain_mass_sparse(self, t, q, values, status)
+    subroutine pendulum_chain_mass_sparse(self, t, q, values, status)
         class(pendulum_chain_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:)
         real(wp), intent(out) :: values(:)
@@ -217,10 +217,10 @@ contains
             values(3 * i - 1) = self%body_mass
             values(3 * i) = self%inertia
         end do
-    end subroutine chain_mass_sparse
+    end subroutine pendulum_chain_mass_sparse
 
     !> The 8 NB - 4 slots of G, column by column.
-    subroutine chain_constraint_jacobian_pattern(self, pattern, status)
+    subroutine pendulum_chain_constraint_jacobian_pattern(self, pattern, status)
         class(pendulum_chain_t), intent(inout) :: self
         type(csc_matrix_t), intent(inout) :: pattern
         type(status_t), intent(inout) :: status
@@ -233,16 +233,16 @@ contains
         q = half_pi
         call jacobian_entries(self, q, values, rows, cols)
         call pattern%build(self%nc, self%nv, rows, cols, status)
-    end subroutine chain_constraint_jacobian_pattern
+    end subroutine pendulum_chain_constraint_jacobian_pattern
 
     !> Values of G in the slots of its pattern.
-    subroutine chain_constraint_jacobian_sparse(self, t, q, values, status)
+    subroutine pendulum_chain_constraint_jacobian_sparse(self, t, q, values, status)
         class(pendulum_chain_t), intent(inout) :: self
         real(wp), intent(in) :: t, q(:)
         real(wp), intent(out) :: values(:)
         type(status_t), intent(inout) :: status
         call jacobian_entries(self, q, values)
-    end subroutine chain_constraint_jacobian_sparse
+    end subroutine pendulum_chain_constraint_jacobian_sparse
 
     !> The nonzeros of G in CSC order (by column, rows ascending), so that
     !> the pattern built from (rows, cols) has them in exactly these slots.
