@@ -63,6 +63,20 @@ module flexmbs_legacy_ddassl_adapter
         type(classic_residual_t) :: problem
     end type session_t
 
+    !> What a call's arguments say, once checked (check_call, §2.11).
+    type :: classic_call_t
+        logical :: first = .false.           !! INFO(1) = 0: a new problem
+        logical :: have_tstop = .false.      !! INFO(4) = 1
+        integer :: maxord = ddassl_max_order !! INFO(9): IWORK(3)
+        integer :: ml = 0, mu = 0            !! INFO(6): IWORK(1), IWORK(2)
+        integer :: ntol = 1                  !! INFO(2): NEQ tolerances, else 1
+        real(wp) :: tstop = 0.0_wp           !! RWORK(1)
+        real(wp) :: hmax = huge(1.0_wp)      !! INFO(7): RWORK(2)
+        real(wp) :: uround = epsilon(1.0_wp)
+        real(wp) :: dir = 1.0_wp             !! the direction of integration
+        real(wp), allocatable :: rt(:), at(:) !! first call: the tolerances as vectors
+    end type classic_call_t
+
     type(session_t), allocatable, target, save :: sessions(:)
     integer, save :: token_counter = 0
     integer, save :: last_idid = 0   !! of the latest call, for -998/-999 without a session
@@ -77,14 +91,13 @@ contains
         type(session_t), pointer :: ses
         type(dae_options_t) :: options
         type(status_t) :: status
-        real(wp), allocatable :: rt(:), at(:), wt(:)
-        integer :: maxord, ml, mu, ntol, isession, nst_start, illegal, i
-        real(wp) :: tstop, hmax, h0, uround, hmin, dir
-        logical :: first, have_tstop
+        type(classic_call_t) :: args
+        real(wp), allocatable :: rt(:), at(:)
+        integer :: nst_start, illegal
 
         ! ---- a failure not acknowledged (§2.11, INFO(1)) ----
         if (info(1) == -1) then
-            ses => find_session()
+            ses => find_session(iwork, liw)
             if (associated(ses)) last_idid = ses%last_idid
             if (last_idid == idid_illegal .or. last_idid == idid_fatal) then
                 idid = idid_fatal
@@ -100,135 +113,20 @@ contains
         end if
 
         ! ---- illegal input (IDID -33, §2.11) ----
-        illegal = 0
-        first = info(1) == 0
-        maxord = ddassl_max_order
-        ml = 0
-        mu = 0
-        if (any(info(1:11) /= 0 .and. info(1:11) /= 1)) illegal = 1
-        if (illegal == 0 .and. neq <= 0) illegal = 2
-        if (illegal == 0 .and. info(9) == 1) then
-            maxord = iwork(3)
-            if (maxord < 1 .or. maxord > ddassl_max_order) illegal = 3
-        end if
-        if (illegal == 0 .and. info(6) == 1) then
-            ml = iwork(1)
-            mu = iwork(2)
-            if (ml < 0 .or. ml >= neq) illegal = 17
-            if (illegal == 0 .and. (mu < 0 .or. mu >= neq)) illegal = 18
-        end if
-        if (illegal == 0) then
-            if (lrw < required_lrw(neq, maxord, info(6) == 1, info(5) == 0, ml, mu)) illegal = 4
-            if (illegal == 0 .and. liw < liw_fixed + neq) illegal = 5
-        end if
-        ntol = 1
-        if (info(2) == 1) ntol = max(neq, 1)
-        if (illegal == 0) then
-            if (any(rtol(1:ntol) < 0.0_wp)) illegal = 6
-            if (illegal == 0 .and. any(atol(1:ntol) < 0.0_wp)) illegal = 7
-            if (illegal == 0 .and. all(rtol(1:ntol) == 0.0_wp) .and. &
-                all(atol(1:ntol) == 0.0_wp)) illegal = 8
-        end if
-        ! The direction of integration: towards TOUT, or that of the steps.
-        dir = sign(1.0_wp, tout - t)
-        if (.not. first) then
-            ses => find_session()
-            if (associated(ses)) dir = sign(1.0_wp, ses%solver%work%h)
-        end if
-        have_tstop = info(4) == 1
-        tstop = 0.0_wp
-        if (illegal == 0 .and. have_tstop) then
-            tstop = rwork(1)
-            if ((tstop - tout) * dir < 0.0_wp) illegal = 9
-        end if
-        hmax = huge(1.0_wp)
-        if (illegal == 0 .and. info(7) == 1) then
-            hmax = rwork(2)
-            if (hmax < 0.0_wp) illegal = 10
-        end if
-        uround = epsilon(1.0_wp)
-        if (illegal == 0 .and. first) then
-            if (tout == t) then
-                illegal = 19
-            else if (info(8) == 1) then
-                h0 = rwork(3)
-                if (h0 == 0.0_wp) then
-                    illegal = 12
-                else if ((tout - t) * h0 < 0.0_wp) then
-                    illegal = 11
-                end if
-            end if
-            if (illegal == 0 .and. have_tstop) then
-                if ((tstop - t) * dir < 0.0_wp) illegal = 15
-            end if
-            if (illegal == 0) then
-                allocate (rt(neq), at(neq), wt(neq))
-                call expand_tolerances()
-                wt = rt * abs(y(1:neq)) + at
-                if (any(.not. wt > 0.0_wp)) illegal = 13
-            end if
-            if (illegal == 0) then
-                hmin = hmin_factor * uround * max(abs(t), abs(tout))
-                if (abs(tout - t) < hmin) illegal = 14
-            end if
-        end if
-        if (illegal == 0 .and. .not. first) then
-            ses => find_session()
-            if (.not. associated(ses)) then
-                illegal = 1
-                call message('INFO(1) = 1 but IWORK holds no integration to continue')
-            else if (.not. ses%solver%work%ready) then
-                illegal = 1
-                call message('INFO(1) = 1 but the integration never started (DDAINI ' // &
-                    'failed): start again with INFO(1) = 0')
-            end if
-            if (illegal == 0) then
-                if ((tout - t) * dir < 0.0_wp) illegal = 11
-                if (illegal == 0 .and. tout == t) illegal = 19
-                if (illegal == 0 .and. have_tstop) then
-                    if ((tstop - ses%solver%work%tn) * dir < 0.0_wp) illegal = 15
-                end if
-            end if
-        end if
+        call check_call(neq, t, y, tout, info, rtol, atol, lrw, rwork, liw, iwork, args, illegal)
         if (illegal /= 0) then
             call illegal_input(illegal)
             return
         end if
 
         ! ---- first call: a session and the core's begin (§2.7) ----
-        if (first) then
-            ses => new_session()
+        if (args%first) then
+            ses => new_session(iwork, liw)
             call attach()
-            ses%problem%n = neq
-            ses%problem%analytic = info(5) == 1
-            ses%problem%banded = info(6) == 1
-            ses%problem%ml = ml
-            ses%problem%mu = mu
-            ses%solver%netlib = .false.
-            ses%solver%fixed_step = .false.
-            ses%solver%tstop = .false.           ! TSTOP is handled here
-            ses%solver%h0_from_first_output = .false.
-            ses%solver%exclude_index23 = .false.  ! §2.10: no mask in the classic code
-            ses%solver%nonnegative = info(10) == 1
-            ses%solver%uround = uround
-            options%pmax = maxord
-            options%rtol_vector = rt
-            options%atol_vector = at
-            options%max_steps = huge(1)
-            if (info(7) == 1) options%hmax = hmax
-            if (info(8) == 1) options%h0 = abs(rwork(3))
-            options%jacobian = 'analytic'
-            if (info(5) == 0) options%jacobian = 'fd'
-            options%linear_solver = 'dense'
-            options%classic_lu = .true.
-            if (info(6) == 1) then
-                options%linear_solver = 'band'
-                options%band_lower = ml
-                options%band_upper = mu
-            end if
-            if (have_tstop) then
+            call configure_session(ses, args, neq, info, rwork, options)
+            if (args%have_tstop) then
                 call ses%solver%begin(ses%problem, t, y(1:neq), yprime(1:neq), tout, options, &
-                    status, initial_derivative=info(11) == 1, tstop=tstop)
+                    status, initial_derivative=info(11) == 1, tstop=args%tstop)
             else
                 call ses%solver%begin(ses%problem, t, y(1:neq), yprime(1:neq), tout, options, &
                     status, initial_derivative=info(11) == 1)
@@ -245,10 +143,11 @@ contains
             end if
             info(1) = 1  ! the code has been initialised: later calls continue
         else
+            ses => find_session(iwork, liw)   ! check_call found it
             call attach()
-            ses%solver%work%hmax = hmax
+            ses%solver%work%hmax = args%hmax
             allocate (rt(neq), at(neq))
-            call expand_tolerances()
+            call expand_tolerances(info, neq, rtol, atol, rt, at)
             ses%solver%work%rtol = rt
             ses%solver%work%atol = at
         end if
@@ -257,7 +156,7 @@ contains
         associate (w => ses%solver%work, solver => ses%solver)
             nst_start = solver%native%nst
             ! A continuation call makes the output tests before stepping.
-            if (.not. first) then
+            if (.not. args%first) then
                 if (output_done(continuation=.true.)) then
                     call finish()
                     return
@@ -270,9 +169,9 @@ contains
                         // 'on this call before reaching TOUT')
                     return
                 end if
-                if (have_tstop) then
+                if (args%have_tstop) then
                     call solver%step(ses%problem, y(1:neq), yprime(1:neq), tout, status, &
-                        .false., tstop)
+                        .false., args%tstop)
                 else
                     call solver%step(ses%problem, y(1:neq), yprime(1:neq), tout, status, &
                         .false.)
@@ -280,8 +179,8 @@ contains
                 if (.not. status%ok()) then
                     call give_back_tn()
                     if (w%failure == ddassl_fail_tolerances) then
-                        rtol(1:ntol) = rtol(1:ntol) * w%tol_scale
-                        atol(1:ntol) = atol(1:ntol) * w%tol_scale
+                        rtol(1:args%ntol) = rtol(1:args%ntol) * w%tol_scale
+                        atol(1:args%ntol) = atol(1:args%ntol) * w%tol_scale
                     end if
                     call failed(w%failure, status%message)
                     return
@@ -298,16 +197,6 @@ contains
 
     contains
 
-        !> INFO(2): scalar or vector tolerances as vectors of length NEQ.
-        subroutine expand_tolerances()
-            if (info(2) == 1) then
-                rt = rtol(1:neq)
-                at = atol(1:neq)
-            else
-                rt = rtol(1)
-                at = atol(1)
-            end if
-        end subroutine expand_tolerances
 
         !> Point the wrapper at this call's user routines and data.
         subroutine attach()
@@ -326,10 +215,11 @@ contains
                 output_done = .false.
                 ! TSTOP first: TOUT may not lie beyond it, so reaching it
                 ! (stepping exactly there) is IDID 2 even when TOUT = TSTOP.
-                if (have_tstop) then
-                    if (abs(w%tn - tstop) <= tstop_tol * w%uround * (abs(w%tn) + abs(w%h))) then
-                        call ses%solver%interpolate(tstop, y(1:neq), yprime(1:neq))
-                        t = tstop
+                if (args%have_tstop) then
+                    if (abs(w%tn - args%tstop) <= &
+                        tstop_tol * w%uround * (abs(w%tn) + abs(w%h))) then
+                        call ses%solver%interpolate(args%tstop, y(1:neq), yprime(1:neq))
+                        t = args%tstop
                         idid = 2
                         output_done = .true.
                         return
@@ -367,92 +257,262 @@ contains
             idid = idid_illegal
             info(1) = -1
             call message('illegal input ' // int_text(number) // ': ' // illegal_text(number))
-            old => find_session()
+            old => find_session(iwork, liw)
             if (associated(old)) old%last_idid = idid
             last_idid = idid
         end subroutine illegal_input
 
         !> The published slots (§2.11) and INFO(1) on every return.
         subroutine finish()
-            integer :: k, base, nphi
-            associate (w => ses%solver%work, nat => ses%solver%native)
-                iwork(7) = w%k
-                iwork(8) = w%kold
-                iwork(11) = nat%nst
-                iwork(12) = nat%nre
-                iwork(13) = nat%nje
-                iwork(14) = nat%netf
-                iwork(15) = nat%ncfn
-                rwork(3) = w%h
-                rwork(4) = w%tn
-                rwork(5) = w%cj
-                rwork(6) = w%cjold
-                rwork(7) = w%hold
-                rwork(9) = w%uround
-                rwork(11:16) = w%alpha
-                rwork(17:22) = w%beta
-                rwork(23:28) = w%gamma
-                rwork(29:34) = w%psi
-                rwork(35:40) = w%sigma
-                if (allocated(w%phi)) then
-                    ! δ, e and wt, then φ (NEQ x (MAXORD + 1)).
-                    base = lrw_fixed
-                    rwork(base + 1:base + neq) = w%delta
-                    rwork(base + neq + 1:base + 2 * neq) = w%e
-                    rwork(base + 2 * neq + 1:base + 3 * neq) = w%wt
-                    nphi = size(w%phi, 2)
-                    do k = 1, nphi
-                        rwork(base + (2 + k) * neq + 1:base + (3 + k) * neq) = w%phi(:, k)
-                    end do
-                end if
-            end associate
-            if (idid < 0) info(1) = -1
-            ses%last_idid = idid
-            last_idid = idid
+            call publish_slots(ses, neq, idid, info, rwork, iwork)
         end subroutine finish
-
-        !> The session IWORK names, if it is one of ours.
-        function find_session() result(found)
-            type(session_t), pointer :: found
-            found => null()
-            if (liw < slot_token .or. .not. allocated(sessions)) return
-            isession = iwork(slot_session)
-            if (isession < 1 .or. isession > size(sessions)) return
-            if (.not. sessions(isession)%in_use) return
-            if (sessions(isession)%token /= iwork(slot_token)) return
-            found => sessions(isession)
-        end function find_session
-
-        !> A session for a new problem: the one IWORK names, else a free one.
-        function new_session() result(fresh)
-            type(session_t), pointer :: fresh
-            type(session_t), allocatable :: grown(:)
-            fresh => find_session()
-            if (.not. associated(fresh)) then
-                if (.not. allocated(sessions)) allocate (sessions(4))
-                isession = 0
-                do i = 1, size(sessions)
-                    if (.not. sessions(i)%in_use) then
-                        isession = i
-                        exit
-                    end if
-                end do
-                if (isession == 0) then
-                    allocate (grown(2 * size(sessions)))
-                    grown(1:size(sessions)) = sessions
-                    isession = size(sessions) + 1
-                    call move_alloc(grown, sessions)
-                end if
-                fresh => sessions(isession)
-            end if
-            token_counter = token_counter + 1
-            fresh%in_use = .true.
-            fresh%token = token_counter
-            fresh%last_idid = 0
-            iwork(slot_session) = isession
-            iwork(slot_token) = fresh%token
-        end function new_session
     end subroutine ddassl_classic
+
+    !> A new session's problem and solver settings, and the core's options,
+    !> from INFO, the checked arguments and RWORK(3) (docs/solvers.md, DDASSL).
+    subroutine configure_session(ses, args, neq, info, rwork, options)
+        type(session_t), intent(inout) :: ses
+        type(classic_call_t), intent(in) :: args
+        integer, intent(in) :: neq, info(15)
+        real(wp), intent(in) :: rwork(*)
+        type(dae_options_t), intent(out) :: options
+        ses%problem%n = neq
+        ses%problem%analytic = info(5) == 1
+        ses%problem%banded = info(6) == 1
+        ses%problem%ml = args%ml
+        ses%problem%mu = args%mu
+        ses%solver%netlib = .false.
+        ses%solver%fixed_step = .false.
+        ses%solver%tstop = .false.           ! TSTOP is handled here
+        ses%solver%h0_from_first_output = .false.
+        ses%solver%exclude_index23 = .false.  ! §2.10: no mask in the classic code
+        ses%solver%nonnegative = info(10) == 1
+        ses%solver%uround = args%uround
+        options%pmax = args%maxord
+        options%rtol_vector = args%rt
+        options%atol_vector = args%at
+        options%max_steps = huge(1)
+        if (info(7) == 1) options%hmax = args%hmax
+        if (info(8) == 1) options%h0 = abs(rwork(3))
+        options%jacobian = 'analytic'
+        if (info(5) == 0) options%jacobian = 'fd'
+        options%linear_solver = 'dense'
+        options%classic_lu = .true.
+        if (info(6) == 1) then
+            options%linear_solver = 'band'
+            options%band_lower = args%ml
+            options%band_upper = args%mu
+        end if
+    end subroutine configure_session
+
+    !> The published slots (§2.11), INFO(1) on a failure and the last IDID,
+    !> on every return.
+    subroutine publish_slots(ses, neq, idid, info, rwork, iwork)
+        type(session_t), intent(inout) :: ses
+        integer, intent(in) :: neq, idid
+        integer, intent(inout) :: info(15), iwork(*)
+        real(wp), intent(inout) :: rwork(*)
+        integer :: k, base, nphi
+        associate (w => ses%solver%work, nat => ses%solver%native)
+            iwork(7) = w%k
+            iwork(8) = w%kold
+            iwork(11) = nat%nst
+            iwork(12) = nat%nre
+            iwork(13) = nat%nje
+            iwork(14) = nat%netf
+            iwork(15) = nat%ncfn
+            rwork(3) = w%h
+            rwork(4) = w%tn
+            rwork(5) = w%cj
+            rwork(6) = w%cjold
+            rwork(7) = w%hold
+            rwork(9) = w%uround
+            rwork(11:16) = w%alpha
+            rwork(17:22) = w%beta
+            rwork(23:28) = w%gamma
+            rwork(29:34) = w%psi
+            rwork(35:40) = w%sigma
+            if (allocated(w%phi)) then
+                ! δ, e and wt, then φ (NEQ x (MAXORD + 1)).
+                base = lrw_fixed
+                rwork(base + 1:base + neq) = w%delta
+                rwork(base + neq + 1:base + 2 * neq) = w%e
+                rwork(base + 2 * neq + 1:base + 3 * neq) = w%wt
+                nphi = size(w%phi, 2)
+                do k = 1, nphi
+                    rwork(base + (2 + k) * neq + 1:base + (3 + k) * neq) = w%phi(:, k)
+                end do
+            end if
+        end associate
+        if (idid < 0) info(1) = -1
+        ses%last_idid = idid
+        last_idid = idid
+    end subroutine publish_slots
+
+    !> §2.11's checks of a call's arguments, in the original's order: the
+    !> number of the first illegal input (0: none) and what the arguments
+    !> say (`args`); the tolerances as vectors on a first call.
+    subroutine check_call(neq, t, y, tout, info, rtol, atol, lrw, rwork, liw, iwork, args, &
+                          illegal)
+        integer, intent(in) :: neq, lrw, liw
+        real(wp), intent(in) :: t, y(*), tout, rtol(*), atol(*), rwork(lrw)
+        integer, intent(in) :: info(15), iwork(liw)
+        type(classic_call_t), intent(out) :: args
+        integer, intent(out) :: illegal
+        type(session_t), pointer :: ses
+        real(wp), allocatable :: wt(:)
+        real(wp) :: h0, hmin
+        illegal = 0
+        args%first = info(1) == 0
+        if (any(info(1:11) /= 0 .and. info(1:11) /= 1)) illegal = 1
+        if (illegal == 0 .and. neq <= 0) illegal = 2
+        if (illegal == 0 .and. info(9) == 1) then
+            args%maxord = iwork(3)
+            if (args%maxord < 1 .or. args%maxord > ddassl_max_order) illegal = 3
+        end if
+        if (illegal == 0 .and. info(6) == 1) then
+            args%ml = iwork(1)
+            args%mu = iwork(2)
+            if (args%ml < 0 .or. args%ml >= neq) illegal = 17
+            if (illegal == 0 .and. (args%mu < 0 .or. args%mu >= neq)) illegal = 18
+        end if
+        if (illegal == 0) then
+            if (lrw < required_lrw(neq, args%maxord, info(6) == 1, info(5) == 0, args%ml, &
+                                   args%mu)) illegal = 4
+            if (illegal == 0 .and. liw < liw_fixed + neq) illegal = 5
+        end if
+        if (info(2) == 1) args%ntol = max(neq, 1)
+        if (illegal == 0) then
+            associate (ntol => args%ntol)
+                if (any(rtol(1:ntol) < 0.0_wp)) illegal = 6
+                if (illegal == 0 .and. any(atol(1:ntol) < 0.0_wp)) illegal = 7
+                if (illegal == 0 .and. all(rtol(1:ntol) == 0.0_wp) .and. &
+                    all(atol(1:ntol) == 0.0_wp)) illegal = 8
+            end associate
+        end if
+        ! The direction of integration: towards TOUT, or that of the steps.
+        args%dir = sign(1.0_wp, tout - t)
+        if (.not. args%first) then
+            ses => find_session(iwork, liw)
+            if (associated(ses)) args%dir = sign(1.0_wp, ses%solver%work%h)
+        end if
+        args%have_tstop = info(4) == 1
+        if (illegal == 0 .and. args%have_tstop) then
+            args%tstop = rwork(1)
+            if ((args%tstop - tout) * args%dir < 0.0_wp) illegal = 9
+        end if
+        if (illegal == 0 .and. info(7) == 1) then
+            args%hmax = rwork(2)
+            if (args%hmax < 0.0_wp) illegal = 10
+        end if
+        if (illegal == 0 .and. args%first) then
+            if (tout == t) then
+                illegal = 19
+            else if (info(8) == 1) then
+                h0 = rwork(3)
+                if (h0 == 0.0_wp) then
+                    illegal = 12
+                else if ((tout - t) * h0 < 0.0_wp) then
+                    illegal = 11
+                end if
+            end if
+            if (illegal == 0 .and. args%have_tstop) then
+                if ((args%tstop - t) * args%dir < 0.0_wp) illegal = 15
+            end if
+            if (illegal == 0) then
+                allocate (args%rt(neq), args%at(neq), wt(neq))
+                call expand_tolerances(info, neq, rtol, atol, args%rt, args%at)
+                wt = args%rt * abs(y(1:neq)) + args%at
+                if (any(.not. wt > 0.0_wp)) illegal = 13
+            end if
+            if (illegal == 0) then
+                hmin = hmin_factor * args%uround * max(abs(t), abs(tout))
+                if (abs(tout - t) < hmin) illegal = 14
+            end if
+        end if
+        if (illegal == 0 .and. .not. args%first) then
+            ses => find_session(iwork, liw)
+            if (.not. associated(ses)) then
+                illegal = 1
+                call message('INFO(1) = 1 but IWORK holds no integration to continue')
+            else if (.not. ses%solver%work%ready) then
+                illegal = 1
+                call message('INFO(1) = 1 but the integration never started (DDAINI ' // &
+                    'failed): start again with INFO(1) = 0')
+            end if
+            if (illegal == 0) then
+                if ((tout - t) * args%dir < 0.0_wp) illegal = 11
+                if (illegal == 0 .and. tout == t) illegal = 19
+                if (illegal == 0 .and. args%have_tstop) then
+                    if ((args%tstop - ses%solver%work%tn) * args%dir < 0.0_wp) illegal = 15
+                end if
+            end if
+        end if
+    end subroutine check_call
+
+    !> INFO(2): scalar or vector tolerances as vectors of length NEQ.
+    subroutine expand_tolerances(info, neq, rtol, atol, rt, at)
+        integer, intent(in) :: info(15), neq
+        real(wp), intent(in) :: rtol(*), atol(*)
+        real(wp), intent(inout) :: rt(:), at(:)
+        if (info(2) == 1) then
+            rt = rtol(1:neq)
+            at = atol(1:neq)
+        else
+            rt = rtol(1)
+            at = atol(1)
+        end if
+    end subroutine expand_tolerances
+
+    !> The session IWORK names, if it is one of ours.
+    function find_session(iwork, liw) result(found)
+        integer, intent(in) :: liw, iwork(liw)
+        type(session_t), pointer :: found
+        integer :: isession
+        found => null()
+        if (liw < slot_token .or. .not. allocated(sessions)) return
+        isession = iwork(slot_session)
+        if (isession < 1 .or. isession > size(sessions)) return
+        if (.not. sessions(isession)%in_use) return
+        if (sessions(isession)%token /= iwork(slot_token)) return
+        found => sessions(isession)
+    end function find_session
+
+    !> A session for a new problem: the one IWORK names, else a free one;
+    !> IWORK's internal slots name it.
+    function new_session(iwork, liw) result(fresh)
+        integer, intent(in) :: liw
+        integer, intent(inout) :: iwork(liw)
+        type(session_t), pointer :: fresh
+        type(session_t), allocatable :: grown(:)
+        integer :: isession, i
+        fresh => find_session(iwork, liw)
+        if (associated(fresh)) then
+            isession = iwork(slot_session)
+        else
+            if (.not. allocated(sessions)) allocate (sessions(4))
+            isession = 0
+            do i = 1, size(sessions)
+                if (.not. sessions(i)%in_use) then
+                    isession = i
+                    exit
+                end if
+            end do
+            if (isession == 0) then
+                allocate (grown(2 * size(sessions)))
+                grown(1:size(sessions)) = sessions
+                isession = size(sessions) + 1
+                call move_alloc(grown, sessions)
+            end if
+            fresh => sessions(isession)
+        end if
+        token_counter = token_counter + 1
+        fresh%in_use = .true.
+        fresh%token = token_counter
+        fresh%last_idid = 0
+        iwork(slot_session) = isession
+        iwork(slot_token) = fresh%token
+    end function new_session
 
     !> §2.11 workspace: dense, or banded (+ the differenced band's extra).
     pure integer function required_lrw(neq, maxord, banded, differenced, ml, mu) result(lrw)
