@@ -110,14 +110,11 @@ contains
         type(classic_problem_t) :: problem
         type(classic_sink_t) :: sink
         type(radau5_t) :: solver
-        type(radau5_t) :: defaults !! its settings' defaults, for zero slots
         type(dae_options_t) :: options
         type(dae_stats_t) :: stats
         type(status_t) :: status
         character(len=:), allocatable :: why
-        integer :: i, nmax, nit, m1, m2, nm1, nind1, nind2, nind3, ljac, lmas, le
-        integer(i8) :: need
-        real(wp) :: uround, safe, thet, fnewt, quot1, quot2, fac_min, fac_max, rtol1
+        integer :: nmax, nind(3), m1, m2, nm1
 
         idid = -1
         ! Sizes first: the option slots are read only from large enough arrays.
@@ -134,142 +131,14 @@ contains
             call reject('LWORK = ' // int_text(lwork) // ': too small')
             return
         end if
-
-        ! ---- option slots; 0 selects the default ----
-        uround = merge(uround_default, work(1), work(1) == 0.0_wp)
-        if (uround <= 1.0e-19_wp .or. uround >= 1.0_wp) then
-            call reject('WORK(1) = uround = ' // rtoa(uround) // ': must lie in (1e-19, 1)')
-            return
-        end if
-        if (itol == 0) then
-            if (atol(1) <= 0.0_wp .or. rtol(1) <= 10.0_wp * uround) then
-                call reject('tolerances RTOL = ' // rtoa(rtol(1)) // ', ATOL = ' // &
-                    rtoa(atol(1)) // ': need ATOL > 0 and RTOL > 10*uround')
-                return
-            end if
-        else
-            do i = 1, n
-                if (atol(i) <= 0.0_wp .or. rtol(i) <= 10.0_wp * uround) then
-                    call reject('tolerances RTOL(' // int_text(i) // ') = ' // rtoa(rtol(i)) // &
-                        ', ATOL(' // int_text(i) // ') = ' // rtoa(atol(i)) // &
-                        ': need ATOL > 0 and RTOL > 10*uround')
-                    return
-                end if
-            end do
-        end if
-        nmax = merge(nmax_default, iwork(2), iwork(2) == 0)
-        if (nmax <= 0) then
-            call reject('IWORK(2) = NMAX = ' // int_text(nmax) // ': must be positive')
-            return
-        end if
-        nit = merge(defaults%nit, iwork(3), iwork(3) == 0)
-        if (nit <= 0) then
-            call reject('IWORK(3) = NIT = ' // int_text(nit) // ': must be positive')
-            return
-        end if
-        nind1 = merge(n, iwork(5), iwork(5) == 0)
-        nind2 = iwork(6)
-        nind3 = iwork(7)
-        if (nind1 < 0 .or. nind2 < 0 .or. nind3 < 0 .or. nind1 + nind2 + nind3 /= n) then
-            call reject('IWORK(5..7) = NIND1..3 = ' // int_text(nind1) // ', ' // int_text(nind2) // &
-                ', ' // int_text(nind3) // ': must be non-negative and add up to N')
-            return
-        end if
-        m1 = iwork(9)
-        m2 = merge(m1, iwork(10), iwork(10) == 0)
-        if (m1 < 0 .or. m2 < 0 .or. m1 + m2 > n) then
-            call reject('IWORK(9..10) = M1, M2 = ' // int_text(m1) // ', ' // int_text(m2) // &
-                ': need M1 >= 0, M2 >= 0 and M1 + M2 <= N')
+        call read_option_slots(n, rtol, atol, itol, work, iwork, solver, nmax, nind, m1, m2, why)
+        if (len(why) == 0) call check_structure(n, m1, m2, mljac, mujac, imas, mlmas, mumas, &
+                                                iwork(1), lwork, problem, why)
+        if (len(why) > 0) then
+            call reject(why)
             return
         end if
         nm1 = n - m1
-        safe = merge(defaults%safe, work(2), work(2) == 0.0_wp)
-        if (len(rule_reason(safety_factor_rule, safe, .false.)) > 0) then
-            call reject('WORK(2) = SAFE = ' // rtoa(safe) // ': ' // &
-                rule_reason(safety_factor_rule, safe, .false.))
-            return
-        end if
-        thet = merge(defaults%thet, work(3), work(3) == 0.0_wp)
-        if (thet >= 1.0_wp) then
-            call reject('WORK(3) = THET = ' // rtoa(thet) // ': must be below 1')
-            return
-        end if
-        ! §1.4: FNEWT is checked against the first transformed rtol.
-        rtol1 = 0.1_wp * rtol(1)**(2.0_wp / 3.0_wp)
-        fnewt = work(4)
-        if (fnewt /= 0.0_wp .and. fnewt <= uround / rtol1) then
-            call reject('WORK(4) = FNEWT = ' // rtoa(fnewt) // ': must exceed uround/rtol'' = ' &
-                // rtoa(uround / rtol1))
-            return
-        end if
-        quot1 = merge(defaults%quot1, work(5), work(5) == 0.0_wp)
-        quot2 = merge(defaults%quot2, work(6), work(6) == 0.0_wp)
-        if (quot1 > 1.0_wp .or. quot2 < 1.0_wp) then
-            call reject('WORK(5..6) = QUOT1, QUOT2 = ' // rtoa(quot1) // ', ' // rtoa(quot2) &
-                // ': need QUOT1 <= 1 <= QUOT2')
-            return
-        end if
-        fac_min = merge(defaults%fac_min, work(8), work(8) == 0.0_wp)
-        fac_max = merge(defaults%fac_max, work(9), work(9) == 0.0_wp)
-        if (fac_min > 1.0_wp .or. fac_max < 1.0_wp) then
-            call reject('WORK(8..9) = ' // rtoa(fac_min) // ', ' // rtoa(fac_max) // &
-                ': need WORK(8) <= 1 <= WORK(9)')
-            return
-        end if
-
-        ! ---- matrix structure ----
-        problem%banded = mljac < nm1
-        if (problem%banded .and. (mljac < 0 .or. mujac < 0)) then
-            call reject('MLJAC, MUJAC = ' // int_text(mljac) // ', ' // int_text(mujac) // &
-                ': bandwidths must not be negative')
-            return
-        end if
-        ! Banded blocks ∂f_lower/∂y_(j+k·M2) need the lower part to be the last M2
-        ! components, M1 a multiple of M2.
-        if (problem%banded .and. m1 > 0) then
-            if (m1 + m2 /= n .or. mod(m1, max(m2, 1)) /= 0) then
-                call reject('banded Jacobian with M1 > 0 needs M1 + M2 = N and M1 a ' // &
-                    'multiple of M2; got M1, M2 = ' // int_text(m1) // ', ' // int_text(m2))
-                return
-            end if
-        end if
-        problem%has_mass = imas /= 0
-        if (problem%has_mass) then
-            problem%mass_banded = mlmas < nm1
-            if (problem%mass_banded .and. (mlmas < 0 .or. mumas < 0)) then
-                call reject('MLMAS, MUMAS = ' // int_text(mlmas) // ', ' // int_text(mumas) // &
-                    ': bandwidths must not be negative')
-                return
-            end if
-            if (problem%banded) then
-                if (.not. problem%mass_banded .or. mlmas > mljac .or. mumas > mujac) then
-                    call reject('mass bandwidths MLMAS, MUMAS = ' // int_text(mlmas) // ', ' // &
-                        int_text(mumas) // ' exceed the Jacobian''s ' // int_text(mljac) // ', ' // &
-                        int_text(mujac))
-                    return
-                end if
-            end if
-        end if
-        ! Hessenberg reduction (plain LU here) is ignored for n <= 2 (§1.13).
-        if (iwork(1) /= 0 .and. n > 2 .and. (problem%banded .or. problem%has_mass)) then
-            call reject('IWORK(1) /= 0 (Hessenberg) needs a full Jacobian and IMAS = 0')
-            return
-        end if
-        ! LWORK >= N(LJAC + LMAS + 3LE + 12) + 20 (widths n - M1 when full).
-        if (problem%banded) then
-            ljac = mljac + mujac + 1
-            le = 2 * mljac + mujac + 1
-        else
-            ljac = nm1
-            le = nm1
-        end if
-        lmas = 0
-        if (problem%has_mass) lmas = merge(mlmas + mumas + 1, nm1, problem%mass_banded)
-        need = int(n, i8) * (int(ljac, i8) + lmas + 3_i8 * le + 12) + 20
-        if (lwork < need) then
-            call reject('LWORK = ' // int_text(lwork) // ': must be at least ' // int_text(need))
-            return
-        end if
 
         ! ---- the problem, the sink and the core ----
         problem%n = n
@@ -288,8 +157,8 @@ contains
         problem%mlmas = mlmas
         problem%mumas = mumas
         problem%ldmas = merge(mlmas + mumas + 1, nm1, problem%mass_banded)
-        problem%nind = [nind1, nind2, nind3]
-        problem%uround = uround
+        problem%nind = nind
+        problem%uround = solver%uround
         allocate (problem%dfy(problem%ldjac, n), source=0.0_wp)
         if (.not. problem%analytic .and. (problem%banded .or. m1 > 0)) then
             ! The face differences these itself (§1.12); the core does the plain full case.
@@ -303,18 +172,6 @@ contains
         sink%n = n
         allocate (sink%y(n), sink%cont(4 * n))
         last_dense_valid = .false.
-
-        solver%uround = uround
-        solver%safe = safe
-        solver%thet = thet
-        solver%fnewt = fnewt
-        solver%quot1 = quot1
-        solver%quot2 = quot2
-        solver%fac_min = fac_min
-        solver%fac_max = fac_max
-        solver%nit = nit
-        solver%controller = iwork(8)
-        solver%zero_start = iwork(4) /= 0
 
         if (itol == 0) then
             options%rtol = rtol(1)
@@ -342,6 +199,184 @@ contains
             call reject(status%text())
             return
         end if
+        call write_back(solver, status, iwork, h, idid)
+
+    contains
+
+        subroutine reject(reason)
+            character(len=*), intent(in) :: reason
+            idid = -1
+            write (error_unit, '(a)') 'RADAU5: IDID = -1: ' // reason
+        end subroutine reject
+    end subroutine radau5_classic
+
+    !> The option slots WORK(1..9) and IWORK(2..10) (0 selects the default)
+    !> into the solver's settings, NMAX, NIND1..3 and M1, M2; `why` says what
+    !> is illegal ('' if nothing).
+    subroutine read_option_slots(n, rtol, atol, itol, work, iwork, solver, nmax, nind, m1, m2, &
+                                 why)
+        integer, intent(in) :: n, itol, iwork(*)
+        real(wp), intent(in) :: rtol(*), atol(*), work(*)
+        type(radau5_t), intent(inout) :: solver
+        integer, intent(out) :: nmax, nind(3), m1, m2
+        character(len=:), allocatable, intent(out) :: why
+        type(radau5_t) :: defaults !! its settings' defaults, for zero slots
+        real(wp) :: uround, rtol1
+        integer :: i
+        why = ''
+        uround = merge(uround_default, work(1), work(1) == 0.0_wp)
+        if (uround <= 1.0e-19_wp .or. uround >= 1.0_wp) then
+            why = 'WORK(1) = uround = ' // rtoa(uround) // ': must lie in (1e-19, 1)'
+            return
+        end if
+        solver%uround = uround
+        if (itol == 0) then
+            if (atol(1) <= 0.0_wp .or. rtol(1) <= 10.0_wp * uround) then
+                why = 'tolerances RTOL = ' // rtoa(rtol(1)) // ', ATOL = ' // &
+                    rtoa(atol(1)) // ': need ATOL > 0 and RTOL > 10*uround'
+                return
+            end if
+        else
+            do i = 1, n
+                if (atol(i) <= 0.0_wp .or. rtol(i) <= 10.0_wp * uround) then
+                    why = 'tolerances RTOL(' // int_text(i) // ') = ' // rtoa(rtol(i)) // &
+                        ', ATOL(' // int_text(i) // ') = ' // rtoa(atol(i)) // &
+                        ': need ATOL > 0 and RTOL > 10*uround'
+                    return
+                end if
+            end do
+        end if
+        nmax = merge(nmax_default, iwork(2), iwork(2) == 0)
+        if (nmax <= 0) then
+            why = 'IWORK(2) = NMAX = ' // int_text(nmax) // ': must be positive'
+            return
+        end if
+        solver%nit = merge(defaults%nit, iwork(3), iwork(3) == 0)
+        if (solver%nit <= 0) then
+            why = 'IWORK(3) = NIT = ' // int_text(solver%nit) // ': must be positive'
+            return
+        end if
+        nind = [merge(n, iwork(5), iwork(5) == 0), iwork(6), iwork(7)]
+        if (any(nind < 0) .or. sum(nind) /= n) then
+            why = 'IWORK(5..7) = NIND1..3 = ' // int_text(nind(1)) // ', ' // &
+                int_text(nind(2)) // ', ' // int_text(nind(3)) // &
+                ': must be non-negative and add up to N'
+            return
+        end if
+        m1 = iwork(9)
+        m2 = merge(m1, iwork(10), iwork(10) == 0)
+        if (m1 < 0 .or. m2 < 0 .or. m1 + m2 > n) then
+            why = 'IWORK(9..10) = M1, M2 = ' // int_text(m1) // ', ' // int_text(m2) // &
+                ': need M1 >= 0, M2 >= 0 and M1 + M2 <= N'
+            return
+        end if
+        solver%safe = merge(defaults%safe, work(2), work(2) == 0.0_wp)
+        if (len(rule_reason(safety_factor_rule, solver%safe, .false.)) > 0) then
+            why = 'WORK(2) = SAFE = ' // rtoa(solver%safe) // ': ' // &
+                rule_reason(safety_factor_rule, solver%safe, .false.)
+            return
+        end if
+        solver%thet = merge(defaults%thet, work(3), work(3) == 0.0_wp)
+        if (solver%thet >= 1.0_wp) then
+            why = 'WORK(3) = THET = ' // rtoa(solver%thet) // ': must be below 1'
+            return
+        end if
+        ! §1.4: FNEWT is checked against the first transformed rtol.
+        rtol1 = 0.1_wp * rtol(1)**(2.0_wp / 3.0_wp)
+        solver%fnewt = work(4)
+        if (solver%fnewt /= 0.0_wp .and. solver%fnewt <= uround / rtol1) then
+            why = 'WORK(4) = FNEWT = ' // rtoa(solver%fnewt) // &
+                ': must exceed uround/rtol'' = ' // rtoa(uround / rtol1)
+            return
+        end if
+        solver%quot1 = merge(defaults%quot1, work(5), work(5) == 0.0_wp)
+        solver%quot2 = merge(defaults%quot2, work(6), work(6) == 0.0_wp)
+        if (solver%quot1 > 1.0_wp .or. solver%quot2 < 1.0_wp) then
+            why = 'WORK(5..6) = QUOT1, QUOT2 = ' // rtoa(solver%quot1) // ', ' // &
+                rtoa(solver%quot2) // ': need QUOT1 <= 1 <= QUOT2'
+            return
+        end if
+        solver%fac_min = merge(defaults%fac_min, work(8), work(8) == 0.0_wp)
+        solver%fac_max = merge(defaults%fac_max, work(9), work(9) == 0.0_wp)
+        if (solver%fac_min > 1.0_wp .or. solver%fac_max < 1.0_wp) then
+            why = 'WORK(8..9) = ' // rtoa(solver%fac_min) // ', ' // rtoa(solver%fac_max) // &
+                ': need WORK(8) <= 1 <= WORK(9)'
+            return
+        end if
+        solver%controller = iwork(8)
+        solver%zero_start = iwork(4) /= 0
+    end subroutine read_option_slots
+
+    !> The Jacobian's and mass's structure (full or banded, M1/M2) and
+    !> LWORK against it; `why` says what is illegal ('' if nothing).
+    subroutine check_structure(n, m1, m2, mljac, mujac, imas, mlmas, mumas, hessenberg, lwork, &
+                               problem, why)
+        integer, intent(in) :: n, m1, m2, mljac, mujac, imas, mlmas, mumas, hessenberg, lwork
+        type(classic_problem_t), intent(inout) :: problem
+        character(len=:), allocatable, intent(out) :: why
+        integer :: nm1, ljac, lmas, le
+        integer(i8) :: need
+        why = ''
+        nm1 = n - m1
+        problem%banded = mljac < nm1
+        if (problem%banded .and. (mljac < 0 .or. mujac < 0)) then
+            why = 'MLJAC, MUJAC = ' // int_text(mljac) // ', ' // int_text(mujac) // &
+                ': bandwidths must not be negative'
+            return
+        end if
+        ! Banded blocks ∂f_lower/∂y_(j+k·M2) need the lower part to be the last M2
+        ! components, M1 a multiple of M2.
+        if (problem%banded .and. m1 > 0) then
+            if (m1 + m2 /= n .or. mod(m1, max(m2, 1)) /= 0) then
+                why = 'banded Jacobian with M1 > 0 needs M1 + M2 = N and M1 a ' // &
+                    'multiple of M2; got M1, M2 = ' // int_text(m1) // ', ' // int_text(m2)
+                return
+            end if
+        end if
+        problem%has_mass = imas /= 0
+        if (problem%has_mass) then
+            problem%mass_banded = mlmas < nm1
+            if (problem%mass_banded .and. (mlmas < 0 .or. mumas < 0)) then
+                why = 'MLMAS, MUMAS = ' // int_text(mlmas) // ', ' // int_text(mumas) // &
+                    ': bandwidths must not be negative'
+                return
+            end if
+            if (problem%banded) then
+                if (.not. problem%mass_banded .or. mlmas > mljac .or. mumas > mujac) then
+                    why = 'mass bandwidths MLMAS, MUMAS = ' // int_text(mlmas) // ', ' // &
+                        int_text(mumas) // ' exceed the Jacobian''s ' // int_text(mljac) // &
+                        ', ' // int_text(mujac)
+                    return
+                end if
+            end if
+        end if
+        ! Hessenberg reduction (plain LU here) is ignored for n <= 2 (§1.13).
+        if (hessenberg /= 0 .and. n > 2 .and. (problem%banded .or. problem%has_mass)) then
+            why = 'IWORK(1) /= 0 (Hessenberg) needs a full Jacobian and IMAS = 0'
+            return
+        end if
+        ! LWORK >= N(LJAC + LMAS + 3LE + 12) + 20 (widths n - M1 when full).
+        if (problem%banded) then
+            ljac = mljac + mujac + 1
+            le = 2 * mljac + mujac + 1
+        else
+            ljac = nm1
+            le = nm1
+        end if
+        lmas = 0
+        if (problem%has_mass) lmas = merge(mlmas + mumas + 1, nm1, problem%mass_banded)
+        need = int(n, i8) * (int(ljac, i8) + lmas + 3_i8 * le + 12) + 20
+        if (lwork < need) why = 'LWORK = ' // int_text(lwork) // ': must be at least ' // &
+            int_text(need)
+    end subroutine check_structure
+
+    !> The statistics IWORK(14..20), H and IDID after the core's run.
+    subroutine write_back(solver, status, iwork, h, idid)
+        type(radau5_t), intent(in) :: solver
+        type(status_t), intent(in) :: status
+        integer, intent(inout) :: iwork(*)
+        real(wp), intent(inout) :: h
+        integer, intent(out) :: idid
         iwork(14) = solver%native%nfcn
         iwork(15) = solver%native%njac
         iwork(16) = solver%native%nstep
@@ -367,15 +402,7 @@ contains
             end select
             write (error_unit, '(a,i0,a)') 'RADAU5: IDID = ', idid, ': ' // status%text()
         end select
-
-    contains
-
-        subroutine reject(reason)
-            character(len=*), intent(in) :: reason
-            idid = -1
-            write (error_unit, '(a)') 'RADAU5: IDID = -1: ' // reason
-        end subroutine reject
-    end subroutine radau5_classic
+    end subroutine write_back
 
     !> `CONTR5`: component i at s of the dense output of the latest SOLOUT
     !> call; NaN when there is none or i is out of range.
