@@ -6,6 +6,7 @@ module test_arm_with_pad
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t
     use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_io_namelist, only: scene_input_t, parse_scene, read_scene
     use flexmbs_run_runner, only: run_scene, run_result_t
     use flexmbs_run_multibody_builder, only: build_multibody
@@ -85,7 +86,8 @@ contains
             1.0e-8_wp]
         type(scene_input_t) :: relative, absolute
         type(run_result_t) :: r_rel, r_abs
-        type(mbs_system_t) :: sys_rel, sys_abs
+        type(mbs_system_t), target :: sys_rel, sys_abs
+        type(flexible_body_t), pointer :: body
         type(status_t) :: status
         real(wp), allocatable :: q0(:), v0(:)
         real(wp) :: diff(2), swing
@@ -96,15 +98,15 @@ contains
         if (status%ok()) call build_multibody(absolute, sys_abs, q0, v0, status)
         call check(error, status%ok(), 'scenes: ' // status%text())
         if (allocated(error)) return
-        fr = sys_rel%flex_q(1)
-        fa = sys_abs%flex_q(1)
-        n = sys_rel%flex(1)%nq
+        call sys_rel%flexible_coordinates(1, fr, n)
+        call sys_abs%flexible_coordinates(1, fa, n)
+        body => sys_rel%flexible_of(1)
         do i = 1, size(tols)
             call run(relative, r_rel)
             if (.not. allocated(error)) call run(absolute, r_abs)
             if (allocated(error)) return
             diff(i) = maxval(abs(r_rel%y(fr + 1:fr + n) - r_abs%y(fa + 1:fa + n)))
-            swing = maxval(abs(r_rel%y(fr + 1:fr + n) - sys_rel%flex(1)%free_positions()))
+            swing = maxval(abs(r_rel%y(fr + 1:fr + n) - body%free_positions()))
         end do
         print '(4x,a,2es9.2,a,es9.2,a)', 'arm with pad, relative against absolute: ', diff, &
             ' m at rtol 1e-6, 1e-8 (the pad moved ', swing, ' m)'

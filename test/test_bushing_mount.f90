@@ -12,7 +12,9 @@ module test_bushing_mount
     use flexmbs_run_multibody_builder, only: build_multibody
     use flexmbs_run_runner, only: run_result_t, run_scene
     use flexmbs_mbs_rotation, only: skew
-    use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_mbs_system, only: mbs_system_t, marker_t
+    use flexmbs_mbs_rigid_body, only: rigid_body_t
+    use flexmbs_mbs_force_element, only: force_element_t
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_index2
     use flexmbs_dae_stats, only: dae_stats_t
     use test_mbs_system, only: integrate
@@ -43,17 +45,22 @@ contains
         real(wp) :: amp(3)
         real(wp) :: m(6, 6), k(6, 6), c(6, 6), t(6, 6)
         complex(wp) :: a(6, 6), x(6, 1)
+        type(rigid_body_t) :: body
+        type(force_element_t) :: el
+        type(marker_t) :: marker
         integer :: e, ipiv(6), info
+        body = sys%rigid_body_of(1)
         m = 0.0_wp
-        m(1, 1) = sys%rigid%bodies(1)%mass
+        m(1, 1) = body%mass
         m(2, 2) = m(1, 1)
         m(3, 3) = m(1, 1)
-        m(4:6, 4:6) = sys%rigid%bodies(1)%inertia
+        m(4:6, 4:6) = body%inertia
         k = 0.0_wp
         c = 0.0_wp
-        do e = 1, size(sys%elements)
-            associate (el => sys%elements(e))
-                if (el%marker_j == 0) cycle
+        do e = 1, sys%element_count()
+            el = sys%element_of(e)
+            associate (mj => el%marker_j)
+                if (mj == 0) cycle
                 t = 0.0_wp
                 t(1, 1) = 1.0_wp
                 t(2, 2) = 1.0_wp
@@ -61,7 +68,8 @@ contains
                 t(4, 4) = 1.0_wp
                 t(5, 5) = 1.0_wp
                 t(6, 6) = 1.0_wp
-                t(1:3, 4:6) = -skew(sys%markers(el%marker_j)%position)
+                marker = sys%marker_of(mj)
+                t(1:3, 4:6) = -skew(marker%position)
                 k = k + matmul(transpose(t), matmul(el%stiffness6, t))
                 c = c + matmul(transpose(t), matmul(el%damping6, t))
             end associate
@@ -106,6 +114,8 @@ contains
         real(wp) :: ts(nsamples), samples(nsamples, 3), exact(3), measured(3), omega, dev
         character(len=200) :: msg
         character(len=5), parameter :: what(3) = ['x    ', 'z    ', 'pitch']
+        type(force_element_t) :: shaker
+        type(marker_t) :: marker
         integer :: k, i
         call read_scene('inputs/bushing_mount.nml', scene, status)
         if (status%ok()) call build_multibody(scene, sys, q0, v0, status)
@@ -126,11 +136,10 @@ contains
         end do
         call check(error, status%ok(), status%text())
         if (allocated(error)) return
-        associate (shaker => sys%elements(size(sys%elements)))
-            omega = shaker%driver%frequency
-            exact = closed_form(sys, omega, shaker%driver%amplitude * shaker%force, &
-                                sys%markers(shaker%marker_i)%position)
-        end associate
+        shaker = sys%element_of(sys%element_count())
+        marker = sys%marker_of(shaker%marker_i)
+        omega = shaker%driver%frequency
+        exact = closed_form(sys, omega, shaker%driver%amplitude * shaker%force, marker%position)
         do i = 1, 3
             measured(i) = fitted_amplitude(ts, samples(:, i), omega)
             dev = abs(measured(i) / exact(i) - 1.0_wp)

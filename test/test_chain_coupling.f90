@@ -291,6 +291,8 @@ contains
             integer, intent(in) :: k
             real(wp) :: q(size(q0)), lambda(sys%nc), force(3, 2), torque(3, 2), &
                 xi(3), xj(3), a(3, 3)
+            type(marker_t) :: marker
+            integer :: ends(2)
             call fill_random(q, seed, -0.1_wp, 0.1_wp)
             q = q0 + q
             q(4:7) = q(4:7) / norm2(q(4:7))
@@ -298,13 +300,16 @@ contains
                 ! the ball joint's rows are a vector: assembled, the body put
                 ! where its marker meets the chain's
                 q(8:11) = q(8:11) / norm2(q(8:11))
-                call sys%marker_pose(sys%joints(k)%marker_i, q, xi, a)
-                q(1:3) = xi - matmul(rotation_matrix(q(4:7)), sys%markers(2)%position)
+                ends = sys%joint_markers(k)
+                marker = sys%marker_of(2)
+                call sys%marker_pose(ends(1), q, xi, a)
+                q(1:3) = xi - matmul(rotation_matrix(q(4:7)), marker%position)
             end if
             call fill_random(lambda, seed, -2.0_wp, 2.0_wp)
             call sys%joint_reaction(k, 0.3_wp, q, lambda, force, torque)
-            call sys%marker_pose(sys%joints(k)%marker_i, q, xi, a)
-            call sys%marker_pose(sys%joints(k)%marker_j, q, xj, a)
+            ends = sys%joint_markers(k)
+            call sys%marker_pose(ends(1), q, xi, a)
+            call sys%marker_pose(ends(2), q, xj, a)
             d = max(maxval(abs(force(:, 1) + force(:, 2))), &
                     maxval(abs(torque(:, 1) + torque(:, 2) + cross(xi - xj, force(:, 1)))))
             ! a side that takes nothing balances trivially
@@ -397,7 +402,7 @@ contains
         sys = new_mbs_system([rigid_body_t(1.0_wp, 0.02_wp * identity)], m, &
             [mbs_joint_t(joint_spherical, 1, 3)], gravity=g_earth, chains=chains, &
             status=status, elements=[spring])
-        call check(error, status%ok() .and. size(sys%elements) == 1, 'force element on a &
+        call check(error, status%ok() .and. sys%element_count() == 1, 'force element on a &
                    &9-coordinate chain: ' // status%text())
     end subroutine test_large
     !> A chain of 14 links (13 revolute with turning axes, link 7 spherical:
@@ -695,7 +700,7 @@ contains
         integer :: trial
         call make_long('analytic', sys, q0, status)
         if (status%ok()) call sys%derivative_patterns(patterns, status)
-        call check(error, status%ok() .and. size(sys%elements) == 3, 'long system: ' // &
+        call check(error, status%ok() .and. sys%element_count() == 3, 'long system: ' // &
                    status%text())
         if (allocated(error)) return
         seed = 93_i8

@@ -58,7 +58,7 @@ contains
         type(marker_t), allocatable :: m(:)
         type(mbs_joint_t), allocatable :: j(:)
         integer, allocatable :: face(:), fixed(:)
-        integer :: i, nflex
+        integer :: i, nflex, oq, nq
         call new_neo_hooke(mat, 7.0e5_wp, 0.3_wp, 920.0_wp, viscosity, status)
         if (status%ok()) call box_mesh(mesh, hex8, [2, 1, 1], [0.4_wp, 0.05_wp, 0.05_wp], &
                                        status, origin=[0.3_wp, -0.025_wp, -0.025_wp])
@@ -99,8 +99,12 @@ contains
         if (.not. status%ok()) return
         allocate (q0(sys%nq))
         q0(1:7) = [0.15_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
-        q0(sys%flex_q(1) + 1:sys%flex_q(1) + flex(1)%nq) = flex(1)%free_positions()
-        if (second) q0(sys%flex_q(2) + 1:) = flex(2)%free_positions()
+        call sys%flexible_coordinates(1, oq, nq)
+        q0(oq + 1:oq + nq) = flex(1)%free_positions()
+        if (second) then
+            call sys%flexible_coordinates(2, oq, nq)
+            q0(oq + 1:) = flex(2)%free_positions()
+        end if
     end subroutine make_loop
 
     !> c, G, c_q, c_t and γ of 'ad' equal 'analytic' at perturbed states,

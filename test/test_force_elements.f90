@@ -405,6 +405,7 @@ contains
         type(mbs_system_t) :: sys
         type(status_t) :: status
         real(wp) :: q(14), v(12), f(3, 2), n(3, 2), xi(3), xj(3), a(3, 3), s, moment(3)
+        type(force_element_t) :: element
         integer :: ie
         character(len=120) :: msg
         sys = all_elements_system(rng, status)
@@ -413,8 +414,9 @@ contains
         call random_state(rng, 2, q, v)
         do ie = 1, 5
             call sys%element_wrench(ie, 0.7_wp, q, v, f, n, status)
-            call sys%marker_pose(sys%elements(ie)%marker_i, q, xi, a)
-            call sys%marker_pose(sys%elements(ie)%marker_j, q, xj, a)
+            element = sys%element_of(ie)
+            call sys%marker_pose(element%marker_i, q, xi, a)
+            call sys%marker_pose(element%marker_j, q, xj, a)
             moment = n(:, 1) + n(:, 2) + cross(xi, f(:, 1)) + cross(xj, f(:, 2))
             write (msg, '(a,i0,3(a,es9.2))') 'element ', ie, ': |F_i + F_j| ', &
                 norm2(f(:, 1) + f(:, 2)), ', |moment| ', norm2(moment), ', |F| ', &

@@ -610,6 +610,8 @@ contains
         real(wp) :: y(48), yp(48), force(3, 2), torque(3, 2), a(3, 3), fsum(3, 2), nsum(3, 2)
         real(wp) :: res_f, res_n
         integer :: k, side, b, mk, iq, iv
+        type(marker_t) :: marker
+        type(rigid_body_t) :: body
         character(len=200) :: msg
         call double_pendulum(sys, y, status)
         y(26) = -0.8_wp
@@ -624,12 +626,13 @@ contains
                 y(gen%offset(block_lambda) + 1:gen%offset(block_lambda) + 10), force, torque)
             do side = 1, 2
                 mk = merge(2 * k - 1, 2 * k, side == 1)
-                b = sys%markers(mk)%body
+                marker = sys%marker_of(mk)
+                b = marker%body
                 if (b == 0) cycle
                 a = rotation_matrix(y(7 * b - 3:7 * b))
                 fsum(:, b) = fsum(:, b) + force(:, side)
                 nsum(:, b) = nsum(:, b) + matmul(transpose(a), torque(:, side)) &
-                    + cross(sys%markers(mk)%position, matmul(transpose(a), force(:, side)))
+                    + cross(marker%position, matmul(transpose(a), force(:, side)))
             end do
         end do
         res_f = 0.0_wp
@@ -637,7 +640,8 @@ contains
         do b = 1, 2
             iq = 7 * (b - 1)
             iv = gen%offset(block_v) + 6 * (b - 1)
-            associate (body => sys%rigid%bodies(b), w => y(iv + 4:iv + 6))
+            body = sys%rigid_body_of(b)
+            associate (w => y(iv + 4:iv + 6))
                 res_f = max(res_f, maxval(abs(body%mass * yp(iv + 1:iv + 3) - body%mass * &
                             [0.0_wp, -g_earth, 0.0_wp] - fsum(:, b))))
                 res_n = max(res_n, maxval(abs(matmul(body%inertia, yp(iv + 4:iv + 6)) + &

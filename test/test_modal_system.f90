@@ -25,7 +25,7 @@ module test_modal_system
     use flexmbs_linalg_lapack, only: dsygv_quiet
     use flexmbs_mbs_modal_body, only: modal_body_t
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
-        node_frame_t
+        node_frame_t, part_rigid, part_modal
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_ggl, &
         formulation_index2, formulation_index3
     use test_modal_body, only: new_test_modal_body, allocate_solver
@@ -76,7 +76,7 @@ contains
         type(mbs_joint_t), allocatable :: j(:)
         type(rigid_body_t), allocatable :: rigid(:)
         logical :: two
-        integer :: nb, b
+        integer :: nb, b, iq, iv
         two = .false.
         if (present(second)) two = second
         nb = merge(2, 1, two)
@@ -114,10 +114,9 @@ contains
             q0(7 * 3 - 6) = bar(1)
         end if
         do b = 1, nb
-            associate (iq => sys%modal_q(b))
-                q0(iq + 1) = bar(1) / 2 + (b - 1) * bar(1)
-                q0(iq + 4) = 1.0_wp
-            end associate
+            call sys%part_offsets(part_modal, b, iq, iv)
+            q0(iq + 1) = bar(1) / 2 + (b - 1) * bar(1)
+            q0(iq + 4) = 1.0_wp
         end do
     end subroutine make
 
@@ -164,12 +163,12 @@ contains
     subroutine normalise_quaternions(sys, y)
         type(mbs_system_t), intent(in) :: sys
         real(wp), intent(inout) :: y(:)
-        integer :: b, i0
-        do b = 1, size(sys%rigid%bodies)
+        integer :: b, i0, iv
+        do b = 1, sys%part_count(part_rigid)
             y(7 * b - 3:7 * b) = y(7 * b - 3:7 * b) / norm2(y(7 * b - 3:7 * b))
         end do
-        do b = 1, size(sys%modal)
-            i0 = sys%modal_q(b)
+        do b = 1, sys%part_count(part_modal)
+            call sys%part_offsets(part_modal, b, i0, iv)
             y(i0 + 4:i0 + 7) = y(i0 + 4:i0 + 7) / norm2(y(i0 + 4:i0 + 7))
         end do
     end subroutine normalise_quaternions
@@ -243,9 +242,13 @@ contains
         type(status_t) :: status
         type(rigid_body_t) :: box
         real(wp), allocatable :: q0(:), ym(:), yr(:), yp(:)
+        type(modal_body_t), pointer :: body
         real(wp) :: t, dev, mass
         call make(0, [character(len=4) :: 'xmin'], 'analytic', 0.0_wp, modal, q0, status)
-        call check(error, status%ok() .and. modal%modal(1)%modes == 0, 'modal: ' // &
+        if (status%ok()) body => modal%modal_of(1)
+        call check(error, status%ok(), 'modal: ' // status%text())
+        if (allocated(error)) return
+        call check(error, body%mode_count() == 0, 'modal: ' // &
                    status%text())
         if (allocated(error)) return
         mass = density * product(bar)
@@ -378,11 +381,12 @@ contains
         type(mesh_t) :: mesh
         type(neo_hooke_t) :: material
         type(flexible_body_t) :: clamped
+        type(modal_body_t), pointer :: body
         integer, allocatable :: xmin(:)
         real(wp), allocatable :: y(:), yp(:), q0(:), k(:, :), m(:, :), w(:), work(:), &
             u_fe(:), x(:), u_modal(:)
         real(wp) :: g(3), t, c
-        integer :: nf, i, info, node, d
+        integer :: nf, i, info, node, d, iq, iv
         g = [0.0_wp, -eps, 0.0_wp]
         ! the FE cantilever, xmin clamped
         call box_mesh(mesh, hex8, [4, 1, 1], bar, status)
@@ -435,8 +439,9 @@ contains
         call check(error, status%ok(), 'run: ' // status%text())
         if (allocated(error)) return
         allocate (x(3 * mesh%node_count()), u_modal(nf))
-        call sys%modal(1)%node_positions(y(sys%modal_q(1) + 1:sys%modal_q(1) + &
-                                           sys%modal(1)%nq), x)
+        body => sys%modal_of(1)
+        call sys%part_offsets(part_modal, 1, iq, iv)
+        call body%node_positions(y(iq + 1:iq + body%nq), x)
         do node = 1, mesh%node_count()
             do d = 1, 3
                 if (clamped%dof(d, node) == 0) cycle

@@ -78,6 +78,7 @@ contains
         type(marker_t), allocatable :: m(:)
         type(mbs_joint_t), allocatable :: j(:)
         integer, allocatable :: xmin(:), xmax(:), cube_face(:)
+        integer :: oq, nq
         real(wp) :: id(4)
         call new_neo_hooke(mat, 7.0e5_wp, 0.3_wp, 920.0_wp, viscosity, status)
         if (status%ok()) call box_mesh(mesh, hex8, [2, 1, 1], [0.4_wp, 0.05_wp, 0.05_wp], &
@@ -135,8 +136,12 @@ contains
             q0(15:21) = [0.7_wp, 0.0_wp, 0.0_wp, id]
             q0(22:28) = [0.7_wp, 0.0_wp, 0.0_wp, id]
         end if
-        q0(sys%flex_q(1) + 1:sys%flex_q(1) + flex(1)%nq) = flex(1)%free_positions()
-        if (weld) q0(sys%flex_q(2) + 1:) = flex(2)%free_positions()
+        call sys%flexible_coordinates(1, oq, nq)
+        q0(oq + 1:oq + nq) = flex(1)%free_positions()
+        if (weld) then
+            call sys%flexible_coordinates(2, oq, nq)
+            q0(oq + 1:) = flex(2)%free_positions()
+        end if
     end subroutine make
 
     !> Rigidly moved (x = c + Q X), the bar and the cube keep every frame
@@ -148,7 +153,7 @@ contains
         type(status_t) :: status
         real(wp), allocatable :: q0(:), q(:), g(:)
         real(wp) :: qrot(4), rq(3, 3), c(3), worst, off
-        integer :: a, b, row
+        integer :: a, b, row, oq, nq
         call make('analytic', .true., 0.0_wp, sys, q0, status)
         call check(error, status%ok(), 'system: ' // status%text())
         if (allocated(error)) return
@@ -162,7 +167,8 @@ contains
             q(7 * b - 6:7 * b - 4) = c + matmul(rq, q0(7 * b - 6:7 * b - 4))
             q(7 * b - 3:7 * b) = qrot
         end do
-        do a = sys%flex_q(1) + 1, sys%nq, 3
+        call sys%flexible_coordinates(1, oq, nq)
+        do a = oq + 1, sys%nq, 3
             q(a:a + 2) = c + matmul(rq, q0(a:a + 2))
         end do
         allocate (g(sys%nc))
@@ -174,7 +180,7 @@ contains
         ! turn frame 1 by 0.1 rad about z: its rotation rows no longer vanish
         q(11:14) = quat_product(qrot, quat_from_axis_angle([0.0_wp, 0.0_wp, 1.0_wp], 0.1_wp))
         call sys%constraint(0.0_wp, q, g, status)
-        row = sys%joint_first_row(size(sys%joints) + 1)
+        row = sys%joint_first_row(sys%joint_count() + 1)
         off = norm2(g(row + 3:row + 5))
         ! about c sin(0.1) = 6e-5 (c = 0.025², the face's second moment)
         call check(error, off > 1.0e-5_wp, 'a turned frame still satisfies its rows')
@@ -196,7 +202,7 @@ contains
         call check(error, status%ok(), 'system: ' // status%text())
         if (allocated(error)) return
         nc = sys%nc
-        r0 = sys%joint_first_row(size(sys%joints) + 1) - 1
+        r0 = sys%joint_first_row(sys%joint_count() + 1) - 1
         allocate (q(sys%nq), v(sys%nv), cq(nc, sys%nq), cfd(nc, sys%nq), gm(nc, sys%nv), &
                   tmat(sys%nq, sys%nv), cp(nc), cm(nc), qd(sys%nq), gam(nc), gp(nc, sys%nv), &
                   gmm(nc, sys%nv))
@@ -338,6 +344,8 @@ contains
         type(flexible_marker_t) :: fit
         real(wp), allocatable :: q0(:), y(:), yp(:), x(:, :), yr(:)
         real(wp) :: t, e0, e1, drift(2), tol(2), origin(3), axes(3, 3), dfit, dmex
+        type(flexible_body_t), pointer :: body
+        type(node_frame_t) :: frame
         integer :: k, n
         tol = [1.0e-5_wp, 1.0e-7_wp]
         do k = 1, 2
@@ -363,14 +371,16 @@ contains
             if (k < 2) deallocate (y, yp)
         end do
         ! the frame against the fit of the face's nodes
-        n = sys%flex(1)%mesh%node_count()
+        body => sys%flexible_of(1)
+        frame = sys%frame_of(1)
+        n = body%mesh%node_count()
         allocate (x(3, n))
-        x = sys%flex(1)%mesh%x
-        associate (fr => sys%frames(1))
+        x = body%mesh%x
+        associate (fr => frame)
             do k = 1, size(fr%nodes)
                 x(:, fr%nodes(k)) = y(fr%nq(k) + 1:fr%nq(k) + 3)
             end do
-            call new_flexible_marker(fit, sys%flex(1)%mesh%x, fr%nodes, status)
+            call new_flexible_marker(fit, body%mesh%x, fr%nodes, status)
             call fit%pose(x, origin, axes, status)
             dfit = max(norm2(origin - y(8:10)), maxval(abs(axes - rotation_matrix(y(11:14)))))
         end associate

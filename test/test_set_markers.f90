@@ -23,7 +23,9 @@ module test_set_markers
     use flexmbs_mbs_joint, only: joint_spherical, joint_revolute, joint_primitive
     use flexmbs_mbs_primitive_kinds, only: primitive_distance
     use flexmbs_mbs_force_element, only: force_element_t, force_spring_damper
-    use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t
+    use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
+        part_rigid, part_flexible, part_frame
+    use flexmbs_fe_flexible_body, only: flexible_body_t
     use flexmbs_mbs_formulation, only: formulation_t, new_formulation, formulation_ggl, &
         formulation_index1, formulation_index2, formulation_index3
     use flexmbs_io_namelist, only: scene_input_t, parse_scene
@@ -98,14 +100,15 @@ contains
         type(status_t) :: status
         real(wp), allocatable :: q0(:), v0(:)
         real(wp) :: dev, fall
-        integer :: s, k, f
+        integer :: s, k, f, o1, n1, o2, n2
         do k = 1, 2
             call parse_scene(hanging_scene(k == 2), 'hanging.nml', scene(k), status)
             if (status%ok()) call build_multibody(scene(k), sys(k), q0, v0, status)
             call check(error, status%ok(), 'scene: ' // status%text())
             if (allocated(error)) return
         end do
-        call check(error, size(sys(1)%frames) == 0 .and. size(sys(2)%frames) == 3, &
+        call check(error, sys(1)%part_count(part_frame) == 0 .and. &
+                   sys(2)%part_count(part_frame) == 3, &
                    'set markers need no node frame; given positions, three')
         call check(error, sys(1)%nc == 6 .and. sys(2)%nc == 6 + 3 * 6, 'constraint rows')
         if (allocated(error)) return
@@ -122,11 +125,10 @@ contains
             dev = 0.0_wp
             fall = 0.0_wp
             do f = 1, 2
-                associate (a => result(1)%y(sys(1)%flex_q(f) + 1:sys(1)%flex_q(f) + &
-                                            sys(1)%flex(f)%nq), &
-                           b => result(2)%y(sys(2)%flex_q(f) + 1:sys(2)%flex_q(f) + &
-                                            sys(2)%flex(f)%nq), &
-                           x0 => q0(sys(2)%flex_q(f) + 1:sys(2)%flex_q(f) + sys(2)%flex(f)%nq))
+                call sys(1)%flexible_coordinates(f, o1, n1)
+                call sys(2)%flexible_coordinates(f, o2, n2)
+                associate (a => result(1)%y(o1 + 1:o1 + n1), b => result(2)%y(o2 + 1:o2 + n2), &
+                           x0 => q0(o2 + 1:o2 + n2))
                     dev = max(dev, maxval(abs(a - b)))
                     fall = max(fall, maxval(abs(b - x0)))
                 end associate
@@ -273,7 +275,8 @@ contains
             if (status%ok()) call build_multibody(scene, sys, q0, v0, status)
             call check(error, status%ok(), 'scene: ' // status%text())
             if (allocated(error)) return
-            call check(error, size(sys%frames) == 0 .and. size(sys%rigid%bodies) == 1, &
+            call check(error, sys%part_count(part_frame) == 0 .and. &
+                       sys%part_count(part_rigid) == 1, &
                        'the hub and no node frame')
             if (allocated(error)) return
             do f = 1, size(forms)
@@ -351,7 +354,8 @@ contains
         if (status%ok()) call build_multibody(scene, sys, q0, v0, status)
         call check(error, status%ok(), 'scene: ' // status%text())
         if (allocated(error)) return
-        call check(error, size(sys%flex) == 3 .and. size(sys%frames) == 0, &
+        call check(error, sys%part_count(part_flexible) == 3 .and. &
+                   sys%part_count(part_frame) == 0, &
                    'three flexible bodies and no node frame')
         if (allocated(error)) return
         call check_invariants(error, scene, sys, q0, v0)
@@ -363,8 +367,11 @@ contains
     subroutine test_refused(error)
         type(error_t), allocatable, intent(out) :: error
         type(scene_input_t) :: scene
-        type(mbs_system_t) :: sys, bad
+        type(mbs_system_t), target :: sys
+        type(mbs_system_t) :: bad
         type(status_t) :: status
+        type(flexible_body_t), allocatable :: flex(:)
+        integer :: i
         type(rigid_body_t) :: body(1)
         type(marker_t), allocatable :: markers(:)
         type(force_element_t) :: spring(1)
@@ -374,29 +381,34 @@ contains
         call check(error, status%ok(), 'scene: ' // status%text())
         if (allocated(error)) return
         ! component by component (a constructor with nodes leaks under gfortran 12)
+        ! the system's flexible bodies, for the systems built from them below
+        allocate (flex(sys%part_count(part_flexible)))
+        do i = 1, size(flex)
+            flex(i) = sys%flexible_of(i)
+        end do
         allocate (markers(3))
         markers(1)%flexible = 1
         markers(1)%nodes = [1, 2, 3]
         markers(3)%body = 1
         bad = new_mbs_system(body, markers, [mbs_joint_t(joint_revolute, 1, 2)], &
-                             status=status, flexible=sys%flex)
+                             status=status, flexible=flex)
         call check(error, index(status%text(), 'no rotation') > 0, &
                    'revolute joint on a set marker: ' // status%text())
         bad = new_mbs_system(body, markers, [mbs_joint_t(joint_primitive, 1, 3, &
-                             primitive_distance)], status=status, flexible=sys%flex)
+                             primitive_distance)], status=status, flexible=flex)
         call check(error, index(status%text(), 'spherical joints only') > 0, &
                    'distance on a set marker: ' // status%text())
         bad = new_mbs_system(body, markers, [mbs_joint_t(joint_spherical, 1, 3)], &
-                             status=status, flexible=sys%flex)
+                             status=status, flexible=flex)
         call check(error, status%ok(), 'set marker to a rigid body: ' // status%text())
         bad = new_mbs_system(body, markers, [mbs_joint_t(joint_spherical, 1, 2)], &
-                             status=status, flexible=sys%flex)
+                             status=status, flexible=flex)
         call check(error, status%ok(), 'set marker to the ground: ' // status%text())
         spring(1)%kind = force_spring_damper
         spring(1)%marker_i = 1
         spring(1)%marker_j = 3
         bad = new_mbs_system(body, markers, [mbs_joint_t(joint_spherical, 1, 2)], &
-                             status=status, flexible=sys%flex, elements=spring)
+                             status=status, flexible=flex, elements=spring)
         call check(error, index(status%text(), 'node-set centroid') > 0, &
                    'spring on a set marker: ' // status%text())
     end subroutine test_refused

@@ -9,7 +9,7 @@
 module test_two_flexible
     use flexmbs_core_kinds, only: wp
     use flexmbs_core_status, only: status_t
-    use flexmbs_mbs_system, only: mbs_system_t
+    use flexmbs_mbs_system, only: mbs_system_t, part_rigid, part_flexible
     use flexmbs_io_namelist, only: scene_input_t, parse_scene, read_scene
     use flexmbs_run_runner, only: run_scene, run_result_t
     use flexmbs_run_multibody_builder, only: build_multibody
@@ -84,7 +84,8 @@ contains
             if (status%ok()) call build_multibody(scene, sys, q0, v0, status)
             call check(error, status%ok(), 'scene: ' // status%text())
             if (allocated(error)) return
-            call check(error, size(sys%flex) == 2 .and. size(sys%rigid%bodies) == 1 + 2 * framed, &
+            call check(error, sys%part_count(part_flexible) == 2 .and. &
+                       sys%part_count(part_rigid) == 1 + 2 * framed, &
                        'two flexible bodies, the hub and (framed) two node frames')
             if (allocated(error)) return
             if (framed == 1) then
@@ -154,13 +155,14 @@ contains
         type(mbs_system_t) :: sys
         type(status_t) :: status
         real(wp), allocatable :: q0(:), v0(:), q_ref(:)
-        integer :: k, first, last
+        integer :: k, first, last, n
         call read_scene('inputs/two_soft_links.nml', scene, status)
         if (status%ok()) call build_multibody(scene, sys, q0, v0, status)
         call check(error, status%ok(), 'scene: ' // status%text())
         if (allocated(error)) return
-        first = sys%flex_q(2) + 1
-        last = sys%flex_q(2) + sys%flex(2)%nq
+        call sys%flexible_coordinates(2, first, n)
+        last = first + n
+        first = first + 1
         do k = 1, size(solvers)
             scene%solver_name = solvers(k)
             scene%rtol = 1.0e-6_wp

@@ -186,10 +186,12 @@ module flexmbs_mbs_system
 
     !> Rigid bodies, markers and joints as a mechanical problem (module header).
     type, extends(mechanical_problem_t), public :: mbs_system_t
+        private
         type(rigid_bodies_t) :: rigid
         type(marker_t), allocatable :: markers(:)
         type(assembled_joint_t), allocatable :: joints(:)
-        integer :: derivatives = constraint_derivatives_analytic
+        !> the constraint derivatives (constraint_derivatives_*): a setting, open to callers
+        integer, public :: derivatives = constraint_derivatives_analytic
         integer :: nq_rigid = 0, nv_rigid = 0
         !> flexible bodies after the rigid ones in q and v; flexible body f's
         !> free coordinates are q(flex_q(f)+1 : flex_q(f)+nq_f), its velocities
@@ -299,6 +301,10 @@ module flexmbs_mbs_system
         procedure :: joint_primitive_count => system_joint_primitive_count
         procedure :: joint_primitive => system_joint_primitive
         procedure :: joint_axis => system_joint_axis
+        procedure :: marker_of => system_marker_of
+        procedure :: rigid_body_of => system_rigid_body_of
+        procedure :: element_of => system_element_of
+        procedure :: frame_of => system_frame_of
     end type mbs_system_t
 
     public :: new_mbs_system, driver_t, driver_values, node_frame_t, force_element_t
@@ -895,6 +901,30 @@ module flexmbs_mbs_system
             class(mbs_system_t), intent(in) :: self
             integer, intent(in) :: j
         end function system_joint_axis
+        !> Marker k (a copy).
+        pure module function system_marker_of(self, k) result(marker)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: k
+            type(marker_t) :: marker
+        end function system_marker_of
+        !> Rigid body b, node frames after the scene's bodies (a copy).
+        pure module function system_rigid_body_of(self, b) result(body)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: b
+            type(rigid_body_t) :: body
+        end function system_rigid_body_of
+        !> Force element e (a copy).
+        pure module function system_element_of(self, e) result(element)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: e
+            type(force_element_t) :: element
+        end function system_element_of
+        !> Node frame k (a copy).
+        pure module function system_frame_of(self, k) result(frame)
+            class(mbs_system_t), intent(in) :: self
+            integer, intent(in) :: k
+            type(node_frame_t) :: frame
+        end function system_frame_of
     end interface
 
 contains

@@ -113,4 +113,20 @@ contains
     module procedure system_joint_axis
         axis = self%joints(j)%joint%axis_i(1)
     end procedure system_joint_axis
+
+    module procedure system_marker_of
+        marker = self%markers(k)
+    end procedure system_marker_of
+
+    module procedure system_rigid_body_of
+        body = self%rigid%bodies(b)
+    end procedure system_rigid_body_of
+
+    module procedure system_element_of
+        element = self%elements(e)
+    end procedure system_element_of
+
+    module procedure system_frame_of
+        frame = self%frames(k)
+    end procedure system_frame_of
 end submodule flexmbs_mbs_system_views
