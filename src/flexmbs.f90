@@ -40,7 +40,7 @@ module flexmbs
         rigid_body_energy, rigid_body_momenta
     use flexmbs_mbs_system, only: mbs_system_t, new_mbs_system, marker_t, mbs_joint_t, &
         constraint_derivatives_analytic, constraint_derivatives_ad, driver_t, driver_values, &
-        node_frame_t
+        node_frame_t, part_rigid, part_chain, part_flexible, part_modal, part_frame
     use flexmbs_mbs_rigid_chain, only: rigid_chain_t, new_rigid_chain, chain_body_t, &
         chain_marker_t, chain_joint_revolute, chain_joint_prismatic
     use flexmbs_problems_mechanisms, only: new_mechanism, mechanism_slider_crank, &
