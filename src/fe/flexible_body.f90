@@ -7,6 +7,9 @@
 !> consistent), the tangent stiffness ∂k/∂q and the damping ∂k/∂v live in
 !> CSC patterns fixed at construction; each assembly refills their values in
 !> place through the triplet-to-slot map, element by element in a fixed order.
+!> Submodules: flexible_body_construction (the constructor: dofs, gradients,
+!> colouring, workspace, patterns, mass and gravity) and flexible_body_views
+!> (what the body says of its mesh).
 module flexmbs_fe_flexible_body
     use flexmbs_core_kinds, only: wp, i8
     use flexmbs_core_status, only: status_t, status_bad_input
@@ -108,187 +111,111 @@ module flexmbs_fe_flexible_body
         procedure :: displacements_of => body_displacements_of
     end type flexible_body_t
 
+    interface
+        !> Body from a mesh, its materials, and fixed nodes. With one material it
+        !> applies to all elements; with several, element_material(e) picks the
+        !> material of element e (the paper's stiffer tip layers).
+        module subroutine new_flexible_body(body, mesh, materials, fixed_nodes, status, gravity, &
+                                     element_material, fixed_components)
+            type(flexible_body_t), intent(out) :: body
+            type(mesh_t), intent(in) :: mesh
+            type(neo_hooke_t), intent(in) :: materials(:)
+            integer, intent(in) :: fixed_nodes(:)     !! node numbers held at X
+            type(status_t), intent(out) :: status
+            real(wp), intent(in), optional :: gravity(3)
+            integer, intent(in), optional :: element_material(:) !! one per element
+            !> Further supports by component (3, nodes): .true. holds that
+            !> coordinate at X (symmetry planes, rollers).
+            logical, intent(in), optional :: fixed_components(:, :)
+        end subroutine new_flexible_body
+        !> Free global dofs of element e in local order (0 for fixed ones).
+        pure module subroutine element_dofs(body, e, dofs)
+            type(flexible_body_t), intent(in) :: body
+            integer, intent(in) :: e
+            integer, intent(out) :: dofs(3 * body%hex%nnode)
+        end subroutine element_dofs
+        !> Element workspaces for n threads (gathers and element results).
+        module subroutine allocate_workspace(body, n)
+            class(flexible_body_t), intent(inout) :: body
+            integer, intent(in) :: n
+        end subroutine allocate_workspace
+    end interface
+
+    interface
+        !> The body's mesh (reference configuration, sets), a copy.
+        module function body_reference_mesh(self) result(mesh)
+            class(flexible_body_t), intent(in) :: self
+            type(mesh_t) :: mesh
+        end function body_reference_mesh
+        !> The nodes of the mesh's node set `name` (flexmbs_fe_mesh's node_set).
+        module subroutine body_node_set(self, name, nodes, status)
+            class(flexible_body_t), intent(in) :: self
+            character(len=*), intent(in) :: name
+            integer, allocatable, intent(out) :: nodes(:)
+            type(status_t), intent(out) :: status
+        end subroutine body_node_set
+        !> The mean of the mesh's reference positions, or of those of `nodes`.
+        pure module function body_centroid(self, nodes) result(c)
+            class(flexible_body_t), intent(in) :: self
+            integer, intent(in), optional :: nodes(:)
+            real(wp) :: c(3)
+        end function body_centroid
+        !> The free dofs (numbers in q and v) of node `node`'s x, y, z; 0 where held.
+        pure module function body_node_dofs(self, node) result(dofs)
+            class(flexible_body_t), intent(in) :: self
+            integer, intent(in) :: node
+            integer :: dofs(3)
+        end function body_node_dofs
+        !> The number of nodes (of the mesh, held ones counted).
+        pure integer module function body_node_count(self) result(n)
+            class(flexible_body_t), intent(in) :: self
+        end function body_node_count
+        !> The number of elements of the mesh.
+        pure integer module function body_element_count(self) result(n)
+            class(flexible_body_t), intent(in) :: self
+        end function body_element_count
+        !> The number of nodes of an element (8 or 27).
+        pure integer module function body_nodes_per_element(self) result(n)
+            class(flexible_body_t), intent(in) :: self
+        end function body_nodes_per_element
+        !> The nodes of element k, in the mesh's order.
+        pure module function body_element_nodes(self, k) result(nodes)
+            class(flexible_body_t), intent(in) :: self
+            integer, intent(in) :: k
+            integer :: nodes(self%mesh%nodes_per_element())
+        end function body_element_nodes
+        !> Every node's reference position X into x (3, nodes): no allocation.
+        pure module subroutine body_reference_nodes(self, x)
+            class(flexible_body_t), intent(in) :: self
+            real(wp), intent(out) :: x(:, :)
+        end subroutine body_reference_nodes
+        !> Node `node`'s reference position X.
+        pure module function body_reference_node(self, node) result(x)
+            class(flexible_body_t), intent(in) :: self
+            integer, intent(in) :: node
+            real(wp) :: x(3)
+        end function body_reference_node
+        !> Every node's displacement w − X (`displacement`) or velocity w (node
+        !> by node x y z) from the free positions or velocities `w`; 0 for a
+        !> held coordinate.
+        pure module subroutine body_nodal_values(self, w, displacement, values)
+            class(flexible_body_t), intent(in) :: self
+            real(wp), intent(in) :: w(:)
+            logical, intent(in) :: displacement
+            real(wp), intent(out) :: values(:)  !! (3 nodes)
+        end subroutine body_nodal_values
+        !> The displacement x − X of nodal positions `x` (every node, node by
+        !> node x y z) from the reference.
+        pure module subroutine body_displacements_of(self, x, values)
+            class(flexible_body_t), intent(in) :: self
+            real(wp), intent(in) :: x(:)        !! (3 nodes)
+            real(wp), intent(out) :: values(:)  !! (3 nodes)
+        end subroutine body_displacements_of
+    end interface
+
     public :: new_flexible_body
 
 contains
-
-    !> Body from a mesh, its materials, and fixed nodes. With one material it
-    !> applies to all elements; with several, element_material(e) picks the
-    !> material of element e (the paper's stiffer tip layers).
-    subroutine new_flexible_body(body, mesh, materials, fixed_nodes, status, gravity, &
-                                 element_material, fixed_components)
-        type(flexible_body_t), intent(out) :: body
-        type(mesh_t), intent(in) :: mesh
-        type(neo_hooke_t), intent(in) :: materials(:)
-        integer, intent(in) :: fixed_nodes(:)     !! node numbers held at X
-        type(status_t), intent(out) :: status
-        real(wp), intent(in), optional :: gravity(3)
-        integer, intent(in), optional :: element_material(:) !! one per element
-        !> Further supports by component (3, nodes): .true. holds that
-        !> coordinate at X (symmetry planes, rollers).
-        logical, intent(in), optional :: fixed_components(:, :)
-        integer :: e, n, i, j, nfree, nthreads
-        character(len=120) :: msg
-        body%mesh = mesh
-        n = mesh%node_count()
-        call new_hexahedron(body%hex, mesh%nnode_element, status)
-        if (.not. status%ok()) return
-        if (any(fixed_nodes < 1 .or. fixed_nodes > n)) then
-            i = findloc(fixed_nodes < 1 .or. fixed_nodes > n, .true., dim=1)
-            write (msg, '(a,i0,a,i0)') 'flexible body: fixed node ', fixed_nodes(i), &
-                ' outside 1..', n
-            call status%set(status_bad_input, trim(msg))
-            return
-        end if
-        body%materials = materials
-        allocate (body%element_material(mesh%element_count()), source=1)
-        if (present(element_material)) then
-            if (size(element_material) /= mesh%element_count()) then
-                write (msg, '(a,i0,a,i0,a)') 'flexible body: ', size(element_material), &
-                    ' element materials given for ', mesh%element_count(), ' elements'
-                call status%set(status_bad_input, trim(msg))
-                return
-            end if
-            body%element_material = element_material
-        end if
-        if (any(body%element_material < 1 .or. body%element_material > size(materials))) then
-            write (msg, '(a,i0,a)') 'flexible body: element material numbers must lie in 1..', &
-                size(materials), ' (materials given)'
-            call status%set(status_bad_input, trim(msg))
-            return
-        end if
-        allocate (body%dndx(3, body%hex%nnode, body%hex%ngauss, mesh%element_count()), &
-                  body%wdv(body%hex%ngauss, mesh%element_count()), stat=e)
-        if (e /= 0) then
-            call out_of_memory(status, 'shape function gradients', 4_i8 * body%hex%nnode * &
-                               body%hex%ngauss * int(mesh%element_count(), i8), 8)
-            return
-        end if
-        do e = 1, mesh%element_count()
-            call reference_gradients(body%hex, mesh%x(:, mesh%connectivity(:, e)), &
-                                     body%dndx(:, :, :, e), body%wdv(:, e), status)
-            if (.not. status%ok()) then
-                write (msg, '(a,i0,a)') 'flexible body: element ', e, ': '
-                call status%set(status_bad_input, trim(msg) // ' ' // status%text())
-                return
-            end if
-        end do
-        allocate (body%dof(3, n), source=1)
-        body%dof(:, fixed_nodes) = 0
-        if (present(fixed_components)) then
-            if (size(fixed_components, 1) /= 3 .or. size(fixed_components, 2) /= n) then
-                write (msg, '(a,i0,a,i0,a,i0,a)') 'flexible body: fixed components given as (', &
-                    size(fixed_components, 1), ', ', size(fixed_components, 2), &
-                    '), expected (3, ', n, ')'
-                call status%set(status_bad_input, trim(msg))
-                return
-            end if
-            where (fixed_components) body%dof = 0
-        end if
-        nfree = 0
-        do i = 1, n
-            do j = 1, 3
-                if (body%dof(j, i) == 0) cycle
-                nfree = nfree + 1
-                body%dof(j, i) = nfree
-            end do
-        end do
-        body%nq = nfree
-        body%nv = nfree
-        body%nc = 0
-        if (present(gravity)) body%gravity = gravity
-        body%x = mesh%x
-        allocate (body%v(3, n), source=0.0_wp)
-        allocate (body%me(mesh%nnode_element, mesh%nnode_element), body%force_work(nfree))
-        nthreads = 1
-        !$ nthreads = omp_get_max_threads()
-        call allocate_workspace(body, nthreads)
-        call colour_elements(mesh%connectivity, mesh%node_count(), body%colour_start, &
-                             body%colour_elements)
-        call build_patterns(body, status)
-    end subroutine new_flexible_body
-
-    !> Free global dofs of element e in local order (0 for fixed ones).
-    pure subroutine element_dofs(body, e, dofs)
-        type(flexible_body_t), intent(in) :: body
-        integer, intent(in) :: e
-        integer, intent(out) :: dofs(3 * body%hex%nnode)
-        integer :: a
-        do a = 1, body%hex%nnode
-            dofs(3 * a - 2:3 * a) = body%dof(:, body%mesh%connectivity(a, e))
-        end do
-    end subroutine element_dofs
-
-    !> Tangent pattern (all free–free pairs of each element, column-major over
-    !> the local dofs), mass pattern and values, and the gravity force.
-    subroutine build_patterns(body, status)
-        type(flexible_body_t), intent(inout) :: body
-        type(status_t), intent(out) :: status
-        integer, allocatable :: rows(:), cols(:), mrows(:), mcols(:)
-        real(wp), allocatable :: mvals(:), m(:, :)
-        integer :: dofs(3 * max_nodes), e, p, q, nd, nf, a, b, i
-        integer(i8) :: nt, nm
-        nd = 3 * body%hex%nnode
-        allocate (m(body%hex%nnode, body%hex%nnode))
-        allocate (body%triplet_start(body%mesh%element_count() + 1))
-        nt = 0
-        nm = 0
-        do e = 1, body%mesh%element_count()
-            call element_dofs(body, e, dofs(1:nd))
-            nf = count(dofs(1:nd) > 0)
-            body%triplet_start(e) = nt + 1
-            nt = nt + nf * nf
-            do a = 1, 3 ! mass couples equal directions only
-                nm = nm + count(dofs(a:nd:3) > 0)**2
-            end do
-        end do
-        body%triplet_start(body%mesh%element_count() + 1) = nt + 1
-        ! the largest arrays of a body: one triplet per free-free pair
-        allocate (rows(nt), cols(nt), mrows(nm), mcols(nm), mvals(nm), stat=e)
-        if (e /= 0) then
-            call out_of_memory(status, 'tangent and mass triplets', 2_i8 * nt + 3_i8 * nm, 8)
-            return
-        end if
-        allocate (body%applied_force(body%nv), source=0.0_wp)
-        nt = 0
-        nm = 0
-        do e = 1, body%mesh%element_count()
-            call element_dofs(body, e, dofs(1:nd))
-            call element_mass(body%hex, body%wdv(:, e), &
-                              body%materials(body%element_material(e))%density, m)
-            do q = 1, nd
-                if (dofs(q) == 0) cycle
-                b = (q - 1) / 3 + 1
-                do p = 1, nd
-                    if (dofs(p) == 0) cycle
-                    nt = nt + 1
-                    rows(nt) = dofs(p)
-                    cols(nt) = dofs(q)
-                    a = (p - 1) / 3 + 1
-                    if (mod(p - q, 3) == 0) then
-                        nm = nm + 1
-                        mrows(nm) = dofs(p)
-                        mcols(nm) = dofs(q)
-                        mvals(nm) = m(a, b)
-                    end if
-                end do
-            end do
-            ! ∫ ρ N_a g dV = Σ_b m_ab g, fixed nodes b included.
-            do p = 1, nd
-                if (dofs(p) == 0) cycle
-                a = (p - 1) / 3 + 1
-                i = p - 3 * (a - 1)
-                body%applied_force(dofs(p)) = body%applied_force(dofs(p)) &
-                    + sum(m(a, :)) * body%gravity(i)
-            end do
-        end do
-        call body%stiffness%build(body%nv, body%nv, rows, cols, status)
-        if (.not. status%ok()) return
-        body%damping = body%stiffness
-        call body%mass_matrix%build(body%nv, body%nv, mrows, mcols, status)
-        if (.not. status%ok()) return
-        call body%mass_matrix%fill(mvals)
-    end subroutine build_patterns
 
     !> Scatter free positions q and velocities w into the nodal arrays.
     pure subroutine scatter(body, q, w)
@@ -433,21 +360,6 @@ contains
                         status%text(), reason)
     end subroutine name_element
 
-    !> Element workspaces for n threads (gathers and element results).
-    subroutine allocate_workspace(body, n)
-        class(flexible_body_t), intent(inout) :: body
-        integer, intent(in) :: n
-        integer :: nn, i
-        nn = body%hex%nnode
-        if (allocated(body%work)) deallocate (body%work)
-        allocate (body%work(n))
-        do i = 1, n
-            allocate (body%work(i)%xe(3, nn), body%work(i)%ve(3, nn), body%work(i)%k_el(3, nn), &
-                      body%work(i)%k_v(3, nn), body%work(i)%ke(3 * nn, 3 * nn), &
-                      body%work(i)%ce(3 * nn, 3 * nn))
-        end do
-    end subroutine allocate_workspace
-
     !> k(q, v) on the free dofs.
     subroutine body_internal_forces(self, q, v, k, status)
         class(flexible_body_t), intent(inout) :: self
@@ -553,121 +465,12 @@ contains
         end if
     end function body_total_energy
 
-    !> The body's mesh (reference configuration, sets), a copy.
-    function body_reference_mesh(self) result(mesh)
-        class(flexible_body_t), intent(in) :: self
-        type(mesh_t) :: mesh
-        mesh = self%mesh
-    end function body_reference_mesh
-
-    !> The nodes of the mesh's node set `name` (flexmbs_fe_mesh's node_set).
-    subroutine body_node_set(self, name, nodes, status)
-        class(flexible_body_t), intent(in) :: self
-        character(len=*), intent(in) :: name
-        integer, allocatable, intent(out) :: nodes(:)
-        type(status_t), intent(out) :: status
-        call self%mesh%node_set(name, nodes, status)
-    end subroutine body_node_set
-
-    !> The mean of the mesh's reference positions, or of those of `nodes`.
-    pure function body_centroid(self, nodes) result(c)
-        class(flexible_body_t), intent(in) :: self
-        integer, intent(in), optional :: nodes(:)
-        real(wp) :: c(3)
-        if (present(nodes)) then
-            c = sum(self%mesh%x(:, nodes), dim=2) / size(nodes)
-        else
-            c = self%mesh%centroid()
-        end if
-    end function body_centroid
-
-    !> The free dofs (numbers in q and v) of node `node`'s x, y, z; 0 where held.
-    pure function body_node_dofs(self, node) result(dofs)
-        class(flexible_body_t), intent(in) :: self
-        integer, intent(in) :: node
-        integer :: dofs(3)
-        dofs = self%dof(:, node)
-    end function body_node_dofs
-
-    !> The number of nodes (of the mesh, held ones counted).
-    pure integer function body_node_count(self) result(n)
-        class(flexible_body_t), intent(in) :: self
-        n = size(self%dof, 2)
-    end function body_node_count
-
-    !> The number of elements of the mesh.
-    pure integer function body_element_count(self) result(n)
-        class(flexible_body_t), intent(in) :: self
-        n = self%mesh%element_count()
-    end function body_element_count
-
-    !> The number of nodes of an element (8 or 27).
-    pure integer function body_nodes_per_element(self) result(n)
-        class(flexible_body_t), intent(in) :: self
-        n = self%mesh%nodes_per_element()
-    end function body_nodes_per_element
-
-    !> The nodes of element k, in the mesh's order.
-    pure function body_element_nodes(self, k) result(nodes)
-        class(flexible_body_t), intent(in) :: self
-        integer, intent(in) :: k
-        integer :: nodes(self%mesh%nodes_per_element())
-        nodes = self%mesh%connectivity(:, k)
-    end function body_element_nodes
-
-    !> Every node's reference position X into x (3, nodes): no allocation.
-    pure subroutine body_reference_nodes(self, x)
-        class(flexible_body_t), intent(in) :: self
-        real(wp), intent(out) :: x(:, :)
-        x = self%mesh%x
-    end subroutine body_reference_nodes
-
-    !> Node `node`'s reference position X.
-    pure function body_reference_node(self, node) result(x)
-        class(flexible_body_t), intent(in) :: self
-        integer, intent(in) :: node
-        real(wp) :: x(3)
-        x = self%mesh%reference_position(node)
-    end function body_reference_node
-
     !> The work f·(q − q_ref) of the constant applied forces (gravity, loads).
     real(wp) function body_applied_work(self, q, q_ref) result(w)
         class(flexible_body_t), intent(in) :: self
         real(wp), intent(in) :: q(:), q_ref(:)
         w = dot_product(self%applied_force, q - q_ref)
     end function body_applied_work
-
-    !> Every node's displacement w − X (`displacement`) or velocity w (node
-    !> by node x y z) from the free positions or velocities `w`; 0 for a
-    !> held coordinate.
-    pure subroutine body_nodal_values(self, w, displacement, values)
-        class(flexible_body_t), intent(in) :: self
-        real(wp), intent(in) :: w(:)
-        logical, intent(in) :: displacement
-        real(wp), intent(out) :: values(:)  !! (3 nodes)
-        integer :: i, j, d
-        do i = 1, size(self%dof, 2)
-            do j = 1, 3
-                d = self%dof(j, i)
-                if (d == 0) then
-                    values(3 * (i - 1) + j) = 0.0_wp
-                else if (displacement) then
-                    values(3 * (i - 1) + j) = w(d) - self%mesh%x(j, i)
-                else
-                    values(3 * (i - 1) + j) = w(d)
-                end if
-            end do
-        end do
-    end subroutine body_nodal_values
-
-    !> The displacement x − X of nodal positions `x` (every node, node by
-    !> node x y z) from the reference.
-    pure subroutine body_displacements_of(self, x, values)
-        class(flexible_body_t), intent(in) :: self
-        real(wp), intent(in) :: x(:)        !! (3 nodes)
-        real(wp), intent(out) :: values(:)  !! (3 nodes)
-        values = x - reshape(self%mesh%x, [size(values)])
-    end subroutine body_displacements_of
 
     !> det F > 0 at every quadrature point of every element; otherwise a
     !> solver failure with reason_det_f naming the element.
