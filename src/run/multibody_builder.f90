@@ -52,7 +52,6 @@ module flexmbs_run_multibody_builder
         type(rigid_chain_t), allocatable :: chains(:)
         type(node_frame_t), allocatable :: frames(:)
         type(modal_body_t), allocatable :: modal(:)
-        integer :: nb = 0                             !! rigid bodies and frames
         real(wp), allocatable :: q0(:), v0(:)
         !> per scene marker: its node frame (0: none), whether it is a
         !> set's centroid for spherical joints alone
@@ -159,7 +158,6 @@ contains
         real(wp) :: p(4), r(3, 3), inertia(3, 3)
         integer :: i, nb
         nb = size(scene%rigid_bodies) + count(parts%frame_of > 0)
-        parts%nb = nb
         allocate (parts%bodies(nb))
         allocate (parts%q0(7 * nb), parts%v0(6 * nb), source=0.0_wp)
         do i = 1, size(scene%rigid_bodies)
@@ -451,7 +449,7 @@ contains
         integer, intent(in) :: c, link
         real(wp), intent(out) :: origin(3), axes(3, 3)
         integer :: first, k
-        first = 7 * parts%nb
+        first = 7 * size(parts%bodies)   ! the rigid bodies' and frames' q first
         do k = 1, c - 1
             first = first + parts%chains(k)%nq
         end do

@@ -97,18 +97,7 @@ contains
 
         ! ---- a failure not acknowledged (§2.11, INFO(1)) ----
         if (info(1) == -1) then
-            ses => find_session(iwork, liw)
-            if (associated(ses)) last_idid = ses%last_idid
-            if (last_idid == idid_illegal .or. last_idid == idid_fatal) then
-                idid = idid_fatal
-                last_idid = idid
-                call message('repeated illegal input: run terminated')
-                return
-            end if
-            idid = idid_no_action
-            last_idid = idid
-            call message('the last call ended with IDID < 0 and no action was taken ' // &
-                '(set INFO(1) = 1 to continue, 0 to start again): run terminated')
+            call refuse_unacknowledged(iwork, liw, idid)
             return
         end if
 
@@ -157,7 +146,7 @@ contains
             nst_start = solver%native%nst
             ! A continuation call makes the output tests before stepping.
             if (.not. args%first) then
-                if (output_done(continuation=.true.)) then
+                if (output_reached(ses, args, .true., info, neq, tout, t, y, yprime, idid)) then
                     call finish()
                     return
                 end if
@@ -185,7 +174,7 @@ contains
                     call failed(w%failure, status%message)
                     return
                 end if
-                if (output_done(continuation=.false.)) exit
+                if (output_reached(ses, args, .false., info, neq, tout, t, y, yprime, idid)) exit
                 if (info(3) == 1) then
                     call give_back_tn()
                     idid = 1
@@ -197,7 +186,6 @@ contains
 
     contains
 
-
         !> Point the wrapper at this call's user routines and data.
         subroutine attach()
             ses%problem%res => res
@@ -205,36 +193,6 @@ contains
             ses%problem%rpar(1:1) => rpar(1:1)
             ses%problem%ipar(1:1) => ipar(1:1)
         end subroutine attach
-
-        !> §2.7 "Output": TOUT reached (IDID 3) or TSTOP reached (IDID 2)?
-        !> On a continuation call with INFO(3) = 1 "TOUT passed" is strict.
-        logical function output_done(continuation)
-            logical, intent(in) :: continuation
-            real(wp) :: passed
-            associate (w => ses%solver%work)
-                output_done = .false.
-                ! TSTOP first: TOUT may not lie beyond it, so reaching it
-                ! (stepping exactly there) is IDID 2 even when TOUT = TSTOP.
-                if (args%have_tstop) then
-                    if (abs(w%tn - args%tstop) <= &
-                        tstop_tol * w%uround * (abs(w%tn) + abs(w%h))) then
-                        call ses%solver%interpolate(args%tstop, y(1:neq), yprime(1:neq))
-                        t = args%tstop
-                        idid = 2
-                        output_done = .true.
-                        return
-                    end if
-                end if
-                passed = (w%tn - tout) * w%h
-                if ((continuation .and. info(3) == 1 .and. passed > 0.0_wp) .or. &
-                    ((.not. continuation .or. info(3) == 0) .and. passed >= 0.0_wp)) then
-                    call ses%solver%interpolate(tout, y(1:neq), yprime(1:neq))
-                    t = tout
-                    idid = 3
-                    output_done = .true.
-                end if
-            end associate
-        end function output_done
 
         !> T = T_N and (Y, YPRIME) there.
         subroutine give_back_tn()
@@ -267,6 +225,64 @@ contains
             call publish_slots(ses, neq, idid, info, rwork, iwork)
         end subroutine finish
     end subroutine ddassl_classic
+
+    !> INFO(1) = -1 on entry: the last failure was not acknowledged. IDID
+    !> -999 after an illegal input (repeated: the run is terminated), else
+    !> -998 (no action taken).
+    subroutine refuse_unacknowledged(iwork, liw, idid)
+        integer, intent(in) :: liw, iwork(liw)
+        integer, intent(out) :: idid
+        type(session_t), pointer :: ses
+        ses => find_session(iwork, liw)
+        if (associated(ses)) last_idid = ses%last_idid
+        if (last_idid == idid_illegal .or. last_idid == idid_fatal) then
+            idid = idid_fatal
+            last_idid = idid
+            call message('repeated illegal input: run terminated')
+            return
+        end if
+        idid = idid_no_action
+        last_idid = idid
+        call message('the last call ended with IDID < 0 and no action was taken ' // &
+            '(set INFO(1) = 1 to continue, 0 to start again): run terminated')
+    end subroutine refuse_unacknowledged
+
+    !> §2.7 "Output": TOUT reached (IDID 3) or TSTOP reached (IDID 2)? Then
+    !> T, Y and YPRIME there. On a continuation call with INFO(3) = 1 "TOUT
+    !> passed" is strict.
+    logical function output_reached(ses, args, continuation, info, neq, tout, t, y, yprime, &
+                                    idid) result(reached)
+        type(session_t), intent(inout) :: ses
+        type(classic_call_t), intent(in) :: args
+        logical, intent(in) :: continuation
+        integer, intent(in) :: info(15), neq
+        real(wp), intent(in) :: tout
+        real(wp), intent(inout) :: t, y(*), yprime(*)
+        integer, intent(inout) :: idid
+        real(wp) :: passed
+        associate (w => ses%solver%work)
+            reached = .false.
+            ! TSTOP first: TOUT may not lie beyond it, so reaching it
+            ! (stepping exactly there) is IDID 2 even when TOUT = TSTOP.
+            if (args%have_tstop) then
+                if (abs(w%tn - args%tstop) <= tstop_tol * w%uround * (abs(w%tn) + abs(w%h))) then
+                    call ses%solver%interpolate(args%tstop, y(1:neq), yprime(1:neq))
+                    t = args%tstop
+                    idid = 2
+                    reached = .true.
+                    return
+                end if
+            end if
+            passed = (w%tn - tout) * w%h
+            if ((continuation .and. info(3) == 1 .and. passed > 0.0_wp) .or. &
+                ((.not. continuation .or. info(3) == 0) .and. passed >= 0.0_wp)) then
+                call ses%solver%interpolate(tout, y(1:neq), yprime(1:neq))
+                t = tout
+                idid = 3
+                reached = .true.
+            end if
+        end associate
+    end function output_reached
 
     !> A new session's problem and solver settings, and the core's options,
     !> from INFO, the checked arguments and RWORK(3) (docs/solvers.md, DDASSL).
