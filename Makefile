@@ -154,7 +154,8 @@ run: build
 # checks of test/cli.sh, the documentation's links and generated scene
 # reference (test/docs.py), the ParaView and XDMF files read by VTK and
 # meshio (test/vtk_files.py, in $(PY_VENV)), the signals of test/kill.sh (python3-h5py reads
-# the files they leave), every example scene with empty standard error
+# the files they leave), runs killed and resumed from their checkpoints
+# (test/restart.sh), every example scene with empty standard error
 # (test/examples.sh), DDASSL and IDA from 1e-2 to 1e-12 on the scenes
 # against RADAU5 (test/tolerances.sh) and the fuzzer of the scene input (test/fuzz, about
 # a thousand mutated scenes, two at a time); one summary line last.
@@ -185,6 +186,8 @@ test: deps
 	    | tail -n 1)"; } 2>&1 | tee $(BUILD)/test-vtk.log; echo "exit $$?" >> $(BUILD)/test-vtk.log
 	@set -o pipefail; FPM="$(FPM)" bash test/kill.sh 2>&1 | tee $(BUILD)/test-kill.log; \
 	    echo "exit $$?" >> $(BUILD)/test-kill.log
+	@set -o pipefail; FPM="$(FPM)" bash test/restart.sh 2>&1 | tee $(BUILD)/test-restart.log; \
+	    echo "exit $$?" >> $(BUILD)/test-restart.log
 	@set -o pipefail; FPM="$(FPM)" bash test/examples.sh 2>&1 | tee $(BUILD)/test-examples.log; \
 	    echo "exit $$?" >> $(BUILD)/test-examples.log
 	@set -o pipefail; FPM="$(FPM)" bash test/tolerances.sh 2>&1 | tee $(BUILD)/test-tolerances.log; \
@@ -194,7 +197,8 @@ test: deps
 	@bash test/summarize.sh $(BUILD)/test-root.log $(BUILD)/test-legacy.log \
 	    $(BUILD)/test-programs.log $(BUILD)/test-dependency.log $(BUILD)/test-layers.log \
 	    $(BUILD)/test-public-docs.log $(BUILD)/test-scene-records.log $(BUILD)/test-cli.log $(BUILD)/test-docs.log \
-	    $(BUILD)/test-vtk.log $(BUILD)/test-kill.log $(BUILD)/test-examples.log \
+	    $(BUILD)/test-vtk.log $(BUILD)/test-kill.log $(BUILD)/test-restart.log \
+	    $(BUILD)/test-examples.log \
 	    $(BUILD)/test-tolerances.log $(BUILD)/test-fuzz.log
 
 PROFILE     ?= debug

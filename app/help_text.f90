@@ -43,6 +43,9 @@ contains
             'usage:', &
             '  flexmbs run FILE.nml [--quiet] [--force] [--verbose]', &
             '                                          run the scene described by FILE.nml', &
+            '  flexmbs run FILE.nml --resume [RESULT.h5]', &
+            '                                          continue a stopped or killed run from', &
+            '                                          the checkpoint in its HDF5 file', &
             '  flexmbs reference STUDY.nml [--quiet] [--force]', &
             '                                          integrate the study''s scene at tight', &
             '                                          tolerance, cross-check, keep in HDF5', &
@@ -139,6 +142,7 @@ contains
     subroutine run_usage(unit)
         integer, intent(in) :: unit
         write (unit, '(a)') 'usage: flexmbs run FILE.nml [--quiet] [--force] [--verbose]', &
+            '       flexmbs run FILE.nml --resume [RESULT.h5] [--quiet] [--verbose]', &
             '', &
             'Run the scene described by FILE.nml: read and check the whole file first', &
             '(every error listed, nothing written), integrate it, write the outputs it', &
@@ -149,9 +153,18 @@ contains
             'scene with bodies, the state y (at most 12 components) for one without', &
             '(docs/user_guide.md).', &
             '', &
+            'The HDF5 file keeps a checkpoint, the state of an accepted step, every', &
+            'checkpoint_interval seconds (&output, default 60) and when SIGINT or SIGTERM', &
+            'stops the run. --resume continues the run from it, in the same file: the', &
+            'records up to the checkpoint stay, the statistics sum every piece. The', &
+            'scene must be the one that wrote the file (docs/output.md, "Restart").', &
+            '', &
             'options:', &
             quiet_text, &
             '  -v, --verbose     every component of the end state y too', &
+            '  --resume [RESULT.h5]', &
+            '                    continue the run kept in RESULT.h5 (the scene''s own', &
+            '                    &output file when not given) from its checkpoint', &
             force_text
     end subroutine run_usage
 
@@ -200,7 +213,9 @@ contains
             '  -j N              the points in N processes at a time (each', &
             '                    flexmbs sweep STUDY.nml --point K), then the merge', &
             '  --point K         grid point K alone (1 .. the grid''s size, in the', &
-            '                    table''s order): its record into the results folder', &
+            '                    table''s order): its record into the results folder;', &
+            '                    a point stopped before (SIGTERM, a time limit) resumes', &
+            '                    from its checkpoint (point_K.h5 there)', &
             '  --merge           the table from the records in the results folder; lists', &
             '                    the points missing, stale or failed and the commands', &
             '                    that run only those', &
@@ -211,7 +226,8 @@ contains
             '                    (default 1)', &
             '  --partition P     (--slurm) #SBATCH --partition=P', &
             '  --time T          (--slurm) #SBATCH --time=T: M, M:S, H:M:S, D-H, D-H:M,', &
-            '                    D-H:M:S or UNLIMITED', &
+            '                    D-H:M:S or UNLIMITED; 120 s before it a task stops its', &
+            '                    point with a checkpoint, requeues and resumes it', &
             '  --mem M           (--slurm) #SBATCH --mem=M: a whole number, unit K, M, G', &
             '                    or T (M when none)', &
             '  --submit          (--slurm) submit both, the merge job to run once the', &

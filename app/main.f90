@@ -60,8 +60,8 @@ program flexmbs_main
     !> Largest state printed whole; larger ones are summarised.
     integer, parameter :: max_printed = 12
 
-    character(len=:), allocatable :: command, file, arg, value, slurm_only
-    logical :: quiet, force, merging, slurm, submit, jobs_given, verbose
+    character(len=:), allocatable :: command, file, arg, value, slurm_only, resume_file
+    logical :: quiet, force, merging, slurm, submit, jobs_given, verbose, resuming
     integer :: i, nargs, jobs, point, ios
     type(slurm_options_t) :: cluster
     !> the IEEE flags at the start, all quiet (finish)
@@ -102,6 +102,8 @@ program flexmbs_main
     case ('run', 'reference', 'sweep')
         quiet = .false.
         verbose = .false.
+        resuming = .false.
+        resume_file = ''
         force = .false.
         file = ''
         jobs = 1
@@ -119,6 +121,16 @@ program flexmbs_main
                 quiet = .true.
             else if (command == 'run' .and. (arg == '--verbose' .or. arg == '-v')) then
                 verbose = .true.
+            else if (command == 'run' .and. arg == '--resume') then
+                ! its optional value is the result file, told by its .h5
+                resuming = .true.
+                if (i < nargs) then
+                    value = argument(i + 1)
+                    if (len(value) > 3 .and. value(max(1, len(value) - 2):) == '.h5') then
+                        resume_file = value
+                        i = i + 1
+                    end if
+                end if
             else if (arg == '--force') then
                 force = .true.
             else if (command == 'sweep' .and. any(arg == [character(len=11) :: '-j', &
@@ -150,7 +162,7 @@ program flexmbs_main
         select case (command)
         case ('run')
             if (len(file) == 0) call fail_usage('run needs a scene file')
-            call run(file, quiet, force)
+            call run(file, quiet, force, resuming, resume_file)
         case ('reference')
             if (len(file) == 0) call fail_usage('reference needs a study file')
             call reference(file, quiet, force)
@@ -183,16 +195,31 @@ program flexmbs_main
 
 contains
 
-    subroutine run(path, quiet, force)
+    subroutine run(path, quiet, force, resuming, resume_file)
         character(len=*), intent(in) :: path
         logical, intent(in) :: quiet, force
+        logical, intent(in) :: resuming          !! --resume
+        character(len=*), intent(in) :: resume_file  !! its file, '' for the scene's
         type(scene_input_t) :: scene
         type(run_result_t) :: result
         type(status_t) :: status
 
         call read_scene(path, scene, status)
         if (.not. status%ok()) call stop_on(status)
-        call run_scene(scene, quiet, result, status, force=force)
+        if (resuming) then
+            if (len(resume_file) > 0) scene%output_file = resume_file
+            if (len(scene%output_file) == 0) call fail_usage('run --resume: ' // path // &
+                ' writes no HDF5 file (&output file = ''none''): name the result to &
+                &continue, --resume RESULT.h5')
+            call run_scene(scene, quiet, result, status, force=force, resume=scene%output_file)
+        else
+            call run_scene(scene, quiet, result, status, force=force)
+        end if
+        if (status%ok() .and. result%finished_before) then
+            write (error_unit, '(a)') 'flexmbs: ' // scene%output_file // ' holds the finished &
+                &run of ' // path // ': nothing to resume'
+            call finish(exit_ok)
+        end if
         select case (status%code)
         case (status_ok)
             if (allocated(result%stats%warning)) &
@@ -546,6 +573,8 @@ contains
         integer :: k, n
         logical :: bodies
         write (output_unit, '(a)') result%solver_name // ': ' // result%stats%summary()
+        if (result%resumed) write (output_unit, '(a,es23.15,a)') 'resumed at t =', &
+            result%resumed_from, ' (the statistics sum every piece of the run)'
         if (allocated(result%stats%linear_solver)) &
             write (output_unit, '(a)') 'linear solver: ' // result%stats%linear_solver
         n = size(result%y)

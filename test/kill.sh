@@ -13,25 +13,7 @@
 # Without an argument the debug build is used (built if needed). The last
 # line is `N passed, M failed`; the exit status is non-zero on failures.
 set -u
-. "$(dirname "$0")/executable.sh" kill "$@"
-# h5py of the system's Python (Debian's python3-h5py, see the Makefile): a
-# python3 earlier on PATH (a virtual environment) may lack it
-py=/usr/bin/python3
-[ -x "$py" ] || py=python3
-if ! "$py" -c 'import h5py' 2>/dev/null; then
-    echo "FAIL kill: $py cannot import h5py (apt-get install python3-h5py)"
-    echo "0 passed, 1 failed"
-    exit 1
-fi
-
-work=$(mktemp -d "${TMPDIR:-/tmp}/flexmbs-kill.XXXXXX")
-pid=""
-trap '[ -n "$pid" ] && kill -KILL "$pid" 2>/dev/null; rm -rf "$work"' EXIT
-cd "$work" || exit 1
-passed=0
-failed=0
-pass() { passed=$((passed + 1)); echo "pass kill/$1"; }
-fail() { failed=$((failed + 1)); echo "FAIL kill/$1: $2"; }
+. "$(dirname "$0")/h5py_suite.sh" kill "$@"
 
 sed -e "s#^&output#\&output file = 'run.h5',#" "$root/inputs/five_body_undamped.nml" > scene.nml
 

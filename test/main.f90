@@ -50,6 +50,7 @@ program flexmbs_tests
     use test_node_frame, only: collect_node_frame
     use test_study, only: collect_study
     use test_run, only: collect_run
+    use test_restart, only: collect_restart
     use test_rejections, only: collect_rejections
     use test_chain_coupling, only: collect_chain_coupling
     use test_sparse_formulation, only: collect_sparse_formulation
@@ -134,6 +135,7 @@ program flexmbs_tests
     call run_suite('node_frame', collect_node_frame(), filter, npassed, nfailed)
     call run_suite('study', collect_study(), filter, npassed, nfailed)
     call run_suite('run', collect_run(), filter, npassed, nfailed)
+    call run_suite('restart', collect_restart(), filter, npassed, nfailed)
     call run_suite('rejections', collect_rejections(), filter, npassed, nfailed)
     write (*, '(i0,a,i0,a)') npassed, ' passed, ', nfailed, ' failed'
     if (nfailed > 0) error stop 1

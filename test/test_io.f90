@@ -37,7 +37,7 @@ module test_io
     use testing, only: test_case_t, new_test, error_t, check, check_close
     implicit none
     private
-    public :: collect_io
+    public :: collect_io, scratch, read_series
 
     character, parameter :: nl = new_line('a')
 

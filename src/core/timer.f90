@@ -5,6 +5,8 @@ module flexmbs_core_timer
     implicit none
     private
 
+    public :: iso_now
+
     !> Measures CPU and wall seconds since `start`.
     type, public :: timer_t
         real(wp) :: cpu0 = 0.0_wp
@@ -41,4 +43,16 @@ contains
         call system_clock(now, rate)
         seconds = real(now - self%count0, wp) / real(max(rate, 1_int64), wp)
     end function timer_wall
+
+    !> The local date and time in ISO 8601 with the offset from UTC
+    !> (2026-11-26T11:08:53+00:00), as results record when they were made.
+    function iso_now() result(text)
+        character(len=:), allocatable :: text
+        character(len=8) :: date
+        character(len=10) :: time
+        character(len=5) :: zone
+        call date_and_time(date, time, zone)
+        text = date(1:4) // '-' // date(5:6) // '-' // date(7:8) // 'T' // time(1:2) // ':' // &
+            time(3:4) // ':' // time(5:6) // zone(1:3) // ':' // zone(4:5)
+    end function iso_now
 end module flexmbs_core_timer

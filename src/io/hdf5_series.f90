@@ -13,7 +13,7 @@ module flexmbs_io_hdf5_series
     implicit none
     private
 
-    public :: create_series
+    public :: create_series, open_series
 
     !> One series and the records not yet written to it.
     type, public :: series_batch_t
@@ -131,32 +131,14 @@ contains
         logical, intent(in), optional :: groups !! create the groups of a path
         integer, intent(in), optional :: columns !! > 1: (m, columns, records)
         integer(hid_t) :: space, plist, lcpl
-        integer(hsize_t) :: dims(3), maxdims(3), chunk(3)
-        integer :: rank, close_err, nc
-        nc = 1
-        if (present(columns)) nc = max(columns, 1)
-        batch%rows = m
-        batch%columns = nc
-        if (m == 0) then
-            rank = 1
-            dims(1) = 0
-            maxdims(1) = H5S_UNLIMITED_F
-            chunk(1) = int(per_chunk, hsize_t)
-        else if (nc > 1) then
-            rank = 3
-            dims = [int(m, hsize_t), int(nc, hsize_t), 0_hsize_t]
-            maxdims = [int(m, hsize_t), int(nc, hsize_t), H5S_UNLIMITED_F]
-            chunk = [int(m, hsize_t), int(nc, hsize_t), int(per_chunk, hsize_t)]
-        else
-            rank = 2
-            dims(1:2) = [int(m, hsize_t), 0_hsize_t]
-            maxdims(1:2) = [int(m, hsize_t), H5S_UNLIMITED_F]
-            chunk(1:2) = [int(m, hsize_t), int(per_chunk, hsize_t)]
-        end if
-        call h5screate_simple_f(rank, dims(1:rank), space, err, maxdims(1:rank))
+        integer(hsize_t), allocatable :: fixed(:)
+        integer :: rank, close_err
+        call record_shape(batch, m, columns, fixed)
+        rank = size(fixed) + 1
+        call h5screate_simple_f(rank, [fixed, 0_hsize_t], space, err, [fixed, H5S_UNLIMITED_F])
         if (err < 0) return
         call h5pcreate_f(H5P_DATASET_CREATE_F, plist, err)
-        if (err >= 0) call h5pset_chunk_f(plist, rank, chunk(1:rank), err)
+        if (err >= 0) call h5pset_chunk_f(plist, rank, [fixed, int(per_chunk, hsize_t)], err)
         lcpl = H5P_DEFAULT_F
         if (present(groups)) then
             if (groups .and. err >= 0) call group_creating(lcpl, err)
@@ -167,4 +149,58 @@ contains
         if (err >= 0) call h5pclose_f(plist, err)
         if (err >= 0) call h5sclose_f(space, err)
     end subroutine create_series
+
+    !> The series `name` that an earlier run created (create_series' m and
+    !> columns), cut to its first `kept` records: a resumed run continues
+    !> it. err < 0 when it is missing, has another shape or fewer records.
+    subroutine open_series(file, name, m, kept, batch, err, columns)
+        integer(hid_t), intent(in) :: file
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: m, kept
+        type(series_batch_t), intent(out) :: batch
+        integer, intent(out) :: err
+        integer, intent(in), optional :: columns
+        integer(hid_t) :: space
+        integer(hsize_t) :: dims(3), maxdims(3)
+        integer(hsize_t), allocatable :: fixed(:)
+        integer :: rank, close_err
+        call record_shape(batch, m, columns, fixed)
+        rank = size(fixed) + 1
+        call h5dopen_f(file, name, batch%dset, err)
+        if (err < 0) return
+        call h5dget_space_f(batch%dset, space, err)
+        if (err < 0) return
+        call h5sget_simple_extent_ndims_f(space, close_err, err)
+        if (err >= 0 .and. close_err /= rank) err = -1
+        if (err >= 0) call h5sget_simple_extent_dims_f(space, dims(1:rank), maxdims(1:rank), err)
+        call h5sclose_f(space, close_err)
+        if (err < 0) return
+        if (any(dims(1:rank - 1) /= fixed) .or. dims(rank) < int(kept, hsize_t)) then
+            err = -1
+            return
+        end if
+        dims(rank) = int(kept, hsize_t)
+        call h5dset_extent_f(batch%dset, dims(1:rank), err)
+    end subroutine open_series
+
+    !> A series' shape before its records: () for m = 0, (m), or (m,
+    !> columns) for columns > 1; the batch learns its rows and columns.
+    subroutine record_shape(batch, m, columns, fixed)
+        type(series_batch_t), intent(inout) :: batch
+        integer, intent(in) :: m
+        integer, intent(in), optional :: columns
+        integer(hsize_t), allocatable, intent(out) :: fixed(:)
+        integer :: nc
+        nc = 1
+        if (present(columns)) nc = max(columns, 1)
+        batch%rows = m
+        batch%columns = nc
+        if (m == 0) then
+            allocate (fixed(0))
+        else if (nc > 1) then
+            fixed = [int(m, hsize_t), int(nc, hsize_t)]
+        else
+            fixed = [int(m, hsize_t)]
+        end if
+    end subroutine record_shape
 end module flexmbs_io_hdf5_series

@@ -27,12 +27,15 @@ module flexmbs_io_hdf5_sink
     use flexmbs_core_status, only: status_t, status_io_error, status_bad_input
     use flexmbs_dae_sink, only: sink_t, dense_output_t
     use flexmbs_dae_stats, only: dae_stats_t
-    use flexmbs_dae_rejections, only: cause_count, cause_attributes
     use flexmbs_core_version, only: creator, version
+    use flexmbs_core_timer, only: iso_now
+    use flexmbs_core_text, only: int_text
+    use flexmbs_io_checkpoint, only: checkpoint_t, write_checkpoint, add_restart_time, put_stats
     use flexmbs_io_record_values, only: record_values_t
     use flexmbs_io_hdf5_text, only: read_string_attribute, write_string_attribute, &
-        string_type, utf8_string_type, delete_attribute, group_creating
-    use flexmbs_io_hdf5_series, only: series_batch_t, create_series
+        write_real_attribute, &
+        string_type, utf8_string_type, group_creating
+    use flexmbs_io_hdf5_series, only: series_batch_t, create_series, open_series
     use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_char, c_null_char
     implicit none
     private
@@ -80,7 +83,11 @@ module flexmbs_io_hdf5_sink
         integer(i8) :: last_write = 0    !! system_clock count of the last write
         logical :: every_step = .false.  !! record accepted steps instead of output times
         logical :: is_open = .false.
+        !> records an earlier run left that this one continues (reopen); -1
+        !> for a new file
+        integer :: kept = -1
         integer(hid_t) :: file = -1
+        real(wp), allocatable :: checkpoint_buffer(:)
         type(series_batch_t) :: time_batch, y_batch
         type(block_t), allocatable :: blocks(:)
         type(series_t), allocatable :: series(:)
@@ -103,6 +110,9 @@ module flexmbs_io_hdf5_sink
         generic :: write_integers => write_integer_matrix, write_integer_list
         procedure :: close => sink_close
         procedure :: record_times => sink_record_times
+        procedure :: reopen => sink_reopen
+        procedure :: keep_checkpoint => sink_keep_checkpoint
+        procedure :: read_records => sink_read_records
     end type hdf5_sink_t
 
     logical, save :: library_open = .false.
@@ -213,7 +223,7 @@ contains
         if (check(err, 'create /y')) return
         call write_string_attribute(self%file, 'creator', creator, err)
         if (err >= 0) call write_string_attribute(self%file, 'flexmbs_version', version, err)
-        if (err >= 0) call write_string_attribute(self%file, 'created', now(), err)
+        if (err >= 0) call write_string_attribute(self%file, 'created', iso_now(), err)
         if (check(err, 'write the attributes creator, flexmbs_version, created')) return
         if (present(input_text)) then
             call self%write_text('input_text', input_text, status)
@@ -232,17 +242,106 @@ contains
         end function check
     end subroutine sink_create
 
-    !> The local date and time in ISO 8601 with the offset from UTC
-    !> (2026-11-26T11:08:53+00:00).
-    function now() result(text)
-        character(len=:), allocatable :: text
-        character(len=8) :: date
-        character(len=10) :: time
-        character(len=5) :: zone
-        call date_and_time(date, time, zone)
-        text = date(1:4) // '-' // date(5:6) // '-' // date(7:8) // 'T' // time(1:2) // ':' // &
-            time(3:4) // ':' // time(5:6) // zone(1:3) // ':' // zone(4:5)
-    end function now
+    !> Continue the result `path` that an earlier run of the same scene
+    !> wrote (run/resume has checked it): its records up to the checkpoint
+    !> `cp` are kept, the later ones dropped, and cp%t is added to the root
+    !> attribute restart_times. Blocks and series are then added as for a
+    !> new file and continue theirs; static datasets written again replace
+    !> their old selves.
+    subroutine sink_reopen(self, path, n, cp, status, every_step)
+        class(hdf5_sink_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: n                   !! length of y
+        type(checkpoint_t), intent(in) :: cp
+        type(status_t), intent(out) :: status
+        logical, intent(in), optional :: every_step !! record steps, not output times
+        integer :: err
+        if (self%is_open) then
+            call status%set(status_bad_input, path // ': HDF5 sink already open on ' // self%path)
+            return
+        end if
+        self%path = path
+        self%n = n
+        self%records = cp%records
+        self%kept = cp%records
+        self%every_step = .false.
+        if (present(every_step)) self%every_step = every_step
+        allocate (self%blocks(0), self%series(0))
+        call open_library(err)
+        if (err >= 0) call h5fopen_f(path, H5F_ACC_RDWR_F, self%file, err)
+        if (err < 0) then
+            call status%set(status_io_error, path // ': HDF5 cannot open the result to &
+                &continue it (another program writing it?)')
+            return
+        end if
+        self%is_open = .true.
+        self%pending = 0
+        self%capacity = 0
+        call open_series(self%file, 'time', 0, cp%records, self%time_batch, err)
+        if (err >= 0) call open_series(self%file, 'y', n, cp%records, self%y_batch, err)
+        if (err >= 0) call add_restart_time(self%file, cp%t, err)
+        if (err >= 0) call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, err)
+        if (err < 0) call status%set(status_io_error, path // ': HDF5 cannot cut /time and /y &
+            &to the ' // int_text(cp%records) // ' records of the checkpoint')
+    end subroutine sink_reopen
+
+    !> Write the records held, then `cp` as the file's checkpoint
+    !> (io/checkpoint), then flush: the checkpoint never counts a record the
+    !> file lacks. cp%records is set here.
+    subroutine sink_keep_checkpoint(self, cp, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        type(checkpoint_t), intent(inout) :: cp
+        type(status_t), intent(inout) :: status
+        integer :: err
+        if (.not. self%is_open) return
+        call write_pending(self, err)
+        if (err >= 0) then
+            cp%records = self%records
+            if (.not. allocated(self%checkpoint_buffer)) &
+                allocate (self%checkpoint_buffer(size(cp%y) + 4))
+            call write_checkpoint(self%file, cp, self%checkpoint_buffer, err)
+        end if
+        if (err >= 0) call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, err)
+        if (err < 0 .and. status%ok()) call status%set(status_io_error, self%path // &
+            ': HDF5 cannot write the checkpoint')
+    end subroutine sink_keep_checkpoint
+
+    !> Records first .. first + size(t) - 1 (from 1) of /time and /y as the
+    !> file holds them (records held in memory are not among them).
+    subroutine sink_read_records(self, first, t, y, status)
+        class(hdf5_sink_t), intent(inout) :: self
+        integer, intent(in) :: first
+        real(wp), intent(out) :: t(:), y(:, :)   !! y(n, size(t))
+        type(status_t), intent(inout) :: status
+        integer(hid_t) :: space, memspace
+        integer(hsize_t) :: count(2)
+        integer :: err, close_err, k
+        integer(hid_t) :: dsets(2)
+        count = [int(self%n, hsize_t), size(t, kind=hsize_t)]
+        dsets = [self%time_batch%dset, self%y_batch%dset]
+        do k = 1, 2
+            call h5dget_space_f(dsets(k), space, err)
+            if (err < 0) exit
+            if (k == 1) then
+                call h5sselect_hyperslab_f(space, H5S_SELECT_SET_F, [int(first - 1, hsize_t)], &
+                                           count(2:2), err)
+                if (err >= 0) call h5screate_simple_f(1, count(2:2), memspace, err)
+                if (err >= 0) call h5dread_f(dsets(k), H5T_NATIVE_DOUBLE, t, count(2:2), err, &
+                                             mem_space_id=memspace, file_space_id=space)
+            else
+                call h5sselect_hyperslab_f(space, H5S_SELECT_SET_F, &
+                                           [0_hsize_t, int(first - 1, hsize_t)], count, err)
+                if (err >= 0) call h5screate_simple_f(2, count, memspace, err)
+                if (err >= 0) call h5dread_f(dsets(k), H5T_NATIVE_DOUBLE, y, count, err, &
+                                             mem_space_id=memspace, file_space_id=space)
+            end if
+            call h5sclose_f(memspace, close_err)
+            call h5sclose_f(space, close_err)
+            if (err < 0) exit
+        end do
+        if (err < 0) call status%set(status_io_error, self%path // ': HDF5 cannot read the &
+            &records from ' // int_text(first))
+    end subroutine sink_read_records
 
     !> Also write y(first:last) as dataset /name (call before the first record).
     subroutine sink_add_block(self, name, first, last, status)
@@ -256,7 +355,7 @@ contains
             call status%set(status_bad_input, 'HDF5 sink: add_block before create')
             return
         end if
-        if (self%records + self%pending > 0) then
+        if (self%records - max(self%kept, 0) + self%pending > 0) then
             call status%set(status_bad_input, self%path // ': block /' // name // &
                 ' added after records were written')
             return
@@ -275,8 +374,12 @@ contains
         block%name = name
         block%first = first
         block%last = last
-        call create_series(self%file, name, m, max(1, min(time_chunk, chunk_bytes / (8 * m))), &
-                           block%batch, err)
+        if (self%kept >= 0) then
+            call open_series(self%file, name, m, self%kept, block%batch, err)
+        else
+            call create_series(self%file, name, m, max(1, min(time_chunk, &
+                               chunk_bytes / (8 * m))), block%batch, err)
+        end if
         if (err < 0) then
             call status%set(status_io_error, self%path // ': HDF5 cannot create /' // name)
             return
@@ -300,6 +403,8 @@ contains
         class(hdf5_sink_t), intent(inout) :: self
         include '../dae/sink_step_arguments.inc'
         if (.not. self%every_step) return
+        ! a resumed run's t0 is the checkpoint's step, recorded already
+        if (nr == 1 .and. self%kept >= 0) return
         call append(self, t, y, status)
     end subroutine sink_step
 
@@ -319,7 +424,8 @@ contains
         integer, intent(in), optional :: columns
         type(series_t), allocatable :: grown(:)
         integer :: err, k
-        if (.not. self%is_open .or. self%records + self%pending > 0 .or. rows < 1) then
+        if (.not. self%is_open .or. self%records - max(self%kept, 0) + self%pending > 0 .or. &
+            rows < 1) then
             call status%set(status_bad_input, 'HDF5 sink: series /' // path // &
                 ' needs an open file without records and rows >= 1')
             return
@@ -337,9 +443,14 @@ contains
             if (present(columns)) s%columns = max(columns, 1)
             allocate (s%source, source=source)
             allocate (s%buffer(rows * s%columns))
-            call create_series(self%file, path, rows, max(1, min(time_chunk, &
-                chunk_bytes / (8 * rows * s%columns))), s%batch, err, groups=.true., &
-                columns=s%columns)
+            if (self%kept >= 0) then
+                call open_series(self%file, path, rows, self%kept, s%batch, err, &
+                                 columns=s%columns)
+            else
+                call create_series(self%file, path, rows, max(1, min(time_chunk, &
+                    chunk_bytes / (8 * rows * s%columns))), s%batch, err, groups=.true., &
+                    columns=s%columns)
+            end if
             if (err >= 0) call write_string_attribute(s%batch%dset, 'unit', unit, err)
             if (err >= 0 .and. present(description)) &
                 call write_string_attribute(s%batch%dset, 'description', description, err)
@@ -389,34 +500,20 @@ contains
         type(status_t), intent(out) :: status
         character(len=*), intent(in), optional :: solver  !! solver name
         character(len=*), intent(in), optional :: outcome !! 'ok' or the failure message
-        integer :: err, c, counts(cause_count)
+        integer :: err
         if (.not. self%is_open) then
             call status%set(status_bad_input, 'HDF5 sink: write_statistics before create')
             return
         end if
         ! records still held go first: a caller may skip `finish`
         call write_pending(self, err)
-        call put_int('NST', stats%nst)
-        call put_int('NAC', stats%nac)
-        call put_int('NRJ', stats%nrj)
-        call put_int('NFE', stats%nfe)
-        call put_int('NFE_JAC', stats%nfe_jac)
-        call put_int('NJE', stats%nje)
-        call put_int('NDEC', stats%ndec)
-        call put_int('NSOL', stats%nsol)
-        call put_int('NPRJ', stats%nprj)
-        ! NRJ by cause (NRJ_ERROR_TEST, ...; they add up to NRJ) and the
-        ! reason of the last model refusal, when there was one
-        counts = stats%rejections%counts_by_cause()
-        do c = 1, cause_count
-            call put_int(trim(cause_attributes(c)), counts(c))
-        end do
+        ! NST .. WALL, with NRJ by cause (NRJ_ERROR_TEST, ...; they add up to NRJ)
+        if (err >= 0) call put_stats(self%file, '', stats, err)
+        ! the reason of the last model refusal, when there was one
         if (err >= 0 .and. len(stats%rejections%refusal_reason()) > 0) &
             call write_string_attribute(self%file, 'refusal', &
                                         stats%rejections%refusal_reason(), err)
-        call put_real('CPU', stats%cpu)
-        call put_real('WALL', stats%wall)
-        call put_real('t_reached', stats%t_reached)
+        call write_real_attribute(self%file, 't_reached', stats%t_reached, err)
         if (allocated(stats%linear_solver) .and. err >= 0) &
             call write_string_attribute(self%file, 'linear_solver', stats%linear_solver, err)
         if (present(solver) .and. err >= 0) &
@@ -426,34 +523,6 @@ contains
         if (err >= 0) call h5fflush_f(self%file, H5F_SCOPE_GLOBAL_F, err)
         if (err < 0) call status%set(status_io_error, self%path // &
             ': HDF5 cannot write the statistics')
-
-    contains
-
-        subroutine put_int(name, value)
-            character(len=*), intent(in) :: name
-            integer, intent(in) :: value
-            integer(hid_t) :: space, attr
-            if (err < 0) return
-            call delete_attribute(self%file, name, err)
-            if (err >= 0) call h5screate_f(H5S_SCALAR_F, space, err)
-            if (err >= 0) call h5acreate_f(self%file, name, H5T_NATIVE_INTEGER, space, attr, err)
-            if (err >= 0) call h5awrite_f(attr, H5T_NATIVE_INTEGER, value, [1_hsize_t], err)
-            if (err >= 0) call h5aclose_f(attr, err)
-            if (err >= 0) call h5sclose_f(space, err)
-        end subroutine put_int
-
-        subroutine put_real(name, value)
-            character(len=*), intent(in) :: name
-            real(wp), intent(in) :: value
-            integer(hid_t) :: space, attr
-            if (err < 0) return
-            call delete_attribute(self%file, name, err)
-            if (err >= 0) call h5screate_f(H5S_SCALAR_F, space, err)
-            if (err >= 0) call h5acreate_f(self%file, name, H5T_NATIVE_DOUBLE, space, attr, err)
-            if (err >= 0) call h5awrite_f(attr, H5T_NATIVE_DOUBLE, value, [1_hsize_t], err)
-            if (err >= 0) call h5aclose_f(attr, err)
-            if (err >= 0) call h5sclose_f(space, err)
-        end subroutine put_real
     end subroutine sink_write_statistics
 
     !> The rows (from 0) and times of the records an index of the file lists
@@ -513,6 +582,8 @@ contains
                 call self%blocks(i)%batch%close(err)
                 worst = min(worst, err)
             end do
+            ! the sink may create or reopen a file again
+            deallocate (self%blocks)
         end if
         if (allocated(self%series)) then
             do i = 1, size(self%series)

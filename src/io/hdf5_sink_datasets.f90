@@ -18,7 +18,8 @@ contains
         if (len(text) <= max_attribute_text) then
             call write_string_attribute(self%file, name, text, err)
         else
-            call string_type(len(text), str_type, err)
+            call remove_link(self%file, name, err)
+            if (err >= 0) call string_type(len(text), str_type, err)
             if (err >= 0) call h5screate_f(H5S_SCALAR_F, space, err)
             if (err >= 0) call h5dcreate_f(self%file, name, str_type, space, dset, err)
             if (err >= 0) call h5dwrite_f(dset, str_type, text, [1_hsize_t], err)
@@ -130,6 +131,9 @@ contains
             call status%set(status_bad_input, 'HDF5 sink: /' // name // ' before create')
             return
         end if
+        ! a resumed run writes its static datasets again
+        call remove_link(self%file, name, err)
+        if (err < 0) return
         call h5screate_simple_f(size(dims), dims, space, err)
         if (err < 0) return
         call group_creating(lcpl, err)
@@ -154,4 +158,29 @@ contains
         if (err < 0 .and. status%ok()) call status%set(status_io_error, self%path // &
             ': HDF5 cannot write /' // name)
     end subroutine close_dataset
+
+    !> Delete the dataset at `path` when there is one (its groups stay);
+    !> err < 0 when it cannot be.
+    subroutine remove_link(file, path, err)
+        integer(hid_t), intent(in) :: file
+        character(len=*), intent(in) :: path
+        integer, intent(out) :: err
+        logical :: exists
+        integer :: start, slash
+        err = 0
+        ! h5lexists_f fails on a path whose group is missing: look level by level
+        start = 1
+        do while (start <= len(path))
+            slash = index(path(start:), '/')
+            if (slash == 0) exit
+            slash = start + slash - 1
+            if (slash > 1) then
+                call h5lexists_f(file, path(1:slash - 1), exists, err)
+                if (err < 0 .or. .not. exists) return
+            end if
+            start = slash + 1
+        end do
+        call h5lexists_f(file, path, exists, err)
+        if (err >= 0 .and. exists) call h5ldelete_f(file, path, err)
+    end subroutine remove_link
 end submodule flexmbs_io_hdf5_sink_datasets

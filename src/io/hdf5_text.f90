@@ -1,16 +1,19 @@
-!> Strings in HDF5 files and the paths to them: variable-length UTF-8
+!> Attributes and strings in HDF5 files and the paths to them: scalar
+!> integer and real attributes, variable-length UTF-8
 !> string attributes and types (h5py reads them as str), reading back both
 !> these and the fixed-length ones of earlier files, and the link creation
 !> property that makes the missing groups of a path.
 module flexmbs_io_hdf5_text
     use hdf5
+    use flexmbs_core_kinds, only: wp
     use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_char, c_null_char, c_null_ptr, &
         c_associated, c_f_pointer, c_size_t, c_int
     implicit none
     private
 
     public :: read_string_attribute, read_stored_text, write_string_attribute, &
-        delete_attribute, string_type, utf8_string_type, group_creating, path_name
+        delete_attribute, string_type, utf8_string_type, group_creating, path_name, &
+        write_int_attribute, write_real_attribute, read_int_attribute, read_real_attribute
 
     interface
         !> The length of a C string (a variable-length HDF5 string read back).
@@ -202,4 +205,89 @@ contains
         end do
         if (part == '.' .or. len(part) == 0) part = '_' // part
     end function path_name
+
+    !> A scalar integer attribute `name` of obj, replacing an earlier one;
+    !> nothing when err < 0 on entry.
+    subroutine write_int_attribute(obj, name, value, err)
+        integer(hid_t), intent(in) :: obj
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: value
+        integer, intent(inout) :: err
+        integer, target :: held
+        held = value
+        call write_scalar(obj, name, H5T_NATIVE_INTEGER, c_loc(held), err)
+    end subroutine write_int_attribute
+
+    !> A scalar real attribute `name` of obj (as write_int_attribute).
+    subroutine write_real_attribute(obj, name, value, err)
+        integer(hid_t), intent(in) :: obj
+        character(len=*), intent(in) :: name
+        real(wp), intent(in) :: value
+        integer, intent(inout) :: err
+        real(wp), target :: held
+        held = value
+        call write_scalar(obj, name, H5T_NATIVE_DOUBLE, c_loc(held), err)
+    end subroutine write_real_attribute
+
+    !> The scalar integer attribute `name` of obj; 0 when there is none;
+    !> nothing when err < 0 on entry.
+    subroutine read_int_attribute(obj, name, value, err)
+        integer(hid_t), intent(in) :: obj
+        character(len=*), intent(in) :: name
+        integer, intent(out), target :: value
+        integer, intent(inout) :: err
+        value = 0
+        call read_scalar(obj, name, H5T_NATIVE_INTEGER, c_loc(value), err)
+    end subroutine read_int_attribute
+
+    !> The scalar real attribute `name` of obj (as read_int_attribute).
+    subroutine read_real_attribute(obj, name, value, err)
+        integer(hid_t), intent(in) :: obj
+        character(len=*), intent(in) :: name
+        real(wp), intent(out), target :: value
+        integer, intent(inout) :: err
+        value = 0.0_wp
+        call read_scalar(obj, name, H5T_NATIVE_DOUBLE, c_loc(value), err)
+    end subroutine read_real_attribute
+
+    !> A scalar attribute of type `dtype` from the value at `buffer`.
+    subroutine write_scalar(obj, name, dtype, buffer, err)
+        integer(hid_t), intent(in) :: obj, dtype
+        character(len=*), intent(in) :: name
+        type(c_ptr), intent(in) :: buffer
+        integer, intent(inout) :: err
+        integer(hid_t) :: space, attr
+        integer :: close_err
+        if (err < 0) return
+        call delete_attribute(obj, name, err)
+        if (err >= 0) call h5screate_f(H5S_SCALAR_F, space, err)
+        if (err < 0) return
+        call h5acreate_f(obj, name, dtype, space, attr, err)
+        if (err >= 0) then
+            call h5awrite_f(attr, dtype, buffer, err)
+            call h5aclose_f(attr, close_err)
+        end if
+        call h5sclose_f(space, close_err)
+    end subroutine write_scalar
+
+    !> A scalar attribute of type `dtype` into `buffer`, left as it is when
+    !> there is none.
+    subroutine read_scalar(obj, name, dtype, buffer, err)
+        integer(hid_t), intent(in) :: obj, dtype
+        character(len=*), intent(in) :: name
+        type(c_ptr), intent(in) :: buffer
+        integer, intent(inout) :: err
+        integer(hid_t) :: attr
+        type(c_ptr) :: into  ! HDF5 takes the pointer intent(inout)
+        integer :: close_err
+        logical :: exists
+        if (err < 0) return
+        call h5aexists_f(obj, name, exists, err)
+        if (err < 0 .or. .not. exists) return
+        call h5aopen_f(obj, name, attr, err)
+        if (err < 0) return
+        into = buffer
+        call h5aread_f(attr, dtype, into, err)
+        call h5aclose_f(attr, close_err)
+    end subroutine read_scalar
 end module flexmbs_io_hdf5_text

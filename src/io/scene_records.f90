@@ -67,6 +67,9 @@ module flexmbs_io_scene_records
         character(len=len_path) :: table = '' !! &output: a table of the outputs (.md, .csv, .tex)
         logical :: reasons = .false. !! &output: the table also counts the rejected steps by cause
         logical :: progress = .true. !! &output: progress display on standard error
+        !> &output: wall time between the checkpoints a run keeps in its HDF5 file for --resume (0:
+        !> every accepted step) [s]
+        real(wp) :: checkpoint_interval = 60.0_wp
         !> &output: ParaView files PREFIX.pvd, PREFIX_NNNN.vtu, PREFIX_bodies|joints_NNNN.vtu
         character(len=len_path) :: vtk = ''
         !> &output: the .vtu files' arrays: binary (appended, base64) or text
@@ -288,6 +291,7 @@ contains
         call get(e, 'output', 'table', r%table)
         call get(e, 'output', 'reasons', r%reasons)
         call get(e, 'output', 'progress', r%progress)
+        call get(e, 'output', 'checkpoint_interval', r%checkpoint_interval)
         call get(e, 'output', 'vtk', r%vtk)
         call get(e, 'output', 'vtk_format', r%vtk_format)
         r%vtk_format = lower(r%vtk_format)

@@ -137,6 +137,9 @@ module flexmbs_io_scene_schema
             doc='the table also counts the rejected steps by cause'), &
         var_spec_t('output', 'progress', kind_logical, default='.true.', &
             doc='progress display on standard error'), &
+        var_spec_t('output', 'checkpoint_interval', kind_real, default='60', &
+            rule='nonnegative', unit='s', doc='wall time between the checkpoints &
+            &a run keeps in its HDF5 file for --resume (0: every accepted step)'), &
         var_spec_t('output', 'vtk', kind_string, &
             doc='ParaView files PREFIX.pvd, PREFIX_NNNN.vtu, PREFIX_bodies|joints_NNNN.vtu'), &
         var_spec_t('output', 'vtk_format', kind_string, default='binary', &

@@ -76,7 +76,11 @@ contains
             eps = sqrt(sum((self%tq / (self%projection_rtol * abs(self%q0) &
                 + self%projection_atol))**2) / self%nq)
             if (eps <= epsreq) return
-            if ((it >= 1 .and. eps > 2.0_wp * eps_old) .or. .not. (eps == eps)) exit
+            if (.not. (eps == eps)) exit
+            ! (separate tests: Fortran does not short-circuit, and 2 huge overflows)
+            if (it >= 1) then
+                if (eps > 2.0_wp * eps_old) exit
+            end if
             eps_old = eps
         end do
         write (msg, '(a,es10.3,a,es10.3)') 'formulation: position projection did not &

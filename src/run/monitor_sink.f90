@@ -31,6 +31,8 @@ module flexmbs_run_monitor_sink
         type(formulation_t), pointer :: formulation => null()
         class(mechanical_problem_t), pointer :: mechanical => null()
         logical :: every_step = .false.      !! as the trajectory sink
+        !> a resumed run: its t0 is the checkpoint's step, recorded already
+        logical :: resumed = .false.
         real(wp), allocatable :: q_start(:)  !! flexible body: the work's origin
         integer :: records = 0
         !> (4, records): t, ‖g‖∞, ‖G v + g_I‖∞, energy
@@ -41,6 +43,7 @@ module flexmbs_run_monitor_sink
         procedure :: output => monitor_output
         procedure :: wants_steps => monitor_wants_steps
         procedure :: step => monitor_step
+        procedure :: replay => record
     end type monitor_sink_t
 
 contains
@@ -59,10 +62,12 @@ contains
     subroutine monitor_step(self, nr, t_old, t, y, dense, stop, status)
         class(monitor_sink_t), intent(inout) :: self
         include '../dae/sink_step_arguments.inc'
+        if (nr == 1 .and. self%resumed) return
         if (self%every_step) call record(self, t, y, status)
     end subroutine monitor_step
 
-    !> Append one row (the table doubles when full).
+    !> Append one row (the table doubles when full); also the records a
+    !> resumed run keeps, given again.
     subroutine record(self, t, y, status)
         class(monitor_sink_t), intent(inout) :: self
         real(wp), intent(in) :: t, y(:)

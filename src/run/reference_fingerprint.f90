@@ -49,7 +49,7 @@ module flexmbs_run_reference_fingerprint
     end type reference_print_t
 
     public :: reference_print, write_reference_print, check_reference_print, &
-        check_reference_times, remake_command, same_times
+        check_reference_times, remake_command, same_times, setting_changes
 
     !> What the scene's settings leave out (io/scene_settings `omit`).
     character(len=*), parameter :: omitted(*) = [character(len=24) :: 'solver/name', &
@@ -295,17 +295,21 @@ contains
     end function shown
 
     !> The scene's variables whose values differ between the settings `old`
-    !> (the reference's) and `new`: the first three, then how many more.
-    function setting_changes(old, new) result(text)
+    !> (the reference's, or those of the file `where` names) and `new`: the
+    !> first three, then how many more.
+    function setting_changes(old, new, where) result(text)
         character(len=*), intent(in) :: old, new
+        character(len=*), intent(in), optional :: where !! 'the reference' unless given
         character(len=:), allocatable :: text
         integer, parameter :: listed = 3
         type(pair_t), allocatable :: was(:), is(:)
-        character(len=:), allocatable :: before
+        character(len=:), allocatable :: before, there
         integer :: k, n
+        there = 'the reference'
+        if (present(where)) there = where
         text = ''
         if (len(old) == 0) then
-            text = 'the reference keeps no settings to compare'
+            text = there // ' keeps no settings to compare'
             return
         end if
         call split_pairs(old, was)
@@ -318,9 +322,9 @@ contains
             if (n > listed) cycle
             if (n > 1) text = text // ', '
             if (len(before) == 0) then
-                text = text // is(k)%key // ' = ' // is(k)%value // ' (not in the reference)'
+                text = text // is(k)%key // ' = ' // is(k)%value // ' (not in ' // there // ')'
             else
-                text = text // is(k)%key // ' = ' // before // ' in the reference, ' // &
+                text = text // is(k)%key // ' = ' // before // ' in ' // there // ', ' // &
                     is(k)%value // ' now'
             end if
         end do
@@ -329,7 +333,7 @@ contains
             n = n + 1
             if (n > listed) cycle
             if (n > 1) text = text // ', '
-            text = text // was(k)%key // ' (in the reference only)'
+            text = text // was(k)%key // ' (in ' // there // ' only)'
         end do
         if (n > listed) text = text // ' and ' // int_text(n - listed) // ' more'
     end function setting_changes

@@ -37,6 +37,9 @@ module flexmbs_run_runner
     use flexmbs_run_summary, only: state_summary
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
     use flexmbs_run_body_builder, only: body_energies
+    use flexmbs_io_checkpoint, only: checkpoint_t, stats_sum
+    use flexmbs_run_checkpoint_sink, only: checkpoint_sink_t, new_checkpoint_sink
+    use flexmbs_run_resume, only: scene_fingerprint, prepare_resume, pieces_note
     use flexmbs_run_chain_builder, only: link_names, tree_count
     implicit none
     private
@@ -70,6 +73,10 @@ module flexmbs_run_runner
         !> last record [J] (NaN where the model defines none)
         logical :: has_monitor_energy = .false.
         real(wp) :: monitor_energy(2) = 0.0_wp
+        !> a resume: the time it started from (the checkpoint's), and
+        !> whether the file held a finished run (nothing was run then)
+        logical :: resumed = .false., finished_before = .false.
+        real(wp) :: resumed_from = 0.0_wp
     end type run_result_t
 
     public :: run_scene
@@ -123,7 +130,7 @@ contains
     !> created), solver_failure or signal (SIGINT/SIGTERM, checked after
     !> every accepted step: outputs kept, `result` says how far it got) or
     !> io_error.
-    subroutine run_scene(scene, quiet, result, status, record, force)
+    subroutine run_scene(scene, quiet, result, status, record, force, resume)
         type(scene_input_t), intent(in) :: scene
         logical, intent(in) :: quiet             !! no progress display
         type(run_result_t), intent(out) :: result
@@ -132,7 +139,13 @@ contains
         class(sink_t), intent(inout), target, optional :: record
         !> replace existing files that are not flexmbs's own (io/output_files)
         logical, intent(in), optional :: force
+        !> continue the run kept in this result (run/resume), which becomes
+        !> the run's HDF5 file
+        character(len=*), intent(in), optional :: resume
         type(run_plan_t), target :: plan
+        type(checkpoint_sink_t), target :: checkpoints
+        type(checkpoint_t) :: cp
+        type(dae_stats_t) :: prior
         type(monitor_sink_t), target :: monitor
         type(vtk_sink_t), target :: vtk
         type(hdf5_sink_t), target :: h5
@@ -154,6 +167,21 @@ contains
         result%q_last = plan%q_last
         result%solver_name = plan%solver%name()
         result%t = scene%t_start
+        ! energies and work count from the scene's start, also when resumed
+        y_start = plan%y0
+        if (present(resume)) then
+            call prepare_resume(scene, resume, plan, result%t, result%y, cp, prior, &
+                                result%finished_before, status)
+            if (.not. status%ok() .or. result%finished_before) return
+            result%resumed = .true.
+            result%resumed_from = result%t
+            if (scene%every_step .and. len_trim(scene%vtk) > 0) then
+                call status%set(status_bad_input, scene%path // ': &output: vtk with &
+                    &every_step: the ParaView pieces before the checkpoint are not in ' // &
+                    resume // ', so this run cannot be resumed; run it again')
+                return
+            end if
+        end if
 
         ! ParaView output is checked before any file is created
         if (len_trim(scene%vtk) > 0) then
@@ -166,7 +194,11 @@ contains
         call check_output_size(scene, plan%problem%n, plan%blocks, status)
         if (.not. status%ok()) return
         if (len(scene%output_file) > 0) then
-            call create_hdf5(h5, plan, scene, result, status)
+            if (result%resumed) then
+                call create_hdf5(h5, plan, scene, result, status, cp)
+            else
+                call create_hdf5(h5, plan, scene, result, status)
+            end if
             if (.not. status%ok()) return
             call sinks%attach(h5)
         end if
@@ -174,6 +206,13 @@ contains
         call progress%watch(plan%solver)
         call sinks%attach(progress)
         call sinks%attach(signals)
+        ! after the file's sink and the signals: the records up to a step
+        ! are there when its checkpoint is written, and a stop is seen
+        if (h5%is_open) then
+            checkpoints = new_checkpoint_sink(h5, plan%solver, plan%problem%n, &
+                scene%checkpoint_interval, cp%piece + merge(1, 0, result%resumed), prior)
+            call sinks%attach(checkpoints)
+        end if
         if (present(record)) call sinks%attach(record)
         if (len_trim(scene%vtk) > 0) call sinks%attach(vtk)
         ! drift and energy of formulated mechanical scenes, at the output times
@@ -183,20 +222,27 @@ contains
                 monitor%formulation => p
                 monitor%mechanical => plan%mechanical
                 monitor%every_step = scene%every_step
-                monitor%q_start = result%y(p%offset(block_q) + 1:p%last(block_q))
+                monitor%resumed = result%resumed
+                monitor%q_start = y_start(p%offset(block_q) + 1:p%last(block_q))
                 call sinks%attach(monitor)
                 result%constraints = p%block_size(block_lambda)
             end if
         end select
 
-        y_start = result%y
         call record_energy(y_start, result%energy_start)
-        call plan%integrate(result%t, result%y, scene%t_end, result%stats, status, sinks)
+        ! the records kept, to the sinks that build on every record
+        if (result%resumed .and. status%ok()) call replay(h5, cp%records, monitor, vtk, &
+            len_trim(scene%vtk) > 0, status, record)
+        if (status%ok()) call plan%integrate(result%t, result%y, scene%t_end, result%stats, &
+                                             status, sinks)
+        if (result%resumed) result%stats = stats_sum(prior, result%stats)
         ! a solver that refuses its options: say which file and group
         if (status%code == status_bad_input) then
             if (index(status%text(), scene%path // ':') /= 1) status%message = scene%path // &
                 ': &solver: ' // status%text()
         end if
+        ! a stop requested on the last step came too late to stop anything
+        if (status%code == status_interrupted .and. result%t == scene%t_end) call status%clear()
         if (status%code == status_interrupted .and. signal_pending()) call status%set( &
             status_signal, 'stopped by ' // signal_name(caught_signal()) // ' at t = ' // &
             real_text(result%t), caught_signal())
@@ -218,6 +264,8 @@ contains
             outcome = 'ok'
             if (.not. status%ok()) outcome = status%text()
             call h5%write_statistics(result%stats, io_status, result%solver_name, outcome)
+            if (result%resumed .and. io_status%ok()) call h5%write_text('statistics', &
+                pieces_note(cp%piece + 1), io_status)
             if (status%ok() .and. .not. io_status%ok()) status = io_status
             ! the records the XDMF file lists, read back before the file closes
             if (xdmf_wanted(scene)) call h5%record_times(xdmf_most_records, xdmf_rows, &
@@ -270,16 +318,27 @@ contains
 
     !> The HDF5 file of the run: y's blocks, the named series, the scene's
     !> texts. `result%hdf5_written` once it exists.
-    subroutine create_hdf5(h5, plan, scene, result, status)
+    subroutine create_hdf5(h5, plan, scene, result, status, resume)
         type(hdf5_sink_t), intent(inout) :: h5
         type(run_plan_t), intent(in), target :: plan
         type(scene_input_t), intent(in) :: scene
         type(run_result_t), intent(inout) :: result
         type(status_t), intent(out) :: status
+        !> continue the file from this checkpoint instead of creating it
+        type(checkpoint_t), intent(in), optional :: resume
         type(status_t) :: io_status
+        character(len=:), allocatable :: settings
+        character(len=64) :: digest
         integer :: i
-        call h5%create(scene%output_file, plan%problem%n, status, input_text=scene%text, &
-                       every_step=scene%every_step)
+        call scene_fingerprint(scene, settings, digest, status)
+        if (.not. status%ok()) return
+        if (present(resume)) then
+            call h5%reopen(scene%output_file, plan%problem%n, resume, status, &
+                           every_step=scene%every_step)
+        else
+            call h5%create(scene%output_file, plan%problem%n, status, input_text=scene%text, &
+                           every_step=scene%every_step)
+        end if
         if (.not. status%ok()) then
             call h5%close(io_status)
             return
@@ -292,13 +351,43 @@ contains
         end do
         call add_named_output(h5, plan, scene, status)
         if (.not. status%ok()) return
-        call h5%write_text('problem', trim(scene%problem), status)
+        call h5%write_text('scene_fingerprint', digest, status)
+        if (status%ok()) call h5%write_text('scene_settings', settings, status)
+        if (status%ok()) call h5%write_text('problem', trim(scene%problem), status)
         if (status%ok()) call h5%write_text('title', trim(scene%title), status)
         if (status%ok()) call h5%write_text('input_file', scene%path, status)
         if (status%ok() .and. allocated(result%assembly)) call h5%write_text('assembly', &
             'moves of the initial assembly from the given positions: ' // &
             result%assembly, status)
     end subroutine create_hdf5
+
+    !> The `kept` records of a resumed run's file, read back, to the sinks
+    !> that build on every record: the monitor, the ParaView pieces (with
+    !> `vtk_on`) and the caller's record.
+    subroutine replay(h5, kept, monitor, vtk, vtk_on, status, record)
+        type(hdf5_sink_t), intent(inout) :: h5
+        integer, intent(in) :: kept
+        type(monitor_sink_t), intent(inout) :: monitor
+        type(vtk_sink_t), intent(inout) :: vtk
+        logical, intent(in) :: vtk_on
+        type(status_t), intent(inout) :: status
+        class(sink_t), intent(inout), optional :: record
+        integer, parameter :: block = 256
+        real(wp), allocatable :: t(:), y(:, :)
+        integer :: first, m, k
+        if (.not. h5%is_open) return
+        allocate (t(block), y(h5%n, block))
+        do first = 1, kept, block
+            m = min(block, kept - first + 1)
+            call h5%read_records(first, t(1:m), y(:, 1:m), status)
+            do k = 1, m
+                if (.not. status%ok()) return
+                if (associated(monitor%formulation)) call monitor%replay(t(k), y(:, k), status)
+                if (vtk_on .and. status%ok()) call vtk%output(t(k), y(:, k), status)
+                if (present(record) .and. status%ok()) call record%output(t(k), y(:, k), status)
+            end do
+        end do
+    end subroutine replay
 
     !> The monitor's table, and the energy, drift (or the note why there is
     !> none) and reactions by name, into the open HDF5 file.

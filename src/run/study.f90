@@ -36,6 +36,8 @@ module flexmbs_run_study
         status_solver_failure, status_signal
     use flexmbs_core_signals, only: signal_pending, caught_signal, signal_name
     use flexmbs_core_text, only: int_text, real_text
+    use flexmbs_core_files, only: delete_file
+    use flexmbs_io_xdmf_file, only: xdmf_beside
     use flexmbs_dae_error_measure, only: paper_error
     use flexmbs_run_catalogue, only: solver_projects, solver_pmax_grid, problem_stabilisations
     use flexmbs_io_namelist, only: study_input_t, scene_input_t, read_scene
@@ -46,7 +48,7 @@ module flexmbs_run_study
     use flexmbs_io_output_files, only: named_path_t, named_path, check_output_paths, &
         output_hdf5, output_table
     use flexmbs_run_study_grid, only: sweep_point_t, sweep_points
-    use flexmbs_run_study_results, only: make_results_folder, record_path
+    use flexmbs_run_study_results, only: make_results_folder, record_path, point_result_path
     use flexmbs_run_study_record, only: sweep_run_t, fingerprint_t, study_fingerprint, &
         write_record
     use flexmbs_run_reference_fingerprint, only: reference_print_t, reference_print, &
@@ -417,7 +419,7 @@ contains
         type(sweep_point_t), allocatable :: points(:)
         type(fingerprint_t) :: print
         real(wp), allocatable :: t_ref(:), y_ref(:, :)
-        character(len=:), allocatable :: folder, stale, refused
+        character(len=:), allocatable :: folder, stale, refused, result_file
         call prepare_sweep(study, base, t_ref, y_ref, points, stale, status, force)
         if (.not. status%ok()) return
         if (k < 1 .or. k > size(points)) then
@@ -430,7 +432,9 @@ contains
         if (status%ok()) call make_results_folder(study, folder, status)
         if (.not. status%ok()) return
         record = record_path(folder, k)
-        run = point_run(base, points(k), t_ref, y_ref, .true., refused)
+        ! the run keeps its checkpoints there: stopped, it resumes next time
+        result_file = point_result_path(folder, k)
+        run = point_run(base, points(k), t_ref, y_ref, .true., refused, result_file)
         if (len(refused) > 0) then
             call status%set(status_bad_input, refusal_text(study, k, refused) // &
                 '; no record written')
@@ -443,7 +447,16 @@ contains
             return
         end if
         call write_record(record, k, points(k), print, run, status)
+        if (status%ok()) call remove_result(result_file)
     end subroutine run_sweep_point
+
+    !> A point's result file and the XDMF file beside it, once its record
+    !> holds what the sweep needs.
+    subroutine remove_result(path)
+        character(len=*), intent(in) :: path
+        if (delete_file(path)) continue
+        if (delete_file(xdmf_beside(path))) continue
+    end subroutine remove_result
 
     !> Why a sweep stops at grid point k whose run cannot be measured
     !> against the reference (`why`, point_run's), and how to go on.
@@ -460,12 +473,15 @@ contains
     !> One point of the grid against the reference; `refused` says why a
     !> run's outputs cannot be compared with the reference's, '' when they
     !> can (a failed run is a row that says why).
-    function point_run(base, point, t_ref, y_ref, quiet, refused) result(run)
+    function point_run(base, point, t_ref, y_ref, quiet, refused, result_file) result(run)
         type(scene_input_t), intent(in) :: base
         type(sweep_point_t), intent(in) :: point
         real(wp), intent(in) :: t_ref(:), y_ref(:, :)
         logical, intent(in) :: quiet
         character(len=:), allocatable, intent(out) :: refused
+        !> the run's HDF5 file with its checkpoints (`sweep --point`): a run
+        !> stopped before resumes from it; none without
+        character(len=*), intent(in), optional :: result_file
         type(sweep_run_t) :: run
         type(scene_input_t) :: scene
         type(run_result_t) :: result
@@ -483,7 +499,12 @@ contains
         if (solver_projects(solver) .and. problem_stabilisations(base%problem)) &
             stab_label = 'projection'
         call configure(base, solver, tol, trim(point%stab), point%pmax, source, scene)
-        call run_scene(scene, quiet, result, run_status, rec)
+        if (present(result_file)) then
+            scene%output_file = result_file
+            call resume_or_run(scene, quiet, result, run_status, rec)
+        else
+            call run_scene(scene, quiet, result, run_status, rec)
+        end if
         run%ok = run_status%ok()
         err = -1.0_wp
         refused = ''
@@ -502,12 +523,34 @@ contains
                 result%stats%summary()
             if (result%has_drift) run%summary = run%summary // ' drift |g| ' // &
                 real_text(result%drift_end(1)) // ' |Gv+gI| ' // real_text(result%drift_end(2))
+            if (result%resumed) run%summary = run%summary // '; resumed at t = ' // &
+                real_text(result%resumed_from) // ' from ' // scene%output_file
         else
             run%summary = label // ' ' // stab_label // ' TOL ' // real_text(tol) // &
                 ': failed at t = ' // real_text(result%stats%t_reached) // ': ' // &
                 run_status%text() // '; ' // result%stats%summary()
         end if
     end function point_run
+
+    !> A grid point's run into its result file: resumed from the file's
+    !> checkpoint when it has one of this run, else from the start (a file
+    !> of another run, without a checkpoint, or holding a finished run
+    !> whose record was never written is replaced).
+    subroutine resume_or_run(scene, quiet, result, status, rec)
+        type(scene_input_t), intent(in) :: scene
+        logical, intent(in) :: quiet
+        type(run_result_t), intent(out) :: result
+        type(status_t), intent(out) :: status
+        type(record_sink_t), intent(inout) :: rec
+        logical :: exists
+        inquire (file=scene%output_file, exist=exists)
+        if (exists) then
+            call run_scene(scene, quiet, result, status, rec, resume=scene%output_file)
+            if (result%resumed) return
+            rec = record_sink_t()
+        end if
+        call run_scene(scene, quiet, result, status, rec, force=.true.)
+    end subroutine resume_or_run
 
     !> Why a run's outputs (`rec`, positions up to q_last) cannot be
     !> compared with the reference's at its times: '' when they can.

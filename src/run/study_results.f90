@@ -6,6 +6,10 @@
 !>   point_K.rec     grid point K's record (run/study_record), written whole
 !>                   or not at all
 !>   point_K.log     what `sweep -j N`'s process of point K printed
+!>   point_K.h5      grid point K's HDF5 result while it runs, with its
+!>                   checkpoints: a point stopped by a signal (a Slurm
+!>                   task's time limit) resumes from it; deleted (with its
+!>                   .xdmf) once the point's record is written
 !>   array.sbatch    the job array of `sweep --slurm`; merge.sbatch its merge job
 !>   slurm_J_K.out   what task K of Slurm job J printed; slurm_merge_J.out
 !>                   the merge job's
@@ -18,7 +22,7 @@ module flexmbs_run_study_results
     private
 
     public :: results_folder, make_results_folder, record_path, log_path, array_script_path, &
-        merge_script_path
+        merge_script_path, point_result_path
 
 contains
 
@@ -55,6 +59,14 @@ contains
         character(len=:), allocatable :: path
         path = folder // '/point_' // int_text(k) // '.rec'
     end function record_path
+
+    !> Point k's HDF5 result in `folder` while it runs (module header).
+    pure function point_result_path(folder, k) result(path)
+        character(len=*), intent(in) :: folder
+        integer, intent(in) :: k
+        character(len=:), allocatable :: path
+        path = folder // '/point_' // int_text(k) // '.h5'
+    end function point_result_path
 
     !> The output of point k's process in `folder`.
     pure function log_path(folder, k) result(path)

@@ -7,6 +7,12 @@
 !> points I .. I + K - 1 (run/study_grid); the script's first argument
 !> overrides K, so that `sbatch --array=2,5 array.sbatch 1` runs points 2
 !> and 5 alone (what `--merge` prints for the missing ones).
+!>
+!> A task asks for SIGTERM `warning_seconds` before its time limit, to its
+!> batch shell, which passes it on to the running point: the point stops
+!> after its step with its checkpoint (run/study point_K.h5), the shell
+!> requeues the task, and the task, run again, skips the points whose
+!> records its first run wrote and resumes the stopped one.
 module flexmbs_run_study_slurm
     use flexmbs_core_status, only: status_t, status_bad_input, status_io_error
     use flexmbs_core_text, only: int_text
@@ -31,6 +37,10 @@ module flexmbs_run_study_slurm
         write_slurm_scripts, shell_word
 
     character, parameter :: nl = new_line('a')
+    !> Seconds before its time limit at which a task gets the warning signal
+    !> (Slurm sends it within about a minute of the time asked): enough for
+    !> the running point to finish its step and write its checkpoint.
+    integer, parameter :: warning_seconds = 120
 
 contains
 
@@ -109,6 +119,12 @@ contains
             '#SBATCH --job-name=' // name // nl // &
             '#SBATCH --array=' // array_spec(npoints, options%chunk) // nl // &
             '#SBATCH --output=' // folder // '/slurm_%A_%a.out' // nl // &
+            '# the warning before the time limit (the batch shell passes it on):' // nl // &
+            '# the running point stops after its step, keeping its checkpoint, and' // nl // &
+            '# the task is requeued and resumes it' // nl // &
+            '#SBATCH --signal=B:TERM@' // int_text(warning_seconds) // nl // &
+            '#SBATCH --requeue' // nl // &
+            '#SBATCH --open-mode=append' // nl // &
             sbatch_options(options) // &
             'set -u' // nl // &
             'exe=' // shell_quoted(exe) // nl // &
@@ -122,11 +138,31 @@ contains
             '# one CPU per task: no threads in the linear algebra' // nl // &
             'export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1' // nl // &
             'status=0' // nl // &
+            'child=""' // nl // &
+            'trap ''[ -n "$child" ] && kill -TERM "$child" 2>/dev/null'' TERM INT' // nl // &
             'for ((k = first; k <= last; k++)); do' // nl // &
-            '    "$exe" sweep "$study" --point "$k" --quiet' // forced(options) // &
-            ' || status=$?' // nl // &
-            '    # stopped by a signal (scancel, the time limit): no further point' // nl // &
-            '    [ "$status" -gt 128 ] && exit "$status"' // nl // &
+            '    # a requeued task keeps the points it finished before' // nl // &
+            '    [ "${SLURM_RESTART_COUNT:-0}" -gt 0 ] && [ -f ' // &
+            shell_quoted(folder) // '"/point_$k.rec" ] && continue' // nl // &
+            '    "$exe" sweep "$study" --point "$k" --quiet' // forced(options) // ' &' // nl // &
+            '    child=$!' // nl // &
+            '    point=0' // nl // &
+            '    wait "$child" || point=$?' // nl // &
+            '    # the trap ends `wait` early: wait for the point to stop' // nl // &
+            '    while kill -0 "$child" 2>/dev/null; do point=0; wait "$child" || point=$?; done' &
+            // nl // &
+            '    child=""' // nl // &
+            '    [ "$point" -ne 0 ] && status=$point' // nl // &
+            '    # stopped by the warning or scancel --signal=TERM (the task still' // nl // &
+            '    # running, not cancelled): again later, from the checkpoint (requeue' // nl // &
+            '    # ends this run of the task)' // nl // &
+            '    task="${SLURM_ARRAY_JOB_ID:-}_${SLURM_ARRAY_TASK_ID}"' // nl // &
+            '    if [ "$point" -eq 143 ] && [ -n "${SLURM_ARRAY_JOB_ID:-}" ] &&' // nl // &
+            '        [ "$(squeue -h -j "$task" -o %T 2>/dev/null)" = RUNNING ]; then' // nl // &
+            '        scontrol requeue "$task" && exit 0' // nl // &
+            '    fi' // nl // &
+            '    # stopped by another signal: no further point' // nl // &
+            '    [ "$point" -gt 128 ] && exit "$point"' // nl // &
             'done' // nl // &
             'exit "$status"' // nl
     end function array_script_text

@@ -13,6 +13,9 @@
 #    lists exactly those (exit 3), its printed sbatch command reruns only
 #    them, and the merge gives the same table; a changed study text makes
 #    every record stale;
+#  - a task warned before its time limit (scancel --signal=TERM --batch)
+#    stops its point with a checkpoint, requeues itself and resumes the
+#    point, as accurate as one run uninterrupted;
 # then the daemons stop and leave nothing behind.
 #
 #   bash test/cluster/run.sh [path/to/flexmbs]
@@ -246,6 +249,47 @@ rc=$?
 if [ "$rc" = 3 ] && [ "$(grep -c '^stale: point [1-6]: computed from another text of the study file' merge4.txt)" = 6 ] \
     && grep -q '^0 runs finished' merge4.txt; then pass study-stale-refused
 else fail study-stale-refused "exit $rc: $(cat merge4.txt)"; fi
+
+# A task warned before its time limit (here by `scancel --signal=TERM
+# --batch`, as `#SBATCH --signal=B:TERM@120` would: Slurm's own warning
+# has a resolution of about a minute): its batch shell passes the signal
+# on to the running point, which stops after its step with its checkpoint;
+# the task requeues itself and, run again, resumes the point from there.
+# Its ERR is within max(10 TOL, 2 x) that of the point run uninterrupted.
+for d in s3 s3u; do
+    study_from "$work/$d"
+    sed -i -e "s#t_end *= *[0-9.e-]*#t_end = 1.0#" -e "s#q_reference.h5#q3_reference.h5#" \
+        -e "s#solvers *=.*#solvers = 'radau5'#" -e "s#tolerances *=.*#tolerances = 1.0e-6#" \
+        "$work/$d/q.nml"
+done
+"$exe" reference "$work/s3/q.nml" --quiet > reference3.txt 2>&1 || fail study-requeue-reference \
+    "$(cat reference3.txt)"
+"$exe" sweep "$work/s3/q.nml" --slurm > slurm3.txt 2>&1
+job=$(sbatch --parsable "$work/s3/q_points/array.sbatch" 2>&1)
+deadline=$(($(date +%s) + 60))
+while [ ! -e s3/q_points/point_1.h5 ] && [ "$(date +%s)" -lt "$deadline" ]; do sleep 0.2; done
+sleep 1
+warned=$(date +%s)
+scancel --signal=TERM --batch "${job}_1" 2>&1
+if [[ "$job" =~ ^[0-9]+$ ]] && cluster_wait 300 "$job"; then
+    pass "study-requeued-ended ($(($(date +%s) - warned)) s after the warning)"
+else fail study-requeued-ended "$job $(cat slurm3.txt)"; fi
+state study-requeued-task "${job}_1" COMPLETED 0:0
+out=s3/q_points/slurm_${job}_1.out
+restarts=$(field "${job}_1" Restarts)
+if [ "$restarts" = 1 ] && grep -q 'point 1: stopped by SIGTERM' "$out" \
+    && grep -q "resumed at t = .* from $work/s3/q_points/point_1.h5" "$out" \
+    && [ -s s3/q_points/point_1.rec ] && [ ! -e s3/q_points/point_1.h5 ]; then
+    pass study-requeued-resumed
+else fail study-requeued-resumed "Restarts=$restarts; $(cat "$out" 2>&1); $(ls s3/q_points)"; fi
+"$exe" sweep "$work/s3u/q.nml" --point 1 > uninterrupted3.txt 2>&1
+tols() { sed -n 's/.*: ERR [^ ]* = \([^ ]*\) TOL.*/\1/p' "$1" | head -n 1; }
+e_run=$(tols "$out")
+e_full=$(tols uninterrupted3.txt)
+if [ -n "$e_run" ] && [ -n "$e_full" ] && awk -v a="$e_run" -v b="$e_full" \
+    'BEGIN { exit !(a + 0 <= (10 > 2 * b ? 10 : 2 * b)) }'; then
+    pass "study-requeued-accuracy (ERR $e_run TOL, uninterrupted $e_full TOL)"
+else fail study-requeued-accuracy "ERR '$e_run' TOL, uninterrupted '$e_full' TOL"; fi
 
 # the stop leaves no daemon and no folder (but with FLEXMBS_SLURM_KEEP=1)
 cd "$root" || exit 1
