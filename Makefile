@@ -12,6 +12,10 @@
 #   make install PREFIX=...   install library (static and shared), modules, the classic
 #                faces and pkg-config files (docs/packaging.md)
 #   make docs    the API documentation (FORD, in a virtual environment) into build/docs/api/
+#   make build-mpi  install OpenMPI and MUMPS's MPI build if missing, build flexmbs on them
+#                (release): build/bin/flexmbs-mpi, for mpirun -n N / srun -n N (docs/cluster.md)
+#   make test-mpi  the same (debug): scenes on 1 and 2 ranks and under srun -n 2 on a
+#                one-node Slurm, against the sequential build
 #   OPENMP=1     (with any of them) thread the finite-element assembly
 #   LTO=1        (with any of them) link-time optimisation
 
@@ -98,7 +102,49 @@ define install_shared_library
 endef
 
 .PHONY: run test bench paper extremes check-memory deps build build-debug install legacy-test \
-        docs clean help py-venv
+        docs clean help py-venv build-mpi mpi-project test-mpi
+
+# The MPI build: MUMPS's MPI library (libmumps-dev, on OpenMPI) instead of
+# the sequential one, in a project of its own under build/mpi (its fpm.toml
+# made from ours with the MPI libraries, the sources linked in), so that the
+# sequential build, the default, is never touched. OpenMPI's mpif.h comes
+# first; -DFLEXMBS_MPI tells the code (linalg/mumps_service).
+MPI_PACKAGES := libmumps-dev libopenmpi-dev openmpi-bin
+MPI_DIR      := $(BUILD)/mpi
+MPI_FFLAGS    = -I$(firstword $(shell mpicc --showme:incdirs 2>/dev/null)) \
+                -I/usr/include/hdf5/serial -I/usr/include/sundials/fortran -I/usr/include \
+                -DFLEXMBS_MPI $(filter -fopenmp -flto -ffat-lto-objects,$(FPM_FFLAGS))
+MPI_LDFLAGS   = $(addprefix -L,$(shell mpicc --showme:libdirs 2>/dev/null) \
+                $(shell mpif90 --showme:libdirs 2>/dev/null)) $(FPM_LDFLAGS)
+MPI_FPM       = cd $(MPI_DIR) && FPM_FFLAGS="$(MPI_FFLAGS)" FPM_LDFLAGS="$(MPI_LDFLAGS)" $(FPM)
+
+mpi-project:
+	@$(MAKE) --no-print-directory deps EXTRA_PACKAGES="$(MPI_PACKAGES)"
+	@mkdir -p $(MPI_DIR)
+	@sed -e 's/"dmumps_seq", "zmumps_seq", "mumps_common_seq", "mpiseq_seq", "pord_seq"/"dmumps", "zmumps", "mumps_common", "pord", "mpi_mpifh", "mpi"/' \
+	    -e '/^\[\[example\]\]/,$$d' fpm.toml > $(MPI_DIR)/fpm.toml.new
+	@grep -q '"mpi_mpifh"' $(MPI_DIR)/fpm.toml.new \
+	    || { echo "make: fpm.toml's MUMPS libraries not found for the MPI build" >&2; exit 1; }
+	@cmp -s $(MPI_DIR)/fpm.toml.new $(MPI_DIR)/fpm.toml && rm $(MPI_DIR)/fpm.toml.new \
+	    || mv $(MPI_DIR)/fpm.toml.new $(MPI_DIR)/fpm.toml
+	@for d in src app test; do ln -sfn $(CURDIR)/$$d $(MPI_DIR)/$$d; done
+
+# The MPI build against the sequential one (test/mpi.sh): scenes on 1 and
+# 2 ranks, the refusals, srun -n 2 on a one-node Slurm (slurm-wlm, munge).
+test-mpi: mpi-project
+	@$(MAKE) --no-print-directory deps EXTRA_PACKAGES="$(MPI_PACKAGES) slurm-wlm munge"
+	@$(FPM) build --profile debug > /dev/null
+	@$(MPI_FPM) build --profile debug > /dev/null
+	@seq=$$($(FPM) run --profile debug --runner echo flexmbs 2>/dev/null | tail -1); \
+	    mpi=$$($(MPI_FPM) run --profile debug --runner echo flexmbs 2>/dev/null | tail -1); \
+	    bash test/mpi.sh "$$seq" "$(MPI_DIR)/$$mpi"
+
+build-mpi: mpi-project
+	$(MPI_FPM) build --profile release
+	@mkdir -p $(BUILD)/bin
+	@exe=$$($(MPI_FPM) run --profile release flexmbs --runner echo 2>/dev/null | tail -1); \
+	    [ -x "$(MPI_DIR)/$$exe" ] || { echo "make build-mpi: no executable (got '$$exe')" >&2; exit 1; }; \
+	    ln -sfn "$$(readlink -f "$(MPI_DIR)/$$exe")" $(BUILD)/bin/flexmbs-mpi
 
 help:
 	@echo "make run | make test | make bench | make paper | make check-memory |" \

@@ -51,6 +51,8 @@ program flexmbs_main
     use flexmbs_app_modes_command, only: modes_command
     use flexmbs_app_help_text, only: has_command_usage, write_usage, write_command_usage
     use flexmbs_run_modes, only: modes_options_t
+    use flexmbs_linalg_mumps_service, only: mpi_build, start_processes, stop_processes, &
+        mumps_serve
     implicit none
 
     integer, parameter :: exit_ok = 0, exit_bad_input = 2, exit_solver = 3, exit_io = 4
@@ -62,12 +64,22 @@ program flexmbs_main
 
     character(len=:), allocatable :: command, file, arg, value, slurm_only, resume_file
     logical :: quiet, force, merging, slurm, submit, jobs_given, verbose, resuming
-    integer :: i, nargs, jobs, point, ios
+    integer :: i, nargs, jobs, point, ios, rank, ranks
     type(slurm_options_t) :: cluster
     !> the IEEE flags at the start, all quiet (finish)
     type(ieee_status_type) :: quiet_flags
 
     call ieee_get_status(quiet_flags)
+
+    ! An MPI run: rank 0 goes on, the others serve its MUMPS calls until it
+    ! finishes (linalg/mumps_service); a signal must not end them first.
+    call start_processes(rank, ranks)
+    if (rank > 0) then
+        if (install_signals(even_if_ignored=.true.)) continue
+        call mumps_serve()
+        call finish(exit_ok)
+    end if
+    call check_launch()
 
     nargs = command_argument_count()
     if (nargs == 0) then
@@ -100,6 +112,8 @@ program flexmbs_main
         write (output_unit, '(a)') 'flexmbs ' // version
         call finish(exit_ok)
     case ('run', 'reference', 'sweep')
+        if (ranks > 1 .and. command /= 'run') call fail_usage(command // ': one process; &
+            &only flexmbs run uses several MPI ranks (got ' // int_text(ranks) // ')')
         quiet = .false.
         verbose = .false.
         resuming = .false.
@@ -206,6 +220,9 @@ contains
 
         call read_scene(path, scene, status)
         if (.not. status%ok()) call stop_on(status)
+        if (ranks > 1 .and. scene%linear_solver /= 'mumps') call fail_usage(path // &
+            ': &solver: linear_solver = ''' // trim(scene%linear_solver) // ''': ' // &
+            int_text(ranks) // ' MPI ranks factor with MUMPS only (linear_solver = ''mumps'')')
         if (resuming) then
             if (len(resume_file) > 0) scene%output_file = resume_file
             if (len(scene%output_file) == 0) call fail_usage('run --resume: ' // path // &
@@ -577,6 +594,10 @@ contains
             result%resumed_from, ' (the statistics sum every piece of the run)'
         if (allocated(result%stats%linear_solver)) &
             write (output_unit, '(a)') 'linear solver: ' // result%stats%linear_solver
+        if (verbose .and. allocated(result%stats%linear_solver_report)) then
+            if (len(result%stats%linear_solver_report) > 0) write (output_unit, '(a)') &
+                'factorisations: ' // result%stats%linear_solver_report
+        end if
         n = size(result%y)
         write (output_unit, '(a,es23.15)') 't =', result%t
         bodies = .false.
@@ -710,6 +731,26 @@ contains
     !> on purpose keep the flags as they were: linalg/lapack). Underflow to
     !> subnormal numbers is IEEE arithmetic working as designed, not an
     !> error, and is not reported. A failure has said why on its own.
+    !> A sequential flexmbs started as several MPI ranks (mpirun, srun -n)
+    !> would run the scene once per rank, each writing the same files: bad
+    !> use, said before anything runs. The launchers' variables tell.
+    subroutine check_launch()
+        character(len=*), parameter :: names(3) = [character(len=21) :: &
+            'OMPI_COMM_WORLD_SIZE', 'PMI_SIZE', 'SLURM_STEP_NUM_TASKS']
+        character(len=32) :: value
+        integer :: k, count, length, stat
+        if (mpi_build) return
+        do k = 1, size(names)
+            call get_environment_variable(trim(names(k)), value, length, stat)
+            if (stat /= 0) cycle
+            read (value, *, iostat=stat) count
+            if (stat == 0 .and. count > 1) call fail_usage('this flexmbs is a sequential &
+                &build, started as ' // trim(value) // ' processes (' // trim(names(k)) // &
+                '): each would run the whole scene; build with make MPI=1 &
+                &(docs/large_scenes.md) or start one process')
+        end do
+    end subroutine check_launch
+
     subroutine finish(code)
         integer, intent(in) :: code
         type(ieee_flag_type), parameter :: real_ones(3) = [ieee_invalid, &
@@ -717,6 +758,7 @@ contains
         logical :: raised(3)
         flush (output_unit)
         flush (error_unit)
+        call stop_processes()
         if (code /= exit_ok) stop code, quiet = .true.
         call ieee_get_flag(real_ones, raised)
         call ieee_set_status(quiet_flags)   ! underflow and denormal too

@@ -390,6 +390,7 @@ contains
         call stats%rejections%annotate(status)
         stats%t_reached = t
         if (allocated(self%work%ls)) stats%linear_solver = self%work%ls%description()
+        if (allocated(self%work%ls)) stats%linear_solver_report = self%work%ls%report()
         if (allocated(self%warning)) stats%warning = self%warning
         self%k_last = self%work%kold
         self%k_next = self%work%k

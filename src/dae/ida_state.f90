@@ -225,6 +225,7 @@ contains
         ! ours behind the SUNLinearSolver, else SUNDIALS' own
         if (w%data%jac_mode == jac_own .and. allocated(w%data%ls)) then
             stats%linear_solver = w%data%ls%description()
+            stats%linear_solver_report = w%data%ls%report()
         else if (w%data%jac_mode == jac_sparse) then
             stats%linear_solver = 'klu (SUNDIALS)'
         else

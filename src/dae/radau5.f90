@@ -154,6 +154,7 @@ contains
         stats%nsol = self%native%nsol + self%nsol_error
         stats%t_reached = w%x
         if (allocated(w%ls)) stats%linear_solver = w%ls%description()
+        if (allocated(w%ls)) stats%linear_solver_report = w%ls%report()
         if (self%h_opt == 0.0_wp) self%h_opt = w%hopt
         stats%cpu = w%timer%cpu()
         stats%wall = w%timer%wall()

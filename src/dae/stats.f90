@@ -34,6 +34,10 @@ module flexmbs_dae_stats
         !> ordering amd', 'dense'): what linear_solver = 'auto' chose.
         !> Empty when the solver factors nothing of ours.
         character(len=:), allocatable :: linear_solver
+        !> What its factorisations cost, where the linear solver counts it
+        !> (MUMPS: processes, seconds per factorisation, memory); empty
+        !> otherwise. `flexmbs run --verbose` prints it.
+        character(len=:), allocatable :: linear_solver_report
     contains
         procedure :: reset => stats_reset
         procedure :: summary => stats_summary
@@ -49,6 +53,7 @@ contains
         self%rejections = rejections_t()
         if (allocated(self%warning)) deallocate (self%warning)
         if (allocated(self%linear_solver)) deallocate (self%linear_solver)
+        if (allocated(self%linear_solver_report)) deallocate (self%linear_solver_report)
     end subroutine stats_reset
 
     !> One line: 'NST=... NAC=... NRJ=... ...', NRJ followed by its causes

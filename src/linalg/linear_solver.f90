@@ -74,6 +74,7 @@ module flexmbs_linalg_linear_solver
         procedure(name_i), deferred :: name
         procedure :: ordering_used => linear_solver_ordering
         procedure :: description => linear_solver_description
+        procedure :: report => linear_solver_report
     end type linear_solver_t
 
     abstract interface
@@ -139,6 +140,15 @@ contains
         order = self%ordering_used()
         if (len(order) > 0) text = text // ', ordering ' // order
     end function linear_solver_description
+
+    !> What the factorisations cost, where the solver counts it (MUMPS:
+    !> processes, time per factorisation, memory), for --verbose
+    !> statistics; '' by default.
+    function linear_solver_report(self) result(text)
+        class(linear_solver_t), intent(in) :: self
+        character(len=:), allocatable :: text
+        text = ''
+    end function linear_solver_report
 
     subroutine fill_nan_real(b)
         real(wp), intent(out) :: b(:)

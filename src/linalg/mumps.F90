@@ -1,11 +1,12 @@
-!> Multifrontal sparse LU through MUMPS (sequential build), real and complex.
+!> Multifrontal sparse LU through MUMPS, real and complex: its sequential
+!> build, or its MPI build (`make MPI=1`), whose other ranks make every call
+!> with rank 0 (linalg/mumps_service).
 !>
 !> A binding over MUMPS's native Fortran interface: `mumps_real_t` holds a
 !> DMUMPS_STRUC, `mumps_complex_t` a ZMUMPS_STRUC, both unsymmetric (SYM = 0)
 !> with the host working (PAR = 1) on the communicator kept in the object
-!> (default: MPI_COMM_WORLD of the sequential library's mpif.h, so that the
-!> MPI build can be linked later without changing callers). The life of an
-!> object: `configure` (optional), `analyse` once on a fixed CSC pattern
+!> (default: MPI_COMM_WORLD of the mpif.h of the MUMPS build linked). The
+!> life of an object: `configure` (optional), `analyse` once on a fixed CSC pattern
 !> (JOB = -1 the first time, then JOB = 1 on the centralised assembled
 !> matrix, 1-based IRN/JCN built once from the CSC), `factor` for every new
 !> set of values (JOB = 2), `solve` with one or several right-hand sides
@@ -51,6 +52,9 @@ module flexmbs_linalg_mumps
     use flexmbs_core_status, only: status_t, status_bad_input, status_solver_failure, &
         reason_singular_matrix, reason_none
     use flexmbs_core_resources, only: out_of_memory
+    use flexmbs_linalg_mumps_service, only: mumps_announce, take_instance, free_instance, &
+        call_real, call_complex, process_count
+    use flexmbs_core_text, only: int_text
     implicit none
     private
 
@@ -118,8 +122,15 @@ module flexmbs_linalg_mumps
         integer(i8) :: workspace = 0       !! entries of WK_USER allocated
         integer(i8) :: workspace_start = 0 !! first WK_USER size asked (0: INFO(8))
         integer(i8) :: workspace_estimate = 0 !! the analysis' estimate INFO(8)
+        integer :: instance = 0            !! its number among the MPI ranks' instances
         integer(i8) :: workspace_needed = 0 !! entries the next factorisation asks for
         integer :: last_nrhs = 0           !! right-hand sides of the latest solve
+        !> factorisations so far, their wall seconds (on rank 0), and the
+        !> most memory one took, MB: on the process that used most (INFOG(21))
+        !> and on all together (INFOG(22))
+        integer :: factorisations = 0
+        real(wp) :: factor_seconds = 0.0_wp
+        integer :: memory_most = 0, memory_all = 0
     contains
         procedure :: configure => mumps_configure
         procedure :: analyse => mumps_analyse
@@ -133,6 +144,7 @@ module flexmbs_linalg_mumps
         procedure :: is_analysed => mumps_is_analysed
         procedure :: is_factored => mumps_is_factored
         procedure :: destroy => mumps_destroy
+        procedure :: report => mumps_report
         procedure(run_i), deferred, private :: run
         procedure(attach_i), deferred, private :: attach
         procedure(release_i), deferred, private :: release
@@ -180,7 +192,7 @@ module flexmbs_linalg_mumps
 #include "mumps_factor.inc"
 #undef SPECIFICATION
 
-    public :: mumps_ordering_code, mumps_ordering_name, mumps_default_comm
+    public :: mumps_ordering_code, mumps_ordering_name, mumps_default_comm, mumps_reports
 
 contains
 
@@ -291,8 +303,12 @@ contains
         ! communicator, with its own coordinate arrays.
         call self%destroy()
         if (self%comm == 0) self%comm = mumps_default_comm()
+        call take_instance(self%instance, status)
+        if (.not. status%ok()) return
         call self%run(job_init)
         if (self%info(1) < 0) then
+            call free_instance(self%instance)
+            self%instance = 0
             call set_error(self, status, 'mumps initialise')
             return
         end if
@@ -521,6 +537,8 @@ contains
         class(mumps_factor_t), intent(inout) :: self
         if (self%stage >= stage_initialised .and. owns(self)) then
             call self%run(job_end)
+            call free_instance(self%instance)
+            self%instance = 0
             call self%release()
         end if
         self%stage = stage_none
@@ -567,9 +585,16 @@ contains
         class(mumps_factor_t), intent(inout) :: self
         type(status_t), intent(inout) :: status
         character(len=200) :: msg
+        integer(i8) :: start, finish, rate
         self%stage = stage_analysed
         self%last_nrhs = 0
+        call system_clock(start, rate)
         call execute(self, job_factor, 'mumps factor', status)
+        call system_clock(finish)
+        self%factorisations = self%factorisations + 1
+        self%factor_seconds = self%factor_seconds + real(finish - start, wp) / real(rate, wp)
+        self%memory_most = max(self%memory_most, self%infog(21))
+        self%memory_all = max(self%memory_all, self%infog(22))
         if (.not. status%ok()) return
         if (self%infog(28) > 0) then
             write (msg, '(a,i0,a,i0,a)') 'mumps factor: matrix is singular: ', self%infog(28), &
@@ -579,6 +604,39 @@ contains
         end if
         self%stage = stage_factored
     end subroutine factor_values
+
+    !> What the factorisations cost, for --verbose statistics: 'MUMPS on 2
+    !> processes: 18 factorisations of 91234 factor entries, 0.012 s each
+    !> (wall), memory 9 MB on the process that used most, 16 MB on all'; ''
+    !> before the first.
+    function mumps_report(self) result(text)
+        class(mumps_factor_t), intent(in) :: self
+        character(len=:), allocatable :: text
+        character(len=32) :: each
+        text = ''
+        if (self%factorisations == 0) return
+        write (each, '(es9.2)') self%factor_seconds / self%factorisations
+        text = 'MUMPS on ' // int_text(process_count()) // ' process' // &
+            trim(merge('  ', 'es', process_count() == 1)) // ': ' // &
+            int_text(self%factorisations) // ' factorisations of ' // &
+            int_text(self%factor_nonzeros()) // ' factor entries, ' // trim(adjustl(each)) // &
+            ' s each (wall), memory ' // int_text(self%memory_most) // ' MB on the process &
+            &that used most, ' // int_text(self%memory_all) // ' MB on all'
+    end function mumps_report
+
+    !> The reports of a real and a complex factorisation of one solver: each
+    !> that factored, 'real: ...; complex: ...' when both did.
+    function mumps_reports(real_lu, complex_lu) result(text)
+        class(mumps_factor_t), intent(in) :: real_lu, complex_lu
+        character(len=:), allocatable :: text, a, b
+        a = real_lu%report()
+        b = complex_lu%report()
+        if (len(a) > 0 .and. len(b) > 0) then
+            text = 'real: ' // a // '; complex: ' // b
+        else
+            text = a // b
+        end if
+    end function mumps_reports
 
     !> Checks before a solve of nrhs right-hand sides of leading size nb.
     logical function can_solve(self, nb, nrhs, status)

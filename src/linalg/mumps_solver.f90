@@ -15,7 +15,7 @@ module flexmbs_linalg_mumps_solver
     use flexmbs_linalg_matrix, only: matrix_t
     use flexmbs_linalg_linear_solver, only: linear_solver_t, fill_nan
     use flexmbs_linalg_shifted_pattern, only: shifted_pattern_t
-    use flexmbs_linalg_mumps, only: mumps_real_t, mumps_complex_t, mumps_factor_t, &
+    use flexmbs_linalg_mumps, only: mumps_real_t, mumps_complex_t, mumps_factor_t, mumps_reports, &
         mumps_ordering_auto
     implicit none
     private
@@ -45,6 +45,7 @@ module flexmbs_linalg_mumps_solver
         procedure :: factor_nonzeros => mumps_solver_factor_nonzeros
         procedure :: nonzeros => mumps_solver_nonzeros
         procedure :: destroy => mumps_solver_destroy
+        procedure :: report => mumps_solver_report
     end type mumps_solver_t
 
 contains
@@ -121,6 +122,13 @@ contains
         character(len=:), allocatable :: name
         name = 'mumps'
     end function mumps_solver_name
+
+    !> What the factorisations cost (linalg/mumps report).
+    function mumps_solver_report(self) result(text)
+        class(mumps_solver_t), intent(in) :: self
+        character(len=:), allocatable :: text
+        text = mumps_reports(self%lu, self%zlu)
+    end function mumps_solver_report
 
     !> The ordering MUMPS chose in the analysis ('scotch', 'pord', 'amf', ...).
     function mumps_solver_ordering_used(self) result(name)

@@ -20,7 +20,7 @@ module flexmbs_linalg_sparse_lu
     use flexmbs_linalg_linear_solver, only: fill_nan
     use flexmbs_linalg_klu, only: klu_factor_t, klu_ordering_auto, klu_ordering_amd, &
         klu_ordering_nd, klu_part_real, klu_ordering_name
-    use flexmbs_linalg_mumps, only: mumps_real_t, mumps_complex_t, mumps_factor_t, &
+    use flexmbs_linalg_mumps, only: mumps_real_t, mumps_complex_t, mumps_factor_t, mumps_reports, &
         mumps_ordering_auto, mumps_ordering_amd, mumps_ordering_scotch
     implicit none
     private
@@ -57,6 +57,7 @@ module flexmbs_linalg_sparse_lu
         procedure :: predicted_fill => lu_predicted_fill
         procedure :: factor_nonzeros => lu_factor_nonzeros
         procedure :: destroy => lu_destroy
+        procedure :: report => lu_report
     end type sparse_lu_t
 
 contains
@@ -204,6 +205,14 @@ contains
         name = merge('mumps', 'klu  ', self%kind == sparse_lu_mumps)
         name = trim(name)
     end function lu_name
+
+    !> What MUMPS's factorisations cost (linalg/mumps report); '' for KLU.
+    function lu_report(self) result(text)
+        class(sparse_lu_t), intent(in) :: self
+        character(len=:), allocatable :: text
+        text = ''
+        if (self%kind == sparse_lu_mumps) text = mumps_reports(self%mumps, self%zmumps)
+    end function lu_report
 
     !> The ordering of the analysis ('amd', 'nd', 'scotch', ...).
     function lu_ordering(self) result(name)

@@ -77,6 +77,7 @@ module flexmbs_mbs_condensed_newton
         procedure :: solve_complex => condensed_solve_complex
         procedure :: name => condensed_name
         procedure :: ordering_used => condensed_ordering
+        procedure :: report => condensed_report
         procedure :: order => condensed_order
         procedure :: eliminated => condensed_eliminated
         procedure :: largest_block => condensed_largest_block
@@ -274,6 +275,14 @@ contains
         name = 'condensed'
         if (allocated(self%lu)) name = 'condensed ' // self%lu%name()
     end function condensed_name
+
+    !> What the factorisations of S cost (linalg/sparse_lu report).
+    function condensed_report(self) result(text)
+        class(condensed_solver_t), intent(in) :: self
+        character(len=:), allocatable :: text
+        text = ''
+        if (allocated(self%lu)) text = self%lu%report()
+    end function condensed_report
 
     !> The ordering of S's analysis.
     function condensed_ordering(self) result(name)
