@@ -12,8 +12,9 @@
 #   make install PREFIX=...   install library (static and shared), modules, the classic
 #                faces and pkg-config files (docs/packaging.md)
 #   make docs    the API documentation (FORD, in a virtual environment) into build/docs/api/
-#   make build-mpi  install OpenMPI and MUMPS's MPI build if missing, build flexmbs on them
-#                (release): build/bin/flexmbs-mpi, for mpirun -n N / srun -n N (docs/cluster.md)
+#   make build-mpi  (or make build MPI=1) install OpenMPI and MUMPS's MPI build if missing,
+#                build flexmbs on them (release): build/bin/flexmbs-mpi, for mpirun -n N /
+#                srun -n N (docs/large_scenes.md)
 #   make test-mpi  the same (debug): scenes on 1 and 2 ranks and under srun -n 2 on a
 #                one-node Slurm, against the sequential build
 #   OPENMP=1     (with any of them) thread the finite-element assembly
@@ -174,12 +175,17 @@ deps:
 
 # build/bin/flexmbs links the release executable (whose folder name fpm
 # derives from the flags), so that a user can put build/bin on PATH.
+# MPI=1: the MPI build instead (make build-mpi: build/bin/flexmbs-mpi).
 build: deps
+ifeq ($(MPI),1)
+	@$(MAKE) --no-print-directory build-mpi
+else
 	$(FPM) build --profile release
 	@mkdir -p $(BUILD)/bin
 	@exe=$$($(FPM) run --profile release flexmbs --runner echo 2>/dev/null | tail -1); \
 	    [ -x "$$exe" ] || { echo "make build: no release executable (got '$$exe')" >&2; exit 1; }; \
 	    ln -sfn "$$(readlink -f "$$exe")" $(BUILD)/bin/flexmbs
+endif
 
 build-debug: deps
 	$(FPM) build --profile debug
