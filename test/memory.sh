@@ -24,7 +24,7 @@ cd "$root" || exit 1
 # (elements, bodies, statics, dynamics, meshes, det F, assembly).
 # Longest first (under valgrind: mexax 6.5 min, fe_ 3, force_elements 2,
 # set_markers 1.4, mumps 1), so that the workers end about together.
-suites=(mexax/ fe_ force_elements/ set_markers/ mumps/ ida/ radau5/ mbs_system/ ddassl/ structured_saddle/ fe/ linalg/ modal_basis/ modal_frame/ modal_system/)
+suites=(mexax/ fe_ force_elements/ set_markers/ mumps/ ida/ radau5/ mbs_system/ ddassl/ structured_saddle/ fe/ linalg/ modal_basis/ modal_frame/ modal_system/ restart/)
 # A scene's end time is cut to t_start + this fraction of its span: two to
 # five steps with their Jacobian, decompositions and output. The fine
 # five-body mesh still takes about 90 s under valgrind, mostly its setup.
