@@ -141,7 +141,8 @@ millis() {
 # each at a random 15..85 % of its uninterrupted time (the first piece
 # fresh, each later one a resume of the file), then resumed to t_end and
 # checked. A first piece that ends before its signal, or is killed before
-# its first checkpoint (the resume then says so), starts again.
+# its first checkpoint or even before its file was whole (the resume then
+# says so), starts again.
 run_case() {
     local label=$1 name=$2 tol=$3
     shift 3
@@ -160,7 +161,7 @@ run_case() {
             for attempt in 1 2 3 4 5 6; do
                 if [ $pieces -gt 0 ]; then
                     rc=$(RESUME=1 interrupt "$name" "$sig" "$delay")
-                    if [ "$rc" -eq 2 ] && grep -qE 'no checkpoint|no such file' "$name.out"; then
+                    if [ "$rc" -eq 2 ] && grep -qE 'no checkpoint|no such file|nothing to resume from' "$name.out"; then
                         pieces=0
                         rm -f "$name.h5"
                         continue
@@ -195,7 +196,7 @@ run_case() {
         fi
         # the last signal came before the first checkpoint: the case again
         if [ $finished -eq 0 ] && [ $round -lt 4 ] \
-            && grep -qE 'no checkpoint|no such file' "$name.resume" 2>/dev/null; then
+            && grep -qE 'no checkpoint|no such file|nothing to resume from' "$name.resume" 2>/dev/null; then
             continue
         fi
         break

@@ -121,7 +121,7 @@ contains
         call h5fopen_f(path, H5F_ACC_RDONLY_F, file, err)
         if (err < 0) then
             call status%set(status_bad_input, path // ': not an HDF5 file (or one another &
-                &program is writing): nothing to resume from')
+                &program is writing, or a run killed while creating it): nothing to resume from')
             return
         end if
         ! (a run killed while creating its file has no fingerprint yet either)

@@ -153,10 +153,7 @@ contains
         type(signal_sink_t), target :: signals
         type(multi_sink_t) :: sinks
         type(status_t) :: io_status
-        character(len=:), allocatable :: outcome
-        real(wp), allocatable :: y_start(:), xdmf_times(:)
-        integer, allocatable :: xdmf_rows(:)
-        integer :: xdmf_records
+        real(wp), allocatable :: y_start(:)
 
         result%xdmf_file = ''
         call make_plan(scene, plan, status)
@@ -170,17 +167,8 @@ contains
         ! energies and work count from the scene's start, also when resumed
         y_start = plan%y0
         if (present(resume)) then
-            call prepare_resume(scene, resume, plan, result%t, result%y, cp, prior, &
-                                result%finished_before, status)
+            call start_resume(scene, resume, plan, result, cp, prior, status)
             if (.not. status%ok() .or. result%finished_before) return
-            result%resumed = .true.
-            result%resumed_from = result%t
-            if (scene%every_step .and. len_trim(scene%vtk) > 0) then
-                call status%set(status_bad_input, scene%path // ': &output: vtk with &
-                    &every_step: the ParaView pieces before the checkpoint are not in ' // &
-                    resume // ', so this run cannot be resumed; run it again')
-                return
-            end if
         end if
 
         ! ParaView output is checked before any file is created
@@ -215,19 +203,7 @@ contains
         end if
         if (present(record)) call sinks%attach(record)
         if (len_trim(scene%vtk) > 0) call sinks%attach(vtk)
-        ! drift and energy of formulated mechanical scenes, at the output times
-        select type (p => plan%problem)
-        type is (formulation_t)
-            if (allocated(plan%mechanical)) then
-                monitor%formulation => p
-                monitor%mechanical => plan%mechanical
-                monitor%every_step = scene%every_step
-                monitor%resumed = result%resumed
-                monitor%q_start = y_start(p%offset(block_q) + 1:p%last(block_q))
-                call sinks%attach(monitor)
-                result%constraints = p%block_size(block_lambda)
-            end if
-        end select
+        call attach_monitor(monitor, plan, scene, y_start, result, sinks)
 
         call record_energy(y_start, result%energy_start)
         ! the records kept, to the sinks that build on every record
@@ -236,16 +212,7 @@ contains
         if (status%ok()) call plan%integrate(result%t, result%y, scene%t_end, result%stats, &
                                              status, sinks)
         if (result%resumed) result%stats = stats_sum(prior, result%stats)
-        ! a solver that refuses its options: say which file and group
-        if (status%code == status_bad_input) then
-            if (index(status%text(), scene%path // ':') /= 1) status%message = scene%path // &
-                ': &solver: ' // status%text()
-        end if
-        ! a stop requested on the last step came too late to stop anything
-        if (status%code == status_interrupted .and. result%t == scene%t_end) call status%clear()
-        if (status%code == status_interrupted .and. signal_pending()) call status%set( &
-            status_signal, 'stopped by ' // signal_name(caught_signal()) // ' at t = ' // &
-            real_text(result%t), caught_signal())
+        call explain_end(scene, result%t, status)
         if (status%ok()) call record_energy(result%y, result%energy_end)
         result%has_energy = result%has_energy .and. status%ok()
 
@@ -256,35 +223,7 @@ contains
             result%has_monitor_energy = .not. any(ieee_is_nan(result%monitor_energy))
         end if
         result%summary = state_summary(plan, scene, result%y)
-        if (h5%is_open) then
-            if (monitor%records > 0) then
-                call write_monitor(h5, monitor, io_status)
-                if (status%ok() .and. .not. io_status%ok()) status = io_status
-            end if
-            outcome = 'ok'
-            if (.not. status%ok()) outcome = status%text()
-            call h5%write_statistics(result%stats, io_status, result%solver_name, outcome)
-            if (result%resumed .and. io_status%ok()) call h5%write_text('statistics', &
-                pieces_note(cp%piece + 1), io_status)
-            if (status%ok() .and. .not. io_status%ok()) status = io_status
-            ! the records the XDMF file lists, read back before the file closes
-            if (xdmf_wanted(scene)) call h5%record_times(xdmf_most_records, xdmf_rows, &
-                                                         xdmf_times, xdmf_records, io_status)
-            if (status%ok() .and. .not. io_status%ok()) status = io_status
-            call h5%close(io_status)
-            if (status%ok() .and. .not. io_status%ok()) status = io_status
-            ! A solver that refused its input computed nothing: leave no file.
-            if (status%code == status_bad_input .and. h5%records == 0) then
-                call delete_file(scene%output_file)
-                result%hdf5_written = .false.
-            end if
-            ! the records there are, also after a failure
-            if (result%hdf5_written .and. xdmf_wanted(scene)) then
-                call write_xdmf_beside(plan, scene, xdmf_rows, xdmf_times, xdmf_records, &
-                                       result, io_status)
-                if (status%ok() .and. .not. io_status%ok()) status = io_status
-            end if
-        end if
+        if (h5%is_open) call close_hdf5(h5, monitor, plan, scene, cp%piece, result, status)
         if (len_trim(scene%table) > 0 .and. status%code /= status_bad_input) then
             call write_table(trim(scene%table), [new_stats_row(result%solver_name, &
                 scene%rtol, scene_stab(scene), result%stats)], io_status, reasons=scene%reasons)
@@ -315,6 +254,112 @@ contains
             end select
         end subroutine record_energy
     end subroutine run_scene
+
+    !> A resume's start (run/resume): the plan, t and y from the checkpoint
+    !> `cp` of the file `path`, `prior` the statistics before it; nothing to
+    !> do when the file holds a finished run (result%finished_before).
+    subroutine start_resume(scene, path, plan, result, cp, prior, status)
+        type(scene_input_t), intent(in) :: scene
+        character(len=*), intent(in) :: path
+        type(run_plan_t), intent(inout) :: plan
+        type(run_result_t), intent(inout) :: result
+        type(checkpoint_t), intent(out) :: cp
+        type(dae_stats_t), intent(out) :: prior
+        type(status_t), intent(out) :: status
+        call prepare_resume(scene, path, plan, result%t, result%y, cp, prior, &
+                            result%finished_before, status)
+        if (.not. status%ok() .or. result%finished_before) return
+        result%resumed = .true.
+        result%resumed_from = result%t
+        if (scene%every_step .and. len_trim(scene%vtk) > 0) call status%set(status_bad_input, &
+            scene%path // ': &output: vtk with every_step: the ParaView pieces before the &
+            &checkpoint are not in ' // path // ', so this run cannot be resumed; run it again')
+    end subroutine start_resume
+
+    !> Drift, energy and reactions of a formulated mechanical scene at the
+    !> output times (or steps): the monitor, attached to `sinks`.
+    subroutine attach_monitor(monitor, plan, scene, y_start, result, sinks)
+        type(monitor_sink_t), intent(inout), target :: monitor
+        type(run_plan_t), intent(in), target :: plan
+        type(scene_input_t), intent(in) :: scene
+        real(wp), intent(in) :: y_start(:)   !! the scene's start: the work's origin
+        type(run_result_t), intent(inout) :: result
+        type(multi_sink_t), intent(inout) :: sinks
+        if (.not. allocated(plan%mechanical)) return
+        select type (p => plan%problem)
+        type is (formulation_t)
+            monitor%formulation => p
+            monitor%mechanical => plan%mechanical
+            monitor%every_step = scene%every_step
+            monitor%resumed = result%resumed
+            monitor%q_start = y_start(p%offset(block_q) + 1:p%last(block_q))
+            call sinks%attach(monitor)
+            result%constraints = p%block_size(block_lambda)
+        end select
+    end subroutine attach_monitor
+
+    !> How the integration ended, said for people: a solver's refusal names
+    !> the file and group; a stop requested on the last step (t = t_end)
+    !> came too late to stop anything; a stop by SIGINT or SIGTERM says so.
+    subroutine explain_end(scene, t, status)
+        type(scene_input_t), intent(in) :: scene
+        real(wp), intent(in) :: t      !! the time reached
+        type(status_t), intent(inout) :: status
+        if (status%code == status_bad_input) then
+            if (index(status%text(), scene%path // ':') /= 1) status%message = scene%path // &
+                ': &solver: ' // status%text()
+        end if
+        if (status%code == status_interrupted .and. t == scene%t_end) call status%clear()
+        if (status%code == status_interrupted .and. signal_pending()) call status%set( &
+            status_signal, 'stopped by ' // signal_name(caught_signal()) // ' at t = ' // &
+            real_text(t), caught_signal())
+    end subroutine explain_end
+
+    !> The end of the open HDF5 file: the monitor's table, the statistics
+    !> and outcome (summed over the pieces of a resumed run, `piece` that
+    !> of its checkpoint), the close, the XDMF file beside it. A solver that
+    !> refused its input computed nothing: no file is left then. An I/O
+    !> error becomes `status` when it was ok.
+    subroutine close_hdf5(h5, monitor, plan, scene, piece, result, status)
+        type(hdf5_sink_t), intent(inout) :: h5
+        type(monitor_sink_t), intent(in) :: monitor
+        type(run_plan_t), intent(in), target :: plan
+        type(scene_input_t), intent(in) :: scene
+        integer, intent(in) :: piece
+        type(run_result_t), intent(inout) :: result
+        type(status_t), intent(inout) :: status
+        type(status_t) :: io_status
+        character(len=:), allocatable :: outcome
+        real(wp), allocatable :: xdmf_times(:)
+        integer, allocatable :: xdmf_rows(:)
+        integer :: xdmf_records
+        if (monitor%records > 0) then
+            call write_monitor(h5, monitor, io_status)
+            if (status%ok() .and. .not. io_status%ok()) status = io_status
+        end if
+        outcome = 'ok'
+        if (.not. status%ok()) outcome = status%text()
+        call h5%write_statistics(result%stats, io_status, result%solver_name, outcome)
+        if (result%resumed .and. io_status%ok()) call h5%write_text('statistics', &
+            pieces_note(piece + 1), io_status)
+        if (status%ok() .and. .not. io_status%ok()) status = io_status
+        ! the records the XDMF file lists, read back before the file closes
+        if (xdmf_wanted(scene)) call h5%record_times(xdmf_most_records, xdmf_rows, &
+                                                     xdmf_times, xdmf_records, io_status)
+        if (status%ok() .and. .not. io_status%ok()) status = io_status
+        call h5%close(io_status)
+        if (status%ok() .and. .not. io_status%ok()) status = io_status
+        if (status%code == status_bad_input .and. h5%records == 0) then
+            call delete_file(scene%output_file)
+            result%hdf5_written = .false.
+        end if
+        ! the records there are, also after a failure
+        if (result%hdf5_written .and. xdmf_wanted(scene)) then
+            call write_xdmf_beside(plan, scene, xdmf_rows, xdmf_times, xdmf_records, &
+                                   result, io_status)
+            if (status%ok() .and. .not. io_status%ok()) status = io_status
+        end if
+    end subroutine close_hdf5
 
     !> The HDF5 file of the run: y's blocks, the named series, the scene's
     !> texts. `result%hdf5_written` once it exists.
